@@ -1,0 +1,119 @@
+// gravcal/simulator.h: simulated multi-position IMU sessions with known truth.
+//
+// A session is a sequence of static poses joined by smooth rotations. Each
+// pose is a nominal orientation from the scheme, disturbed by a random
+// placement (tilt and heading) error. The true specific force in the body
+// frame is f = C_bn^T (0, 0, g) (the unit reads +g on the axis that points up)
+// plus, while static, hand tremor if set; the raw accelerometer is
+//   v = M^-1 f + b + n_a,     n_a white, plus a bias random walk,
+// and the raw gyroscope u = M_g^-1 w + b_g + n_g, with w the true body rate
+// (exactly consistent with the attitude trajectory). Raw outputs are either
+// in counts (quantised) or in SI units. A temperature column follows a
+// warm-up curve.
+#ifndef GRAVCAL_SIMULATOR_H_
+#define GRAVCAL_SIMULATOR_H_
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gravcal/accel_model.h"
+#include "gravcal/gyro_model.h"
+#include "gravcal/imu_log.h"
+
+namespace gravcal {
+
+struct SimulatorOptions {
+  // "six", "twelve" (the seed's six faces plus six 45-degree poses), "ten"
+  // (ten poses of differing roll and pitch), or "random:N".
+  std::string scheme = "twelve";
+  // Time held still in each pose, and the initial still period, seconds.
+  double hold_seconds = 10.0;
+  double initial_still_seconds = 10.0;
+  // Duration of each rotation between poses, seconds.
+  double rotation_seconds = 3.0;
+  double sample_rate = 100.0;
+  double gravity = 9.80665;
+
+  // Raw accelerometer in counts (true) or m/s^2 (false).
+  bool raw_counts = true;
+  // Counts per g of the accelerometer (16384 = +-2 g, 16 bit).
+  double accel_counts_per_g = 16384.0;
+  // Counts per deg/s of the gyroscope (131 = +-250 deg/s, 16 bit).
+  double gyro_counts_per_dps = 131.0;
+
+  // Accelerometer white noise, m/s^2 per sample (standard deviation).
+  double accel_noise = 0.02;
+  // Accelerometer bias random walk, m/s^2 / sqrt(s). 0 = off.
+  double accel_bias_random_walk = 0.0;
+  // Gyroscope white noise, rad/s per sample.
+  double gyro_noise = 0.002;
+  // Gyroscope bias random walk, rad/s / sqrt(s). 0 = off.
+  double gyro_bias_random_walk = 0.0;
+
+  // Truth error magnitudes (standard deviations of the random sensor).
+  // Accelerometer bias in m/s^2 (converted to raw units).
+  double accel_bias_std = 0.3;
+  double accel_scale_std = 0.02;
+  double accel_misalignment_std = 0.01;  // rad
+  double gyro_bias_std = 0.02;           // rad/s
+  double gyro_scale_std = 0.02;
+  double gyro_misalignment_std = 0.005;  // rad
+
+  // Placement error of each pose, degrees (standard deviation per axis).
+  double placement_error_deg = 2.0;
+  // Hand tremor while "static": specific force disturbance, m/s^2 rms. 0 = a
+  // table.
+  double tremor = 0.0;
+
+  // Temperature: starts at temperature_start and relaxes towards
+  // temperature_end with time constant temperature_tau seconds.
+  double temperature_start = 25.0;
+  double temperature_end = 25.0;
+  double temperature_tau = 300.0;
+
+  bool IsValid(std::string* error) const;
+};
+
+// One simulated static pose, as placed.
+struct SimulatedPose {
+  // Samples [begin, end) of the log are this pose's still period.
+  size_t begin = 0;
+  size_t end = 0;
+  // Body-to-navigation rotation while held (navigation frame: z up).
+  Eigen::Quaterniond attitude = Eigen::Quaterniond::Identity();
+  // The housing axis the scheme meant to point up, 0..5 or -1 (see position.h).
+  int nominal_up = -1;
+};
+
+struct SimulatedSession {
+  ImuLog log;
+  AccelModel accel_truth;
+  GyroModel gyro_truth;
+  std::vector<SimulatedPose> poses;
+  double gravity = 9.80665;
+  // Raw units per m/s^2 (accelerometer) and per rad/s (gyroscope).
+  double accel_units_per_si = 1.0;
+  double gyro_units_per_si = 1.0;
+  uint64_t seed = 0;
+};
+
+// Nominal orientations (body-to-navigation) of a scheme, and the nominal up
+// axis of each (-1 where none points up). Returns false for an unknown scheme.
+bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
+                     std::vector<Eigen::Quaterniond>* attitudes, std::vector<int>* nominal_up,
+                     std::string* error);
+
+// Simulates one session. Deterministic for a given (options, seed).
+bool Simulate(const SimulatorOptions& options, uint64_t seed, SimulatedSession* session,
+              std::string* error);
+
+// The truth as JSON text (accel and gyro models in the calibration JSON
+// shape, gravity, poses, seed, options).
+std::string TruthToJson(const SimulatedSession& session, const SimulatorOptions& options);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_SIMULATOR_H_

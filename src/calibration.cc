@@ -1,0 +1,274 @@
+#include "gravcal/calibration.h"
+
+#include <glog/logging.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <sstream>
+
+#include "gravcal/housing_rotation.h"
+#include "statistics.h"
+
+namespace gravcal {
+
+const char* ToString(RefinementSolver solver) {
+  switch (solver) {
+    case RefinementSolver::kCeres:
+      return "ceres";
+    case RefinementSolver::kNewton:
+      return "newton";
+  }
+  return "unknown";
+}
+
+bool FromString(const std::string& name, RefinementSolver* solver) {
+  if (name == "ceres") {
+    *solver = RefinementSolver::kCeres;
+  } else if (name == "newton") {
+    *solver = RefinementSolver::kNewton;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool CalibrationOptions::IsValid(std::string* error) const {
+  if (!detector.IsValid(error) || !gravity.IsValid(error) || !coarse.IsValid(error) ||
+      !refinement.IsValid(error)) {
+    return false;
+  }
+  if (!(nominal_scale > 0.0 && std::isfinite(nominal_scale))) {
+    *error = "nominal_scale: must be positive";
+    return false;
+  }
+  for (int up : nominal_up) {
+    if (up < -1 || up > 5) {
+      *error = "nominal_up: entries must be +x, -x, +y, -y, +z, -z or ?";
+      return false;
+    }
+  }
+  return true;
+}
+
+namespace {
+
+ResidualSummary Summarise(const std::vector<double>& r) { return {Rms(r), MaxAbs(r)}; }
+
+// Fills bias_std, matrix_std and the covariance from the magnitude
+// parameters' covariance and, for affine, the housing rotation's.
+void PropagateUncertainty(const RefinementResult& refinement, const HousingRotation* housing,
+                          AccelCalibration* accel) {
+  const AccelModel& model = accel->model;
+  const std::vector<int> free = FreeUpperIndices(model.parameterization);
+  const int nm = refinement.num_parameters;
+  const int nr = housing != nullptr ? 3 : 0;
+  const int np = nm + nr;
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(np, np);
+  cov.topLeftCorner(nm, nm) = refinement.covariance;
+  if (housing != nullptr) cov.bottomRightCorner(3, 3) = housing->angle_covariance;
+  accel->covariance = cov;
+  accel->covariance_names = refinement.parameter_names;
+  if (housing != nullptr) {
+    for (const char* name : {"rot_x", "rot_y", "rot_z"}) accel->covariance_names.push_back(name);
+  }
+  // Jacobian of (b, vec(M)) with respect to the parameters.
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(12, np);
+  j.topLeftCorner<3, 3>().setIdentity();
+  static const int kRow[6] = {0, 0, 0, 1, 1, 2};
+  static const int kCol[6] = {0, 1, 2, 1, 2, 2};
+  for (size_t i = 0; i < free.size(); ++i) {
+    Eigen::Matrix3d e = Eigen::Matrix3d::Zero();
+    e(kRow[free[i]], kCol[free[i]]) = 1.0;
+    const Eigen::Matrix3d dm = model.rotation * e;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) j(3 + 3 * r + c, 3 + i) = dm(r, c);
+    }
+  }
+  if (housing != nullptr) {
+    const Eigen::Matrix3d m = model.matrix();
+    for (int a = 0; a < 3; ++a) {
+      Eigen::Matrix3d skew = Eigen::Matrix3d::Zero();
+      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(a);
+      skew << 0, -axis(2), axis(1), axis(2), 0, -axis(0), -axis(1), axis(0), 0;
+      const Eigen::Matrix3d dm = skew * m;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) j(3 + 3 * r + c, nm + a) = dm(r, c);
+      }
+    }
+  }
+  const Eigen::MatrixXd out = j * cov * j.transpose();
+  // An entry is estimated when some parameter moves it.
+  for (int i = 0; i < 3; ++i) accel->bias_std(i) = std::sqrt(out(i, i));
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      const int row = 3 + 3 * r + c;
+      accel->matrix_std(r, c) = j.row(row).squaredNorm() > 0.0 ? std::sqrt(out(row, row)) : NAN;
+    }
+  }
+  // Parameters in a null direction are not determined: no number.
+  for (const std::string& name : refinement.observability.undetermined) {
+    if (name.rfind("bias_", 0) == 0) {
+      accel->bias_std(name[5] - 'x') = NAN;
+    } else if (name.rfind("u_", 0) == 0) {
+      accel->matrix_std.col(name[3] - 'x').setConstant(NAN);
+    }
+  }
+}
+
+}  // namespace
+
+bool CalibrateFromPositions(const std::vector<Position>& positions,
+                            const CalibrationOptions& options, Calibration* calibration) {
+  CHECK(calibration != nullptr);
+  *calibration = Calibration();
+  Calibration& c = *calibration;
+  std::string error;
+  if (!options.IsValid(&error)) {
+    c.message = error;
+    return false;
+  }
+  if (!ResolveGravity(options.gravity, &c.gravity, &c.gravity_source, &error)) {
+    c.message = error;
+    return false;
+  }
+  if (c.gravity_source == "standard") {
+    c.warnings.push_back(
+        "using standard gravity 9.80665 m/s^2: local gravity differs by up to 0.3 %, which goes "
+        "into the scale factors; give gravity, or latitude and height");
+  }
+  const AccelParameterization p = options.refinement.parameterization;
+  const int needed = p == AccelParameterization::kScale ? 6 : 9;
+  if (static_cast<int>(positions.size()) < needed) {
+    std::ostringstream s;
+    s << "found " << positions.size() << " static positions; the '" << ToString(p)
+      << "' model needs at least " << needed;
+    c.message = s.str();
+    return false;
+  }
+  std::vector<Position> placed = positions;
+  if (!options.nominal_up.empty()) {
+    if (options.nominal_up.size() != positions.size()) {
+      std::ostringstream s;
+      s << "nominal_up: gives " << options.nominal_up.size() << " axes for " << positions.size()
+        << " detected positions";
+      c.message = s.str();
+      return false;
+    }
+    for (size_t k = 0; k < placed.size(); ++k) placed[k].nominal_up = options.nominal_up[k];
+  }
+
+  if (!CoarseFit(placed, c.gravity, p, options.coarse, &c.coarse)) {
+    c.message = c.coarse.message;
+    return false;
+  }
+  for (size_t k = 0; k < placed.size(); ++k) placed[k].nominal_up = c.coarse.nominal_up[k];
+
+  bool ok;
+  if (options.solver == RefinementSolver::kCeres) {
+    ok = Refine(placed, c.coarse.model, c.gravity, options.refinement, &c.refinement);
+    c.solver_name = "ceres_levenberg_marquardt";
+  } else {
+    NewtonOptions newton;
+    newton.parameterization = p;
+    newton.residual = options.newton_residual;
+    newton.max_iterations = options.refinement.max_iterations;
+    newton.compute_covariance = options.refinement.compute_covariance;
+    ok = NewtonRefine(placed, c.coarse.model, c.gravity, newton, &c.refinement);
+    c.solver_name = std::string("newton_") + ToString(options.newton_residual);
+  }
+  if (!ok) {
+    c.message = c.refinement.message;
+    return false;
+  }
+  c.accel.model = c.refinement.model;
+  for (const std::string& w : c.refinement.warnings) c.warnings.push_back(w);
+
+  // Residual summaries.
+  AccelModel nominal;
+  nominal.upper = options.nominal_scale * Eigen::Matrix3d::Identity();
+  c.residual_nominal = Summarise(MagnitudeResiduals(placed, nominal, c.gravity));
+  c.residual_coarse = Summarise(MagnitudeResiduals(placed, c.coarse.model, c.gravity));
+  c.residual_refined = Summarise(MagnitudeResiduals(placed, c.accel.model, c.gravity));
+
+  HousingRotation housing;
+  bool have_housing = false;
+  if (p == AccelParameterization::kAffine) {
+    if (EstimateHousingRotation(placed, c.coarse.nominal_up, c.accel.model, &housing, &error)) {
+      c.accel.model.rotation = housing.rotation;
+      c.accel.tilt_rms = housing.tilt_rms;
+      have_housing = true;
+      std::ostringstream s;
+      s.precision(3);
+      s << "affine: bias, scale and non-orthogonality come from the gravity magnitude; the "
+           "rotation of the sensor axes in the housing comes from the nominal axes of "
+        << housing.positions_used
+        << " axis-aligned positions (placement error seen: " << housing.tilt_rms * 180.0 / M_PI
+        << " deg rms), so its accuracy is that of the placement";
+      c.warnings.push_back(s.str());
+    } else {
+      c.warnings.push_back(
+          "affine: the rotation of the sensor axes in the housing is not "
+          "determined (" +
+          error +
+          "); it is left at identity with no standard "
+          "deviation");
+    }
+  }
+  if (c.refinement.covariance_available) {
+    PropagateUncertainty(c.refinement, have_housing ? &housing : nullptr, &c.accel);
+    if (p == AccelParameterization::kAffine && !have_housing) c.accel.matrix_std.setConstant(NAN);
+  }
+
+  const std::vector<double> sigmas = c.refinement.sigmas;
+  for (size_t k = 0; k < placed.size(); ++k) {
+    PositionReport r;
+    r.position = placed[k];
+    const double n = static_cast<double>(std::max<size_t>(placed[k].sample_count, 1));
+    r.raw_std = (placed[k].raw_mean_cov.diagonal() * n).cwiseSqrt();
+    r.nominal_up = placed[k].nominal_up;
+    r.residual_before = c.refinement.residuals_before[k];
+    r.residual_after = c.refinement.residuals_after.empty() ? NAN : c.refinement.residuals_after[k];
+    r.sigma = sigmas[k];
+    c.positions.push_back(r);
+  }
+
+  if (!c.refinement.converged) {
+    c.accel = AccelCalibration();
+    c.accel.model = c.coarse.model;
+    c.message = "refinement did not converge (" + c.refinement.message +
+                "); the coarse result is kept and is not a calibration to trust";
+    return false;
+  }
+  c.success = true;
+  std::ostringstream s;
+  s << "calibrated '" << ToString(p) << "' from " << placed.size() << " positions ("
+    << c.coarse.message << "; refinement " << c.refinement.message << ")";
+  c.message = s.str();
+  return true;
+}
+
+bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options,
+                            Calibration* calibration) {
+  CHECK(calibration != nullptr);
+  *calibration = Calibration();
+  std::string error;
+  if (!options.IsValid(&error)) {
+    calibration->message = error;
+    return false;
+  }
+  if (!log.Validate(&error)) {
+    calibration->message = error;
+    return false;
+  }
+  StaticDetection detection;
+  if (!DetectStaticIntervals(log, options.detector, &detection)) {
+    calibration->message = log.source + ": " + detection.message;
+    return false;
+  }
+  const std::vector<Position> positions = PositionsFromIntervals(detection.intervals);
+  const bool ok = CalibrateFromPositions(positions, options, calibration);
+  if (!ok && !log.source.empty()) calibration->message = log.source + ": " + calibration->message;
+  return ok;
+}
+
+}  // namespace gravcal

@@ -1,0 +1,160 @@
+#include "cli/commands.h"
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "gravcal/calibration.h"
+#include "gravcal/calibration_io.h"
+#include "gravcal/log_reader.h"
+#include "gravcal/simulator.h"
+
+namespace gravcal {
+namespace cli {
+
+int Fail(const std::string& message, int code) {
+  std::fprintf(stderr, "gravcal: error: %s\n", message.c_str());
+  return code;
+}
+
+namespace {
+
+bool CheckConfig(const Config& config, std::string* error) { return config.IsValid(error); }
+
+void PrintWarnings(const Calibration& c) {
+  for (const std::string& w : c.warnings) std::fprintf(stderr, "gravcal: warning: %s\n", w.c_str());
+}
+
+// "1.234 +- 0.005" or "1.234 (not determined)".
+std::string WithStd(double value, double std, const char* format) {
+  char buffer[96];
+  char v[48];
+  std::snprintf(v, sizeof(v), format, value);
+  if (std::isfinite(std)) {
+    char s[48];
+    std::snprintf(s, sizeof(s), format, std);
+    std::snprintf(buffer, sizeof(buffer), "%s +- %s", v, s);
+  } else {
+    std::snprintf(buffer, sizeof(buffer), "%s (fixed or not determined)", v);
+  }
+  return buffer;
+}
+
+}  // namespace
+
+int RunDemo(const CommandArgs& args) {
+  std::string error;
+  if (!CheckConfig(args.config, &error)) return Fail(error);
+  SimulatedSession session;
+  if (!Simulate(args.config.simulation, args.seed, &session, &error)) return Fail(error);
+  CalibrationOptions options = args.config.calibration;
+  if (options.gravity.gravity <= 0.0 && std::isnan(options.gravity.latitude)) {
+    options.gravity.gravity = session.gravity;
+  }
+  options.nominal_scale = 1.0 / session.accel_units_per_si;
+  Calibration c;
+  const bool ok = CalibrateAccelerometer(session.log, options, &c);
+  std::printf("gravcal demo: simulated '%s' session, seed %llu, %zu samples at %.0f Hz, raw %s\n",
+              args.config.simulation.scheme.c_str(), static_cast<unsigned long long>(args.seed),
+              session.log.size(), args.config.simulation.sample_rate,
+              args.config.simulation.raw_counts ? "counts" : "m/s^2");
+  std::printf("detected %zu static positions; %s\n\n", c.positions.size(), c.message.c_str());
+  PrintWarnings(c);
+  if (!ok) return Fail(c.message, 2);
+  // The magnitude determines b and U; compare those with the truth's.
+  const AccelModel& est = c.accel.model;
+  const AccelModel& truth = session.accel_truth;
+  std::printf("%-8s %16s %34s %10s\n", "param", "truth", "estimate +- std", "err/std");
+  auto row = [](const char* name, double t, double e, double s, const char* fmt) {
+    char tb[32];
+    std::snprintf(tb, sizeof(tb), fmt, t);
+    std::printf("%-8s %16s %34s %10.2f\n", name, tb, WithStd(e, s, fmt).c_str(),
+                std::isfinite(s) && s > 0 ? (e - t) / s : NAN);
+  };
+  const char* axes = "xyz";
+  for (int i = 0; i < 3; ++i) {
+    const std::string name = std::string("bias_") + axes[i];
+    row(name.c_str(), truth.bias(i), est.bias(i), c.accel.bias_std(i), "%.3f");
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int col = r; col < 3; ++col) {
+      if (est.parameterization == AccelParameterization::kScale && r != col) continue;
+      const std::string name = std::string("u_") + axes[r] + axes[col];
+      // matrix_std of M = U (R = I) is the std of U.
+      row(name.c_str(), truth.upper(r, col), est.upper(r, col), c.accel.matrix_std(r, col), "%.6e");
+    }
+  }
+  std::printf(
+      "\n|a| - g over positions, m/s^2: before (nominal scale) rms %.4f max %.4f; "
+      "coarse rms %.5f; after rms %.5f max %.5f\n",
+      c.residual_nominal.rms, c.residual_nominal.max, c.residual_coarse.rms, c.residual_refined.rms,
+      c.residual_refined.max);
+  std::printf("solver: %s, %d iterations, %s, %.1f us; chi2 %.2f on %d dof\n",
+              c.solver_name.c_str(), c.refinement.iterations, c.refinement.termination.c_str(),
+              c.refinement.solve_seconds * 1e6, c.refinement.chi2, c.refinement.dof);
+  return 0;
+}
+
+int RunCalibrate(const CommandArgs& args) {
+  if (args.input.empty()) return Fail("calibrate needs --input <raw log>");
+  if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
+  std::string error;
+  if (!CheckConfig(args.config, &error)) return Fail(error);
+  ImuLog log;
+  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  Calibration c;
+  const bool ok = CalibrateAccelerometer(log, args.config.calibration, &c);
+  PrintWarnings(c);
+  if (!ok) return Fail(c.message, c.refinement.termination.empty() ? 1 : 2);
+  if (!WriteCalibrationJson(c, args.config.output_covariance, args.output, &error)) {
+    return Fail(error);
+  }
+  std::fprintf(stderr, "gravcal: %s; |a| - g rms %.5f -> %.5f m/s^2; wrote %s\n", c.message.c_str(),
+               c.residual_nominal.rms, c.residual_refined.rms, args.output.c_str());
+  return 0;
+}
+
+int RunApply(const CommandArgs& args) {
+  if (args.calibration.empty()) return Fail("apply needs --calibration <calib.json>");
+  if (args.input.empty()) return Fail("apply needs --input <raw log>");
+  if (args.output.empty()) return Fail("apply needs --output <corrected.csv>");
+  std::string error;
+  if (!CheckConfig(args.config, &error)) return Fail(error);
+  LoadedCalibration calibration;
+  if (!ReadCalibrationJson(args.calibration, &calibration, &error)) return Fail(error);
+  ImuLog log;
+  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  for (Eigen::Vector3d& a : log.accel) a = calibration.accel.Apply(a);
+  if (calibration.has_gyro) {
+    for (Eigen::Vector3d& w : log.gyro) w = calibration.gyro.Apply(w);
+  }
+  if (!WriteImuLogCsv(log, args.output, &error)) return Fail(error);
+  return 0;
+}
+
+int RunSimulate(const CommandArgs& args) {
+  if (args.output_dir.empty()) return Fail("simulate needs --output-dir <folder>");
+  std::string error;
+  if (!CheckConfig(args.config, &error)) return Fail(error);
+  SimulatedSession session;
+  if (!Simulate(args.config.simulation, args.seed, &session, &error)) return Fail(error);
+  mkdir(args.output_dir.c_str(), 0755);
+  struct stat st;
+  if (stat(args.output_dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+    return Fail(args.output_dir + ": cannot create the folder");
+  }
+  const std::string raw = args.output_dir + "/raw.csv";
+  const std::string truth = args.output_dir + "/truth.json";
+  if (!WriteImuLogCsv(session.log, raw, &error)) return Fail(error);
+  if (!WriteFileAtomically(truth, TruthToJson(session, args.config.simulation), &error)) {
+    std::remove(raw.c_str());
+    return Fail(error);
+  }
+  std::fprintf(stderr, "gravcal: wrote %s (%zu samples) and %s\n", raw.c_str(), session.log.size(),
+               truth.c_str());
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace gravcal

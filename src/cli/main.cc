@@ -1,0 +1,179 @@
+// gravcal: command-line front end. The only place with gflags and
+// InitGoogleLogging.
+//
+// Config keys (config.h) can be given as flags of the same name; they are
+// taken out of argv here and applied on top of --config, and the rest goes to
+// gflags.
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "gravcal/config.h"
+
+DEFINE_string(input, "", "raw log to read");
+DEFINE_string(output, "", "file to write (calibration JSON or corrected CSV)");
+DEFINE_string(output_dir, "", "folder to write simulated raw.csv and truth.json into");
+DEFINE_string(config, "", "YAML config file (configs/*.yaml)");
+DEFINE_string(calibration, "", "calibration JSON to apply");
+DEFINE_uint64(seed, 1, "random seed of the simulator");
+
+namespace {
+
+struct CommandInfo {
+  const char* name;
+  const char* summary;
+  std::vector<const char*> flags;
+};
+
+const std::vector<CommandInfo>& Commands() {
+  static const std::vector<CommandInfo> commands = {
+      {"demo",
+       "simulate a twelve-position session in raw counts, calibrate it, print estimate vs truth",
+       {"config", "seed"}},
+      {"calibrate",
+       "calibrate the accelerometer from a multi-position log",
+       {"input", "config", "output"}},
+      {"apply",
+       "apply a calibration to a raw log, writing SI units",
+       {"calibration", "input", "output"}},
+      {"simulate", "simulate a session: raw.csv and truth.json", {"config", "seed", "output_dir"}},
+      {"help", "list commands, or the flags and config keys of one: gravcal help <command>", {}},
+  };
+  return commands;
+}
+
+void PrintHelp(const std::string& command) {
+  gravcal::Config defaults;
+  if (command.empty()) {
+    std::printf("gravcal: IMU calibration with gravity as the only reference\n\n");
+    std::printf("usage: gravcal <command> [--flag value ...]\n\ncommands:\n");
+    for (const CommandInfo& c : Commands()) std::printf("  %-10s %s\n", c.name, c.summary);
+    std::printf("\n'gravcal <command> --help' lists that command's flags and the config keys.\n");
+    return;
+  }
+  for (const CommandInfo& c : Commands()) {
+    if (command != c.name) continue;
+    std::printf("gravcal %s: %s\n\nflags:\n", c.name, c.summary);
+    for (const char* f : c.flags) {
+      gflags::CommandLineFlagInfo info;
+      gflags::GetCommandLineFlagInfo(f, &info);
+      std::string name = f;
+      for (char& ch : name) {
+        if (ch == '_') ch = '-';
+      }
+      std::printf("  --%-22s %s\n", name.c_str(), info.description.c_str());
+    }
+    std::printf("\nconfig keys (in the YAML file, or as --key value; default in brackets):\n");
+    std::string section;
+    for (const gravcal::ConfigKey& k : gravcal::ConfigKeys()) {
+      if (k.section != section) {
+        section = k.section;
+        std::printf("  %s:\n", section.c_str());
+      }
+      std::printf("    --%-26s %s [%s]\n", k.name.c_str(), k.help.c_str(),
+                  gravcal::ConfigValueText(defaults, k.name).c_str());
+    }
+    return;
+  }
+  std::printf("unknown command '%s'\n", command.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  google::InitGoogleLogging(argv[0]);
+  FLAGS_logtostderr = true;
+  FLAGS_minloglevel = google::GLOG_WARNING;
+  using gravcal::cli::Fail;
+  if (argc < 2) {
+    PrintHelp("");
+    return 1;
+  }
+  const std::string command = argv[1];
+  if (command == "help" || command == "--help" || command == "-h") {
+    PrintHelp(argc > 2 ? argv[2] : "");
+    return 0;
+  }
+  bool known = false;
+  for (const CommandInfo& c : Commands()) known |= command == c.name;
+  if (!known) return Fail("unknown command '" + command + "' (gravcal help lists them)");
+
+  // Split argv: config keys become overrides, the rest goes to gflags.
+  std::vector<std::pair<std::string, std::string>> overrides;
+  std::vector<char*> rest = {argv[0]};
+  std::vector<std::string> storage;
+  storage.reserve(argc);
+  for (int i = 2; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      PrintHelp(command);
+      return 0;
+    }
+    if (arg.rfind("--", 0) != 0) return Fail("unexpected argument '" + arg + "'");
+    std::string name = arg.substr(2);
+    std::string value;
+    bool has_value = false;
+    const size_t eq = name.find('=');
+    if (eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+      has_value = true;
+    }
+    for (char& ch : name) {
+      if (ch == '-') ch = '_';
+    }
+    if (gravcal::IsConfigKey(name)) {
+      if (!has_value) {
+        if (i + 1 >= argc) return Fail("flag --" + name + " needs a value");
+        value = argv[++i];
+      }
+      overrides.emplace_back(name, value);
+      continue;
+    }
+    // Every gflags flag here takes a value.
+    if (!has_value) {
+      if (i + 1 >= argc) return Fail("flag --" + name + " needs a value");
+      value = argv[++i];
+    }
+    storage.push_back("--" + name + "=" + value);
+    rest.push_back(storage.back().data());
+  }
+  int rest_argc = static_cast<int>(rest.size());
+  char** rest_argv = rest.data();
+  for (int i = 1; i < rest_argc; ++i) {
+    std::string name = rest_argv[i] + 2;
+    name = name.substr(0, name.find('='));
+    gflags::CommandLineFlagInfo info;
+    if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info) ||
+        info.filename.find("cli/main.cc") == std::string::npos) {
+      return Fail("unknown flag --" + name + " ('gravcal " + command + " --help' lists the flags)");
+    }
+  }
+  gflags::ParseCommandLineNonHelpFlags(&rest_argc, &rest_argv, false);
+
+  gravcal::cli::CommandArgs args;
+  std::string error;
+  args.config_path = FLAGS_config;
+  if (!FLAGS_config.empty() && !gravcal::LoadConfigFile(FLAGS_config, &args.config, &error)) {
+    return Fail(error);
+  }
+  for (const auto& [key, value] : overrides) {
+    if (!gravcal::SetConfigValue(key, value, &args.config, &error))
+      return Fail("command line: " + error);
+  }
+  args.input = FLAGS_input;
+  args.output = FLAGS_output;
+  args.output_dir = FLAGS_output_dir;
+  args.calibration = FLAGS_calibration;
+  args.seed = FLAGS_seed;
+
+  if (command == "demo") return gravcal::cli::RunDemo(args);
+  if (command == "calibrate") return gravcal::cli::RunCalibrate(args);
+  if (command == "apply") return gravcal::cli::RunApply(args);
+  return gravcal::cli::RunSimulate(args);
+}

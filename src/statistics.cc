@@ -1,0 +1,79 @@
+#include "statistics.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gravcal {
+namespace {
+
+// Regularised lower incomplete gamma P(a, x) by its series (x < a + 1).
+double GammaSeries(double a, double x) {
+  double sum = 1.0 / a;
+  double term = sum;
+  for (int n = 1; n < 1000; ++n) {
+    term *= x / (a + n);
+    sum += term;
+    if (std::fabs(term) < std::fabs(sum) * 1e-15) break;
+  }
+  return sum * std::exp(-x + a * std::log(x) - std::lgamma(a));
+}
+
+// Regularised upper incomplete gamma Q(a, x) by Lentz's continued fraction
+// (x >= a + 1).
+double GammaContinuedFraction(double a, double x) {
+  const double tiny = 1e-300;
+  double b = x + 1.0 - a;
+  double c = 1.0 / tiny;
+  double d = 1.0 / b;
+  double h = d;
+  for (int i = 1; i < 1000; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::fabs(d) < tiny) d = tiny;
+    c = b + an / c;
+    if (std::fabs(c) < tiny) c = tiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::fabs(delta - 1.0) < 1e-15) break;
+  }
+  return std::exp(-x + a * std::log(x) - std::lgamma(a)) * h;
+}
+
+}  // namespace
+
+double ChiSquareUpperTail(double x, int dof) {
+  if (dof <= 0) return 1.0;
+  if (!(x > 0.0)) return 1.0;
+  const double a = 0.5 * dof;
+  const double hx = 0.5 * x;
+  if (hx < a + 1.0) return 1.0 - GammaSeries(a, hx);
+  return GammaContinuedFraction(a, hx);
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double m = values[mid];
+  if (values.size() % 2 == 0) {
+    m = 0.5 * (m + *std::max_element(values.begin(), values.begin() + mid));
+  }
+  return m;
+}
+
+double Rms(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  double s = 0.0;
+  for (double v : values) s += v * v;
+  return std::sqrt(s / values.size());
+}
+
+double MaxAbs(const std::vector<double>& values) {
+  double m = 0.0;
+  for (double v : values) m = std::max(m, std::fabs(v));
+  return m;
+}
+
+}  // namespace gravcal

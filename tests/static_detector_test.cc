@@ -1,0 +1,534 @@
+#include "gravcal/static_detector.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gravcal/log_reader.h"
+#include "gravcal/position.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+constexpr double kGravity = 9.80665;
+
+// One still segment of a synthetic log: the gravity direction in the body
+// frame, held for `seconds`, followed by a smooth rotation to the next pose
+// lasting `move_seconds` (none after the last).
+struct Pose {
+  Eigen::Vector3d up;  // body axis pointing up (need not be unit)
+  double seconds;
+};
+
+struct Truth {
+  size_t begin, end;  // samples [begin, end) held still
+};
+
+struct SyntheticOptions {
+  double rate = 100.0;
+  double move_seconds = 2.0;
+  bool counts = false;        // raw int16-like counts instead of SI units
+  double accel_noise = 0.02;  // m/s^2
+  double gyro_noise = 0.002;  // rad/s
+  bool with_gyro = true;
+  bool with_temperature = false;
+  unsigned seed = 1;
+};
+
+// Builds a log of still poses joined by smooth rotations (cosine velocity
+// profile) with white noise; in counts mode with a bias, a scale of 16384
+// counts per g and quantisation, like an MPU-6050.
+ImuLog MakeLog(const std::vector<Pose>& poses, const SyntheticOptions& o,
+               std::vector<Truth>* truth) {
+  std::mt19937 rng(o.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  ImuLog log;
+  log.source = "synthetic";
+  const Eigen::Vector3d accel_bias(0.12, -0.08, 0.3);   // m/s^2
+  const Eigen::Vector3d gyro_bias(0.01, -0.02, 0.005);  // rad/s
+  auto emit = [&](const Eigen::Vector3d& f, const Eigen::Vector3d& w) {
+    log.t.push_back(static_cast<double>(log.t.size()) / o.rate + 1000.0);
+    Eigen::Vector3d a = f + accel_bias;
+    Eigen::Vector3d g = w + gyro_bias;
+    for (int k = 0; k < 3; ++k) {
+      a[k] += o.accel_noise * normal(rng);
+      g[k] += o.gyro_noise * normal(rng);
+    }
+    if (o.counts) {
+      a = (a * 16384.0 / kGravity).array().round().matrix();
+      g = (g * 180.0 / M_PI * 131.0).array().round().matrix();
+    }
+    log.accel.push_back(a);
+    if (o.with_gyro) log.gyro.push_back(g);
+    if (o.with_temperature) log.temperature.push_back(25.0 + 0.001 * log.t.size());
+  };
+  for (size_t p = 0; p < poses.size(); ++p) {
+    const Eigen::Vector3d f = poses[p].up.normalized() * kGravity;
+    const size_t still = static_cast<size_t>(std::lround(poses[p].seconds * o.rate));
+    if (truth) truth->push_back({log.size(), log.size() + still});
+    for (size_t i = 0; i < still; ++i) emit(f, Eigen::Vector3d::Zero());
+    if (p + 1 == poses.size()) break;
+    // Rotate f onto the next pose's direction about the common normal.
+    const Eigen::Vector3d to = poses[p + 1].up.normalized() * kGravity;
+    Eigen::Vector3d axis = f.cross(to);
+    double angle = std::atan2(axis.norm(), f.dot(to));
+    if (axis.norm() < 1e-9) axis = f.unitOrthogonal();
+    axis.normalize();
+    const size_t move = static_cast<size_t>(std::lround(o.move_seconds * o.rate));
+    for (size_t i = 0; i < move; ++i) {
+      const double tau = (i + 0.5) / static_cast<double>(move);
+      const double s = 0.5 * (1.0 - std::cos(M_PI * tau));
+      const double s_dot = 0.5 * M_PI * std::sin(M_PI * tau) / o.move_seconds;
+      // The body turns by -angle*s about `axis`, so gravity appears to turn
+      // by +angle*s.
+      const Eigen::Vector3d fi = Eigen::AngleAxisd(angle * s, axis) * f;
+      emit(fi, -axis * angle * s_dot);
+    }
+  }
+  return log;
+}
+
+std::vector<Pose> SixPoses(double seconds) {
+  return {{{0, 0, 1}, seconds},  {{1, 0, 0}, seconds},  {{0, 1, 0}, seconds},
+          {{0, 0, -1}, seconds}, {{-1, 0, 0}, seconds}, {{0, -1, 0}, seconds}};
+}
+
+// Each truth segment matches exactly one interval that lies within it (give or
+// take `slack` samples) and covers all of it but the settling margins.
+void ExpectMatches(const StaticDetection& d, const std::vector<Truth>& truth, size_t settle,
+                   size_t slack) {
+  ASSERT_EQ(d.intervals.size(), truth.size()) << d.message;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const StaticInterval& s = d.intervals[i];
+    SCOPED_TRACE("interval " + std::to_string(i));
+    EXPECT_LT(s.begin, s.end);
+    if (i > 0) EXPECT_LE(d.intervals[i - 1].end, s.begin);
+    EXPECT_GE(s.begin + slack, truth[i].begin);
+    EXPECT_LE(s.end, truth[i].end + slack);
+    EXPECT_LE(s.begin, truth[i].begin + settle + slack);
+    EXPECT_GE(s.end + settle + slack, truth[i].end);
+  }
+}
+
+TEST(StaticDetector, FindsPosesInSiAndCountsWithTheSameOptions) {
+  const StaticDetectorOptions options;
+  for (bool counts : {false, true}) {
+    SCOPED_TRACE(counts ? "counts" : "SI");
+    SyntheticOptions so;
+    so.counts = counts;
+    std::vector<Truth> truth;
+    const ImuLog log = MakeLog(SixPoses(5.0), so, &truth);
+    StaticDetection d;
+    ASSERT_TRUE(DetectStaticIntervals(log, options, &d)) << d.message;
+    // Settle 0.3 s = 30 samples; up to 0.3 s of the slow end of a move may
+    // pass for still and is trimmed too.
+    ExpectMatches(d, truth, 30, 30);
+    EXPECT_GT(d.accel_noise_floor, 0.0);
+    EXPECT_NEAR(d.accel_threshold, options.threshold_factor * d.accel_noise_floor,
+                1e-12 * d.accel_threshold);
+    EXPECT_GT(d.gyro_noise_floor, 0.0);
+    // The floor is the sensor noise: 3 axes * sigma^2.
+    const double sigma = counts ? 0.02 * 16384.0 / kGravity : 0.02;
+    EXPECT_NEAR(d.accel_noise_floor, 3.0 * sigma * sigma, 0.5 * 3.0 * sigma * sigma);
+    // Interval statistics: the mean is gravity plus bias, the covariance the
+    // noise.
+    const double scale = counts ? 16384.0 / kGravity : 1.0;
+    const Eigen::Vector3d bias = Eigen::Vector3d(0.12, -0.08, 0.3) * scale;
+    const auto poses = SixPoses(5.0);
+    for (size_t i = 0; i < d.intervals.size(); ++i) {
+      const StaticInterval& s = d.intervals[i];
+      const Eigen::Vector3d expected = poses[i].up * kGravity * scale + bias;
+      EXPECT_LT((s.accel_mean - expected).norm(), 0.01 * scale) << i;
+      EXPECT_NEAR(s.accel_cov(0, 0), sigma * sigma, 0.25 * sigma * sigma) << i;
+      EXPECT_DOUBLE_EQ(s.t_begin, log.t[s.begin]);
+      EXPECT_DOUBLE_EQ(s.t_end, log.t[s.end - 1]);
+      EXPECT_TRUE(std::isnan(s.temperature_mean));
+    }
+  }
+}
+
+TEST(StaticDetector, AccelerometerOnlyLogsWork) {
+  SyntheticOptions so;
+  so.with_gyro = false;
+  so.counts = true;
+  std::vector<Truth> truth;
+  const ImuLog log = MakeLog(SixPoses(4.0), so, &truth);
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  ExpectMatches(d, truth, 30, 30);
+  EXPECT_EQ(d.gyro_noise_floor, 0.0);
+  EXPECT_EQ(d.gyro_threshold, 0.0);
+  EXPECT_EQ(d.intervals[0].gyro_mean, Eigen::Vector3d::Zero());
+}
+
+TEST(StaticDetector, RejectsShortStillSegments) {
+  SyntheticOptions so;
+  std::vector<Truth> truth;
+  std::vector<Pose> poses = SixPoses(5.0);
+  poses[2].seconds = 1.5;  // 0.9 s after trimming: shorter than 2 s
+  poses[4].seconds = 0.5;  // shorter than a window
+  const ImuLog log = MakeLog(poses, so, &truth);
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  ExpectMatches(d, {truth[0], truth[1], truth[3], truth[5]}, 30, 30);
+}
+
+TEST(StaticDetector, NoStillSegmentGivesNoInterval) {
+  // Continuous tumbling: gravity turns at 20-40 deg/s in the body frame.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  ImuLog log;
+  const double rate = 100.0;
+  double angle = 0.0;
+  for (int i = 0; i < 6000; ++i) {
+    const double t = i / rate;
+    const double w = (30.0 + 10.0 * std::sin(0.5 * t)) * M_PI / 180.0;
+    angle += w / rate;
+    log.t.push_back(t);
+    Eigen::Vector3d f(0.0, std::sin(angle) * kGravity, std::cos(angle) * kGravity);
+    Eigen::Vector3d g(w, 0.0, 0.0);
+    for (int k = 0; k < 3; ++k) {
+      f[k] += 0.02 * normal(rng);
+      g[k] += 0.002 * normal(rng);
+    }
+    log.accel.push_back(f);
+    log.gyro.push_back(g);
+  }
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  EXPECT_TRUE(d.intervals.empty())
+      << d.intervals.size() << " intervals, first at " << d.intervals[0].begin;
+  // Without the white-noise cap the floor is the motion itself, and all of
+  // it passes for still: the cap is what makes this work.
+  StaticDetectorOptions no_cap;
+  no_cap.max_floor_ratio = 0.0;
+  ASSERT_TRUE(DetectStaticIntervals(log, no_cap, &d));
+  EXPECT_FALSE(d.intervals.empty());
+}
+
+TEST(StaticDetector, MergesABriefBumpButNotAPickUp) {
+  SyntheticOptions so;
+  std::vector<Truth> truth;
+  const ImuLog base = MakeLog({{{0, 0, 1}, 20.0}, {{1, 0, 0}, 5.0}}, so, &truth);
+
+  // A tap: 0.1 s of a 0.3 m/s^2 rms jolt in the middle of the first pose.
+  ImuLog tapped = base;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0.0, 0.3);
+  for (size_t i = 1000; i < 1010; ++i)
+    tapped.accel[i] += Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(tapped, StaticDetectorOptions(), &d)) << d.message;
+  ExpectMatches(d, truth, 30, 30);
+
+  // With merging off, the tap splits the pose in two.
+  StaticDetectorOptions no_merge;
+  no_merge.merge_angle_deg = 0.0;
+  ASSERT_TRUE(DetectStaticIntervals(tapped, no_merge, &d)) << d.message;
+  EXPECT_EQ(d.intervals.size(), 3u);
+
+  // Picked up and put back down in the same orientation: 1 s of large
+  // motion. Two intervals, and neither includes the motion.
+  ImuLog picked = base;
+  for (size_t i = 1000; i < 1100; ++i) {
+    const double s = std::sin(M_PI * (i - 1000) / 100.0);
+    picked.accel[i] += Eigen::Vector3d(2.0 * s, -1.0 * s, 3.0 * s * s);
+  }
+  ASSERT_TRUE(DetectStaticIntervals(picked, StaticDetectorOptions(), &d)) << d.message;
+  ASSERT_EQ(d.intervals.size(), 3u);
+  EXPECT_LE(d.intervals[0].end, 1000u);
+  EXPECT_GE(d.intervals[1].begin, 1100u);
+  EXPECT_LT(d.intervals[0].accel_cov.trace(), 2.0 * 3.0 * 0.02 * 0.02);
+  EXPECT_LT(d.intervals[1].accel_cov.trace(), 2.0 * 3.0 * 0.02 * 0.02);
+}
+
+TEST(StaticDetector, ConstantQuantisedDataIsStill) {
+  // A quiet sensor whose counts never change in the first pose: the floor
+  // must not be zero, and the positions must have a usable covariance.
+  SyntheticOptions so;
+  so.counts = true;
+  so.accel_noise = 0.0;
+  so.gyro_noise = 0.0;
+  so.with_temperature = true;
+  std::vector<Truth> truth;
+  const ImuLog log = MakeLog(SixPoses(4.0), so, &truth);
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  ExpectMatches(d, truth, 30, 30);
+  EXPECT_GT(d.accel_noise_floor, 0.0);
+  EXPECT_EQ(d.intervals[0].accel_cov, Eigen::Matrix3d::Zero());
+  EXPECT_FALSE(std::isnan(d.intervals[0].temperature_mean));
+  const std::vector<Position> positions = PositionsFromIntervals(d.intervals);
+  ASSERT_EQ(positions.size(), d.intervals.size());
+  for (const Position& p : positions) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(p.raw_mean_cov);
+    EXPECT_GT(eig.eigenvalues()[0], 0.0);
+    EXPECT_LE(eig.eigenvalues()[2], 1.0);  // a fraction of a count^2
+    EXPECT_EQ(p.temperature, d.intervals[&p - positions.data()].temperature_mean);
+  }
+}
+
+TEST(StaticDetector, RejectsInvalidOptionsNamingTheField) {
+  SyntheticOptions so;
+  const ImuLog log = MakeLog(SixPoses(3.0), so, nullptr);
+  struct Case {
+    std::string field;
+    void (*set)(StaticDetectorOptions*);
+  };
+  const std::vector<Case> cases = {
+      {"window_seconds", [](StaticDetectorOptions* o) { o->window_seconds = 0.0; }},
+      {"window_seconds", [](StaticDetectorOptions* o) { o->window_seconds = NAN; }},
+      {"noise_quantile", [](StaticDetectorOptions* o) { o->noise_quantile = 1.0; }},
+      {"noise_quantile", [](StaticDetectorOptions* o) { o->noise_quantile = 0.0; }},
+      {"threshold_factor", [](StaticDetectorOptions* o) { o->threshold_factor = 0.5; }},
+      {"gyro_threshold_factor", [](StaticDetectorOptions* o) { o->gyro_threshold_factor = -1; }},
+      {"max_floor_ratio", [](StaticDetectorOptions* o) { o->max_floor_ratio = -1.0; }},
+      {"min_duration_seconds", [](StaticDetectorOptions* o) { o->min_duration_seconds = -1; }},
+      {"settle_seconds", [](StaticDetectorOptions* o) { o->settle_seconds = INFINITY; }},
+      {"merge_angle_deg", [](StaticDetectorOptions* o) { o->merge_angle_deg = 200.0; }},
+      {"merge_gap_windows", [](StaticDetectorOptions* o) { o->merge_gap_windows = -2.0; }},
+  };
+  for (const Case& c : cases) {
+    StaticDetectorOptions options;
+    c.set(&options);
+    std::string error;
+    EXPECT_FALSE(options.IsValid(&error)) << c.field;
+    EXPECT_NE(error.find(c.field), std::string::npos) << error;
+    StaticDetection d;
+    EXPECT_FALSE(DetectStaticIntervals(log, options, &d)) << c.field;
+    EXPECT_NE(d.message.find(c.field), std::string::npos) << d.message;
+    EXPECT_TRUE(d.intervals.empty());
+  }
+  std::string error;
+  EXPECT_TRUE(StaticDetectorOptions().IsValid(&error)) << error;
+
+  // Valid but absurd durations: no interval, no overflow.
+  StaticDetection d;
+  StaticDetectorOptions options;
+  options.settle_seconds = 1e300;
+  EXPECT_TRUE(DetectStaticIntervals(log, options, &d)) << d.message;
+  EXPECT_TRUE(d.intervals.empty());
+  options = StaticDetectorOptions();
+  options.min_duration_seconds = 1e300;
+  EXPECT_TRUE(DetectStaticIntervals(log, options, &d)) << d.message;
+  EXPECT_TRUE(d.intervals.empty());
+}
+
+TEST(StaticDetector, RejectsLogsItCannotUse) {
+  SyntheticOptions so;
+  ImuLog log = MakeLog({{{0, 0, 1}, 0.5}}, so, nullptr);  // 50 samples < 100
+  StaticDetection d;
+  EXPECT_FALSE(DetectStaticIntervals(log, StaticDetectorOptions(), &d));
+  EXPECT_NE(d.message.find("window"), std::string::npos) << d.message;
+  EXPECT_TRUE(d.intervals.empty());
+
+  ImuLog empty;
+  EXPECT_FALSE(DetectStaticIntervals(empty, StaticDetectorOptions(), &d));
+  EXPECT_FALSE(d.message.empty());
+
+  log = MakeLog(SixPoses(3.0), so, nullptr);
+  ImuLog bad = log;
+  bad.accel[500][1] = NAN;
+  EXPECT_FALSE(DetectStaticIntervals(bad, StaticDetectorOptions(), &d));
+  EXPECT_NE(d.message.find("not finite"), std::string::npos) << d.message;
+  bad = log;
+  bad.t[700] = bad.t[699];
+  EXPECT_FALSE(DetectStaticIntervals(bad, StaticDetectorOptions(), &d));
+  EXPECT_NE(d.message.find("sample 700"), std::string::npos) << d.message;
+  bad = log;
+  bad.gyro.pop_back();
+  EXPECT_FALSE(DetectStaticIntervals(bad, StaticDetectorOptions(), &d));
+  EXPECT_NE(d.message.find("gyroscope"), std::string::npos) << d.message;
+  EXPECT_FALSE(DetectStaticIntervals(log, StaticDetectorOptions(), nullptr));
+}
+
+TEST(StaticDetector, MakeIntervalComputesTheStatistics) {
+  ImuLog log;
+  for (int i = 0; i < 5; ++i) {
+    log.t.push_back(0.1 * i);
+    log.accel.push_back(Eigen::Vector3d(16000.0 + i, -3.0 * i, 7.0));
+    log.gyro.push_back(Eigen::Vector3d(i % 2, 0.0, 1.0));
+    log.temperature.push_back(20.0 + i);
+  }
+  const StaticInterval s = MakeInterval(log, 1, 4);  // samples 1, 2, 3
+  EXPECT_EQ(s.count(), 3u);
+  EXPECT_DOUBLE_EQ(s.t_begin, 0.1);
+  EXPECT_DOUBLE_EQ(s.t_end, 0.3);
+  EXPECT_TRUE(s.accel_mean.isApprox(Eigen::Vector3d(16002.0, -6.0, 7.0)));
+  EXPECT_DOUBLE_EQ(s.accel_cov(0, 0), 1.0);
+  EXPECT_DOUBLE_EQ(s.accel_cov(1, 1), 9.0);
+  EXPECT_DOUBLE_EQ(s.accel_cov(0, 1), -3.0);
+  EXPECT_DOUBLE_EQ(s.accel_cov(2, 2), 0.0);
+  EXPECT_TRUE(s.accel_resolution.isApprox(Eigen::Vector3d(1.0, 3.0, 0.0)));
+  EXPECT_NEAR(s.gyro_mean[0], 2.0 / 3.0, 1e-15);
+  EXPECT_NEAR(s.gyro_cov(0, 0), 1.0 / 3.0, 1e-15);
+  EXPECT_DOUBLE_EQ(s.temperature_mean, 22.0);
+
+  // Out-of-range requests are clamped, never read past the log.
+  const StaticInterval clamped = MakeInterval(log, 3, 99);
+  EXPECT_EQ(clamped.end, 5u);
+  EXPECT_EQ(clamped.count(), 2u);
+  EXPECT_EQ(MakeInterval(log, 4, 2).count(), 0u);
+}
+
+TEST(StaticDetector, PositionsCarryTheCovarianceOfTheMean) {
+  StaticInterval s;
+  s.begin = 10;
+  s.end = 110;
+  s.t_begin = 1.0;
+  s.t_end = 2.0;
+  s.accel_mean = Eigen::Vector3d(1.0, 2.0, 3.0);
+  s.accel_cov = Eigen::Vector3d(4.0, 9.0, 16.0).asDiagonal();
+  s.accel_cov(0, 1) = s.accel_cov(1, 0) = 1.0;
+  s.temperature_mean = 30.0;
+  const std::vector<Position> p = PositionsFromIntervals({s});
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_EQ(p[0].raw_mean, s.accel_mean);
+  EXPECT_TRUE(p[0].raw_mean_cov.isApprox(s.accel_cov / 100.0));
+  EXPECT_EQ(p[0].sample_count, 100u);
+  EXPECT_EQ(p[0].t_begin, 1.0);
+  EXPECT_EQ(p[0].t_end, 2.0);
+  EXPECT_EQ(p[0].temperature, 30.0);
+  EXPECT_EQ(p[0].nominal_up, -1);
+
+  // Singular (one axis constant): quantisation variance step^2/12 added.
+  s.accel_cov(2, 2) = 0.0;
+  s.accel_resolution = Eigen::Vector3d(0.5, 0.5, 0.0);
+  const std::vector<Position> q = PositionsFromIntervals({s});
+  EXPECT_NEAR(q[0].raw_mean_cov(2, 2), 0.25 / 12.0, 1e-15);
+  EXPECT_NEAR(q[0].raw_mean_cov(0, 0), 0.04 + 0.25 / 12.0, 1e-15);
+  EXPECT_TRUE(PositionsFromIntervals({}).empty());
+}
+
+TEST(StaticDetector, NominalAxes) {
+  const char* names[] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+  for (int i = 0; i < 6; ++i) {
+    const Eigen::Vector3d a = NominalAxis(i);
+    EXPECT_DOUBLE_EQ(a.norm(), 1.0);
+    EXPECT_DOUBLE_EQ(a[i / 2], i % 2 == 0 ? 1.0 : -1.0);
+    EXPECT_EQ(NominalAxisName(i), names[i]);
+  }
+  EXPECT_EQ(NominalAxisName(-1), "?");
+  EXPECT_EQ(NominalAxisName(6), "?");
+  EXPECT_EQ(NominalAxis(-1), Eigen::Vector3d::Zero());
+}
+
+// --- Real recordings (skipped when ../shared/data/real is missing) ---------
+
+ImuLog ReadReal(const std::string& file, const LogReaderOptions& options) {
+  ImuLog log;
+  std::string error;
+  EXPECT_TRUE(ReadImuLog(testing_util::RealDataDir() + "/" + file, options, &log, &error)) << error;
+  return log;
+}
+
+bool Overlaps(const StaticInterval& s, size_t begin, size_t end) {
+  return s.begin < end && begin < s.end;
+}
+
+// NilsPod, 102.4 Hz, on a table: the six labelled faces, and besides them
+// seven still periods in the x-, y- and z-up orientations: before the first
+// face (0.3-2.8 s, split from x_p by a pick-up-and-put-down) and before and
+// after each of the three rotations. 13 intervals, 6 orientations.
+TEST(StaticDetectorRealData, FerrarisNilsPod) {
+  if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "no real data";
+  LogReaderOptions options;
+  options.rename = {{"t", "n_samples"}, {"ax", "acc_x"}, {"ay", "acc_y"}, {"az", "acc_z"},
+                    {"gx", "gyr_x"},    {"gy", "gyr_y"}, {"gz", "gyr_z"}};
+  options.time_scale = 1.0 / 102.4;
+  const ImuLog log = ReadReal("ferraris_nilspod/session.csv", options);
+  ASSERT_EQ(log.size(), 10376u);
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  EXPECT_EQ(d.intervals.size(), 13u) << d.message;
+
+  std::ifstream in(testing_util::RealDataDir() + "/ferraris_nilspod/sections.json");
+  ASSERT_TRUE(in.good());
+  const nlohmann::json sections = nlohmann::json::parse(in);
+  for (const char* face : {"x_p", "x_a", "y_p", "y_a", "z_p", "z_a"}) {
+    const size_t begin = sections[face]["start"].get<size_t>();
+    const size_t end = sections[face]["end"].get<size_t>();
+    int found = 0;
+    for (const StaticInterval& s : d.intervals) {
+      if (Overlaps(s, begin, end)) {
+        ++found;
+        // Most of the labelled face is inside the interval.
+        EXPECT_LE(s.begin, begin + 50) << face;
+        EXPECT_GE(s.end + 50, end) << face;
+      }
+    }
+    EXPECT_EQ(found, 1) << face;
+  }
+  for (const char* rotation : {"x_rot", "y_rot", "z_rot"}) {
+    const size_t begin = sections[rotation]["start"].get<size_t>();
+    const size_t end = sections[rotation]["end"].get<size_t>();
+    for (const StaticInterval& s : d.intervals) EXPECT_FALSE(Overlaps(s, begin, end)) << rotation;
+  }
+  // On a table: every interval is quiet (accelerometer sd < 0.05 m/s^2) and
+  // near gravity (the raw norms range over 9.2-10.5 m/s^2: uncalibrated).
+  for (const StaticInterval& s : d.intervals) {
+    EXPECT_LT(std::sqrt(s.accel_cov.trace()), 0.05) << s.begin;
+    EXPECT_NEAR(s.accel_mean.norm(), 9.8, 1.0) << s.begin;
+  }
+}
+
+// MPU-6050, raw counts at 100 Hz: 37 s still (z up) at the start, then nine
+// hand-held poses of 2.5-7 s, each in a different orientation: ten
+// orientations in all, the "ten poses" of the logger including the initial
+// period.
+TEST(StaticDetectorRealData, Mpu6050TenPose) {
+  if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "no real data";
+  LogReaderOptions options;
+  options.skip_lines = 4;
+  options.sample_rate = 100.0;
+  const ImuLog log = ReadReal("mpu6050_ten_pose/session.csv", options);
+  ASSERT_EQ(log.size(), 10245u);
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  ASSERT_EQ(d.intervals.size(), 10u) << d.message;
+  EXPECT_GT(d.intervals[0].t_end - d.intervals[0].t_begin, 35.0);
+  EXPECT_LT(d.intervals[0].t_begin - log.t[0], 1.0);
+  for (size_t i = 1; i < d.intervals.size(); ++i) {
+    EXPECT_GT(d.intervals[i].t_end - d.intervals[i].t_begin, 2.0) << i;
+    // Distinct orientations: every pair of means more than 20 degrees apart.
+    for (size_t j = 0; j < i; ++j) {
+      const Eigen::Vector3d a = d.intervals[i].accel_mean.normalized();
+      const Eigen::Vector3d b = d.intervals[j].accel_mean.normalized();
+      EXPECT_LT(a.dot(b), std::cos(20.0 * M_PI / 180.0)) << i << " " << j;
+    }
+  }
+  // Gravity is 16384 counts give or take the sensor's own large errors (the
+  // raw norms range over 14900-18600 counts).
+  for (const StaticInterval& s : d.intervals) EXPECT_NEAR(s.accel_mean.norm(), 16384, 2800);
+}
+
+// Commercial AHRS, 100 Hz, 66 s: nine still poses of 4-7 s. Two of them (at
+// 25 s and 46 s) are nearly the same orientation (0.8 degrees apart) but far
+// apart in time: two intervals.
+TEST(StaticDetectorRealData, AhrsStaticPoses) {
+  if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "no real data";
+  LogReaderOptions options;
+  options.format = LogFormat::kWhitespace;
+  options.columns = {"t",  "ax", "ay", "az", "gx", "gy", "gz",
+                     "mx", "my", "mz", "qx", "qy", "qz", "qw"};
+  const ImuLog log = ReadReal("ahrs_static_poses/imu_good1.txt", options);
+  ASSERT_GT(log.size(), 6500u);
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  ASSERT_EQ(d.intervals.size(), 9u) << d.message;
+  for (const StaticInterval& s : d.intervals) {
+    EXPECT_GT(s.t_end - s.t_begin, 4.0);
+    EXPECT_NEAR(s.accel_mean.norm(), 9.79871, 0.4);
+  }
+}
+
+}  // namespace
+}  // namespace gravcal

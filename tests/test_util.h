@@ -1,0 +1,89 @@
+// Helpers shared by the tests.
+#ifndef GRAVCAL_TESTS_TEST_UTIL_H_
+#define GRAVCAL_TESTS_TEST_UTIL_H_
+
+#include <sys/stat.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gravcal/accel_model.h"
+#include "gravcal/position.h"
+
+namespace gravcal {
+namespace testing_util {
+
+// A uniformly random unit vector.
+inline Eigen::Vector3d RandomDirection(std::mt19937_64* rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Vector3d v(n(*rng), n(*rng), n(*rng));
+  return v.normalized();
+}
+
+// The twelve directions of gravity in the body frame of Chen et al.: six
+// faces and six 45-degree poses.
+inline std::vector<Eigen::Vector3d> TwelveDirections() {
+  const double c = std::sqrt(0.5);
+  return {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1},
+          {c, c, 0}, {-c, c, 0}, {0, c, c}, {0, -c, c}, {c, 0, c}, {c, 0, -c}};
+}
+
+// Static positions of a sensor `truth` whose body frame sees gravity along
+// `directions` (unit, body frame), each tilted by N(0, tilt_rad) per axis,
+// with `samples` samples of white noise `noise_si` (m/s^2 per sample) each:
+// the mean raw vector gets noise of the mean and the covariance of the mean
+// is the exact one. nominal_up is set for axis directions when
+// `set_nominal` is true.
+inline std::vector<Position> MakePositions(const AccelModel& truth,
+                                           const std::vector<Eigen::Vector3d>& directions,
+                                           double gravity, double tilt_rad, double noise_si,
+                                           int samples, bool set_nominal, std::mt19937_64* rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  // Raw noise: the truth's inverse maps SI noise into raw units.
+  const Eigen::Matrix3d minv = truth.matrix().inverse();
+  const Eigen::Matrix3d raw_cov = noise_si * noise_si * minv * minv.transpose();
+  const Eigen::Matrix3d raw_cov_mean = raw_cov / samples;
+  const Eigen::Matrix3d l = raw_cov_mean.llt().matrixL();
+  std::vector<Position> out;
+  for (size_t k = 0; k < directions.size(); ++k) {
+    const Eigen::Vector3d tilt(tilt_rad * n(*rng), tilt_rad * n(*rng), tilt_rad * n(*rng));
+    const Eigen::Matrix3d r =
+        tilt.norm() > 0 ? Eigen::AngleAxisd(tilt.norm(), tilt.normalized()).toRotationMatrix()
+                        : Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d f = gravity * (r * directions[k]);
+    Position p;
+    p.raw_mean = truth.Invert(f) + l * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+    p.raw_mean_cov = raw_cov_mean;
+    p.sample_count = samples;
+    p.t_begin = 10.0 * k;
+    p.t_end = 10.0 * k + 5.0;
+    if (set_nominal) {
+      for (int a = 0; a < 6; ++a) {
+        if ((directions[k] - NominalAxis(a)).norm() < 1e-9) p.nominal_up = a;
+      }
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+// The folder of real recordings, or "" when it is not there (tests skip).
+inline std::string RealDataDir() {
+  struct stat st;
+  const std::string dir = GRAVCAL_REAL_DATA_DIR;
+  if (stat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) return dir;
+  return "";
+}
+
+inline std::string SourceDir() { return GRAVCAL_SOURCE_DIR; }
+
+}  // namespace testing_util
+}  // namespace gravcal
+
+#endif  // GRAVCAL_TESTS_TEST_UTIL_H_
