@@ -1,0 +1,220 @@
+// The command-line tool end to end: bad input gets one line naming the file,
+// line or key, a non-zero exit and no output file.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string err;
+  std::string out;
+};
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char pattern[] = "/tmp/gravcal_cli_XXXXXX";
+    ASSERT_NE(mkdtemp(pattern), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override { std::system(("rm -rf '" + dir_ + "'").c_str()); }
+
+  RunResult Run(const std::string& args) const {
+    const std::string out = dir_ + "/stdout.txt";
+    const std::string err = dir_ + "/stderr.txt";
+    const std::string command =
+        std::string(GRAVCAL_CLI_PATH) + " " + args + " >" + out + " 2>" + err + " </dev/null";
+    const int status = std::system(command.c_str());
+    RunResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = Slurp(out);
+    r.err = Slurp(err);
+    return r;
+  }
+  static std::string Slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  std::string Write(const std::string& name, const std::string& text) const {
+    const std::string path = dir_ + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+  }
+  bool Exists(const std::string& path) const {
+    struct stat st;
+    return stat(path.c_str(), &st) == 0;
+  }
+  std::string Config() const { return testing_util::SourceDir() + "/configs/twelve_position.yaml"; }
+  // A simulated twelve-position session in raw counts.
+  std::string Simulated(int seed = 7) {
+    const std::string sim = dir_ + "/sim" + std::to_string(seed);
+    const RunResult r = Run("simulate --config " + Config() + " --seed " + std::to_string(seed) +
+                            " --output-dir " + sim);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return sim + "/raw.csv";
+  }
+  // The error line, checked to be exactly one line.
+  static std::string OneLine(const RunResult& r) {
+    std::string last;
+    int errors = 0;
+    std::istringstream in(r.err);
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("gravcal: error:", 0) == 0) {
+        ++errors;
+        last = line;
+      }
+    }
+    EXPECT_EQ(errors, 1) << r.err;
+    return last;
+  }
+
+  std::string dir_;
+};
+
+TEST_F(CliTest, DemoPrintsEstimateNextToTruth) {
+  const RunResult r = Run("demo --config " + Config());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("truth"), std::string::npos);
+  EXPECT_NE(r.out.find("+-"), std::string::npos);
+  EXPECT_NE(r.out.find("before"), std::string::npos);
+}
+
+TEST_F(CliTest, SimulateCalibrateApplyRoundTrip) {
+  const std::string raw = Simulated();
+  const std::string calib = dir_ + "/calib.json";
+  RunResult r = Run("calibrate --input " + raw + " --config " + Config() +
+                    " --latitude 45.4 --height 20 --output " + calib);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(calib);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["accel"]["model"], "scale_misalignment");
+  EXPECT_EQ(j["positions"].size(), 12u);
+  EXPECT_TRUE(j["accel"]["std"]["matrix"][1][0].is_null());
+  EXPECT_TRUE(j["accel"]["std"]["matrix"][0][1].is_number());
+  EXPECT_NE(j["gravity"]["source"].get<std::string>().find("latitude"), std::string::npos);
+  EXPECT_EQ(j["accel"]["covariance"]["parameters"].size(), 9u);
+  const std::string corrected = dir_ + "/corrected.csv";
+  r = Run("apply --calibration " + calib + " --input " + raw + " --output " + corrected);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(Exists(corrected));
+}
+
+TEST_F(CliTest, FlagOverridesConfig) {
+  const std::string raw = Simulated();
+  const std::string calib = dir_ + "/calib.json";
+  const RunResult r = Run("calibrate --input " + raw + " --config " + Config() +
+                          " --gravity 9.81744 --parameterization=scale --output " + calib);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(calib);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["gravity"]["value"], 9.81744);
+  EXPECT_EQ(j["accel"]["model"], "scale");
+  EXPECT_TRUE(j["accel"]["std"]["matrix"][0][1].is_null());
+}
+
+TEST_F(CliTest, BadInputsGiveOneLineAndNoOutput) {
+  const std::string out = dir_ + "/out.json";
+  struct Case {
+    std::string file_text;
+    std::string expect;  // in the error line
+  };
+  const std::vector<Case> cases = {
+      {"", "no samples"},
+      {"t,ax,ay\n0,1,2\n", "'az'"},
+      {"t,ax,ay,az\n0,1,2,3\n0.1,1,abc,3\n", ":3:"},
+      {"t,ax,ay,az\n0,1,2,3\n0.1,1,nan,3\n", ":3:"},
+      {"t,ax,ay,az\n0,1,2,3\n0.1,1,inf,3\n", ":3:"},
+      {"t,ax,ay,az\n0,1,2,3\n0,1,2,3\n", "time"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const std::string input = Write("bad" + std::to_string(i) + ".csv", cases[i].file_text);
+    const RunResult r =
+        Run("calibrate --input " + input + " --config " + Config() + " --output " + out);
+    EXPECT_EQ(r.exit_code, 1) << i;
+    const std::string line = OneLine(r);
+    EXPECT_NE(line.find("bad" + std::to_string(i) + ".csv"), std::string::npos) << line;
+    EXPECT_NE(line.find(cases[i].expect), std::string::npos) << line;
+    EXPECT_FALSE(Exists(out)) << i;
+  }
+}
+
+TEST_F(CliTest, TooFewPositionsSaysHowMany) {
+  // Six positions are too few for the nine-parameter model.
+  const std::string sim = dir_ + "/six";
+  RunResult r = Run("simulate --config " + Config() + " --sim_scheme six --output-dir " + sim);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string out = dir_ + "/out.json";
+  r = Run("calibrate --input " + sim + "/raw.csv --config " + Config() + " --output " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  const std::string line = OneLine(r);
+  EXPECT_NE(line.find("found 6 static positions"), std::string::npos) << line;
+  EXPECT_NE(line.find("at least 9"), std::string::npos) << line;
+  EXPECT_FALSE(Exists(out));
+}
+
+TEST_F(CliTest, UnknownConfigKeyIsNamed) {
+  const std::string config = Write("bad.yaml", "method: twelve_position\nlosss: huber\n");
+  const std::string raw = Simulated();
+  const std::string out = dir_ + "/out.json";
+  const RunResult r = Run("calibrate --input " + raw + " --config " + config + " --output " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  const std::string line = OneLine(r);
+  EXPECT_NE(line.find("bad.yaml:2"), std::string::npos) << line;
+  EXPECT_NE(line.find("'losss'"), std::string::npos) << line;
+  EXPECT_FALSE(Exists(out));
+}
+
+TEST_F(CliTest, BadValuesAndFlagsAreNamed) {
+  const std::string raw = Simulated();
+  const std::string out = dir_ + "/out.json";
+  RunResult r =
+      Run("calibrate --input " + raw + " --config " + Config() + " --loss l3 --output " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("'loss'"), std::string::npos);
+  r = Run("calibrate --input " + raw + " --config " + Config() + " --gravity 3 --output " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("gravity"), std::string::npos);
+  r = Run("calibrate --input " + raw + " --frobnicate 1 --output " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("--frobnicate"), std::string::npos);
+  r = Run("calibrate --input " + raw);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("--output"), std::string::npos);
+  EXPECT_FALSE(Exists(out));
+}
+
+TEST_F(CliTest, NonConvergenceKeepsCoarseAndExitsTwo) {
+  const std::string raw = Simulated();
+  const std::string out = dir_ + "/out.json";
+  const RunResult r = Run("calibrate --input " + raw + " --config " + Config() +
+                          " --max_iterations 1 --output " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(OneLine(r).find("did not converge"), std::string::npos);
+  EXPECT_FALSE(Exists(out));
+}
+
+TEST_F(CliTest, HelpListsCommandsAndKeys) {
+  RunResult r = Run("help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("calibrate"), std::string::npos);
+  r = Run("calibrate --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("--parameterization"), std::string::npos);
+  EXPECT_NE(r.out.find("--latitude"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace gravcal
