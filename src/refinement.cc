@@ -211,6 +211,7 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   ceres::Problem::Options problem_options;
   problem_options.enable_fast_removal = false;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.disable_all_safety_checks = true;
   ceres::Problem problem(problem_options);
   std::unique_ptr<ceres::LossFunctionWrapper> loss;
   if (options.loss != LossType::kNone) {
@@ -227,7 +228,7 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   }
 
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.gradient_tolerance = options.gradient_tolerance;
