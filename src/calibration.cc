@@ -110,7 +110,12 @@ void PropagateUncertainty(const RefinementResult& refinement, const HousingRotat
     if (name.rfind("bias_", 0) == 0) {
       accel->bias_std(name[5] - 'x') = NAN;
     } else if (name.rfind("u_", 0) == 0) {
-      accel->matrix_std.col(name[3] - 'x').setConstant(NAN);
+      // U(r, c) moves column c of M = R U: just that entry when R = I.
+      if (housing == nullptr) {
+        accel->matrix_std(name[2] - 'x', name[3] - 'x') = NAN;
+      } else {
+        accel->matrix_std.col(name[3] - 'x').setConstant(NAN);
+      }
     }
   }
 }
@@ -232,7 +237,18 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
     c.positions.push_back(r);
   }
 
+  const std::vector<std::string>& undetermined = c.refinement.observability.undetermined;
+  if (!undetermined.empty() && !options.allow_undetermined) {
+    std::string names;
+    for (const std::string& n : undetermined) names += (names.empty() ? "" : ", ") + n;
+    c.message = "the positions do not determine " + names + " of the '" + ToString(p) +
+                "' model: record more poses with other axes up or down, choose a smaller "
+                "parameterization (scale), or set allow_undetermined: true to report them "
+                "without a number";
+    return false;
+  }
   if (!c.refinement.converged) {
+    c.not_converged = true;
     c.accel = AccelCalibration();
     c.accel.model = c.coarse.model;
     c.message = "refinement did not converge (" + c.refinement.message +

@@ -214,6 +214,13 @@ const std::vector<KeyHandler>& Handlers() {
                      "shortest static interval kept, s"),
       GRAVCAL_DOUBLE("settle", "detector", calibration.detector.settle_seconds,
                      "trimmed from each end of a static interval, s"),
+      GRAVCAL_DOUBLE("gyro_threshold_factor", "detector",
+                     calibration.detector.gyro_threshold_factor,
+                     "gyroscope: static when its variance is below this times its floor"),
+      GRAVCAL_DOUBLE("max_floor_ratio", "detector", calibration.detector.max_floor_ratio,
+                     "noise floor capped at this times the sample-to-sample white noise"),
+      GRAVCAL_DOUBLE("merge_gap_windows", "detector", calibration.detector.merge_gap_windows,
+                     "longest gap, in windows, across which two intervals are merged"),
       GRAVCAL_BOOL("use_gyro", "detector", calibration.detector.use_gyro,
                    "use the gyroscope variance too, when present"),
       GRAVCAL_DOUBLE("merge_angle", "detector", calibration.detector.merge_angle_deg,
@@ -249,6 +256,8 @@ const std::vector<KeyHandler>& Handlers() {
          for (int a : c.calibration.nominal_up) names.push_back(NominalAxisName(a));
          return ListText(names);
        }},
+      GRAVCAL_BOOL("allow_undetermined", "model", calibration.allow_undetermined,
+                   "write parameters the positions do not determine as null instead of failing"),
       GRAVCAL_DOUBLE("nominal_scale", "model", calibration.nominal_scale,
                      "m/s^2 per raw unit assumed before calibration (for the 'before' residual)"),
       GRAVCAL_ENUM("solver", "solver", calibration.solver, "ceres, newton",

@@ -18,6 +18,10 @@ bool ImuLog::Validate(std::string* error) const {
   if (!temperature.empty() && temperature.size() != t.size())
     return fail("temperature and time have different lengths");
   for (size_t i = 0; i < t.size(); ++i) {
+    const bool ok = std::isfinite(t[i]) && (i == 0 || t[i] > t[i - 1]) && accel[i].allFinite() &&
+                    (gyro.empty() || gyro[i].allFinite()) &&
+                    (temperature.empty() || std::isfinite(temperature[i]));
+    if (ok) continue;  // The message is built only for the bad sample.
     std::ostringstream where;
     where << "sample " << i << ": ";
     if (!std::isfinite(t[i])) return fail(where.str() + "time is not finite");

@@ -142,6 +142,64 @@ double SumSquares(const std::vector<double>& r, const std::vector<double>& sigma
   return s;
 }
 
+// GravityMagnitudeResidual (gravity_magnitude_residual.h) of `count`
+// positions in one residual block, with the analytic Jacobian (the formula
+// of MagnitudeJacobian, over all six entries of U). Same residuals, same
+// derivatives; it exists for speed only: with 12 positions Ceres spends more
+// on the bookkeeping of twelve one-residual blocks (and on Jet arithmetic)
+// than on the fit itself. Jacobians are row-major, as Ceres wants them.
+class MagnitudeBlockCost final : public ceres::CostFunction {
+ public:
+  MagnitudeBlockCost(const Position* positions, const double* sigmas, int count, double gravity)
+      : raw_means_(count), sigmas_(sigmas, sigmas + count), gravity_(gravity) {
+    for (int k = 0; k < count; ++k) raw_means_[k] = positions[k].raw_mean;
+    set_num_residuals(count);
+    mutable_parameter_block_sizes()->assign({3, kUpperSize});
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* b = parameters[0];
+    const double* u = parameters[1];
+    double* jb = jacobians != nullptr ? jacobians[0] : nullptr;
+    double* ju = jacobians != nullptr ? jacobians[1] : nullptr;
+    for (size_t k = 0; k < raw_means_.size(); ++k) {
+      const double d0 = raw_means_[k](0) - b[0];
+      const double d1 = raw_means_[k](1) - b[1];
+      const double d2 = raw_means_[k](2) - b[2];
+      const double a0 = u[0] * d0 + u[1] * d1 + u[2] * d2;
+      const double a1 = u[3] * d1 + u[4] * d2;
+      const double a2 = u[5] * d2;
+      const double norm = std::sqrt(a0 * a0 + a1 * a1 + a2 * a2);
+      residuals[k] = (norm - gravity_) / sigmas_[k];
+      if (jb == nullptr && ju == nullptr) continue;
+      // d r / d a = a / (|a| sigma).
+      const double w = 1.0 / (norm * sigmas_[k]);
+      const double e0 = w * a0, e1 = w * a1, e2 = w * a2;
+      if (jb != nullptr) {
+        jb[3 * k + 0] = -e0 * u[0];
+        jb[3 * k + 1] = -(e0 * u[1] + e1 * u[3]);
+        jb[3 * k + 2] = -(e0 * u[2] + e1 * u[4] + e2 * u[5]);
+      }
+      if (ju != nullptr) {
+        double* row = ju + kUpperSize * k;
+        row[0] = e0 * d0;
+        row[1] = e0 * d1;
+        row[2] = e0 * d2;
+        row[3] = e1 * d1;
+        row[4] = e1 * d2;
+        row[5] = e2 * d2;
+      }
+    }
+    return true;
+  }
+
+ private:
+  std::vector<Eigen::Vector3d> raw_means_;
+  std::vector<double> sigmas_;
+  double gravity_;
+};
+
 }  // namespace
 
 bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
@@ -218,17 +276,53 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
     loss = std::make_unique<ceres::LossFunctionWrapper>(MakeLoss(options.loss, scales.back()),
                                                         ceres::TAKE_OWNERSHIP);
   }
-  for (int k = 0; k < n; ++k) {
+  // A robust loss acts on each block's squared norm, so with a loss every
+  // position is its own block; without one, all positions share one block
+  // (MagnitudeBlockCost above), which is the same cost.
+  if (loss) {
+    for (int k = 0; k < n; ++k) {
+      problem.AddResidualBlock(
+          new MagnitudeBlockCost(&normalized[k], &result->sigmas[k], 1, gravity), loss.get(), bias,
+          upper);
+    }
+  } else {
     problem.AddResidualBlock(
-        GravityMagnitudeResidual::Create(normalized[k].raw_mean, gravity, result->sigmas[k]),
-        loss.get(), bias, upper);
+        new MagnitudeBlockCost(normalized.data(), result->sigmas.data(), n, gravity), nullptr, bias,
+        upper);
   }
-  if (p == AccelParameterization::kScale) {
-    problem.SetManifold(upper, new ceres::SubsetManifold(kUpperSize, {1, 2, 4}));
+  // Held entries: the scale model's off-diagonal, and held_parameters.
+  std::vector<int> held_bias, held_upper;
+  if (p == AccelParameterization::kScale) held_upper = {1, 2, 4};
+  std::vector<bool> held_column(num_parameters, false);
+  for (const std::string& name : options.held_parameters) {
+    const auto it = std::find(result->parameter_names.begin(), result->parameter_names.end(), name);
+    if (it == result->parameter_names.end()) {
+      result->message =
+          "held_parameters: '" + name + "' is not a parameter of '" + ToString(p) + "'";
+      return false;
+    }
+    const int column = static_cast<int>(it - result->parameter_names.begin());
+    held_column[column] = true;
+    if (column < 3) {
+      held_bias.push_back(column);
+    } else {
+      held_upper.push_back(free[column - 3]);
+    }
+  }
+  if (held_bias.size() == 3) {
+    problem.SetParameterBlockConstant(bias);
+  } else if (!held_bias.empty()) {
+    problem.SetManifold(bias, new ceres::SubsetManifold(3, held_bias));
+  }
+  if (held_upper.size() == kUpperSize) {
+    problem.SetParameterBlockConstant(upper);
+  } else if (!held_upper.empty()) {
+    problem.SetManifold(upper, new ceres::SubsetManifold(kUpperSize, held_upper));
   }
 
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.dense_linear_algebra_library_type = ceres::LAPACK;
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.gradient_tolerance = options.gradient_tolerance;
@@ -265,14 +359,29 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   result->residuals_after = MagnitudeResiduals(positions, refined, gravity);
   result->chi2 = SumSquares(result->residuals_after, result->sigmas);
   result->final_cost = 0.5 * result->chi2;
-  result->dof = n - num_parameters;
+  result->dof = n - num_parameters +
+                static_cast<int>(std::count(held_column.begin(), held_column.end(), true));
 
   // Observability from the analytic whitened Jacobian at the optimum.
-  result->observability = AnalyzeObservability(
-      MagnitudeJacobian(normalized, refined_n, result->sigmas), result->parameter_names);
+  // Held columns are not estimated and take no part in the rank.
+  const Eigen::MatrixXd jacobian = MagnitudeJacobian(normalized, refined_n, result->sigmas);
+  std::vector<int> active;
+  std::vector<std::string> active_names;
+  for (int i = 0; i < num_parameters; ++i) {
+    if (held_column[i]) continue;
+    active.push_back(i);
+    active_names.push_back(result->parameter_names[i]);
+  }
+  Eigen::MatrixXd active_jacobian(n, active.size());
+  for (size_t i = 0; i < active.size(); ++i) active_jacobian.col(i) = jacobian.col(active[i]);
+  result->observability = AnalyzeObservability(active_jacobian, active_names);
+  const int num_active = static_cast<int>(active.size());
+  for (int i = 0; i < num_parameters; ++i) {
+    if (held_column[i]) result->observability.undetermined.push_back(result->parameter_names[i]);
+  }
   if (!result->observability.full_rank()) {
     std::ostringstream s;
-    s << "the positions do not determine " << num_parameters - result->observability.rank
+    s << "the positions do not determine " << num_active - result->observability.rank
       << " direction(s) of the model:";
     for (const std::string& d : result->observability.descriptions) s << " [" << d << "]";
     s << "; add positions with other axes up";
@@ -282,7 +391,7 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   if (options.compute_covariance) {
     ceres::Covariance::Options covariance_options;
     covariance_options.algorithm_type = ceres::DENSE_SVD;
-    covariance_options.null_space_rank = num_parameters - result->observability.rank;
+    covariance_options.null_space_rank = num_active - result->observability.rank;
     covariance_options.num_threads = 1;
     ceres::Covariance covariance(covariance_options);
     std::vector<std::pair<const double*, const double*>> blocks = {
@@ -310,6 +419,7 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
       // mean scale, so the limits apply directly.
       std::vector<std::string> weak;
       for (int i = 0; i < num_parameters; ++i) {
+        if (held_column[i]) continue;
         const double limit = i < 3 ? options.max_bias_std : options.max_matrix_std;
         if (std::sqrt(std::max(cov(i, i), 0.0)) > limit) weak.push_back(result->parameter_names[i]);
       }
@@ -320,6 +430,24 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
         if (std::find(undetermined.begin(), undetermined.end(), name) == undetermined.end()) {
           undetermined.push_back(name);
         }
+      }
+      if (!weak.empty() && !result->converged) {
+        // The flat directions stalled the solver: hold them at their initial
+        // (coarse) value and fit the rest again. (When the solve converged,
+        // the free fit is kept: holding would make the other parameters'
+        // standard deviations conditional on the held value.)
+        RefinementOptions again = options;
+        again.held_parameters.insert(again.held_parameters.end(), weak.begin(), weak.end());
+        const double first_seconds = result->solve_seconds;
+        const int first_iterations = result->iterations;
+        if (!Refine(positions, initial, gravity, again, result)) return false;
+        result->solve_seconds += first_seconds;
+        result->iterations += first_iterations;
+        result->warnings.push_back("the positions do not determine " + listed +
+                                   " (standard deviation beyond max_bias_std / max_matrix_std); "
+                                   "they are held at the coarse fit's value and reported without "
+                                   "a number: add positions with other axes up or down");
+        return true;
       }
       if (!weak.empty()) {
         result->warnings.push_back("the positions do not determine " + listed +

@@ -139,6 +139,33 @@ TEST(Calibration, TooFewPositionsSaysFoundAndNeeded) {
   EXPECT_TRUE(CalibrateAccelerometer(session.log, scale, &c)) << c.message;
 }
 
+TEST(Calibration, UndeterminedParametersFailOrAreReportedWithoutNumber) {
+  // Twelve positions, all on the six faces: non-orthogonality enters the
+  // magnitude only at second order there, so it is not determined.
+  std::mt19937_64 rng(21);
+  const AccelModel truth =
+      AccelModel::Random(AccelParameterization::kAffine, 9.80665 / 16384, 0.02, 0.01, 400, &rng);
+  auto faces = testing_util::TwelveDirections();
+  faces.resize(6);
+  faces.insert(faces.end(), faces.begin(), faces.end());
+  const auto positions =
+      testing_util::MakePositions(truth, faces, 9.80665, 0.0, 0.02, 1000, false, &rng);
+  CalibrationOptions options;
+  options.gravity.gravity = 9.80665;
+  Calibration c;
+  EXPECT_FALSE(CalibrateFromPositions(positions, options, &c));
+  EXPECT_NE(c.message.find("do not determine"), std::string::npos) << c.message;
+  EXPECT_NE(c.message.find("u_xy"), std::string::npos) << c.message;
+  options.allow_undetermined = true;
+  ASSERT_TRUE(CalibrateFromPositions(positions, options, &c)) << c.message;
+  EXPECT_TRUE(std::isnan(c.accel.matrix_std(0, 1)));
+  EXPECT_TRUE(std::isfinite(c.accel.matrix_std(0, 0)));
+  EXPECT_TRUE(std::isfinite(c.accel.bias_std(0)));
+  bool warned = false;
+  for (const std::string& w : c.warnings) warned |= w.find("u_xy") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
 // ---------------------------------------------------------------------------
 // Real recordings: the detected poses match their known count and the rms of
 // |a| - g over poses drops at least 20 times from the nominal scaling.

@@ -47,6 +47,10 @@ struct CalibrationOptions {
   // The nominal up axis of each detected position in order ("+x", "-z",
   // "?"); empty = assign automatically.
   std::vector<int> nominal_up;
+  // When the positions do not determine some parameter: false = fail with a
+  // message naming it; true = succeed, report it without a standard
+  // deviation and say so in the warnings.
+  bool allow_undetermined = false;
 
   bool IsValid(std::string* error) const;
 };
@@ -85,6 +89,8 @@ struct PositionReport {
 
 struct Calibration {
   bool success = false;
+  // The refinement ran and did not converge (the coarse result is kept).
+  bool not_converged = false;
   AccelCalibration accel;
   double gravity = kStandardGravity;
   std::string gravity_source;
@@ -108,7 +114,8 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
 
 // From positions already extracted. Returns false with a one-line message
 // on invalid options, too few positions (how many found, how many needed),
-// no coarse fit, or a refinement that did not converge (the coarse result
+// no coarse fit, parameters the positions do not determine (unless
+// allow_undetermined), or a refinement that did not converge (the coarse result
 // is then in calibration->accel.model).
 bool CalibrateFromPositions(const std::vector<Position>& positions,
                             const CalibrationOptions& options, Calibration* calibration);

@@ -45,6 +45,12 @@ struct RefinementOptions {
   // relative to the mean scale factor.
   double max_bias_std = 0.1;
   double max_matrix_std = 0.01;
+  // Parameters held at their initial value (names as in
+  // MagnitudeParameterNames, e.g. "u_xy"). When the solve does not converge
+  // because the positions do not determine some parameters, those are added
+  // here and the fit is repeated, so a flat direction does not stall the
+  // solver; they are reported as undetermined.
+  std::vector<std::string> held_parameters;
   int max_iterations = 100;
   double function_tolerance = 1e-14;
   double gradient_tolerance = 1e-14;

@@ -106,7 +106,8 @@ int RunCalibrate(const CommandArgs& args) {
   Calibration c;
   const bool ok = CalibrateAccelerometer(log, args.config.calibration, &c);
   PrintWarnings(c);
-  if (!ok) return Fail(c.message, c.refinement.termination.empty() ? 1 : 2);
+  // 2 only for a solver that ran and did not converge; 1 for the data.
+  if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
   if (!WriteCalibrationJson(c, args.config.output_covariance, args.output, &error)) {
     return Fail(error);
   }
