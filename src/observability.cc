@@ -10,12 +10,17 @@ namespace gravcal {
 
 namespace {
 
-// Eigenvalues, ascending, of S^T S (empty on failure). Gram is a fixed-size
-// matrix type where it can be: that makes the solve several times cheaper.
+// Eigenvalues, ascending, of S^T S with S = J diag(1 / scale) (empty on
+// failure). Gram is a fixed-size matrix type where it can be: that makes the
+// solve several times cheaper.
 template <typename Gram>
-Eigen::VectorXd GramEigenvalues(const Eigen::MatrixXd& scaled) {
-  Gram gram(scaled.cols(), scaled.cols());
-  gram.template triangularView<Eigen::Lower>() = scaled.transpose().lazyProduct(scaled);
+Eigen::VectorXd GramEigenvalues(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& scale) {
+  const Eigen::Index cols = jacobian.cols();
+  Gram gram(cols, cols);
+  gram.template triangularView<Eigen::Lower>() = jacobian.transpose().lazyProduct(jacobian);
+  for (Eigen::Index j = 0; j < cols; ++j) {
+    for (Eigen::Index i = j; i < cols; ++i) gram(i, j) /= scale(i) * scale(j);
+  }
   const Eigen::SelfAdjointEigenSolver<Gram> eigen(gram, Eigen::EigenvaluesOnly);
   if (eigen.info() != Eigen::Success) return Eigen::VectorXd();
   return eigen.eigenvalues();
@@ -34,7 +39,6 @@ ObservabilityReport AnalyzeObservability(const Eigen::MatrixXd& jacobian,
   for (int j = 0; j < cols; ++j) {
     if (!(scale(j) > 0.0)) scale(j) = 1.0;
   }
-  const Eigen::MatrixXd scaled = jacobian * scale.cwiseInverse().asDiagonal();
   report.rank = 0;
   // Fast path, for speed only (the Jacobi SVD below is most of the cost of a
   // 12-position refinement). When the Gram matrix S^T S of the scaled
@@ -46,15 +50,15 @@ ObservabilityReport AnalyzeObservability(const Eigen::MatrixXd& jacobian,
   // the default rank tolerance, so the rank is certainly `cols` and there is
   // no null space to report. Anything closer to rank deficiency (or a
   // tolerance above 1e-6) takes the SVD, exactly as before.
-  if (cols <= 12 && scaled.rows() >= cols) {
+  if (cols <= 12 && jacobian.rows() >= cols) {
     Eigen::VectorXd lambda;  // Ascending.
     if (cols == 9) {
-      lambda = GramEigenvalues<Eigen::Matrix<double, 9, 9>>(scaled);
+      lambda = GramEigenvalues<Eigen::Matrix<double, 9, 9>>(jacobian, scale);
     } else if (cols == 6) {
-      lambda = GramEigenvalues<Eigen::Matrix<double, 6, 6>>(scaled);
+      lambda = GramEigenvalues<Eigen::Matrix<double, 6, 6>>(jacobian, scale);
     } else {
       lambda = GramEigenvalues<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 12>>(
-          scaled);
+          jacobian, scale);
     }
     const double ratio = std::max(1e-4, 100.0 * relative_tolerance);
     if (lambda.size() == cols && std::isfinite(lambda(cols - 1)) &&
@@ -65,6 +69,7 @@ ObservabilityReport AnalyzeObservability(const Eigen::MatrixXd& jacobian,
       return report;
     }
   }
+  const Eigen::MatrixXd scaled = jacobian * scale.cwiseInverse().asDiagonal();
   // Pad with zero rows so the SVD has at least `cols` singular values.
   Eigen::MatrixXd padded = Eigen::MatrixXd::Zero(std::max<Eigen::Index>(scaled.rows(), cols), cols);
   padded.topRows(scaled.rows()) = scaled;
