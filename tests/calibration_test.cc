@@ -14,16 +14,7 @@
 namespace gravcal {
 namespace {
 
-// Free magnitude parameters (b, U) in the order of the covariance.
-Eigen::VectorXd Params(const AccelModel& m, AccelParameterization p) {
-  const std::vector<int> free = FreeUpperIndices(p);
-  Eigen::VectorXd x(3 + free.size());
-  x.head<3>() = m.bias;
-  double u[6];
-  m.GetUpper(u);
-  for (size_t i = 0; i < free.size(); ++i) x(3 + i) = u[free[i]];
-  return x;
-}
+using testing_util::FreeParameters;
 
 struct Outcome {
   Eigen::VectorXd rms_ratio;  // RMS of error / reported sigma per parameter
@@ -46,7 +37,8 @@ Outcome RunSeeds(const SimulatorOptions& sim, const CalibrationOptions& options,
     EXPECT_TRUE(CalibrateAccelerometer(session.log, o, &c)) << c.message;
     EXPECT_EQ(c.positions.size(), session.poses.size()) << "seed " << seed;
     if (!c.success || !c.refinement.covariance_available) continue;
-    const Eigen::VectorXd err = Params(c.accel.model, p) - Params(session.accel_truth, p);
+    const Eigen::VectorXd err =
+        FreeParameters(c.accel.model, p) - FreeParameters(session.accel_truth, p);
     for (int i = 0; i < n; ++i) out.rms_ratio(i) += err(i) * err(i) / c.refinement.covariance(i, i);
     out.refined_error += (c.accel.model.upper - session.accel_truth.upper).squaredNorm() /
                          session.accel_truth.upper.squaredNorm();

@@ -13,6 +13,8 @@
 namespace gravcal {
 namespace {
 
+using testing_util::FreeParameters;
+
 using testing_util::MakePositions;
 using testing_util::TwelveDirections;
 
@@ -22,17 +24,6 @@ constexpr double kTilt = 2.0 * M_PI / 180.0;
 
 AccelModel Truth(std::mt19937_64* rng, double scale = kCountScale) {
   return AccelModel::Random(AccelParameterization::kAffine, scale, 0.02, 0.01, 0.3 / scale, rng);
-}
-
-// Free parameters of a model in the refinement's order.
-Eigen::VectorXd Params(const AccelModel& m, AccelParameterization p) {
-  const std::vector<int> free = FreeUpperIndices(p);
-  Eigen::VectorXd x(3 + free.size());
-  x.head<3>() = m.bias;
-  double u[6];
-  m.GetUpper(u);
-  for (size_t i = 0; i < free.size(); ++i) x(3 + i) = u[free[i]];
-  return x;
 }
 
 AccelModel Coarse(const std::vector<Position>& positions, AccelParameterization p) {
@@ -122,8 +113,8 @@ TEST(Refinement, CeresAndNewtonReachTheSameOptimum) {
       ASSERT_TRUE(ceres_result.converged) << ceres_result.message;
       ASSERT_TRUE(newton_result.converged) << newton_result.message;
       const auto p = AccelParameterization::kScaleMisalignment;
-      const Eigen::VectorXd a = Params(ceres_result.model, p);
-      const Eigen::VectorXd b = Params(newton_result.model, p);
+      const Eigen::VectorXd a = FreeParameters(ceres_result.model, p);
+      const Eigen::VectorXd b = FreeParameters(newton_result.model, p);
       for (int i = 0; i < a.size(); ++i) {
         EXPECT_LT(std::fabs(a(i) - b(i)), 1e-9 * std::fabs(a(i)) + 1e-12)
             << "parameter " << i << " noise " << noise;
@@ -156,7 +147,7 @@ void CheckCalibratedUncertainty(AccelParameterization p, double unit_scale) {
     ASSERT_TRUE(Refine(positions, start, kG, options, &result));
     ASSERT_TRUE(result.converged);
     ASSERT_TRUE(result.covariance_available);
-    const Eigen::VectorXd err = Params(result.model, p) - Params(truth, p);
+    const Eigen::VectorXd err = FreeParameters(result.model, p) - FreeParameters(truth, p);
     for (int i = 0; i < n; ++i) sum_sq(i) += err(i) * err(i) / result.covariance(i, i);
     coarse_err += (start.upper - truth.upper).squaredNorm();
     refined_err += (result.model.upper - truth.upper).squaredNorm();
@@ -204,8 +195,8 @@ TEST(Refinement, RobustLossResistsDisturbedPositions) {
       options.loss = loss;
       RefinementResult result;
       ASSERT_TRUE(Refine(positions, start, kG, options, &result));
-      const Eigen::VectorXd err =
-          Params(result.model, options.parameterization) - Params(truth, options.parameterization);
+      const Eigen::VectorXd err = FreeParameters(result.model, options.parameterization) -
+                                  FreeParameters(truth, options.parameterization);
       bool within = result.covariance_available;
       for (int i = 0; i < err.size() && within; ++i) {
         within = std::fabs(err(i)) < 3.0 * std::sqrt(result.covariance(i, i));

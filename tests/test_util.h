@@ -15,9 +15,22 @@
 
 #include "gravcal/accel_model.h"
 #include "gravcal/position.h"
+#include "gravcal/refinement.h"
 
 namespace gravcal {
 namespace testing_util {
+
+// The free magnitude parameters (b, free entries of U) of a model, in the
+// order of the refinement's covariance.
+inline Eigen::VectorXd FreeParameters(const AccelModel& m, AccelParameterization p) {
+  const std::vector<int> free = FreeUpperIndices(p);
+  Eigen::VectorXd x(3 + free.size());
+  x.head<3>() = m.bias;
+  double u[6];
+  m.GetUpper(u);
+  for (size_t i = 0; i < free.size(); ++i) x(3 + i) = u[free[i]];
+  return x;
+}
 
 // A uniformly random unit vector.
 inline Eigen::Vector3d RandomDirection(std::mt19937_64* rng) {
