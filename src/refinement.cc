@@ -142,64 +142,6 @@ double SumSquares(const std::vector<double>& r, const std::vector<double>& sigma
   return s;
 }
 
-// GravityMagnitudeResidual (gravity_magnitude_residual.h) of `count`
-// positions in one residual block, with the analytic Jacobian (the formula
-// of MagnitudeJacobian, over all six entries of U). Same residuals, same
-// derivatives; it exists for speed only: with 12 positions Ceres spends more
-// on the bookkeeping of twelve one-residual blocks (and on Jet arithmetic)
-// than on the fit itself. Jacobians are row-major, as Ceres wants them.
-class MagnitudeBlockCost final : public ceres::CostFunction {
- public:
-  MagnitudeBlockCost(const Position* positions, const double* sigmas, int count, double gravity)
-      : raw_means_(count), sigmas_(sigmas, sigmas + count), gravity_(gravity) {
-    for (int k = 0; k < count; ++k) raw_means_[k] = positions[k].raw_mean;
-    set_num_residuals(count);
-    mutable_parameter_block_sizes()->assign({3, kUpperSize});
-  }
-
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const double* b = parameters[0];
-    const double* u = parameters[1];
-    double* jb = jacobians != nullptr ? jacobians[0] : nullptr;
-    double* ju = jacobians != nullptr ? jacobians[1] : nullptr;
-    for (size_t k = 0; k < raw_means_.size(); ++k) {
-      const double d0 = raw_means_[k](0) - b[0];
-      const double d1 = raw_means_[k](1) - b[1];
-      const double d2 = raw_means_[k](2) - b[2];
-      const double a0 = u[0] * d0 + u[1] * d1 + u[2] * d2;
-      const double a1 = u[3] * d1 + u[4] * d2;
-      const double a2 = u[5] * d2;
-      const double norm = std::sqrt(a0 * a0 + a1 * a1 + a2 * a2);
-      residuals[k] = (norm - gravity_) / sigmas_[k];
-      if (jb == nullptr && ju == nullptr) continue;
-      // d r / d a = a / (|a| sigma).
-      const double w = 1.0 / (norm * sigmas_[k]);
-      const double e0 = w * a0, e1 = w * a1, e2 = w * a2;
-      if (jb != nullptr) {
-        jb[3 * k + 0] = -e0 * u[0];
-        jb[3 * k + 1] = -(e0 * u[1] + e1 * u[3]);
-        jb[3 * k + 2] = -(e0 * u[2] + e1 * u[4] + e2 * u[5]);
-      }
-      if (ju != nullptr) {
-        double* row = ju + kUpperSize * k;
-        row[0] = e0 * d0;
-        row[1] = e0 * d1;
-        row[2] = e0 * d2;
-        row[3] = e1 * d1;
-        row[4] = e1 * d2;
-        row[5] = e2 * d2;
-      }
-    }
-    return true;
-  }
-
- private:
-  std::vector<Eigen::Vector3d> raw_means_;
-  std::vector<double> sigmas_;
-  double gravity_;
-};
-
 }  // namespace
 
 bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
@@ -269,6 +211,8 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   ceres::Problem::Options problem_options;
   problem_options.enable_fast_removal = false;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  // For speed: the blocks below are built correctly by construction, so
+  // Ceres's checks of them are pure overhead (results are bit-identical).
   problem_options.disable_all_safety_checks = true;
   ceres::Problem problem(problem_options);
   std::unique_ptr<ceres::LossFunctionWrapper> loss;
@@ -276,19 +220,12 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
     loss = std::make_unique<ceres::LossFunctionWrapper>(MakeLoss(options.loss, scales.back()),
                                                         ceres::TAKE_OWNERSHIP);
   }
-  // A robust loss acts on each block's squared norm, so with a loss every
-  // position is its own block; without one, all positions share one block
-  // (MagnitudeBlockCost above), which is the same cost.
-  if (loss) {
-    for (int k = 0; k < n; ++k) {
-      problem.AddResidualBlock(
-          new MagnitudeBlockCost(&normalized[k], &result->sigmas[k], 1, gravity), loss.get(), bias,
-          upper);
-    }
-  } else {
+  // One autodiff residual block per position (the public functor), so the
+  // robust loss acts per position.
+  for (int k = 0; k < n; ++k) {
     problem.AddResidualBlock(
-        new MagnitudeBlockCost(normalized.data(), result->sigmas.data(), n, gravity), nullptr, bias,
-        upper);
+        GravityMagnitudeResidual::Create(normalized[k].raw_mean, gravity, result->sigmas[k]),
+        loss.get(), bias, upper);
   }
   // Held entries: the scale model's off-diagonal, and held_parameters.
   std::vector<int> held_bias, held_upper;
@@ -321,6 +258,10 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   }
 
   ceres::Solver::Options solver_options;
+  // For speed: with 9 parameters and the normalised (well-conditioned)
+  // problem, J^T J + D and a Cholesky factor are about 4 times cheaper per
+  // step than Householder QR; the optimum is the same to within the solver's
+  // tolerances (benchmarks/RESULTS.md).
   solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.function_tolerance = options.function_tolerance;
