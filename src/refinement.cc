@@ -371,7 +371,8 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
           undetermined.push_back(name);
         }
       }
-      if (!weak.empty() && !result->converged) {
+      // Only when something is left to fit.
+      if (!weak.empty() && !result->converged && static_cast<int>(weak.size()) < num_active) {
         // The flat directions stalled the solver: hold them at their initial
         // (coarse) value and fit the rest again. (When the solve converged,
         // the free fit is kept: holding would make the other parameters'
