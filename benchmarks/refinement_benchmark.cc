@@ -77,7 +77,23 @@ const std::vector<Imu>& Imus(int num_positions) {
 }
 
 // Solver iterations per IMU and the share that converged, as counters.
-void ReportSolver(benchmark::State& state, double iterations, double converged) {
+// The timed loop shared by the refinement benchmarks: `solve(imu, &result)`
+// refines one IMU; the counters report iterations, convergence and IMUs/s.
+template <typename Solve>
+void RunRefinement(benchmark::State& state, const std::vector<Imu>& imus, Solve solve) {
+  RefinementResult result;
+  double iterations = 0.0, converged = 0.0;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Imu& imu = imus[i++ % imus.size()];
+    if (!solve(imu, &result)) {
+      state.SkipWithError(result.message.c_str());
+      return;
+    }
+    benchmark::DoNotOptimize(result.model.upper.data());
+    iterations += result.iterations;
+    converged += result.converged;
+  }
   const double n = static_cast<double>(state.iterations());
   state.counters["solver_iters"] = iterations / n;
   state.counters["converged"] = converged / n;
@@ -89,20 +105,9 @@ void BM_CeresRefine(benchmark::State& state) {
   const std::vector<Imu>& imus = Imus(static_cast<int>(state.range(0)));
   RefinementOptions options;
   options.compute_covariance = state.range(1) != 0;
-  RefinementResult result;
-  double iterations = 0.0, converged = 0.0;
-  size_t i = 0;
-  for (auto _ : state) {
-    const Imu& imu = imus[i++ % imus.size()];
-    if (!Refine(imu.positions, imu.start, kG, options, &result)) {
-      state.SkipWithError(result.message.c_str());
-      return;
-    }
-    benchmark::DoNotOptimize(result.model.upper.data());
-    iterations += result.iterations;
-    converged += result.converged;
-  }
-  ReportSolver(state, iterations, converged);
+  RunRefinement(state, imus, [&](const Imu& imu, RefinementResult* result) {
+    return Refine(imu.positions, imu.start, kG, options, result);
+  });
 }
 BENCHMARK(BM_CeresRefine)
     ->ArgNames({"positions", "cov"})
@@ -115,20 +120,9 @@ void BM_CeresRefineCauchy(benchmark::State& state) {
   RefinementOptions options;
   options.loss = LossType::kCauchy;
   options.compute_covariance = state.range(1) != 0;
-  RefinementResult result;
-  double iterations = 0.0, converged = 0.0;
-  size_t i = 0;
-  for (auto _ : state) {
-    const Imu& imu = imus[i++ % imus.size()];
-    if (!Refine(imu.positions, imu.start, kG, options, &result)) {
-      state.SkipWithError(result.message.c_str());
-      return;
-    }
-    benchmark::DoNotOptimize(result.model.upper.data());
-    iterations += result.iterations;
-    converged += result.converged;
-  }
-  ReportSolver(state, iterations, converged);
+  RunRefinement(state, imus, [&](const Imu& imu, RefinementResult* result) {
+    return Refine(imu.positions, imu.start, kG, options, result);
+  });
 }
 BENCHMARK(BM_CeresRefineCauchy)
     ->ArgNames({"positions", "cov"})
@@ -143,20 +137,9 @@ void BM_NewtonRefine(benchmark::State& state) {
   options.residual =
       state.range(1) == 0 ? NewtonResidual::kSquaredMagnitude : NewtonResidual::kMagnitude;
   options.compute_covariance = state.range(2) != 0;
-  RefinementResult result;
-  double iterations = 0.0, converged = 0.0;
-  size_t i = 0;
-  for (auto _ : state) {
-    const Imu& imu = imus[i++ % imus.size()];
-    if (!NewtonRefine(imu.positions, imu.start, kG, options, &result)) {
-      state.SkipWithError(result.message.c_str());
-      return;
-    }
-    benchmark::DoNotOptimize(result.model.upper.data());
-    iterations += result.iterations;
-    converged += result.converged;
-  }
-  ReportSolver(state, iterations, converged);
+  RunRefinement(state, imus, [&](const Imu& imu, RefinementResult* result) {
+    return NewtonRefine(imu.positions, imu.start, kG, options, result);
+  });
 }
 BENCHMARK(BM_NewtonRefine)
     ->ArgNames({"positions", "magnitude", "cov"})

@@ -224,7 +224,7 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
     if (p == AccelParameterization::kAffine && !have_housing) c.accel.matrix_std.setConstant(NAN);
   }
 
-  const std::vector<double> sigmas = c.refinement.sigmas;
+  const std::vector<double>& sigmas = c.refinement.sigmas;
   for (size_t k = 0; k < placed.size(); ++k) {
     PositionReport r;
     r.position = placed[k];

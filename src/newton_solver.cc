@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "magnitude_fit.h"
 #include "normalization.h"
 #include "statistics.h"
 
@@ -89,35 +90,9 @@ bool NewtonRefine(const std::vector<Position>& positions, const AccelModel& init
   const std::vector<int> free = FreeUpperIndices(p);
   const int num_parameters = 3 + static_cast<int>(free.size());
   const int n = static_cast<int>(positions.size());
-  if (n < num_parameters) {
-    std::ostringstream s;
-    s << "Newton refinement of '" << ToString(p) << "' needs at least " << num_parameters
-      << " static positions, found " << n;
-    result->message = s.str();
+  AccelModel model;
+  if (!StartMagnitudeFit(positions, initial, gravity, p, "Newton refinement", &model, result)) {
     return false;
-  }
-  AccelModel model = initial;
-  model.parameterization = p;
-  if (p == AccelParameterization::kScale) {
-    model.upper(0, 1) = model.upper(0, 2) = model.upper(1, 2) = 0.0;
-  }
-  result->sigmas = MagnitudeSigmas(positions, model);
-  for (int k = 0; k < n; ++k) {
-    if (!(result->sigmas[k] > 0.0) || !std::isfinite(result->sigmas[k])) {
-      std::ostringstream s;
-      s << "position " << k << " has no usable noise estimate; it needs more than one sample";
-      result->message = s.str();
-      return false;
-    }
-  }
-  result->residuals_before = MagnitudeResiduals(positions, model, gravity);
-  result->num_residuals = n;
-  result->num_parameters = num_parameters;
-  result->parameter_names = MagnitudeParameterNames(p);
-  {
-    double s = 0.0;
-    for (int k = 0; k < n; ++k) s += std::pow(result->residuals_before[k] / result->sigmas[k], 2);
-    result->initial_cost = 0.5 * s;
   }
 
   // Iterate in well-conditioned units (normalization.h).
@@ -179,10 +154,8 @@ bool NewtonRefine(const std::vector<Position>& positions, const AccelModel& init
   model = norm.Undo(model);
   result->model = model;
   result->residuals_after = MagnitudeResiduals(positions, model, gravity);
-  double chi2 = 0.0;
-  for (int k = 0; k < n; ++k) chi2 += std::pow(result->residuals_after[k] / result->sigmas[k], 2);
-  result->chi2 = chi2;
-  result->final_cost = 0.5 * chi2;
+  result->chi2 = WhitenedSumOfSquares(result->residuals_after, result->sigmas);
+  result->final_cost = 0.5 * result->chi2;
   result->dof = n - num_parameters;
   result->observability = AnalyzeObservability(jm, result->parameter_names);
   if (options.compute_covariance && result->observability.full_rank()) {

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "gravcal/gravity_magnitude_residual.h"
+#include "magnitude_fit.h"
 #include "normalization.h"
 #include "statistics.h"
 
@@ -136,12 +137,6 @@ ceres::LossFunction* MakeLoss(LossType type, double scale) {
   return nullptr;
 }
 
-double SumSquares(const std::vector<double>& r, const std::vector<double>& sigmas) {
-  double s = 0.0;
-  for (size_t k = 0; k < r.size(); ++k) s += (r[k] / sigmas[k]) * (r[k] / sigmas[k]);
-  return s;
-}
-
 }  // namespace
 
 bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
@@ -153,42 +148,14 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
     result->message = error;
     return false;
   }
-  if (!(gravity > 0.0)) {
-    result->message = "gravity must be positive";
-    return false;
-  }
   const AccelParameterization p = options.parameterization;
   const std::vector<int> free = FreeUpperIndices(p);
   const int num_parameters = 3 + static_cast<int>(free.size());
   const int n = static_cast<int>(positions.size());
-  if (n < num_parameters) {
-    std::ostringstream s;
-    s << "refinement of '" << ToString(p) << "' needs at least " << num_parameters
-      << " static positions, found " << n;
-    result->message = s.str();
+  AccelModel model;
+  if (!StartMagnitudeFit(positions, initial, gravity, p, "refinement", &model, result)) {
     return false;
   }
-
-  AccelModel model = initial;
-  model.parameterization = p;
-  if (p == AccelParameterization::kScale) {
-    model.upper(0, 1) = model.upper(0, 2) = model.upper(1, 2) = 0.0;
-  }
-  result->sigmas = MagnitudeSigmas(positions, model);
-  for (int k = 0; k < n; ++k) {
-    if (!(result->sigmas[k] > 0.0) || !std::isfinite(result->sigmas[k])) {
-      std::ostringstream s;
-      s << "position " << k << " has no usable noise estimate (sigma = " << result->sigmas[k]
-        << "); it needs more than one sample";
-      result->message = s.str();
-      return false;
-    }
-  }
-  result->residuals_before = MagnitudeResiduals(positions, model, gravity);
-  result->initial_cost = 0.5 * SumSquares(result->residuals_before, result->sigmas);
-  result->num_residuals = n;
-  result->num_parameters = num_parameters;
-  result->parameter_names = MagnitudeParameterNames(p);
 
   // Solve in well-conditioned units (normalization.h); |a| is unchanged.
   const Normalization norm = Normalization::For(model);
@@ -297,7 +264,7 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   }
   result->model = refined;
   result->residuals_after = MagnitudeResiduals(positions, refined, gravity);
-  result->chi2 = SumSquares(result->residuals_after, result->sigmas);
+  result->chi2 = WhitenedSumOfSquares(result->residuals_after, result->sigmas);
   result->final_cost = 0.5 * result->chi2;
   result->dof = n - num_parameters +
                 static_cast<int>(std::count(held_column.begin(), held_column.end(), true));
