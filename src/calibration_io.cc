@@ -46,7 +46,30 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
     accel["placement_error_deg"] = Number(c.accel.tilt_rms * 180.0 / M_PI);
   }
   json out;
+  out["method"] = c.method;
   out["accel"] = accel;
+  if (c.gyro.estimated) {
+    json gyro;
+    gyro["bias"] = Vector(c.gyro.model.bias);
+    gyro["matrix"] = Matrix(c.gyro.model.matrix);
+    gyro["std"] = {{"bias", Vector(c.gyro.bias_std)}, {"matrix", Matrix(c.gyro.matrix_std)}};
+    if (include_covariance && c.gyro.covariance.size() > 0) {
+      gyro["covariance"] = {{"parameters", c.gyro.covariance_names},
+                            {"matrix", Matrix(c.gyro.covariance)}};
+    }
+    json extra = json::object();
+    for (size_t i = 0; i < c.gyro.extra_names.size(); ++i) {
+      extra[c.gyro.extra_names[i]] = {{"value", Number(c.gyro.extra_values[i])},
+                                      {"std", Number(c.gyro.extra_std[i])}};
+    }
+    if (!extra.empty()) gyro["extra"] = extra;
+    if (!c.gyro.rotation_residual_deg.empty()) {
+      json r = json::array();
+      for (double v : c.gyro.rotation_residual_deg) r.push_back(Number(v));
+      gyro["rotation_residual_deg"] = r;
+    }
+    out["gyro"] = gyro;
+  }
   out["gravity"] = {{"value", c.gravity}, {"source", c.gravity_source}};
   auto summary = [](const ResidualSummary& s) {
     return json{{"rms", Number(s.rms)}, {"max", Number(s.max)}};

@@ -17,6 +17,7 @@
 
 #include "gravcal/accel_model.h"
 #include "gravcal/coarse_fit.h"
+#include "gravcal/gyro_model.h"
 #include "gravcal/gravity.h"
 #include "gravcal/imu_log.h"
 #include "gravcal/newton_solver.h"
@@ -77,6 +78,29 @@ struct AccelCalibration {
   double tilt_rms = 0.0;
 };
 
+// The gyroscope part of a calibration, filled by the methods that estimate
+// it (estimated = false otherwise, and the JSON has no "gyro" key).
+struct GyroCalibration {
+  bool estimated = false;
+  GyroModel model;
+  // Standard deviations of b_g (raw units) and of M_g, element by element;
+  // NaN where the parameter was not estimated or is not determined.
+  Eigen::Vector3d bias_std = Eigen::Vector3d::Constant(NAN);
+  Eigen::Matrix3d matrix_std = Eigen::Matrix3d::Constant(NAN);
+  // Covariance of the estimated gyroscope parameters, covariance_names order.
+  Eigen::MatrixXd covariance;
+  std::vector<std::string> covariance_names;
+  // Method-specific scalar results with their standard deviations (for
+  // example "g_sensitivity_xy" in rad/s per m/s^2), written as
+  // gyro.extra.<name> = {value, std}.
+  std::vector<std::string> extra_names;
+  std::vector<double> extra_values;
+  std::vector<double> extra_std;
+  // One residual per rotation (or per segment) in degrees, when the method
+  // has them.
+  std::vector<double> rotation_residual_deg;
+};
+
 struct PositionReport {
   Position position;
   // sqrt of the diagonal of the sample covariance, raw units.
@@ -92,6 +116,9 @@ struct Calibration {
   // The refinement ran and did not converge (the coarse result is kept).
   bool not_converged = false;
   AccelCalibration accel;
+  GyroCalibration gyro;
+  // The method that produced this result (config key `method`).
+  std::string method = "twelve_position";
   double gravity = kStandardGravity;
   std::string gravity_source;
   // |a| - g over positions with the nominal scale, the coarse fit, the

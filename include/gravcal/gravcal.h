@@ -15,6 +15,7 @@
 #include "gravcal/log_reader.h"
 #include "gravcal/newton_solver.h"
 #include "gravcal/observability.h"
+#include "gravcal/pipeline.h"
 #include "gravcal/position.h"
 #include "gravcal/refinement.h"
 #include "gravcal/simulator.h"

@@ -8,6 +8,7 @@
 #include "gravcal/calibration.h"
 #include "gravcal/calibration_io.h"
 #include "gravcal/log_reader.h"
+#include "gravcal/pipeline.h"
 #include "gravcal/simulator.h"
 
 namespace gravcal {
@@ -28,7 +29,7 @@ void PrintWarnings(const Calibration& c) {
 
 // "1.234 +- 0.005" or "1.234 (not determined)".
 std::string WithStd(double value, double std, const char* format) {
-  char buffer[96];
+  char buffer[128];
   char v[48];
   std::snprintf(v, sizeof(v), format, value);
   if (std::isfinite(std)) {
@@ -101,10 +102,11 @@ int RunCalibrate(const CommandArgs& args) {
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
-  ImuLog log;
-  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  PipelineInput input;
+  input.source = args.input;
+  if (!ReadImuLog(args.input, args.config.input, &input.log, &error)) return Fail(error);
   Calibration c;
-  const bool ok = CalibrateAccelerometer(log, args.config.calibration, &c);
+  const bool ok = RunCalibration(args.config, input, &c);
   PrintWarnings(c);
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);

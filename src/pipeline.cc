@@ -1,0 +1,22 @@
+#include "gravcal/pipeline.h"
+
+namespace gravcal {
+
+bool RunCalibration(const Config& config, const PipelineInput& input, Calibration* calibration) {
+  *calibration = Calibration();
+  std::string error;
+  if (!config.IsValid(&error)) {
+    calibration->message = error;
+    return false;
+  }
+  // One branch per method; each fills the same Calibration.
+  if (config.method == "twelve_position") {
+    const bool ok = CalibrateAccelerometer(input.log, config.calibration, calibration);
+    calibration->method = config.method;
+    return ok;
+  }
+  calibration->message = "key 'method': unknown method '" + config.method + "'";
+  return false;
+}
+
+}  // namespace gravcal
