@@ -649,6 +649,17 @@ bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* err
   }
 }
 
+bool ReadFileBytes(const std::string& path, std::string* bytes, std::string* error) {
+  try {
+    FileText text;
+    if (!text.Read(path, error)) return false;
+    bytes->assign(text.view());
+    return true;
+  } catch (const std::exception& e) {
+    return SetError(error, path + ": cannot read: " + e.what());
+  }
+}
+
 bool WriteFileAtomically(const std::string& path, const std::string& contents, std::string* error) {
   if (path.empty()) return SetError(error, "cannot write a file with an empty name");
   try {
