@@ -117,6 +117,17 @@ std::map<std::string, FileId> JsonFiles(const std::string& folder) {
   return files;
 }
 
+// Names in a folder that contain `part`.
+size_t CountNames(const std::string& folder, const std::string& part) {
+  size_t n = 0;
+  DIR* dir = opendir(folder.c_str());
+  if (dir == nullptr) return 0;
+  while (const dirent* e = readdir(dir))
+    n += std::string(e->d_name).find(part) != std::string::npos;
+  closedir(dir);
+  return n;
+}
+
 // Twelve units: nine good ones (one with its own gravity, one with a planted
 // accelerometer bias), a corrupt file, a missing file and a session with
 // too few poses.
@@ -415,10 +426,14 @@ TEST_F(BatchTest, KilledRunResumesWithoutRecomputing) {
   ASSERT_LT(state.size(), 360u);
   EXPECT_EQ(JsonFiles(out).count("summary.json"), 0u);
 
+  // As if the kill had caught a write half way.
+  std::ofstream(out + "/r1000.json.tmp." + std::to_string(pid)) << "{";
   const Process resumed = Run(args(out));
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   EXPECT_NE(resumed.err.find("skipped " + std::to_string(state.size()) + " "), std::string::npos)
       << resumed.err;
+  // No temporary file of the killed run is left.
+  EXPECT_EQ(CountNames(out, ".tmp.") + CountNames(out + "/batch_state", ".tmp."), 0u);
   const std::map<std::string, FileId> state_after = JsonFiles(out + "/batch_state");
   const std::map<std::string, FileId> results_after = JsonFiles(out);
   EXPECT_EQ(state_after.size(), 360u);

@@ -7,7 +7,10 @@
 // Every file is written atomically. A unit is skipped when its state file
 // has the unit's current content hash (and, if it calibrated, <unit>.json
 // exists): its summary row is taken from the state file. Units whose input
-// could not be read get no state file, so they are tried again.
+// could not be read get no state file, so they are tried again. Temporary
+// files a killed run left behind are removed when their process is gone.
+#include <dirent.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -16,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <system_error>
@@ -53,6 +57,24 @@ bool MakeFolders(const std::string& path, std::string* error) {
     return false;
   }
   return true;
+}
+
+// Removes the temporary files (<name>.tmp.<pid>) that a killed run left in
+// `folder`, when their process is gone.
+void RemoveStaleTemporaries(const std::string& folder) {
+  DIR* dir = opendir(folder.c_str());
+  if (dir == nullptr) return;
+  while (const dirent* entry = readdir(dir)) {
+    const std::string name = entry->d_name;
+    const size_t tmp = name.rfind(".tmp.");
+    if (tmp == std::string::npos) continue;
+    const std::string pid = name.substr(tmp + 5);
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (kill(static_cast<pid_t>(std::atol(pid.c_str())), 0) != 0 && errno == ESRCH) {
+      unlink((folder + "/" + name).c_str());
+    }
+  }
+  closedir(dir);
 }
 
 bool FileExists(const std::string& path) {
@@ -210,6 +232,8 @@ int RunBatch(const CommandArgs& args) {
   const std::string& out = args.output_dir;
   const std::string state_folder = out + "/" + kStateFolder;
   if (!MakeFolders(state_folder, &error)) return Fail(error);
+  RemoveStaleTemporaries(out);
+  RemoveStaleTemporaries(state_folder);
 
   std::vector<SummaryRow> rows(units.size());
   std::vector<char> have_row(units.size(), 0);
@@ -277,7 +301,7 @@ int RunBatch(const CommandArgs& args) {
   const double busy = sum.read_seconds + sum.detect_seconds + sum.solve_seconds;
   std::fprintf(
       stderr,
-      "gravcal: batch: %zu units (shard %d/%d of %zu): %zu ok, %zu failed, %zu not "
+      "gravcal: batch: %zu units (shard %d/%d of a fleet of %zu): %zu ok, %zu failed, %zu not "
       "converged, %zu outliers; skipped %zu (stored results up to date); %.1f units/s "
       "computed; time in read %.0f %%, detect %.0f %%, solve %.0f %%; wrote %s/summary.csv "
       "and summary.json\n",
