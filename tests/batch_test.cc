@@ -521,6 +521,26 @@ TEST_F(BatchTest, InputDirUnitsAreSortedFileStems) {
   EXPECT_NE(error.find("no file matches '*.nothing'"), std::string::npos);
 }
 
+TEST(ContentHash, SeesEveryByteFramingAndConfig) {
+  const Config config;
+  std::string bytes(1000, 'x');
+  const std::string h = UnitContentHash(bytes, "", "", config);
+  EXPECT_EQ(h.size(), 32u);
+  EXPECT_EQ(UnitContentHash(bytes, "", "", config), h);
+  std::set<std::string> seen = {h};
+  for (size_t i : {0, 7, 8, 31, 32, 500, 998, 999}) {
+    std::string changed = bytes;
+    changed[i] = 'y';
+    EXPECT_TRUE(seen.insert(UnitContentHash(changed, "", "", config)).second) << i;
+  }
+  EXPECT_TRUE(seen.insert(UnitContentHash(bytes + "x", "", "", config)).second);
+  EXPECT_TRUE(seen.insert(UnitContentHash("ab", "c", "", config)).second);
+  EXPECT_TRUE(seen.insert(UnitContentHash("a", "bc", "", config)).second);
+  Config other = config;
+  other.calibration.gravity.gravity = 9.81;
+  EXPECT_TRUE(seen.insert(UnitContentHash(bytes, "", "", other)).second);
+}
+
 TEST(Shard, ParsesAndSplitsByPositionModN) {
   Shard shard;
   std::string error;
