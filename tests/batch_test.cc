@@ -366,6 +366,34 @@ TEST_F(BatchTest, CliGoodUnitsEqualCalibrateAloneAndBadUnitsHaveMessages) {
   EXPECT_EQ(WithoutTimes(Slurp(out + "/summary.csv")), WithoutTimes(first_csv));
 }
 
+TEST_F(BatchTest, NotConvergedUnitsExitTwoAndInputDirWorks) {
+  // One Ceres iteration cannot converge: that unit only, exit code 2.
+  std::ofstream(*dir_ + "/conv.csv") << "unit,path,max_iterations\nu00,u00.csv,\nu01,u01.csv,1\n";
+  const std::string out = *dir_ + "/conv";
+  Process p = Run(
+      {"batch", "--manifest", *dir_ + "/conv.csv", "--config", *config_path_, "--output-dir", out});
+  EXPECT_EQ(p.exit_code, 2) << p.err;
+  EXPECT_NE(p.err.find("gravcal: error: 1 of 2 units did not converge"), std::string::npos)
+      << p.err;
+  std::vector<SummaryRow> rows;
+  std::string error;
+  ASSERT_TRUE(ParseSummaryCsv(Slurp(out + "/summary.csv"), "s", &rows, &error)) << p.err;
+  ASSERT_EQ(rows.size(), 2u) << p.err;
+  EXPECT_EQ(rows[0].status, BatchStatus::kOk);
+  EXPECT_EQ(rows[1].status, BatchStatus::kNotConverged);
+  EXPECT_NE(rows[1].message.find("did not converge"), std::string::npos) << rows[1].message;
+  const json summary = json::parse(Slurp(out + "/summary.json"));
+  EXPECT_EQ(summary["not_converged"], 1);
+  EXPECT_EQ(summary["outlier_check"], "skipped: 1 calibrated units, needs 5");
+
+  // Every good file of the folder, all calibrated: exit 0.
+  p = Run({"batch", "--input-dir", *dir_, "--pattern", "u0[0-8].csv", "--config", *config_path_,
+           "--output-dir", *dir_ + "/folder", "--threads", "0"});
+  EXPECT_EQ(p.exit_code, 0) << p.err;
+  EXPECT_NE(p.err.find("9 ok, 0 failed"), std::string::npos) << p.err;
+  ASSERT_EQ(json::parse(Slurp(*dir_ + "/folder/u08.json"))["positions"].size(), 12u);
+}
+
 TEST_F(BatchTest, ShardedRunsMergedEqualOneRun) {
   const std::string whole = *dir_ + "/whole";
   ASSERT_EQ(RunBatch(whole).exit_code, 1);
