@@ -158,7 +158,7 @@ bool WriteSummary(const std::string& folder, const std::vector<SummaryRow>& rows
          WriteFileAtomically(folder + "/summary.json", FleetStatisticsToJson(*statistics), error);
 }
 
-// The one-line report of failures and outliers after a summary is written.
+// On stderr, one line each: the first failed units and every outlier.
 void ReportFleet(const FleetStatistics& s) {
   size_t shown = 0;
   for (const SummaryRow& f : s.failures) {
