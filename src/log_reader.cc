@@ -106,6 +106,29 @@ bool CheckColumnNames(const std::vector<std::string>& names, const char* what, s
 }
 
 // A whole file in memory, read without initialising the buffer first.
+// Raw counts are plain integers; reading them digit by digit is several
+// times cheaper than from_chars and gives the same double bit for bit (at
+// most 15 digits, so exact). Returns false, leaving the field to from_chars,
+// when it is not an optional '-' and 1 to 15 digits not followed by '.', 'e',
+// 'E' or another digit.
+bool ParsePlainInteger(const char* p, const char* end, double* x, const char** after) {
+  const bool negative = p < end && *p == '-';
+  const char* const digits = p + (negative ? 1 : 0);
+  const char* q = digits;
+  int64_t value = 0;
+  while (q < end && q - digits <= 15 && static_cast<unsigned>(*q - '0') < 10u) {
+    value = value * 10 + (*q - '0');
+    ++q;
+  }
+  if (q == digits || q - digits > 15) return false;
+  if (q < end && (*q == '.' || *q == 'e' || *q == 'E' || static_cast<unsigned>(*q - '0') < 10u)) {
+    return false;
+  }
+  *x = negative ? -static_cast<double>(value) : static_cast<double>(value);
+  *after = q;
+  return true;
+}
+
 class FileText {
  public:
   bool Read(const std::string& path, std::string* error) {
@@ -333,8 +356,12 @@ class Parser {
           ++number;
         }
         double x = 0.0;
-        const auto result = std::from_chars(number, end, x);
-        const char* after = result.ptr;
+        const char* after = nullptr;
+        std::from_chars_result result{number, std::errc()};
+        if (!ParsePlainInteger(number, end, &x, &after)) {
+          result = std::from_chars(number, end, x);
+          after = result.ptr;
+        }
         bool ok = result.ec == std::errc();
         if (kCsv) {
           while (after < end && IsBlank(*after)) ++after;
@@ -646,6 +673,17 @@ bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* err
     return WriteFileAtomically(path, contents, error);
   } catch (const std::exception& e) {
     return SetError(error, path + ": cannot write: " + e.what());
+  }
+}
+
+bool ReadFileBytes(const std::string& path, std::string* bytes, std::string* error) {
+  try {
+    FileText text;
+    if (!text.Read(path, error)) return false;
+    bytes->assign(text.view());
+    return true;
+  } catch (const std::exception& e) {
+    return SetError(error, path + ": cannot read: " + e.what());
   }
 }
 

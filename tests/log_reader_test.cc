@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -490,6 +491,29 @@ TEST(LogReader, ReadsAhrsStaticPoses) {
   EXPECT_EQ(log.accel[0], Eigen::Vector3d(0.06808426231146, -0.04261315613985, -9.42799282074));
   EXPECT_NEAR(log.t.back() - log.t.front(), 65.65, 0.5);
   EXPECT_TRUE(log.Validate(&error)) << error;
+}
+
+// Integer cells take a fast path; every value must equal from_chars's.
+TEST(LogReader, IntegerCellsReadAsFromCharsWould) {
+  const std::vector<std::string> cells = {
+      "0",    "-0",   "7",     "007", "-16384", "32767", "123456789012345", "1234567890123456789",
+      "12.5", "12e3", "-12E-1"};
+  std::string text = "t,ax,ay,az\n";
+  for (size_t i = 0; i < cells.size(); ++i) {
+    text += std::to_string(i) + "," + cells[i] + ",1,-1\n";
+  }
+  ImuLog log;
+  std::string error;
+  ASSERT_TRUE(ParseImuLog(text, "ints.csv", LogReaderOptions(), &log, &error)) << error;
+  ASSERT_EQ(log.size(), cells.size());
+  for (size_t i = 0; i < cells.size(); ++i) {
+    double expected = 0.0;
+    std::from_chars(cells[i].data(), cells[i].data() + cells[i].size(), expected);
+    EXPECT_EQ(std::memcmp(&log.accel[i].x(), &expected, sizeof(double)), 0) << cells[i];
+  }
+  EXPECT_TRUE(std::signbit(log.accel[1].x()));
+  EXPECT_FALSE(ParseImuLog("t,ax,ay,az\n0,12x,1,1\n", "bad.csv", LogReaderOptions(), &log, &error));
+  EXPECT_NE(error.find("bad.csv:2"), std::string::npos) << error;
 }
 
 }  // namespace

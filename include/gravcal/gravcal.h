@@ -3,9 +3,12 @@
 #define GRAVCAL_GRAVCAL_H_
 
 #include "gravcal/accel_model.h"
+#include "gravcal/batch.h"
+#include "gravcal/batch_manifest.h"
 #include "gravcal/calibration.h"
 #include "gravcal/calibration_io.h"
 #include "gravcal/coarse_fit.h"
+#include "gravcal/fleet_summary.h"
 #include "gravcal/config.h"
 #include "gravcal/gravity.h"
 #include "gravcal/gravity_magnitude_residual.h"

@@ -4,6 +4,7 @@
 #define GRAVCAL_SRC_CLI_COMMANDS_H_
 
 #include <string>
+#include <vector>
 
 #include "gravcal/config.h"
 
@@ -18,12 +19,28 @@ struct CommandArgs {
   std::string calibration;
   std::string config_path;
   uint64_t seed = 1;
+  // batch and merge-summaries.
+  std::string manifest;
+  std::string input_dir;
+  std::string pattern = "*.csv";
+  int threads = 0;
+  std::string shard;
+  double outlier_sigmas = 5.0;
+  int outlier_min_units = 5;
+  // Arguments that are not flags (merge-summaries: the shard folders).
+  std::vector<std::string> positional;
 };
 
 int RunDemo(const CommandArgs& args);
 int RunCalibrate(const CommandArgs& args);
 int RunApply(const CommandArgs& args);
 int RunSimulate(const CommandArgs& args);
+// batch_command.cc. Exit codes: 0 every unit calibrated; 1 bad invocation
+// or manifest (nothing written), or at least one unit failed as calibrate
+// would with exit 1; 2 the only failures are units that did not converge.
+int RunBatch(const CommandArgs& args);
+// 0 merged; 1 bad input (nothing written).
+int RunMergeSummaries(const CommandArgs& args);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

@@ -14,13 +14,24 @@
 
 #include "cli/commands.h"
 #include "gravcal/config.h"
+#include "gravcal/fleet_summary.h"
 
 DEFINE_string(input, "", "raw log to read");
 DEFINE_string(output, "", "file to write (calibration JSON or corrected CSV)");
-DEFINE_string(output_dir, "", "folder to write simulated raw.csv and truth.json into");
+DEFINE_string(output_dir, "",
+              "folder to write into (simulate: raw.csv, truth.json; batch: results)");
 DEFINE_string(config, "", "YAML config file (configs/*.yaml)");
 DEFINE_string(calibration, "", "calibration JSON to apply");
 DEFINE_uint64(seed, 1, "random seed of the simulator");
+DEFINE_string(manifest, "", "batch: CSV with columns unit, path and optional config keys");
+DEFINE_string(input_dir, "", "batch: every file matching --pattern in this folder is a unit");
+DEFINE_string(pattern, "*.csv", "batch: file name pattern for --input-dir");
+DEFINE_int32(threads, 0, "batch: worker threads, 0 = one per core");
+DEFINE_string(shard, "", "batch: K/N, calibrate only units i with i mod N = K - 1");
+DEFINE_double(outlier_sigmas, gravcal::FleetOptions().outlier_sigmas,
+              "batch: outlier threshold, robust standard deviations from the fleet median");
+DEFINE_int32(outlier_min_units, gravcal::FleetOptions().min_units,
+             "batch: fewest calibrated units for the outlier check");
 
 namespace {
 
@@ -42,6 +53,15 @@ const std::vector<CommandInfo>& Commands() {
        "apply a calibration to a raw log, writing SI units",
        {"calibration", "input", "output"}},
       {"simulate", "simulate a session: raw.csv and truth.json", {"config", "seed", "output_dir"}},
+      {"batch",
+       "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
+       "statistics)",
+       {"manifest", "input_dir", "pattern", "config", "output_dir", "threads", "shard",
+        "outlier_sigmas", "outlier_min_units"}},
+      {"merge-summaries",
+       "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
+       "shard1/ shard2/ ...",
+       {"output_dir", "outlier_sigmas", "outlier_min_units"}},
       {"help", "list commands, or the flags and config keys of one: gravcal help <command>", {}},
   };
   return commands;
@@ -108,13 +128,18 @@ int main(int argc, char** argv) {
   std::vector<char*> rest = {argv[0]};
   std::vector<std::string> storage;
   storage.reserve(argc);
+  std::vector<std::string> positional;
   for (int i = 2; i < argc; ++i) {
     std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
       PrintHelp(command);
       return 0;
     }
-    if (arg.rfind("--", 0) != 0) return Fail("unexpected argument '" + arg + "'");
+    if (arg.rfind("--", 0) != 0) {
+      if (command != "merge-summaries") return Fail("unexpected argument '" + arg + "'");
+      positional.push_back(arg);
+      continue;
+    }
     std::string name = arg.substr(2);
     std::string value;
     bool has_value = false;
@@ -171,9 +196,19 @@ int main(int argc, char** argv) {
   args.output_dir = FLAGS_output_dir;
   args.calibration = FLAGS_calibration;
   args.seed = FLAGS_seed;
+  args.manifest = FLAGS_manifest;
+  args.input_dir = FLAGS_input_dir;
+  args.pattern = FLAGS_pattern;
+  args.threads = FLAGS_threads;
+  args.shard = FLAGS_shard;
+  args.outlier_sigmas = FLAGS_outlier_sigmas;
+  args.outlier_min_units = FLAGS_outlier_min_units;
+  args.positional = positional;
 
   if (command == "demo") return gravcal::cli::RunDemo(args);
   if (command == "calibrate") return gravcal::cli::RunCalibrate(args);
   if (command == "apply") return gravcal::cli::RunApply(args);
+  if (command == "batch") return gravcal::cli::RunBatch(args);
+  if (command == "merge-summaries") return gravcal::cli::RunMergeSummaries(args);
   return gravcal::cli::RunSimulate(args);
 }
