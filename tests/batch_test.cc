@@ -495,6 +495,7 @@ TEST_F(BatchTest, ManifestErrorsNameFileLineAndColumnAndWriteNothing) {
       {"unit,path\na,\"a.csv\n", "m.csv:2:3: the quoted field is not closed"},
       {"unit,path,parameterization\na,a.csv,cubic\n", "m.csv:2:9: key 'parameterization'"},
       {"unit,path\n", "m.csv: the manifest lists no units"},
+      {"unit,path,window\na,a.csv,-1\n", "m.csv:2:1: unit 'a': "},
   };
   for (const Case& c : cases) {
     std::vector<BatchUnit> units;
