@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "accel_uncertainty.h"
 #include "gravcal/housing_rotation.h"
 #include "statistics.h"
 
@@ -54,8 +55,8 @@ namespace {
 
 ResidualSummary Summarise(const std::vector<double>& r) { return {Rms(r), MaxAbs(r)}; }
 
-// Fills bias_std, matrix_std and the covariance from the magnitude
-// parameters' covariance and, for affine, the housing rotation's.
+}  // namespace
+
 void PropagateUncertainty(const RefinementResult& refinement, const HousingRotation* housing,
                           AccelCalibration* accel) {
   const AccelModel& model = accel->model;
@@ -119,8 +120,6 @@ void PropagateUncertainty(const RefinementResult& refinement, const HousingRotat
     }
   }
 }
-
-}  // namespace
 
 bool CalibrateFromPositions(const std::vector<Position>& positions,
                             const CalibrationOptions& options, Calibration* calibration) {

@@ -316,6 +316,32 @@ const std::vector<KeyHandler>& Handlers() {
       GRAVCAL_DOUBLE("sim_temperature_end", "simulator", simulation.temperature_end, "deg C"),
       GRAVCAL_DOUBLE("sim_temperature_tau", "simulator", simulation.temperature_tau,
                      "warm-up time constant, s"),
+      // Issue 5: gyroscope calibration from the rotations between static poses.
+      GRAVCAL_ENUM("gyro_model", "gyro", gyro.parameterization, "none, bias, scale, full",
+                   "gyroscope from the rotations between poses: none, bias (+ common scale), "
+                   "scale (diagonal) or full (scale and misalignment)"),
+      GRAVCAL_BOOL("gyro_g_sensitivity", "gyro", gyro.g_sensitivity,
+                   "also estimate the gyroscope g-sensitivity G (rad/s per m/s^2)"),
+      GRAVCAL_BOOL("gyro_joint", "gyro", gyro.joint,
+                   "refine the accelerometer's bias and U together with the gyroscope"),
+      GRAVCAL_ENUM("gyro_loss", "gyro", gyro.loss, "none, huber, cauchy, soft_l1, arctan, tukey",
+                   "robust loss on the gyroscope residuals"),
+      GRAVCAL_DOUBLE("gyro_loss_scale", "gyro", gyro.loss_scale,
+                     "gyroscope robust loss scale, in standard deviations"),
+      GRAVCAL_DOUBLE("gyro_edge", "gyro", gyro.edge_seconds,
+                     "seconds at each end of a static interval integrated with the rotations"),
+      GRAVCAL_DOUBLE("gyro_max_rotation", "gyro", gyro.max_rotation_seconds,
+                     "longest gap between poses used as a rotation, s"),
+      GRAVCAL_STRING("sim_rotation_profile", "simulator", simulation.rotation_profile,
+                     "rotations between poses: smooth (fixed axis) or hand (1-4 s, irregular)"),
+      GRAVCAL_DOUBLE("sim_hand_min_rotation", "simulator", simulation.hand_min_seconds,
+                     "hand profile: shortest rotation, s"),
+      GRAVCAL_DOUBLE("sim_hand_max_rotation", "simulator", simulation.hand_max_seconds,
+                     "hand profile: longest rotation, s"),
+      GRAVCAL_DOUBLE("sim_hand_wobble", "simulator", simulation.hand_wobble_deg,
+                     "hand profile: axis wobble, degrees (standard deviation)"),
+      GRAVCAL_DOUBLE("sim_gyro_g_sensitivity", "simulator", simulation.gyro_g_sensitivity_std,
+                     "truth gyroscope g-sensitivity spread, rad/s per m/s^2"),
   };
   return handlers;
 }
@@ -354,6 +380,10 @@ bool Config::IsValid(std::string* error) const {
     return false;
   }
   if (!calibration.IsValid(&what)) {
+    *error = what;
+    return false;
+  }
+  if (!gyro.IsValid(&what)) {
     *error = what;
     return false;
   }

@@ -1,5 +1,7 @@
 #include "gravcal/pipeline.h"
 
+#include "gravcal/gyro_calibration.h"
+
 namespace gravcal {
 
 bool RunCalibration(const Config& config, const PipelineInput& input, Calibration* calibration) {
@@ -13,7 +15,9 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
   if (config.method == "twelve_position") {
     const bool ok = CalibrateAccelerometer(input.log, config.calibration, calibration);
     calibration->method = config.method;
-    return ok;
+    if (!ok || config.gyro.parameterization == GyroParameterization::kNone) return ok;
+    return AddGyroscopeCalibration(input.log, config.calibration.detector, config.gyro,
+                                   calibration);
   }
   calibration->message = "key 'method': unknown method '" + config.method + "'";
   return false;

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "gravcal/gravity_magnitude_residual.h"
+#include "loss_function.h"
 #include "magnitude_fit.h"
 #include "normalization.h"
 #include "statistics.h"
@@ -117,8 +118,6 @@ std::vector<double> MagnitudeResiduals(const std::vector<Position>& positions,
   return r;
 }
 
-namespace {
-
 ceres::LossFunction* MakeLoss(LossType type, double scale) {
   switch (type) {
     case LossType::kNone:
@@ -136,8 +135,6 @@ ceres::LossFunction* MakeLoss(LossType type, double scale) {
   }
   return nullptr;
 }
-
-}  // namespace
 
 bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
             const RefinementOptions& options, RefinementResult* result) {

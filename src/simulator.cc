@@ -125,6 +125,46 @@ double SmoothStepRate(double x) { return 30.0 * x * x * (1.0 - x) * (1.0 - x); }
 
 long SampleCount(double seconds, double rate) { return std::lround(seconds * rate); }
 
+// A hand-like rotation: random duration, an irregular time warp
+// tau(x) = x + sum_j c_j sin(2 pi j x) / (2 pi j) of the minimum-jerk
+// profile (tau' = 1 + sum_j c_j cos(2 pi j x) > 0, so it never runs
+// backwards), and a wobble beta(x) = 64 A x^3 (1 - x)^3 about a random axis,
+// zero at both ends with zero rate and angular acceleration (a jump in the
+// angular acceleration would cost any sampled integrator an O(h^2) error).
+struct HandProfile {
+  double seconds = 1.0;
+  double c[3] = {0.0, 0.0, 0.0};
+  double amplitude = 0.0;
+  Eigen::Vector3d wobble_axis = Eigen::Vector3d::UnitX();
+
+  static HandProfile Random(const SimulatorOptions& options, std::mt19937_64* rng) {
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    std::normal_distribution<double> n01(0.0, 1.0);
+    HandProfile p;
+    p.seconds = options.hand_min_seconds +
+                (options.hand_max_seconds - options.hand_min_seconds) * u01(*rng);
+    for (double& cj : p.c) cj = 0.5 * (u01(*rng) - 0.5);
+    p.amplitude = options.hand_wobble_deg * kPi / 180.0 * n01(*rng);
+    Eigen::Vector3d v(n01(*rng), n01(*rng), n01(*rng));
+    if (v.norm() > 0.0) p.wobble_axis = v.normalized();
+    return p;
+  }
+  double Warp(double x) const {
+    double tau = x;
+    for (int j = 1; j <= 3; ++j) tau += c[j - 1] * std::sin(2.0 * kPi * j * x) / (2.0 * kPi * j);
+    return tau;
+  }
+  double WarpRate(double x) const {
+    double rate = 1.0;
+    for (int j = 1; j <= 3; ++j) rate += c[j - 1] * std::cos(2.0 * kPi * j * x);
+    return rate;
+  }
+  double Wobble(double x) const { return amplitude * 64.0 * std::pow(x * (1.0 - x), 3); }
+  double WobbleRate(double x) const {
+    return amplitude * 192.0 * std::pow(x * (1.0 - x), 2) * (1.0 - 2.0 * x);
+  }
+};
+
 bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSession* session,
                   std::string* error) {
   auto fail = [&](const std::string& what) {
@@ -181,9 +221,25 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   const double dt = 1.0 / rate;
   const long first_still = SampleCount(options.initial_still_seconds + options.hold_seconds, rate);
   const long hold = SampleCount(options.hold_seconds, rate);
-  const long rotation = SampleCount(options.rotation_seconds, rate);
-  const size_t total =
-      static_cast<size_t>(first_still) + (pose_count - 1) * static_cast<size_t>(hold + rotation);
+  const bool hand = options.rotation_profile == "hand";
+  // The hand profiles and G draw from a stream of their own, so switching
+  // them on leaves every other number of a seed unchanged.
+  std::mt19937_64 extra_rng(seed ^ 0xc2b2ae3d27d4eb4fULL);
+  if (options.gyro_g_sensitivity_std > 0.0) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        s.gyro_g_sensitivity(r, c) = options.gyro_g_sensitivity_std * n01(extra_rng);
+      }
+    }
+  }
+  std::vector<HandProfile> profiles(pose_count > 0 ? pose_count - 1 : 0);
+  std::vector<long> rotation(profiles.size(), SampleCount(options.rotation_seconds, rate));
+  for (size_t k = 0; k < profiles.size() && hand; ++k) {
+    profiles[k] = HandProfile::Random(options, &extra_rng);
+    rotation[k] = std::max(1L, SampleCount(profiles[k].seconds, rate));
+  }
+  size_t total = static_cast<size_t>(first_still) + (pose_count - 1) * static_cast<size_t>(hold);
+  for (long r : rotation) total += static_cast<size_t>(r);
   if (static_cast<double>(total) > kMaxSamples) {
     return fail("the session is too long (" + std::to_string(total) + " samples)");
   }
@@ -212,7 +268,8 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   // Writes sample i from the true specific force and body rate.
   auto emit = [&](size_t i, const Eigen::Vector3d& force, const Eigen::Vector3d& body_rate) {
     Eigen::Vector3d v = accel_inverse * force + s.accel_truth.bias;
-    Eigen::Vector3d u = gyro_inverse * body_rate + s.gyro_truth.bias;
+    Eigen::Vector3d u =
+        gyro_inverse * (body_rate + s.gyro_g_sensitivity * force) + s.gyro_truth.bias;
     if (accel_noise > 0.0) v += accel_noise * normal3();
     if (gyro_noise > 0.0) u += gyro_noise * normal3();
     if (accel_walk > 0.0) {
@@ -264,13 +321,28 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
     Eigen::Quaterniond delta = attitudes[k].conjugate() * attitudes[k + 1];
     if (delta.w() < 0.0) delta.coeffs() *= -1.0;
     const Eigen::AngleAxisd step(delta);
-    const double duration = static_cast<double>(rotation) * dt;
-    for (long j = 0; j < rotation; ++j, ++i) {
-      const double x = static_cast<double>(j) / static_cast<double>(rotation);
+    const double duration = static_cast<double>(rotation[k]) * dt;
+    for (long j = 0; j < rotation[k]; ++j, ++i) {
+      const double x = static_cast<double>(j) / static_cast<double>(rotation[k]);
+      if (!hand) {
+        const Eigen::Quaterniond q =
+            attitudes[k] * AxisAngle(SmoothStep(x) * step.angle(), step.axis());
+        emit(i, q.conjugate() * gravity_nav,
+             step.axis() * (step.angle() * SmoothStepRate(x) / duration));
+        continue;
+      }
+      // Hand: q(x) = q0 exp(s(tau(x)) angle axis) exp(beta(x) v), whose
+      // body rate is R(exp(beta v))^T axis angle s'(tau) tau'(x) / T +
+      // v beta'(x) / T.
+      const HandProfile& p = profiles[k];
+      const double tau = p.Warp(x);
+      const Eigen::Quaterniond wobble = AxisAngle(p.Wobble(x), p.wobble_axis);
       const Eigen::Quaterniond q =
-          attitudes[k] * AxisAngle(SmoothStep(x) * step.angle(), step.axis());
+          attitudes[k] * AxisAngle(SmoothStep(tau) * step.angle(), step.axis()) * wobble;
+      const Eigen::Vector3d main_rate =
+          step.axis() * (step.angle() * SmoothStepRate(tau) * p.WarpRate(x) / duration);
       emit(i, q.conjugate() * gravity_nav,
-           step.axis() * (step.angle() * SmoothStepRate(x) / duration));
+           wobble.conjugate() * main_rate + p.wobble_axis * (p.WobbleRate(x) / duration));
     }
   }
 
@@ -348,14 +420,29 @@ bool SimulatorOptions::IsValid(std::string* error) const {
   if (!at_most("gyro_scale_std", gyro_scale_std, kMaxScaleStd)) return false;
   if (!at_most("gyro_misalignment_std", gyro_misalignment_std, kMaxMisalignmentStd)) return false;
   if (!non_negative("placement_error_deg", placement_error_deg)) return false;
+  if (rotation_profile != "smooth" && rotation_profile != "hand") {
+    if (error) {
+      *error = "SimulatorOptions.rotation_profile: '" + rotation_profile +
+               "' is not one of smooth, hand";
+    }
+    return false;
+  }
+  if (!one_sample("hand_min_seconds", hand_min_seconds)) return false;
+  if (!(hand_max_seconds >= hand_min_seconds) || !std::isfinite(hand_max_seconds)) {
+    return fail("hand_max_seconds", hand_max_seconds, "must be at least hand_min_seconds");
+  }
+  if (!non_negative("hand_wobble_deg", hand_wobble_deg)) return false;
+  if (!non_negative("gyro_g_sensitivity_std", gyro_g_sensitivity_std)) return false;
   if (!non_negative("tremor", tremor)) return false;
   if (!finite("temperature_start", temperature_start)) return false;
   if (!finite("temperature_end", temperature_end)) return false;
   if (!positive("temperature_tau", temperature_tau)) return false;
 
-  const double samples = (initial_still_seconds + hold_seconds +
-                          static_cast<double>(pose_count - 1) * (hold_seconds + rotation_seconds)) *
-                         sample_rate;
+  const double samples =
+      (initial_still_seconds + hold_seconds +
+       static_cast<double>(pose_count - 1) *
+           (hold_seconds + (rotation_profile == "hand" ? hand_max_seconds : rotation_seconds))) *
+      sample_rate;
   if (!(samples <= kMaxSamples)) {
     std::ostringstream msg;
     msg << "SimulatorOptions: the session would have " << samples << " samples (limit "
@@ -447,7 +534,8 @@ std::string TruthToJson(const SimulatedSession& session, const SimulatorOptions&
                   {"upper", ToJson(a.upper)},
                   {"rotation", ToJson(a.rotation)}};
     j["gyro"] = {{"bias", ToJson(session.gyro_truth.bias)},
-                 {"matrix", ToJson(session.gyro_truth.matrix)}};
+                 {"matrix", ToJson(session.gyro_truth.matrix)},
+                 {"g_sensitivity", ToJson(session.gyro_g_sensitivity)}};
     j["accel_units_per_si"] = session.accel_units_per_si;
     j["gyro_units_per_si"] = session.gyro_units_per_si;
     nlohmann::json poses = nlohmann::json::array();
@@ -485,6 +573,11 @@ std::string TruthToJson(const SimulatedSession& session, const SimulatorOptions&
                     {"gyro_misalignment_std", o.gyro_misalignment_std},
                     {"placement_error_deg", o.placement_error_deg},
                     {"tremor", o.tremor},
+                    {"rotation_profile", o.rotation_profile},
+                    {"hand_min_seconds", o.hand_min_seconds},
+                    {"hand_max_seconds", o.hand_max_seconds},
+                    {"hand_wobble_deg", o.hand_wobble_deg},
+                    {"gyro_g_sensitivity_std", o.gyro_g_sensitivity_std},
                     {"temperature_start", o.temperature_start},
                     {"temperature_end", o.temperature_end},
                     {"temperature_tau", o.temperature_tau}};

@@ -216,5 +216,41 @@ TEST_F(CliTest, HelpListsCommandsAndKeys) {
   EXPECT_NE(r.out.find("--latitude"), std::string::npos);
 }
 
+// Issue 5: the gyroscope from the rotations between poses, end to end.
+TEST_F(CliTest, CalibratesTheGyroscopeAndRejectsALogWithoutOne) {
+  const std::string config = testing_util::SourceDir() + "/configs/twelve_position_gyro.yaml";
+  ASSERT_EQ(
+      Run("simulate --config " + config + " --output-dir " + dir_ + "/sim --seed 4").exit_code, 0);
+  const std::string out = dir_ + "/calib.json";
+  const RunResult ok = Run("calibrate --config " + config + " --input " + dir_ +
+                           "/sim/raw.csv --output " + out + " --gravity 9.80665");
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  const nlohmann::json j = nlohmann::json::parse(Slurp(out));
+  ASSERT_TRUE(j.contains("gyro"));
+  EXPECT_EQ(j["gyro"]["rotation_residual_deg"].size(), 11u);
+  EXPECT_EQ(j["gyro"]["matrix"].size(), 3u);
+
+  // The same log without its gyroscope columns: one line, exit 1, no file.
+  std::ifstream raw(dir_ + "/sim/raw.csv");
+  std::ostringstream accel_only;
+  std::string line;
+  while (std::getline(raw, line)) {
+    std::istringstream fields(line);
+    std::string field;
+    for (int i = 0; i < 4 && std::getline(fields, field, ','); ++i) {
+      accel_only << (i ? "," : "") << field;
+    }
+    accel_only << "\n";
+  }
+  const std::string input = Write("nogyro.csv", accel_only.str());
+  const std::string missing = dir_ + "/missing.json";
+  const RunResult bad = Run("calibrate --config " + config + " --input " + input + " --output " +
+                            missing + " --gravity 9.80665");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("nogyro.csv: the log has no gyroscope columns"), std::string::npos)
+      << bad.err;
+  EXPECT_FALSE(Exists(missing));
+}
+
 }  // namespace
 }  // namespace gravcal

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gravcal/calibration.h"
+#include "gravcal/gyro_calibration.h"
 #include "gravcal/log_reader.h"
 #include "gravcal/simulator.h"
 
@@ -25,6 +26,8 @@ struct Config {
   LogReaderOptions input;
   CalibrationOptions calibration;
   SimulatorOptions simulation;
+  // Gyroscope from the rotations between the poses (gyro_model != none).
+  GyroCalibrationOptions gyro;
   // Write accel.covariance into the calibration JSON.
   bool output_covariance = true;
 

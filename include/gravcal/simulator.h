@@ -6,8 +6,9 @@
 // frame is f = C_bn^T (0, 0, g) (the unit reads +g on the axis that points up)
 // plus, while static, hand tremor if set; the raw accelerometer is
 //   v = M^-1 f + b + n_a,     n_a white, plus a bias random walk,
-// and the raw gyroscope u = M_g^-1 w + b_g + n_g, with w the true body rate
-// (exactly consistent with the attitude trajectory). Raw outputs are either
+// and the raw gyroscope u = M_g^-1 (w + G f) + b_g + n_g, with w the true
+// body rate (exactly consistent with the attitude trajectory) and G the
+// g-sensitivity (zero by default). Raw outputs are either
 // in counts (quantised) or in SI units. A temperature column follows a
 // warm-up curve.
 #ifndef GRAVCAL_SIMULATOR_H_
@@ -68,6 +69,20 @@ struct SimulatorOptions {
   // table.
   double tremor = 0.0;
 
+  // Rotations between poses: "smooth" (minimum-jerk about one fixed axis,
+  // rotation_seconds each) or "hand" (hand-like: each lasts a random
+  // hand_min_seconds..hand_max_seconds, its rate speeds up and slows down
+  // irregularly, and the axis wobbles by about hand_wobble_deg on the way;
+  // still at both ends).
+  std::string rotation_profile = "smooth";
+  double hand_min_seconds = 1.0;
+  double hand_max_seconds = 4.0;
+  double hand_wobble_deg = 10.0;
+  // Gyroscope g-sensitivity: each element of the truth G drawn N(0, std),
+  // rad/s per m/s^2; the raw gyroscope is u = M_g^-1 (w + G f) + b_g + n_g.
+  // 0 = off.
+  double gyro_g_sensitivity_std = 0.0;
+
   // Temperature: starts at temperature_start and relaxes towards
   // temperature_end with time constant temperature_tau seconds.
   double temperature_start = 25.0;
@@ -92,6 +107,9 @@ struct SimulatedSession {
   ImuLog log;
   AccelModel accel_truth;
   GyroModel gyro_truth;
+  // Truth g-sensitivity G, rad/s per m/s^2 (zero unless
+  // gyro_g_sensitivity_std > 0).
+  Eigen::Matrix3d gyro_g_sensitivity = Eigen::Matrix3d::Zero();
   std::vector<SimulatedPose> poses;
   double gravity = 9.80665;
   // Raw units per m/s^2 (accelerometer) and per rad/s (gyroscope).

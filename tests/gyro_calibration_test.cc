@@ -1,0 +1,398 @@
+// Gyroscope calibration from the rotations between static poses
+// (gyro_calibration.h): the integrator, sigmas against the spread over many
+// simulated seeds, the residual per rotation, the g-sensitivity, the joint
+// fit, a missing rotation axis, bad input, and the pipeline.
+#include "gravcal/gyro_calibration.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "gravcal/calibration.h"
+#include "gravcal/calibration_io.h"
+#include "gravcal/config.h"
+#include "gravcal/gyro_rotation_residual.h"
+#include "gravcal/pipeline.h"
+#include "gravcal/simulator.h"
+#include "gravcal/static_detector.h"
+
+namespace gravcal {
+namespace {
+
+// The simulated IMU of these tests: the twelve poses, hand-like rotations.
+SimulatorOptions HandSession() {
+  SimulatorOptions sim;
+  sim.rotation_profile = "hand";
+  sim.hold_seconds = 6.0;
+  sim.initial_still_seconds = 4.0;
+  return sim;
+}
+
+struct GyroRun {
+  SimulatedSession session;
+  Calibration accel;
+  GyroCalibrationResult gyro;
+  bool ok = false;
+};
+
+GyroRun CalibrateSimulated(const SimulatorOptions& sim, uint64_t seed,
+                           const GyroCalibrationOptions& options) {
+  GyroRun run;
+  std::string error;
+  EXPECT_TRUE(Simulate(sim, seed, &run.session, &error)) << error;
+  CalibrationOptions accel_options;
+  accel_options.gravity.gravity = run.session.gravity;
+  EXPECT_TRUE(CalibrateAccelerometer(run.session.log, accel_options, &run.accel))
+      << run.accel.message;
+  StaticDetection detection;
+  EXPECT_TRUE(DetectStaticIntervals(run.session.log, accel_options.detector, &detection));
+  EXPECT_EQ(detection.intervals.size(), run.session.poses.size()) << "seed " << seed;
+  run.ok =
+      CalibrateGyroscope(run.session.log, detection.intervals, run.accel.accel.model,
+                         run.accel.refinement.covariance, run.accel.gravity, options, &run.gyro);
+  EXPECT_TRUE(run.ok) << "seed " << seed << ": " << run.gyro.message;
+  return run;
+}
+
+// The truth in the frame the calibration works in. The calibrated
+// accelerometer a = U (v - b) (scale_misalignment, R = I) sees R_a^T f,
+// R_a the truth accelerometer's housing rotation, so the calibrated
+// gyroscope must give R_a^T w: M = R_a^T M_g, G = R_a^T G_true R_a.
+Eigen::Matrix3d MatrixInAccelFrame(const SimulatedSession& s) {
+  return s.accel_truth.rotation.transpose() * s.gyro_truth.matrix;
+}
+Eigen::Matrix3d GInAccelFrame(const SimulatedSession& s) {
+  return s.accel_truth.rotation.transpose() * s.gyro_g_sensitivity * s.accel_truth.rotation;
+}
+
+// Accumulates (error / sigma)^2 and reports the RMS.
+struct RatioRms {
+  Eigen::MatrixXd sum;
+  int count = 0;
+  void Add(const Eigen::MatrixXd& error, const Eigen::MatrixXd& sigma) {
+    if (sum.size() == 0) sum = Eigen::MatrixXd::Zero(error.rows(), error.cols());
+    sum += error.cwiseQuotient(sigma).cwiseAbs2();
+    ++count;
+  }
+  Eigen::MatrixXd Rms() const { return (sum / count).cwiseSqrt(); }
+};
+
+// The band of the issue: reported sigmas match the spread over the seeds.
+void ExpectInBand(const Eigen::MatrixXd& rms, const std::string& what) {
+  for (int r = 0; r < rms.rows(); ++r) {
+    for (int c = 0; c < rms.cols(); ++c) {
+      EXPECT_GT(rms(r, c), 0.7) << what << "(" << r << ", " << c << ")\n" << rms;
+      EXPECT_LT(rms(r, c), 1.4) << what << "(" << r << ", " << c << ")\n" << rms;
+    }
+  }
+}
+
+// Largest attitude error of the integrated truth rate over the rotations of
+// a noise-free hand-profile session.
+double WorstIntegrationError(double sample_rate) {
+  SimulatorOptions sim = HandSession();
+  sim.raw_counts = false;
+  sim.accel_noise = 0.0;
+  sim.gyro_noise = 0.0;
+  sim.hand_wobble_deg = 30.0;
+  sim.sample_rate = sample_rate;
+  SimulatedSession s;
+  std::string error;
+  EXPECT_TRUE(Simulate(sim, 3, &s, &error)) << error;
+  double bias[3], matrix[9];
+  for (int i = 0; i < 3; ++i) bias[i] = s.gyro_truth.bias(i);
+  for (int i = 0; i < 9; ++i) matrix[i] = s.gyro_truth.matrix(i / 3, i % 3);
+  double worst = 0.0;
+  for (size_t k = 0; k + 1 < s.poses.size(); ++k) {
+    GyroRotationData d;
+    for (size_t i = s.poses[k].end - 1; i <= s.poses[k + 1].begin; ++i) {
+      d.t.push_back(s.log.t[i]);
+      d.gyro.push_back(s.log.gyro[i]);
+    }
+    double dq[4];
+    IntegrateGyroRotation<double>(d, bias, matrix, nullptr, dq);
+    const Eigen::Quaterniond estimate(dq[0], dq[1], dq[2], dq[3]);
+    const Eigen::Quaterniond truth = s.poses[k].attitude.conjugate() * s.poses[k + 1].attitude;
+    worst = std::max(worst, Eigen::AngleAxisd(estimate.conjugate() * truth).angle());
+  }
+  return worst;
+}
+
+TEST(GyroCalibration, IntegratorIsHigherOrderOnHandRotations) {
+  // Rotations of up to 180 degrees in 1-4 s with a 30-degree axis wobble.
+  const double e100 = WorstIntegrationError(100.0);
+  const double e200 = WorstIntegrationError(200.0);
+  // A trapezoid rule is second order (ratio 4) once the axis moves; the
+  // cubic Magnus step is third order here (its first and last steps are
+  // trapezoids where the unit comes to rest).
+  EXPECT_GT(e100 / e200, 6.0) << e100 << " " << e200;
+  // Far below the noise of an integrated MEMS gyroscope (about 5e-4 rad).
+  EXPECT_LT(e100, 2e-5);
+}
+
+TEST(GyroCalibration, FullModelSigmaMatchesSpreadAndResidualsAtNoiseLevel) {
+  const SimulatorOptions sim = HandSession();
+  GyroCalibrationOptions options;
+  options.parameterization = GyroParameterization::kFull;
+  RatioRms matrix, bias;
+  double chi2 = 0.0, dof = 0.0, residual2 = 0.0, sigma2 = 0.0;
+  for (int seed = 1; seed <= 40; ++seed) {
+    const GyroRun run = CalibrateSimulated(sim, seed, options);
+    if (!run.ok) continue;
+    EXPECT_TRUE(run.gyro.undetermined.empty()) << "seed " << seed;
+    EXPECT_EQ(run.gyro.rotations.size(), run.session.poses.size() - 1);
+    matrix.Add(run.gyro.model.matrix - MatrixInAccelFrame(run.session), run.gyro.matrix_std);
+    bias.Add(run.gyro.model.bias - run.session.gyro_truth.bias, run.gyro.bias_std);
+    chi2 += run.gyro.chi2;
+    dof += run.gyro.dof;
+    for (const GyroRotationReport& r : run.gyro.rotations) {
+      residual2 += r.residual_deg * r.residual_deg;
+      sigma2 += r.sigma_deg * r.sigma_deg;
+    }
+  }
+  ExpectInBand(matrix.Rms(), "M_g error / sigma RMS");
+  ExpectInBand(bias.Rms(), "b_g error / sigma RMS");
+  // The residuals are what the noise explains: chi2 / dof near 1 (about 1800
+  // dof, so +-0.1 is more than 3 standard deviations).
+  EXPECT_NEAR(chi2 / dof, 1.0, 0.1);
+  // The residual angle per rotation against its predicted size: the fit
+  // absorbs 9 of the 22 rotation residuals, so the expected ratio is about
+  // sqrt(13 / 22) = 0.77.
+  const double ratio = std::sqrt(residual2 / sigma2);
+  EXPECT_GT(ratio, 0.6);
+  EXPECT_LT(ratio, 1.0);
+}
+
+TEST(GyroCalibration, GSensitivitySigmaMatchesSpread) {
+  SimulatorOptions sim = HandSession();
+  sim.gyro_g_sensitivity_std = 2e-4;  // about 0.1 deg/s per g
+  // 60 seeds: 18 ratios are tested, and over 100 seeds g_xy sits at 1.23
+  // (30 seeds put it at 1.43 by chance; see notes/issue5.md).
+  GyroCalibrationOptions options;
+  options.parameterization = GyroParameterization::kFull;
+  options.g_sensitivity = true;
+  RatioRms matrix, g;
+  for (int seed = 1; seed <= 60; ++seed) {
+    const GyroRun run = CalibrateSimulated(sim, seed, options);
+    if (!run.ok) continue;
+    matrix.Add(run.gyro.model.matrix - MatrixInAccelFrame(run.session), run.gyro.matrix_std);
+    g.Add(run.gyro.g_sensitivity - GInAccelFrame(run.session), run.gyro.g_sensitivity_std);
+  }
+  ExpectInBand(matrix.Rms(), "M_g error / sigma RMS");
+  ExpectInBand(g.Rms(), "G error / sigma RMS");
+}
+
+TEST(GyroCalibration, UnmodelledGSensitivityIsFlagged) {
+  SimulatorOptions sim = HandSession();
+  sim.gyro_g_sensitivity_std = 2e-3;
+  GyroCalibrationOptions options;
+  options.parameterization = GyroParameterization::kFull;
+  const GyroRun run = CalibrateSimulated(sim, 1, options);
+  ASSERT_TRUE(run.ok);
+  bool flagged = false;
+  for (const std::string& w : run.gyro.warnings) {
+    flagged = flagged || w.find("gyro_g_sensitivity") != std::string::npos;
+  }
+  EXPECT_TRUE(flagged) << "chi2 " << run.gyro.chi2 << " dof " << run.gyro.dof;
+}
+
+TEST(GyroCalibration, JointFitSigmaMatchesSpread) {
+  const SimulatorOptions sim = HandSession();
+  GyroCalibrationOptions options;
+  options.parameterization = GyroParameterization::kFull;
+  options.joint = true;
+  RatioRms matrix, accel_bias;
+  for (int seed = 1; seed <= 30; ++seed) {
+    const GyroRun run = CalibrateSimulated(sim, seed, options);
+    if (!run.ok) continue;
+    ASSERT_TRUE(run.gyro.accel_refined);
+    ASSERT_TRUE(run.gyro.accel.covariance_available);
+    matrix.Add(run.gyro.model.matrix - MatrixInAccelFrame(run.session), run.gyro.matrix_std);
+    accel_bias.Add(run.gyro.accel.model.bias - run.session.accel_truth.bias,
+                   run.gyro.accel.covariance.diagonal().head<3>().cwiseSqrt());
+  }
+  ExpectInBand(matrix.Rms(), "M_g error / sigma RMS (joint)");
+  ExpectInBand(accel_bias.Rms(), "accelerometer bias error / sigma RMS (joint)");
+}
+
+TEST(GyroCalibration, ScaleAndBiasModels) {
+  const SimulatorOptions sim = HandSession();
+  for (GyroParameterization p : {GyroParameterization::kScale, GyroParameterization::kBias}) {
+    GyroCalibrationOptions options;
+    options.parameterization = p;
+    const GyroRun run = CalibrateSimulated(sim, 5, options);
+    ASSERT_TRUE(run.ok) << run.gyro.message;
+    const Eigen::Matrix3d& m = run.gyro.model.matrix;
+    EXPECT_EQ(m(0, 1), 0.0);
+    EXPECT_TRUE(std::isnan(run.gyro.matrix_std(0, 1)));
+    const Eigen::Matrix3d truth = MatrixInAccelFrame(run.session);
+    // The truth has misalignment (0.005 rad, plus the accelerometer frame's
+    // 0.01 rad) and a 2 % scale spread: a restricted model is off by about
+    // that, not more.
+    const double tolerance = p == GyroParameterization::kScale ? 0.01 : 0.05;
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(m(i, i) / truth(i, i), 1.0, tolerance) << ToString(p);
+    if (p == GyroParameterization::kBias) {
+      EXPECT_EQ(m(0, 0), m(1, 1));
+      EXPECT_EQ(run.gyro.parameter_names.back(), "scale");
+    }
+  }
+}
+
+// A session whose rotations all turn about the body x or y axis: the
+// gyroscope's z column is never excited. SI units, identity accelerometer.
+ImuLog SessionWithoutZRotation(const GyroModel& gyro, uint64_t seed) {
+  const double rate = 100.0, hold = 5.0, turn = 2.0, g = 9.80665;
+  const double noise_a = 0.02, noise_g = 0.002;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  auto noise = [&](double s) -> Eigen::Vector3d {
+    return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)) * s;
+  };
+  ImuLog log;
+  log.source = "no_z_rotation";
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  const Eigen::Matrix3d minv = gyro.matrix.inverse();
+  auto emit = [&](const Eigen::Quaterniond& attitude, const Eigen::Vector3d& w) {
+    log.t.push_back(static_cast<double>(log.t.size()) / rate);
+    log.accel.push_back(attitude.conjugate() * Eigen::Vector3d(0, 0, g) + noise(noise_a));
+    log.gyro.push_back(minv * w + gyro.bias + noise(noise_g));
+  };
+  constexpr int kTurns = 11;
+  for (int k = 0; k <= kTurns; ++k) {
+    for (int i = 0; i < hold * rate; ++i) emit(q, Eigen::Vector3d::Zero());
+    if (k == kTurns) break;
+    // About body x and y in turn, unless that axis is near vertical (a turn
+    // about the vertical would not move gravity), by 50..120 degrees.
+    const Eigen::Vector3d up = q.conjugate() * Eigen::Vector3d::UnitZ();
+    const int a = std::fabs(up(k % 2)) > 0.8 ? 1 - k % 2 : k % 2;
+    const Eigen::Vector3d axis = Eigen::Vector3d::Unit(a);
+    const double angle = (k % 2 == 0 ? 1.0 : -1.0) * (50.0 + 7.0 * k) * M_PI / 180.0;
+    const int n = static_cast<int>(turn * rate);
+    for (int i = 0; i < n; ++i) {
+      const double x = static_cast<double>(i) / n;
+      const double s = x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
+      const double ds = 30.0 * x * x * (1.0 - x) * (1.0 - x);
+      emit(q * Eigen::Quaterniond(Eigen::AngleAxisd(s * angle, axis)), axis * angle * ds / turn);
+    }
+    q = q * Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis));
+  }
+  return log;
+}
+
+TEST(GyroCalibration, MissingRotationAxisIsNamed) {
+  GyroModel truth;
+  truth.matrix << 1.01, 0.004, -0.003, 0.002, 0.98, 0.005, -0.004, 0.003, 1.02;
+  truth.bias << 0.01, -0.02, 0.015;
+  const ImuLog log = SessionWithoutZRotation(truth, 7);
+  StaticDetection detection;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &detection));
+  ASSERT_EQ(detection.intervals.size(), 12u);
+
+  GyroCalibrationOptions options;
+  options.parameterization = GyroParameterization::kFull;
+  GyroCalibrationResult result;
+  ASSERT_TRUE(CalibrateGyroscope(log, detection.intervals, AccelModel(), Eigen::MatrixXd(), 9.80665,
+                                 options, &result))
+      << result.message;
+  bool named = false;
+  for (const std::string& w : result.warnings) {
+    named = named || (w.find("no rotation about the body z axis") != std::string::npos &&
+                      w.find("gyro scale z") != std::string::npos);
+  }
+  EXPECT_TRUE(named);
+  for (int r = 0; r < 3; ++r) {
+    EXPECT_TRUE(std::isnan(result.matrix_std(r, 2))) << r;
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_TRUE(std::isfinite(result.matrix_std(r, c))) << r << c;
+      EXPECT_NEAR(result.model.matrix(r, c), truth.matrix(r, c), 5.0 * result.matrix_std(r, c));
+    }
+  }
+}
+
+TEST(GyroCalibration, BadInputGivesAMessage) {
+  SimulatedSession s;
+  std::string error;
+  ASSERT_TRUE(Simulate(HandSession(), 1, &s, &error)) << error;
+  StaticDetection detection;
+  ASSERT_TRUE(DetectStaticIntervals(s.log, StaticDetectorOptions(), &detection));
+  GyroCalibrationOptions options;
+  GyroCalibrationResult result;
+  // Nothing asked for.
+  EXPECT_FALSE(CalibrateGyroscope(s.log, detection.intervals, AccelModel(), Eigen::MatrixXd(), 9.8,
+                                  options, &result));
+  EXPECT_NE(result.message.find("none"), std::string::npos) << result.message;
+  options.parameterization = GyroParameterization::kFull;
+  // No gyroscope columns.
+  ImuLog no_gyro = s.log;
+  no_gyro.gyro.clear();
+  EXPECT_FALSE(CalibrateGyroscope(no_gyro, detection.intervals, AccelModel(), Eigen::MatrixXd(),
+                                  9.8, options, &result));
+  EXPECT_NE(result.message.find("no gyroscope columns"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find(s.log.source), std::string::npos) << result.message;
+  // Too few poses for the full model (three poses, two rotations).
+  const std::vector<StaticInterval> three(detection.intervals.begin(),
+                                          detection.intervals.begin() + 3);
+  EXPECT_FALSE(
+      CalibrateGyroscope(s.log, three, AccelModel(), Eigen::MatrixXd(), 9.8, options, &result));
+  EXPECT_NE(result.message.find("found 2 rotations"), std::string::npos) << result.message;
+  // Intervals out of order.
+  std::vector<StaticInterval> swapped = detection.intervals;
+  std::swap(swapped[1], swapped[2]);
+  EXPECT_FALSE(
+      CalibrateGyroscope(s.log, swapped, AccelModel(), Eigen::MatrixXd(), 9.8, options, &result));
+  EXPECT_NE(result.message.find("static interval 2"), std::string::npos) << result.message;
+  // Invalid options.
+  options.loss_scale = -1.0;
+  EXPECT_FALSE(CalibrateGyroscope(s.log, detection.intervals, AccelModel(), Eigen::MatrixXd(), 9.8,
+                                  options, &result));
+  EXPECT_NE(result.message.find("gyro_loss_scale"), std::string::npos) << result.message;
+}
+
+TEST(GyroCalibration, PipelineFillsTheGyroscopeOfTheCalibration) {
+  Config config;
+  config.simulation = HandSession();
+  std::string error;
+  ASSERT_TRUE(SetConfigValue("gyro_model", "full", &config, &error)) << error;
+  ASSERT_TRUE(SetConfigValue("gyro_g_sensitivity", "true", &config, &error)) << error;
+  EXPECT_FALSE(SetConfigValue("gyro_model", "diagonal", &config, &error));
+  EXPECT_NE(error.find("gyro_model"), std::string::npos) << error;
+  SimulatedSession s;
+  ASSERT_TRUE(Simulate(config.simulation, 2, &s, &error)) << error;
+  config.calibration.gravity.gravity = s.gravity;
+  PipelineInput input;
+  input.log = s.log;
+  Calibration c;
+  ASSERT_TRUE(RunCalibration(config, input, &c)) << c.message;
+  ASSERT_TRUE(c.gyro.estimated);
+  EXPECT_EQ(c.gyro.rotation_residual_deg.size(), 11u);
+  EXPECT_EQ(c.gyro.extra_names.size(), 9u);
+  EXPECT_EQ(c.gyro.covariance_names.size(), 21u);
+  EXPECT_LT((c.gyro.model.matrix - MatrixInAccelFrame(s)).norm(),
+            1e-3 * s.gyro_truth.matrix.norm());
+  const std::string json = CalibrationToJson(c, true);
+  EXPECT_NE(json.find("\"rotation_residual_deg\""), std::string::npos);
+  EXPECT_NE(json.find("\"g_sensitivity_xy\""), std::string::npos);
+
+  // The same log without gyroscope: a clear error, no calibration.
+  input.log.gyro.clear();
+  input.log.source = "nogyro.csv";
+  EXPECT_FALSE(RunCalibration(config, input, &c));
+  EXPECT_FALSE(c.success);
+  EXPECT_NE(c.message.find("nogyro.csv: the log has no gyroscope columns"), std::string::npos)
+      << c.message;
+}
+
+// Cross-checks against the rate-table baseline and the handheld Kalman
+// calibration (issue 5: "results agree ... within their uncertainties").
+// Those calibrations are being written on other branches; once merged, run
+// them on the same simulated IMU as here (HandSession(), seeds 1..30) and
+// check |M_this - M_other| against sqrt(sigma_this^2 + sigma_other^2) per
+// entry (the Kalman filter estimates diagonal scale only: compare those).
+TEST(GyroCalibration, DISABLED_AgreesWithRateTableAndHandheldKalman) {
+  GTEST_SKIP() << "enable when the rate-table and Kalman calibrations are on main";
+}
+
+}  // namespace
+}  // namespace gravcal
