@@ -19,6 +19,7 @@
 #include "gravcal/position.h"
 #include "gravcal/refinement.h"
 #include "gravcal/simulator.h"
+#include "gravcal/static_alignment.h"
 #include "gravcal/static_detector.h"
 
 #endif  // GRAVCAL_GRAVCAL_H_
