@@ -1,5 +1,8 @@
 #include "gravcal/pipeline.h"
 
+#include "gravcal/known_attitude.h"
+#include "gravcal/ten_position.h"
+
 namespace gravcal {
 
 bool RunCalibration(const Config& config, const PipelineInput& input, Calibration* calibration) {
@@ -14,6 +17,12 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
     const bool ok = CalibrateAccelerometer(input.log, config.calibration, calibration);
     calibration->method = config.method;
     return ok;
+  }
+  if (config.method == "ten_position") {
+    return CalibrateTenPosition(input.log, config.calibration, config.ten_position, calibration);
+  }
+  if (config.method == "known_attitude") {
+    return CalibrateKnownAttitude(input.log, input.attitudes_path, config.calibration, calibration);
   }
   calibration->message = "key 'method': unknown method '" + config.method + "'";
   return false;

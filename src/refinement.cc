@@ -13,6 +13,7 @@
 #include "gravcal/gravity_magnitude_residual.h"
 #include "magnitude_fit.h"
 #include "normalization.h"
+#include "robust_loss.h"
 #include "statistics.h"
 
 namespace gravcal {
@@ -116,28 +117,6 @@ std::vector<double> MagnitudeResiduals(const std::vector<Position>& positions,
   }
   return r;
 }
-
-namespace {
-
-ceres::LossFunction* MakeLoss(LossType type, double scale) {
-  switch (type) {
-    case LossType::kNone:
-      return nullptr;
-    case LossType::kHuber:
-      return new ceres::HuberLoss(scale);
-    case LossType::kCauchy:
-      return new ceres::CauchyLoss(scale);
-    case LossType::kSoftL1:
-      return new ceres::SoftLOneLoss(scale);
-    case LossType::kArctan:
-      return new ceres::ArctanLoss(scale);
-    case LossType::kTukey:
-      return new ceres::TukeyLoss(scale);
-  }
-  return nullptr;
-}
-
-}  // namespace
 
 bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
             const RefinementOptions& options, RefinementResult* result) {

@@ -3,6 +3,7 @@
 #define GRAVCAL_GRAVCAL_H_
 
 #include "gravcal/accel_model.h"
+#include "gravcal/attitude_fixture.h"
 #include "gravcal/calibration.h"
 #include "gravcal/calibration_io.h"
 #include "gravcal/coarse_fit.h"
@@ -12,6 +13,7 @@
 #include "gravcal/gyro_model.h"
 #include "gravcal/housing_rotation.h"
 #include "gravcal/imu_log.h"
+#include "gravcal/known_attitude.h"
 #include "gravcal/log_reader.h"
 #include "gravcal/newton_solver.h"
 #include "gravcal/observability.h"
@@ -21,5 +23,6 @@
 #include "gravcal/simulator.h"
 #include "gravcal/static_alignment.h"
 #include "gravcal/static_detector.h"
+#include "gravcal/ten_position.h"
 
 #endif  // GRAVCAL_GRAVCAL_H_

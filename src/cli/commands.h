@@ -17,6 +17,8 @@ struct CommandArgs {
   std::string output_dir;
   std::string calibration;
   std::string config_path;
+  // known_attitude: the attitudes CSV.
+  std::string attitudes;
   uint64_t seed = 1;
 };
 

@@ -21,6 +21,7 @@ DEFINE_string(output_dir, "", "folder to write simulated raw.csv and truth.json 
 DEFINE_string(config, "", "YAML config file (configs/*.yaml)");
 DEFINE_string(calibration, "", "calibration JSON to apply");
 DEFINE_uint64(seed, 1, "random seed of the simulator");
+DEFINE_string(attitudes, "", "known_attitude: CSV of each static position's roll and pitch");
 
 namespace {
 
@@ -37,11 +38,13 @@ const std::vector<CommandInfo>& Commands() {
        {"config", "seed"}},
       {"calibrate",
        "calibrate the accelerometer from a multi-position log",
-       {"input", "config", "output"}},
+       {"input", "config", "output", "attitudes"}},
       {"apply",
        "apply a calibration to a raw log, writing SI units",
        {"calibration", "input", "output"}},
-      {"simulate", "simulate a session: raw.csv and truth.json", {"config", "seed", "output_dir"}},
+      {"simulate",
+       "simulate a session: raw.csv, truth.json and the fixture's attitudes.csv",
+       {"config", "seed", "output_dir"}},
       {"help", "list commands, or the flags and config keys of one: gravcal help <command>", {}},
   };
   return commands;
@@ -171,6 +174,7 @@ int main(int argc, char** argv) {
   args.output_dir = FLAGS_output_dir;
   args.calibration = FLAGS_calibration;
   args.seed = FLAGS_seed;
+  args.attitudes = FLAGS_attitudes;
 
   if (command == "demo") return gravcal::cli::RunDemo(args);
   if (command == "calibrate") return gravcal::cli::RunCalibrate(args);
