@@ -53,6 +53,37 @@ Eigen::Vector3d Mean(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t
   return m / static_cast<double>(end - begin);
 }
 
+using Matrix12 = Eigen::Matrix<double, 12, 12>;
+using Vector12 = Eigen::Matrix<double, 12, 1>;
+using Measurement3 = Eigen::Matrix<double, 3, 12>;
+
+// Kalman update with z = H dx + noise(R): P -= P H^T S^-1 H P (kept
+// symmetric); returns the state correction K z.
+Vector12 KalmanUpdate(const Measurement3& h, const Eigen::Vector3d& z, const Eigen::Matrix3d& r,
+                      Matrix12* p) {
+  const Eigen::Matrix<double, 12, 3> ph = p->selfadjointView<Eigen::Upper>() * h.transpose();
+  const Eigen::Matrix3d s = h * ph + r;
+  const Eigen::Matrix<double, 12, 3> k = ph * s.inverse();
+  p->triangularView<Eigen::Upper>() -= k * ph.transpose();
+  return k * z;
+}
+
+// P <- F P F^T for F = I + E, where E (dt times the static-base model) is
+// non-zero only in rows 3-5 (velocity), columns 0-2 (attitude) and 6-8
+// (accelerometer bias): P + E P + (E P)^T + E P E^T, on the upper triangle.
+void Propagate(const Eigen::Matrix3d& e_phi, const Eigen::Matrix3d& e_bias, Matrix12* p) {
+  const Matrix12 full = p->selfadjointView<Eigen::Upper>();
+  const Eigen::Matrix<double, 3, 12> ep =
+      e_phi * full.middleRows<3>(0) + e_bias * full.middleRows<3>(6);
+  const Eigen::Matrix3d epe =
+      ep.middleCols<3>(0) * e_phi.transpose() + ep.middleCols<3>(6) * e_bias.transpose();
+  Matrix12 next = full;
+  next.middleRows<3>(3) += ep;
+  next.middleCols<3>(3) += ep.transpose();
+  next.block<3, 3>(3, 3) += epe;
+  p->triangularView<Eigen::Upper>() = next;
+}
+
 Eigen::Vector3d Log(const Eigen::Matrix3d& r) {
   const Eigen::AngleAxisd aa(r);
   return aa.angle() * aa.axis();
@@ -229,9 +260,9 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
   // learns from the velocity the accelerometer integrates (zero-velocity
   // update, every sample) and, with a gyroscope, from its rate (zero angular
   // rate update: u - b_g = C^T w_ie, every sample).
-  // Error state: phi 0-2, dv 3-5, db_a 6-8, db_g 9-11.
-  const int ns = gyro ? 12 : 9;
-  Eigen::MatrixXd p = Eigen::MatrixXd::Zero(ns, ns);
+  // Error state: phi 0-2, dv 3-5, db_a 6-8, db_g 9-11 (without a gyroscope
+  // the last block stays at zero covariance and nothing couples to it).
+  Matrix12 p = Matrix12::Zero();
   const double bias_var = options.accel_bias_std * options.accel_bias_std +
                           options.accel_matrix_std * options.accel_matrix_std * g * g;
   const Eigen::Matrix3d p_ba = bias_var * Eigen::Matrix3d::Identity();
@@ -265,51 +296,39 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
   Eigen::Vector3d ba = Eigen::Vector3d::Zero();
   const Eigen::Vector3d gravity_n(0.0, 0.0, g);
   const double qv = r.accel_noise * r.accel_noise * dt * dt;
-  // Measurements: zero velocity (rows 0-2) and zero angular rate (3-5).
-  const int nm = gyro ? 6 : 3;
-  Eigen::MatrixXd rm = Eigen::MatrixXd::Zero(nm, nm);
-  rm.topLeftCorner<3, 3>().diagonal().setConstant(options.zero_velocity_std *
-                                                  options.zero_velocity_std);
-  if (gyro) rm.bottomRightCorner<3, 3>().diagonal().setConstant(gyro_noise_var);
-  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(nm, ns);
-  h.block<3, 3>(0, 3).setIdentity();
+  const Eigen::Matrix3d r_velocity =
+      options.zero_velocity_std * options.zero_velocity_std * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d r_rate = gyro_noise_var * Eigen::Matrix3d::Identity();
   // dv' = [f^n x] phi + C db_a with the static base's f^n = (0, 0, g).
-  Eigen::MatrixXd f = Eigen::MatrixXd::Identity(ns, ns);
-  f.block<3, 3>(3, 0) = Skew(gravity_n) * dt;
-  Eigen::VectorXd z(nm);
-  Eigen::MatrixXd kgain(ns, nm);
-  Eigen::MatrixXd ikh(ns, ns);
-  for (size_t i = n0; i < n; ++i) {
-    v += (c_est * (specific_force[i] - ba) - gravity_n) * dt;
-    f.block<3, 3>(3, 6) = c_est * dt;
-    p = f * p * f.transpose();
-    p.block<3, 3>(3, 3).diagonal().array() += qv;
-
-    z.head<3>() = v;
-    if (gyro) {
-      // u - b_g - C_est^T w = db_g + C_est^T [w x] phi + noise, from
-      // C_true^T = C_est^T (I - [phi x]).
-      const Eigen::Vector3d earth_body = c_est.transpose() * earth;
-      z.tail<3>() = rate[i] - bg - earth_body;
-      h.block<3, 3>(3, 0) = c_est.transpose() * Skew(earth);
-      h.block<3, 3>(3, 9).setIdentity();
-    }
-    const Eigen::MatrixXd s = h * p * h.transpose() + rm;
-    kgain = p * h.transpose() * s.inverse();
-    ikh.setIdentity();
-    ikh -= kgain * h;
-    p = ikh * p * ikh.transpose() + kgain * rm * kgain.transpose();
-    const Eigen::VectorXd dx = kgain * z;
-    // Closed loop: apply the correction and reset the error state.
+  const Eigen::Matrix3d e_phi = Skew(gravity_n) * dt;
+  // Closed loop: apply a correction and reset the error state.
+  auto correct = [&](const Vector12& dx) {
     Eigen::Vector3d dphi = dx.head<3>();
     if (!r.heading_observed) dphi(2) = 0.0;
     c_est = Exp(dphi) * c_est;
     v -= dx.segment<3>(3);
     ba += dx.segment<3>(6);
-    if (gyro) bg += dx.segment<3>(9);
+    bg += dx.segment<3>(9);
+  };
+  Measurement3 h_velocity = Measurement3::Zero();
+  h_velocity.block<3, 3>(0, 3).setIdentity();
+  Measurement3 h_rate = Measurement3::Zero();
+  h_rate.block<3, 3>(0, 9).setIdentity();
+  for (size_t i = n0; i < n; ++i) {
+    v += (c_est * (specific_force[i] - ba) - gravity_n) * dt;
+    Propagate(e_phi, c_est * dt, &p);
+    p.block<3, 3>(3, 3).diagonal().array() += qv;
+    // The two measurements have independent noise: one after the other.
+    correct(KalmanUpdate(h_velocity, v, r_velocity, &p));
+    if (gyro) {
+      // u - b_g - C_est^T w = db_g + C_est^T [w x] phi + noise, from
+      // C_true^T = C_est^T (I - [phi x]).
+      h_rate.block<3, 3>(0, 0) = c_est.transpose() * Skew(earth);
+      correct(KalmanUpdate(h_rate, rate[i] - bg - c_est.transpose() * earth, r_rate, &p));
+    }
     ++r.filter_updates;
   }
-  p = 0.5 * (p + p.transpose());
+  p = Matrix12(p.selfadjointView<Eigen::Upper>());
 
   const Eigen::Vector3d rph = RollPitchHeadingOf(c_est);
   r.roll = rph(0);
