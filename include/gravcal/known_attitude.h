@@ -44,8 +44,9 @@ struct KnownAttitude {
 // positions[k]). Fills calibration->accel (affine model, bias_std,
 // matrix_std, covariance over bias_* and m_* in raw units), refinement (the
 // solver's summary: iterations, chi2, dof), per-position attitude and
-// residuals. `options` supplies gravity, loss, loss_scale, covariance and
-// max_iterations. Returns false on fewer than 4 positions, invalid
+// residuals. `options` supplies gravity (unless calibration->gravity_source is
+// already set, as CalibrateKnownAttitude leaves it), loss, loss_scale,
+// covariance and max_iterations. Returns false on fewer than 4 positions, invalid
 // attitudes, a singular initial fit or no convergence.
 bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
                                  const std::vector<KnownAttitude>& attitudes,
