@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "gravcal/config.h"
+#include "gravcal/log_reader.h"
 #include "gravcal/pipeline.h"
 #include "gravcal/simulator.h"
 #include "test_util.h"
@@ -102,6 +103,39 @@ TEST(TenPosition, RecoversBiasAndScaleWithHonestSigmas) {
        {std::sqrt(sum_bias / n), std::sqrt(sum_scale / n), std::sqrt(sum_nonorth / n)}) {
     EXPECT_GT(rms, 0.7);
     EXPECT_LT(rms, 1.35);
+  }
+}
+
+// The real MPU-6050 session of ten hand-held poses (skips when the data is
+// absent): the method runs on it, the calibrated |a| is g to 1 mm/s^2 in
+// every pose, and its bias agrees with the twelve-position refinement's (the
+// same magnitude information) within their sigmas.
+TEST(TenPosition, RealMpu6050TenPoses) {
+  const std::string dir = testing_util::RealDataDir();
+  if (dir.empty()) GTEST_SKIP() << "no real data folder";
+  Config config;
+  std::string error;
+  ASSERT_TRUE(
+      LoadConfigFile(testing_util::SourceDir() + "/configs/mpu6050_ten_pose.yaml", &config, &error))
+      << error;
+  PipelineInput input;
+  input.source = dir + "/mpu6050_ten_pose/session.csv";
+  ASSERT_TRUE(ReadImuLog(input.source, config.input, &input.log, &error)) << error;
+  Calibration twelve;
+  ASSERT_TRUE(RunCalibration(config, input, &twelve)) << twelve.message;
+  config.method = "ten_position";
+  config.ten_position.gyro_nominal_scale = M_PI / 180.0 / 131.0;
+  Calibration ten;
+  ASSERT_TRUE(RunCalibration(config, input, &ten)) << ten.message;
+  ASSERT_EQ(ten.positions.size(), 10u);
+  for (const PositionReport& r : ten.positions) {
+    EXPECT_LT(std::fabs(r.residual_after), 1e-3);
+    EXPECT_TRUE(std::isfinite(r.roll_deg));
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double sigma = std::hypot(ten.accel.bias_std(i), twelve.accel.bias_std(i));
+    if (!std::isfinite(sigma)) continue;
+    EXPECT_LT(std::fabs(ten.accel.model.bias(i) - twelve.accel.model.bias(i)), 3.0 * sigma) << i;
   }
 }
 
