@@ -280,8 +280,16 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
   p.block<3, 3>(6, 6) = p_ba;
   if (!r.heading_observed) p(2, 2) = kUnobservedHeadingVariance;
   if (gyro) {
+    // The zero-rate measurement is linear in phi only to first order; the
+    // second-order term, up to W |phi|^2 / 2, stays as long as the tilt error
+    // the accelerometer bias leaves does (it is unobservable), so it acts as
+    // a constant gyroscope error: it joins the bias prior. (Negligible for a
+    // MEMS gyroscope; it keeps a navigation-grade one from claiming tilt and
+    // heading to better than this.)
+    const double second_order = 0.5 * kEarthRate * p.block<3, 3>(0, 0).trace();
     const Eigen::Matrix3d p_bg =
-        (gyro_bias_var + earth_unmodelled_var) * Eigen::Matrix3d::Identity();
+        (gyro_bias_var + earth_unmodelled_var + second_order * second_order) *
+        Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d noise_g0 =
         gyro_noise_var / static_cast<double>(n0) * Eigen::Matrix3d::Identity();
     p.block<3, 3>(0, 0) += b_sens * (p_bg + noise_g0) * b_sens.transpose();
@@ -316,14 +324,19 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
   h_rate.block<3, 3>(0, 9).setIdentity();
   for (size_t i = n0; i < n; ++i) {
     v += (c_est * (specific_force[i] - ba) - gravity_n) * dt;
-    Propagate(e_phi, c_est * dt, &p);
+    // Jacobians at the coarse attitude, not the current estimate (first
+    // estimates): the corrections rotate the estimate, and Jacobians that
+    // followed them would make the tilt/bias/heading direction no static
+    // base can see look observable (measured: heading sigma 3-5x too small
+    // with a navigation-grade gyroscope).
+    Propagate(e_phi, c * dt, &p);
     p.block<3, 3>(3, 3).diagonal().array() += qv;
     // The two measurements have independent noise: one after the other.
     correct(KalmanUpdate(h_velocity, v, r_velocity, &p));
     if (gyro) {
       // u - b_g - C_est^T w = db_g + C_est^T [w x] phi + noise, from
       // C_true^T = C_est^T (I - [phi x]).
-      h_rate.block<3, 3>(0, 0) = c_est.transpose() * Skew(earth);
+      h_rate.block<3, 3>(0, 0) = c.transpose() * Skew(earth);  // first estimate, as above
       correct(KalmanUpdate(h_rate, rate[i] - bg - c_est.transpose() * earth, r_rate, &p));
     }
     ++r.filter_updates;

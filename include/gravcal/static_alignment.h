@@ -18,15 +18,21 @@
 // is 0 and reported as not observed (heading_observed = false, NaN std).
 //
 // Fine alignment: a closed-loop error-state Kalman filter over the rest of
-// the interval. States (12, or 9 without a gyroscope):
+// the interval. States (12; without a gyroscope the last three stay at zero
+// covariance):
 //   x = [phi (3, nav, rad), dv (3, nav, m/s), db_a (3, body, m/s^2), db_g (3, body, rad/s)],
-// with C_true = (I + [phi x]) C_est. On a static base
-//   phi' = -[w_c x] phi - C db_g + n_g,     dv' = [f^n x] phi + C db_a + n_a,
-// w_c the Earth rate the mechanisation compensates (all of it when heading is
-// observed, else only its vertical part W sin(lat), or none without a
-// latitude: the rest is absorbed by db_g). Measurement: zero velocity,
-// z = v_est, H = [0 I 0 0]. The white noises come from the interval itself
-// (sample standard deviation per axis) unless given.
+// with C_true = Exp(phi) C_est. The attitude of a static base is constant, so
+// the filter holds it (no gyroscope integration) and
+//   phi' = 0,     dv' = [f^n x] phi + C db_a + n_a,   f^n = (0, 0, g),
+// v_est integrating C_est (f - b_a) - f^n. Measurements at every sample: zero
+// velocity, z = v_est = dv; with a gyroscope, zero angular rate,
+//   z = u - b_g - C_est^T w = db_g + C^T [w x] phi + n_g,
+// w the Earth rate the model accounts for (all of it when heading is
+// observed, else its vertical part W sin(lat), or none without a latitude:
+// the rest is inside b_g, whose prior grows by it). The white noises come
+// from the interval itself (sample standard deviation per axis) unless
+// given. The Jacobians are evaluated at the coarse attitude (first
+// estimates), which keeps the unobservable directions unobservable.
 //
 // Honesty: on a static base a horizontal accelerometer bias and a tilt give
 // the same measurements, so roll and pitch are never better than the bias
