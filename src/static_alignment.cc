@@ -280,16 +280,8 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
   p.block<3, 3>(6, 6) = p_ba;
   if (!r.heading_observed) p(2, 2) = kUnobservedHeadingVariance;
   if (gyro) {
-    // The zero-rate measurement is linear in phi only to first order; the
-    // second-order term, up to W |phi|^2 / 2, stays as long as the tilt error
-    // the accelerometer bias leaves does (it is unobservable), so it acts as
-    // a constant gyroscope error: it joins the bias prior. (Negligible for a
-    // MEMS gyroscope; it keeps a navigation-grade one from claiming tilt and
-    // heading to better than this.)
-    const double second_order = 0.5 * kEarthRate * p.block<3, 3>(0, 0).trace();
     const Eigen::Matrix3d p_bg =
-        (gyro_bias_var + earth_unmodelled_var + second_order * second_order) *
-        Eigen::Matrix3d::Identity();
+        (gyro_bias_var + earth_unmodelled_var) * Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d noise_g0 =
         gyro_noise_var / static_cast<double>(n0) * Eigen::Matrix3d::Identity();
     p.block<3, 3>(0, 0) += b_sens * (p_bg + noise_g0) * b_sens.transpose();
