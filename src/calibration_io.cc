@@ -81,15 +81,23 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
                      {"after", summary(c.residual_refined)}};
   json positions = json::array();
   for (const PositionReport& r : c.positions) {
-    positions.push_back({{"t_begin", r.position.t_begin},
-                         {"t_end", r.position.t_end},
-                         {"samples", r.position.sample_count},
-                         {"raw_mean", Vector(r.position.raw_mean)},
-                         {"raw_std", Vector(r.raw_std)},
-                         {"nominal_up", NominalAxisName(r.nominal_up)},
-                         {"residual_before", Number(r.residual_before)},
-                         {"residual_after", Number(r.residual_after)},
-                         {"sigma", Number(r.sigma)}});
+    json p = {{"t_begin", r.position.t_begin},
+              {"t_end", r.position.t_end},
+              {"samples", r.position.sample_count},
+              {"raw_mean", Vector(r.position.raw_mean)},
+              {"raw_std", Vector(r.raw_std)},
+              {"nominal_up", NominalAxisName(r.nominal_up)},
+              {"residual_before", Number(r.residual_before)},
+              {"residual_after", Number(r.residual_after)},
+              {"sigma", Number(r.sigma)}};
+    // Only the methods that use an attitude per position have one.
+    if (std::isfinite(r.roll_deg) && std::isfinite(r.pitch_deg)) {
+      p["attitude_deg"] = {{"roll", r.roll_deg},
+                           {"pitch", r.pitch_deg},
+                           {"roll_std", Number(r.roll_std_deg)},
+                           {"pitch_std", Number(r.pitch_std_deg)}};
+    }
+    positions.push_back(p);
   }
   out["positions"] = positions;
   const RefinementResult& f = c.refinement;

@@ -148,8 +148,10 @@ bool GetEnum(const YAML::Node& n, Enum* v, const char* choices, std::string* err
 
 const std::vector<KeyHandler>& Handlers() {
   static const std::vector<KeyHandler> handlers = {
-      GRAVCAL_STRING("method", "general", method,
-                     "calibration method: twelve_position (multi-position magnitude fit)"),
+      GRAVCAL_STRING(
+          "method", "general", method,
+          "calibration method: twelve_position (multi-position magnitude fit), ten_position "
+          "(patent, self-aligned), known_attitude (fixture attitudes, --attitudes)"),
       GRAVCAL_BOOL("output_covariance", "general", output_covariance,
                    "write accel.covariance into the calibration JSON"),
       // Input.
@@ -342,6 +344,29 @@ const std::vector<KeyHandler>& Handlers() {
                      "hand profile: axis wobble, degrees (standard deviation)"),
       GRAVCAL_DOUBLE("sim_gyro_g_sensitivity", "simulator", simulation.gyro_g_sensitivity_std,
                      "truth gyroscope g-sensitivity spread, rad/s per m/s^2"),
+      // Issue 3: ten-position (static alignment) and known-attitude methods.
+      GRAVCAL_DOUBLE("align_accel_bias_std", "alignment", ten_position.alignment.accel_bias_std,
+                     "prior of the accelerometer bias the static base cannot see, m/s^2"),
+      GRAVCAL_DOUBLE("align_accel_matrix_std", "alignment", ten_position.alignment.accel_matrix_std,
+                     "prior of each scale/misalignment error entry (seen as a bias dM f)"),
+      GRAVCAL_DOUBLE("align_gyro_bias_std", "alignment", ten_position.alignment.gyro_bias_std,
+                     "prior of the gyroscope bias, rad/s (decides gyrocompassing)"),
+      GRAVCAL_DOUBLE("align_max_heading_std", "alignment",
+                     ten_position.alignment.max_heading_std_deg,
+                     "gyrocompass only when heading would be better than this, degrees"),
+      GRAVCAL_DOUBLE("align_coarse_seconds", "alignment", ten_position.alignment.coarse_seconds,
+                     "coarse alignment window at the start of each position, s"),
+      GRAVCAL_DOUBLE("align_zero_velocity_std", "alignment",
+                     ten_position.alignment.zero_velocity_std,
+                     "zero-velocity measurement standard deviation, m/s"),
+      GRAVCAL_BOOL("align_use_gyro", "alignment", ten_position.alignment.use_gyro,
+                   "use the gyroscope in the alignment when the log has one"),
+      GRAVCAL_DOUBLE("gyro_nominal_scale", "alignment", ten_position.gyro_nominal_scale,
+                     "rad/s per raw gyroscope unit, for the alignment (1 = rad/s)"),
+      GRAVCAL_DOUBLE("sim_latitude", "simulator", simulation.latitude_deg,
+                     "the gyroscope senses Earth rate at this latitude, degrees (null = off)"),
+      GRAVCAL_DOUBLE("sim_attitude_noise", "simulator", simulation.fixture_attitude_noise_deg,
+                     "noise of the fixture attitudes simulate writes (attitudes.csv), degrees"),
   };
   return handlers;
 }
@@ -370,8 +395,9 @@ bool SetNode(const std::string& key, const YAML::Node& node, Config* config, std
 }  // namespace
 
 bool Config::IsValid(std::string* error) const {
-  if (method != "twelve_position") {
-    *error = "key 'method': unknown method '" + method + "' (available: twelve_position)";
+  if (method != "twelve_position" && method != "ten_position" && method != "known_attitude") {
+    *error = "key 'method': unknown method '" + method +
+             "' (available: twelve_position, ten_position, known_attitude)";
     return false;
   }
   std::string what;
@@ -384,6 +410,10 @@ bool Config::IsValid(std::string* error) const {
     return false;
   }
   if (!gyro.IsValid(&what)) {
+    *error = what;
+    return false;
+  }
+  if (method == "ten_position" && !ten_position.IsValid(&what)) {
     *error = what;
     return false;
   }

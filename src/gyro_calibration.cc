@@ -16,7 +16,7 @@
 #include <sstream>
 
 #include "accel_uncertainty.h"
-#include "loss_function.h"
+#include "robust_loss.h"
 #include "gravcal/gravity_magnitude_residual.h"
 #include "gravcal/gyro_rotation_residual.h"
 #include "gravcal/gyro_static_residual.h"

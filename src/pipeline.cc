@@ -1,6 +1,8 @@
 #include "gravcal/pipeline.h"
 
 #include "gravcal/gyro_calibration.h"
+#include "gravcal/known_attitude.h"
+#include "gravcal/ten_position.h"
 
 namespace gravcal {
 
@@ -18,6 +20,12 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
     if (!ok || config.gyro.parameterization == GyroParameterization::kNone) return ok;
     return AddGyroscopeCalibration(input.log, config.calibration.detector, config.gyro,
                                    calibration);
+  }
+  if (config.method == "ten_position") {
+    return CalibrateTenPosition(input.log, config.calibration, config.ten_position, calibration);
+  }
+  if (config.method == "known_attitude") {
+    return CalibrateKnownAttitude(input.log, input.attitudes_path, config.calibration, calibration);
   }
   calibration->message = "key 'method': unknown method '" + config.method + "'";
   return false;

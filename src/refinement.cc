@@ -11,9 +11,9 @@
 #include <sstream>
 
 #include "gravcal/gravity_magnitude_residual.h"
-#include "loss_function.h"
 #include "magnitude_fit.h"
 #include "normalization.h"
+#include "robust_loss.h"
 #include "statistics.h"
 
 namespace gravcal {
@@ -116,24 +116,6 @@ std::vector<double> MagnitudeResiduals(const std::vector<Position>& positions,
     r[k] = (model.upper * (positions[k].raw_mean - model.bias)).norm() - gravity;
   }
   return r;
-}
-
-ceres::LossFunction* MakeLoss(LossType type, double scale) {
-  switch (type) {
-    case LossType::kNone:
-      return nullptr;
-    case LossType::kHuber:
-      return new ceres::HuberLoss(scale);
-    case LossType::kCauchy:
-      return new ceres::CauchyLoss(scale);
-    case LossType::kSoftL1:
-      return new ceres::SoftLOneLoss(scale);
-    case LossType::kArctan:
-      return new ceres::ArctanLoss(scale);
-    case LossType::kTukey:
-      return new ceres::TukeyLoss(scale);
-  }
-  return nullptr;
 }
 
 bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,

@@ -252,6 +252,13 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   log.temperature.resize(total);
 
   const Eigen::Vector3d gravity_nav(0.0, 0.0, options.gravity);
+  // Earth rotation in the navigation frame (East-North-Up), when on.
+  Eigen::Vector3d earth_rate_nav = Eigen::Vector3d::Zero();
+  if (std::isfinite(options.latitude_deg)) {
+    constexpr double kEarthRotation = 7.2921151467e-5;
+    const double lat = options.latitude_deg * kPi / 180.0;
+    earth_rate_nav = kEarthRotation * Eigen::Vector3d(0.0, std::cos(lat), std::sin(lat));
+  }
   const double accel_noise = options.accel_noise * s.accel_units_per_si;
   const double gyro_noise = options.gyro_noise * s.gyro_units_per_si;
   const double accel_walk = options.accel_bias_random_walk * std::sqrt(dt) * s.accel_units_per_si;
@@ -304,13 +311,14 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
     pose.attitude = attitudes[k];
     pose.nominal_up = nominal_up[k];
     const Eigen::Vector3d force = attitudes[k].conjugate() * gravity_nav;
+    const Eigen::Vector3d still_rate = attitudes[k].conjugate() * earth_rate_nav;
     if (options.tremor > 0.0) tremor = options.tremor * normal3();
     for (; i < pose.end; ++i) {
       if (options.tremor > 0.0) {
-        emit(i, force + tremor, Eigen::Vector3d::Zero());
+        emit(i, force + tremor, still_rate);
         tremor = tremor_pole * tremor + tremor_drive * normal3();
       } else {
-        emit(i, force, Eigen::Vector3d::Zero());
+        emit(i, force, still_rate);
       }
     }
     if (k + 1 == pose_count) break;
@@ -328,7 +336,8 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
         const Eigen::Quaterniond q =
             attitudes[k] * AxisAngle(SmoothStep(x) * step.angle(), step.axis());
         emit(i, q.conjugate() * gravity_nav,
-             step.axis() * (step.angle() * SmoothStepRate(x) / duration));
+             step.axis() * (step.angle() * SmoothStepRate(x) / duration) +
+                 q.conjugate() * earth_rate_nav);
         continue;
       }
       // Hand: q(x) = q0 exp(s(tau(x)) angle axis) exp(beta(x) v), whose
@@ -342,7 +351,8 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
       const Eigen::Vector3d main_rate =
           step.axis() * (step.angle() * SmoothStepRate(tau) * p.WarpRate(x) / duration);
       emit(i, q.conjugate() * gravity_nav,
-           wobble.conjugate() * main_rate + p.wobble_axis * (p.WobbleRate(x) / duration));
+           wobble.conjugate() * main_rate + p.wobble_axis * (p.WobbleRate(x) / duration) +
+               q.conjugate() * earth_rate_nav);
     }
   }
 
@@ -437,6 +447,10 @@ bool SimulatorOptions::IsValid(std::string* error) const {
   if (!finite("temperature_start", temperature_start)) return false;
   if (!finite("temperature_end", temperature_end)) return false;
   if (!positive("temperature_tau", temperature_tau)) return false;
+  if (!std::isnan(latitude_deg) && !(std::fabs(latitude_deg) <= 90.0)) {
+    return fail("latitude_deg", latitude_deg, "must be NaN (off) or within -90..90");
+  }
+  if (!non_negative("fixture_attitude_noise_deg", fixture_attitude_noise_deg)) return false;
 
   const double samples =
       (initial_still_seconds + hold_seconds +
@@ -580,7 +594,10 @@ std::string TruthToJson(const SimulatedSession& session, const SimulatorOptions&
                     {"gyro_g_sensitivity_std", o.gyro_g_sensitivity_std},
                     {"temperature_start", o.temperature_start},
                     {"temperature_end", o.temperature_end},
-                    {"temperature_tau", o.temperature_tau}};
+                    {"temperature_tau", o.temperature_tau},
+                    {"latitude_deg", std::isfinite(o.latitude_deg) ? nlohmann::json(o.latitude_deg)
+                                                                   : nlohmann::json(nullptr)},
+                    {"fixture_attitude_noise_deg", o.fixture_attitude_noise_deg}};
     return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
   } catch (const std::exception&) {
     return "{}";

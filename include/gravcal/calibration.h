@@ -12,13 +12,14 @@
 #define GRAVCAL_CALIBRATION_H_
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 #include <vector>
 
 #include "gravcal/accel_model.h"
 #include "gravcal/coarse_fit.h"
-#include "gravcal/gyro_model.h"
 #include "gravcal/gravity.h"
+#include "gravcal/gyro_model.h"
 #include "gravcal/imu_log.h"
 #include "gravcal/newton_solver.h"
 #include "gravcal/position.h"
@@ -109,6 +110,13 @@ struct PositionReport {
   double residual_before = 0.0;
   double residual_after = 0.0;
   double sigma = 0.0;
+  // The attitude the method used for this position (ten_position: from
+  // static alignment; known_attitude: as estimated with the fixture's
+  // prior), degrees, and its standard deviation; NaN when the method has none.
+  double roll_deg = NAN;
+  double pitch_deg = NAN;
+  double roll_std_deg = NAN;
+  double pitch_std_deg = NAN;
 };
 
 struct Calibration {

@@ -16,18 +16,23 @@
 #include "gravcal/gyro_calibration.h"
 #include "gravcal/log_reader.h"
 #include "gravcal/simulator.h"
+#include "gravcal/ten_position.h"
 
 namespace gravcal {
 
 struct Config {
-  // Calibration method; "twelve_position" is the multi-position magnitude
-  // calibration (any number of positions).
+  // Calibration method: "twelve_position" is the multi-position magnitude
+  // calibration (any number of positions), "ten_position" the patent's
+  // self-aligned method (ten_position.h), "known_attitude" the calibration
+  // from a fixture's attitudes (known_attitude.h).
   std::string method = "twelve_position";
   LogReaderOptions input;
   CalibrationOptions calibration;
   SimulatorOptions simulation;
   // Gyroscope from the rotations between the poses (gyro_model != none).
   GyroCalibrationOptions gyro;
+  // Issue 3: the ten-position method's alignment settings.
+  TenPositionOptions ten_position;
   // Write accel.covariance into the calibration JSON.
   bool output_covariance = true;
 

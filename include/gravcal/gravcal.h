@@ -5,6 +5,7 @@
 #include "gravcal/accel_model.h"
 #include "gravcal/batch.h"
 #include "gravcal/batch_manifest.h"
+#include "gravcal/attitude_fixture.h"
 #include "gravcal/calibration.h"
 #include "gravcal/calibration_io.h"
 #include "gravcal/coarse_fit.h"
@@ -18,6 +19,7 @@
 #include "gravcal/gyro_static_residual.h"
 #include "gravcal/housing_rotation.h"
 #include "gravcal/imu_log.h"
+#include "gravcal/known_attitude.h"
 #include "gravcal/log_reader.h"
 #include "gravcal/newton_solver.h"
 #include "gravcal/observability.h"
@@ -25,6 +27,8 @@
 #include "gravcal/position.h"
 #include "gravcal/refinement.h"
 #include "gravcal/simulator.h"
+#include "gravcal/static_alignment.h"
 #include "gravcal/static_detector.h"
+#include "gravcal/ten_position.h"
 
 #endif  // GRAVCAL_GRAVCAL_H_

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -88,6 +89,14 @@ struct SimulatorOptions {
   double temperature_start = 25.0;
   double temperature_end = 25.0;
   double temperature_tau = 300.0;
+
+  // Issue 3: when finite, the gyroscope also senses Earth rotation at this
+  // geodetic latitude, degrees (navigation frame East-North-Up). NaN = off.
+  double latitude_deg = NAN;
+  // Issue 3: the fixture attitudes (roll, pitch) written next to a simulated
+  // session (WriteFixtureAttitudes) get N(0, this) degrees of noise, and
+  // this is the uncertainty they state (at least 0.001 deg).
+  double fixture_attitude_noise_deg = 0.0;
 
   bool IsValid(std::string* error) const;
 };

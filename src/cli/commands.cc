@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "gravcal/attitude_fixture.h"
 #include "gravcal/calibration.h"
 #include "gravcal/calibration_io.h"
 #include "gravcal/log_reader.h"
@@ -104,6 +105,7 @@ int RunCalibrate(const CommandArgs& args) {
   if (!CheckConfig(args.config, &error)) return Fail(error);
   PipelineInput input;
   input.source = args.input;
+  input.attitudes_path = args.attitudes;
   if (!ReadImuLog(args.input, args.config.input, &input.log, &error)) return Fail(error);
   Calibration c;
   const bool ok = RunCalibration(args.config, input, &c);
@@ -149,13 +151,22 @@ int RunSimulate(const CommandArgs& args) {
   }
   const std::string raw = args.output_dir + "/raw.csv";
   const std::string truth = args.output_dir + "/truth.json";
+  const std::string attitudes = args.output_dir + "/attitudes.csv";
   if (!WriteImuLogCsv(session.log, raw, &error)) return Fail(error);
   if (!WriteFileAtomically(truth, TruthToJson(session, args.config.simulation), &error)) {
     std::remove(raw.c_str());
     return Fail(error);
   }
-  std::fprintf(stderr, "gravcal: wrote %s (%zu samples) and %s\n", raw.c_str(), session.log.size(),
-               truth.c_str());
+  // What a fixture (or an inclinometer) would say about each pose.
+  const std::string fixture = FixtureAttitudesToCsv(SimulatedFixtureAttitudes(
+      session, args.config.simulation.fixture_attitude_noise_deg, args.seed));
+  if (!WriteFileAtomically(attitudes, fixture, &error)) {
+    std::remove(raw.c_str());
+    std::remove(truth.c_str());
+    return Fail(error);
+  }
+  std::fprintf(stderr, "gravcal: wrote %s (%zu samples), %s and %s\n", raw.c_str(),
+               session.log.size(), truth.c_str(), attitudes.c_str());
   return 0;
 }
 

@@ -18,6 +18,8 @@ struct CommandArgs {
   std::string output_dir;
   std::string calibration;
   std::string config_path;
+  // known_attitude: the attitudes CSV.
+  std::string attitudes;
   uint64_t seed = 1;
   // batch and merge-summaries.
   std::string manifest;

@@ -32,6 +32,7 @@ DEFINE_double(outlier_sigmas, gravcal::FleetOptions().outlier_sigmas,
               "batch: outlier threshold, robust standard deviations from the fleet median");
 DEFINE_int32(outlier_min_units, gravcal::FleetOptions().min_units,
              "batch: fewest calibrated units for the outlier check");
+DEFINE_string(attitudes, "", "known_attitude: CSV of each static position's roll and pitch");
 
 namespace {
 
@@ -48,11 +49,13 @@ const std::vector<CommandInfo>& Commands() {
        {"config", "seed"}},
       {"calibrate",
        "calibrate the accelerometer from a multi-position log",
-       {"input", "config", "output"}},
+       {"input", "config", "output", "attitudes"}},
       {"apply",
        "apply a calibration to a raw log, writing SI units",
        {"calibration", "input", "output"}},
-      {"simulate", "simulate a session: raw.csv and truth.json", {"config", "seed", "output_dir"}},
+      {"simulate",
+       "simulate a session: raw.csv, truth.json and the fixture's attitudes.csv",
+       {"config", "seed", "output_dir"}},
       {"batch",
        "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
        "statistics)",
@@ -204,6 +207,7 @@ int main(int argc, char** argv) {
   args.outlier_sigmas = FLAGS_outlier_sigmas;
   args.outlier_min_units = FLAGS_outlier_min_units;
   args.positional = positional;
+  args.attitudes = FLAGS_attitudes;
 
   if (command == "demo") return gravcal::cli::RunDemo(args);
   if (command == "calibrate") return gravcal::cli::RunCalibrate(args);

@@ -1,0 +1,236 @@
+// Known-attitude calibration: all twelve parameters within their reported
+// uncertainty over many simulated sessions, and bad attitude files rejected
+// with a message naming the file and line (library and command line).
+#include "gravcal/known_attitude.h"
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "gravcal/attitude_fixture.h"
+#include "gravcal/log_reader.h"
+#include "gravcal/simulator.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+// `text` with field `field` of line `line` (0-based, comment line included)
+// replaced by `value`.
+std::string WithField(const std::string& text, int line, int field, const std::string& value) {
+  std::vector<std::string> lines;
+  std::stringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  std::vector<std::string> f;
+  std::stringstream ls(lines[line]);
+  for (std::string x; std::getline(ls, x, ',');) f.push_back(x);
+  f.resize(8);
+  f[field] = value;
+  std::string joined;
+  for (size_t i = 0; i < f.size(); ++i) joined += (i ? "," : "") + f[i];
+  lines[line] = joined;
+  std::string out;
+  for (const std::string& l : lines) out += l + "\n";
+  return out;
+}
+
+class KnownAttitudeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char pattern[] = "/tmp/gravcal_known_XXXXXX";
+    ASSERT_NE(mkdtemp(pattern), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override { std::system(("rm -rf '" + dir_ + "'").c_str()); }
+
+  std::string Write(const std::string& name, const std::string& text) const {
+    const std::string path = dir_ + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  static SimulatorOptions TenPositions() {
+    SimulatorOptions sim;
+    sim.scheme = "ten";
+    sim.hold_seconds = 8.0;
+    sim.initial_still_seconds = 2.0;
+    sim.rotation_seconds = 2.0;
+    sim.fixture_attitude_noise_deg = 0.05;
+    return sim;
+  }
+
+  static CalibrationOptions Options() {
+    CalibrationOptions options;
+    options.gravity.gravity = 9.80665;
+    return options;
+  }
+
+  std::string dir_;
+};
+
+TEST_F(KnownAttitudeTest, AllTwelveParametersWithinTheirUncertainty) {
+  const SimulatorOptions sim = TenPositions();
+  const int seeds = 40;
+  Eigen::Matrix<double, 12, 1> sum = Eigen::Matrix<double, 12, 1>::Zero();
+  for (int seed = 1; seed <= seeds; ++seed) {
+    SimulatedSession s;
+    std::string error;
+    ASSERT_TRUE(Simulate(sim, seed, &s, &error)) << error;
+    const std::string path = Write(
+        "attitudes.csv", FixtureAttitudesToCsv(SimulatedFixtureAttitudes(
+                             s, sim.fixture_attitude_noise_deg, static_cast<uint64_t>(seed))));
+    Calibration c;
+    ASSERT_TRUE(CalibrateKnownAttitude(s.log, path, Options(), &c)) << c.message;
+    EXPECT_EQ(c.method, "known_attitude");
+    ASSERT_EQ(c.positions.size(), 10u);
+    const Eigen::Matrix3d m = c.accel.model.matrix();
+    const Eigen::Matrix3d truth = s.accel_truth.matrix();
+    for (int i = 0; i < 3; ++i) {
+      const double e = (c.accel.model.bias(i) - s.accel_truth.bias(i)) / c.accel.bias_std(i);
+      sum(i) += e * e;
+    }
+    for (int i = 0; i < 9; ++i) {
+      const double e = (m(i / 3, i % 3) - truth(i / 3, i % 3)) / c.accel.matrix_std(i / 3, i % 3);
+      sum(3 + i) += e * e;
+    }
+  }
+  const Eigen::Matrix<double, 12, 1> rms = (sum / seeds).cwiseSqrt();
+  const double overall = std::sqrt(sum.sum() / (12.0 * seeds));
+  EXPECT_GT(overall, 0.8) << rms.transpose();
+  EXPECT_LT(overall, 1.25) << rms.transpose();
+  // Each parameter on its own (40 seeds: the RMS itself scatters by ~11 %).
+  EXPECT_LT(rms.maxCoeff(), 1.5) << rms.transpose();
+  EXPECT_GT(rms.minCoeff(), 0.6) << rms.transpose();
+}
+
+TEST_F(KnownAttitudeTest, WorseAttitudesGiveLargerHonestSigmas) {
+  // With 1 degree attitudes the rotation part is much less certain, and the
+  // reported sigma says so.
+  SimulatorOptions sim = TenPositions();
+  SimulatedSession s;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, 5, &s, &error)) << error;
+  Calibration fine, coarse;
+  ASSERT_TRUE(CalibrateKnownAttitude(
+      s.log, Write("fine.csv", FixtureAttitudesToCsv(SimulatedFixtureAttitudes(s, 0.01, 5))),
+      Options(), &fine))
+      << fine.message;
+  ASSERT_TRUE(CalibrateKnownAttitude(
+      s.log, Write("coarse.csv", FixtureAttitudesToCsv(SimulatedFixtureAttitudes(s, 1.0, 5))),
+      Options(), &coarse))
+      << coarse.message;
+  EXPECT_GT(coarse.accel.matrix_std(0, 1), 10.0 * fine.accel.matrix_std(0, 1));
+  EXPECT_LT(std::fabs(coarse.accel.model.matrix()(0, 1) - s.accel_truth.matrix()(0, 1)),
+            4.0 * coarse.accel.matrix_std(0, 1));
+}
+
+TEST_F(KnownAttitudeTest, RejectsBadAttitudeFiles) {
+  SimulatedSession s;
+  std::string error;
+  ASSERT_TRUE(Simulate(TenPositions(), 2, &s, &error)) << error;
+  const std::string good = FixtureAttitudesToCsv(SimulatedFixtureAttitudes(s, 0.05, 2));
+  std::vector<std::string> lines;
+  std::stringstream in(good);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  ASSERT_EQ(lines.size(), 12u);  // comment, header, ten rows
+  auto join = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const std::string& l : v) s += l + "\n";
+    return s;
+  };
+  auto with_field = [&](int line, int field, const std::string& value) {
+    return WithField(good, line, field, value);
+  };
+  std::vector<std::string> missing = lines;
+  missing.erase(missing.begin() + 5);
+  struct Case {
+    std::string text;
+    std::string expect;
+  };
+  const std::vector<Case> cases = {
+      {join(missing), "no attitude for static position 3"},
+      {with_field(4, 2, "200"), ":5: roll_deg = 200 is out of range"},
+      {with_field(6, 3, "95"), ":7: pitch_deg = 95 is out of range"},
+      {with_field(3, 2, "nan"), ":4: roll_deg = 'nan' is not a finite number"},
+      {with_field(8, 5, "0"), ":9: roll_std_deg = 0 is out of range"},
+      {with_field(9, 2, ""), ":10: roll_deg = '' is not a finite number"},
+      {WithField(with_field(2, 0, "1000"), 2, 1, "1010"),
+       ":3: no detected static position lies in t 1000"},
+      {with_field(2, 1, "-5"), ":3: t_end must be after t_begin"},
+      {"t_begin,t_end,roll_deg,pitch_deg\n0,1,0,0\n", ":1: header has no column 'roll_std_deg'"},
+      {"position,roll_deg,pitch_deg,roll_std_deg,pitch_std_deg\n12,0,0,1,1\n",
+       ":2: position 12 does not exist"},
+  };
+  for (const Case& k : cases) {
+    const std::string path = Write("bad.csv", k.text);
+    Calibration c;
+    EXPECT_FALSE(CalibrateKnownAttitude(s.log, path, Options(), &c)) << k.expect;
+    EXPECT_NE(c.message.find(path), std::string::npos) << c.message;
+    EXPECT_NE(c.message.find(k.expect), std::string::npos) << c.message;
+    EXPECT_EQ(c.message.find('\n'), std::string::npos) << c.message;
+    EXPECT_FALSE(c.success);
+  }
+  Calibration c;
+  EXPECT_FALSE(CalibrateKnownAttitude(s.log, dir_ + "/absent.csv", Options(), &c));
+  EXPECT_NE(c.message.find("cannot open"), std::string::npos) << c.message;
+  EXPECT_FALSE(CalibrateKnownAttitude(s.log, "", Options(), &c));
+  EXPECT_NE(c.message.find("--attitudes"), std::string::npos) << c.message;
+}
+
+// The command line: simulate writes a usable attitudes.csv; a bad one gives
+// one line naming file:line, exit code 1 and no output file.
+TEST_F(KnownAttitudeTest, CommandLineEndToEnd) {
+  const std::string cli = GRAVCAL_CLI_PATH;
+  const std::string config = testing_util::SourceDir() + "/configs/known_attitude.yaml";
+  auto run = [&](const std::string& args, std::string* err) {
+    const std::string err_path = dir_ + "/stderr.txt";
+    const int status =
+        std::system((cli + " " + args + " >/dev/null 2>" + err_path + " </dev/null").c_str());
+    std::ifstream in(err_path);
+    std::stringstream s;
+    s << in.rdbuf();
+    *err = s.str();
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  std::string err;
+  ASSERT_EQ(
+      run("simulate --config " + config + " --seed 3 --sim_hold 6 --output-dir " + dir_ + "/sim",
+          &err),
+      0)
+      << err;
+  const std::string calib = dir_ + "/calib.json";
+  ASSERT_EQ(run("calibrate --config " + config + " --gravity 9.80665 --input " + dir_ +
+                    "/sim/raw.csv --attitudes " + dir_ + "/sim/attitudes.csv --output " + calib,
+                &err),
+            0)
+      << err;
+  struct stat st;
+  EXPECT_EQ(stat(calib.c_str(), &st), 0);
+
+  std::ifstream in(dir_ + "/sim/attitudes.csv");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string bad = WithField(text.str(), 3, 2, "NaN");
+  const std::string bad_path = Write("bad.csv", bad);
+  const std::string out = dir_ + "/bad.json";
+  EXPECT_EQ(run("calibrate --config " + config + " --gravity 9.80665 --input " + dir_ +
+                    "/sim/raw.csv --attitudes " + bad_path + " --output " + out,
+                &err),
+            1);
+  EXPECT_NE(err.find(bad_path + ":4: roll_deg = 'NaN' is not a finite number"), std::string::npos)
+      << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_NE(stat(out.c_str(), &st), 0);
+  EXPECT_EQ(
+      run("calibrate --config " + config + " --input " + dir_ + "/sim/raw.csv --output " + out,
+          &err),
+      1);
+  EXPECT_NE(err.find("--attitudes"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace gravcal
