@@ -1,5 +1,7 @@
 #include "gravcal/pipeline.h"
 
+#include "gravcal/handheld_kalman.h"
+
 namespace gravcal {
 
 bool RunCalibration(const Config& config, const PipelineInput& input, Calibration* calibration) {
@@ -12,6 +14,14 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
   // One branch per method; each fills the same Calibration.
   if (config.method == "twelve_position") {
     const bool ok = CalibrateAccelerometer(input.log, config.calibration, calibration);
+    calibration->method = config.method;
+    return ok;
+  }
+  if (config.method == "handheld_kalman") {
+    HandheldKalmanOptions options = config.handheld;
+    options.gravity = config.calibration.gravity;
+    options.accel_nominal_scale = config.calibration.nominal_scale;
+    const bool ok = CalibrateHandheld(input.log, options, calibration);
     calibration->method = config.method;
     return ok;
   }

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "gravcal/calibration.h"
+#include "gravcal/handheld_kalman.h"
+#include "gravcal/handheld_simulator.h"
 #include "gravcal/log_reader.h"
 #include "gravcal/simulator.h"
 
@@ -27,6 +29,13 @@ struct Config {
   SimulatorOptions simulation;
   // Write accel.covariance into the calibration JSON.
   bool output_covariance = true;
+  // Issue 4: the handheld Kalman calibration (method handheld_kalman; its
+  // gravity and accelerometer nominal scale come from `calibration`), and
+  // the motion simulator used by `gravcal simulate` when sim_motion names a
+  // profile (empty = the multi-position scheme).
+  HandheldKalmanOptions handheld;
+  MotionOptions motion;
+  std::string sim_motion;
 
   bool IsValid(std::string* error) const;
 };

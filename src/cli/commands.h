@@ -17,6 +17,8 @@ struct CommandArgs {
   std::string output_dir;
   std::string calibration;
   std::string config_path;
+  // calibrate: the time history CSV of recursive methods (--history).
+  std::string history;
   uint64_t seed = 1;
 };
 

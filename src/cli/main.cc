@@ -21,6 +21,7 @@ DEFINE_string(output_dir, "", "folder to write simulated raw.csv and truth.json 
 DEFINE_string(config, "", "YAML config file (configs/*.yaml)");
 DEFINE_string(calibration, "", "calibration JSON to apply");
 DEFINE_uint64(seed, 1, "random seed of the simulator");
+DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
 
 namespace {
 
@@ -36,8 +37,9 @@ const std::vector<CommandInfo>& Commands() {
        "simulate a twelve-position session in raw counts, calibrate it, print estimate vs truth",
        {"config", "seed"}},
       {"calibrate",
-       "calibrate the accelerometer from a multi-position log",
-       {"input", "config", "output"}},
+       "calibrate the accelerometer from a multi-position log (or, with method "
+       "handheld_kalman, both sensors from a handheld log)",
+       {"input", "config", "output", "history"}},
       {"apply",
        "apply a calibration to a raw log, writing SI units",
        {"calibration", "input", "output"}},
@@ -171,6 +173,7 @@ int main(int argc, char** argv) {
   args.output_dir = FLAGS_output_dir;
   args.calibration = FLAGS_calibration;
   args.seed = FLAGS_seed;
+  args.history = FLAGS_history;
 
   if (command == "demo") return gravcal::cli::RunDemo(args);
   if (command == "calibrate") return gravcal::cli::RunCalibrate(args);
