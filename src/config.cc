@@ -148,8 +148,9 @@ bool GetEnum(const YAML::Node& n, Enum* v, const char* choices, std::string* err
 
 const std::vector<KeyHandler>& Handlers() {
   static const std::vector<KeyHandler> handlers = {
-      GRAVCAL_STRING("method", "general", method,
-                     "calibration method: twelve_position (multi-position magnitude fit), handheld_kalman"),
+      GRAVCAL_STRING(
+          "method", "general", method,
+          "calibration method: twelve_position (multi-position magnitude fit), handheld_kalman"),
       GRAVCAL_BOOL("output_covariance", "general", output_covariance,
                    "write accel.covariance into the calibration JSON"),
       // Input.
@@ -345,6 +346,22 @@ const std::vector<KeyHandler>& Handlers() {
                      "prior gyroscope bias, rad/s"),
       GRAVCAL_DOUBLE("hk_gyro_scale_std", "handheld_kalman", handheld.gyro_scale_std,
                      "prior gyroscope scale-factor error (fraction)"),
+      {{"hk_cross_axis", "handheld_kalman",
+        "also estimate cross-axis terms (accelerometer upper-triangular, gyroscope full)"},
+       [](const YAML::Node& n, Config* c, std::string* e) {
+         bool on = false;
+         if (!GetBool(n, &on, e)) return false;
+         c->handheld.accel_terms =
+             on ? SensorErrorTerms::ScaleAndUpperCrossAxis() : SensorErrorTerms::ScaleOnly();
+         c->handheld.gyro_terms =
+             on ? SensorErrorTerms::ScaleAndCrossAxis() : SensorErrorTerms::ScaleOnly();
+         return true;
+       },
+       [](const Config& c) {
+         return std::string(c.handheld.gyro_terms.matrix_entries.size() > 3 ? "true" : "false");
+       }},
+      GRAVCAL_DOUBLE("hk_cross_axis_std", "handheld_kalman", handheld.cross_axis_std,
+                     "prior cross-axis term (with hk_cross_axis), rad"),
       GRAVCAL_DOUBLE("hk_initial_attitude_std", "handheld_kalman", handheld.initial_attitude_std,
                      "initial roll/pitch error beyond the accelerometer's, rad"),
       GRAVCAL_BOOL("hk_earth_rate", "handheld_kalman", handheld.earth_rate,

@@ -14,6 +14,12 @@ SensorErrorTerms SensorErrorTerms::ScaleAndCrossAxis() {
   return terms;
 }
 
+SensorErrorTerms SensorErrorTerms::ScaleAndUpperCrossAxis() {
+  SensorErrorTerms terms;
+  terms.matrix_entries.insert(terms.matrix_entries.end(), {{0, 1}, {0, 2}, {1, 2}});
+  return terms;
+}
+
 bool SensorErrorTerms::IsValid(std::string* error) const {
   bool seen[3][3] = {};
   for (const auto& [r, c] : matrix_entries) {

@@ -689,9 +689,14 @@ bool CalibrateHandheld(const ImuLog& log, const HandheldKalmanOptions& options,
   convert(filter->accel(), sa, StateBlock::kAccelBias, StateBlock::kAccelMatrix, layout.accel(),
           &accel_bias, &accel_matrix, &c.accel.bias_std, &c.accel.matrix_std, &c.accel.covariance,
           &c.accel.covariance_names);
-  const bool accel_diagonal = accel_matrix.isDiagonal(0.0);
-  if (accel_diagonal) {
-    c.accel.model.parameterization = AccelParameterization::kScale;
+  // Diagonal E: the `scale` model; upper-triangular E (the accelerometer
+  // axes define the body frame): `scale_misalignment`; otherwise `affine`.
+  const bool accel_upper =
+      accel_matrix.isUpperTriangular(0.0) && accel_matrix.diagonal().minCoeff() > 0.0;
+  if (accel_upper) {
+    c.accel.model.parameterization = accel_matrix.isDiagonal(0.0)
+                                         ? AccelParameterization::kScale
+                                         : AccelParameterization::kScaleMisalignment;
     c.accel.model.bias = accel_bias;
     c.accel.model.upper = accel_matrix;
     c.accel.model.rotation.setIdentity();

@@ -9,7 +9,10 @@
 #include <sstream>
 
 #include "gravcal/calibration_io.h"
+#include "gravcal/config.h"
 #include "gravcal/handheld_simulator.h"
+#include "gravcal/log_reader.h"
+#include "gravcal/pipeline.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -199,30 +202,69 @@ TEST(HandheldKalman, ResultUsesCalibrationModelsInRawUnits) {
   EXPECT_FALSE(j["convergence"]["criterion"].get<std::string>().empty());
 }
 
-TEST(HandheldKalman, CrossAxisLayoutRuns) {
-  // The layout takes the cross-axis terms: 21 + 12 states. Not in the
-  // paper's model and not exposed as a key; this checks that the filter
-  // takes every offset from the layout.
+TEST(HandheldKalman, LayoutTakesCrossAxisTerms) {
   const ErrorStateLayout paper;
   EXPECT_EQ(paper.size(), 21);
   EXPECT_EQ(paper.names()[12], "accel_scale_x");
-  const ErrorStateLayout cross(SensorErrorTerms::ScaleAndCrossAxis(),
+  const ErrorStateLayout cross(SensorErrorTerms::ScaleAndUpperCrossAxis(),
                                SensorErrorTerms::ScaleAndCrossAxis());
-  EXPECT_EQ(cross.size(), 33);
-  EXPECT_EQ(cross.offset(StateBlock::kGyroBias), 21);
+  EXPECT_EQ(cross.size(), 30);
+  EXPECT_EQ(cross.offset(StateBlock::kGyroBias), 18);
   EXPECT_EQ(cross.names()[15], "accel_cross_xy");
-  const SimulatorOptions sensor = FilterSensor();
-  MotionSession s;
-  std::string error;
-  ASSERT_TRUE(SimulateMotion(sensor, MotionOptions(), 2, &s, &error)) << error;
+  EXPECT_EQ(cross.names()[29], "gyro_cross_zy");
+}
+
+TEST(HandheldKalman, CrossAxisTermsRecoverAMisalignedImu) {
+  // With misalignment the paper's model is biased (benchmarks/RESULTS.md:
+  // errors about 10 sigma at 0.005 rad). With the cross-axis terms (the
+  // accelerometer's x axis and xy plane define the body frame) every entry
+  // comes out within its sigma. Truth in that frame: the accelerometer is U
+  // (M = R U), the gyroscope M_g^-1 R.
+  SimulatorOptions sensor = FilterSensor();
+  sensor.accel_misalignment_std = 0.005;
+  sensor.gyro_misalignment_std = 0.005;
   HandheldKalmanOptions options = MatchingOptions(sensor);
-  options.accel_terms = SensorErrorTerms::ScaleAndCrossAxis();
+  options.accel_terms = SensorErrorTerms::ScaleAndUpperCrossAxis();
   options.gyro_terms = SensorErrorTerms::ScaleAndCrossAxis();
-  Calibration c;
-  ASSERT_TRUE(CalibrateHandheld(s.sensor.log, options, &c)) << c.message;
-  EXPECT_EQ(c.convergence.entries.size(), 24u);
-  EXPECT_TRUE(c.gyro.matrix_std.allFinite());
-  EXPECT_NEAR(c.gyro.model.bias(0), ErrorTruth(s.sensor).gyro_bias(0), 4.0 * c.gyro.bias_std(0));
+  const ErrorStateLayout layout(options.accel_terms, options.gyro_terms);
+  double sum_z2 = 0.0;
+  int count = 0;
+  for (int seed = 1; seed <= 10; ++seed) {
+    MotionSession s;
+    std::string error;
+    ASSERT_TRUE(SimulateMotion(sensor, MotionOptions(), seed, &s, &error)) << error;
+    Calibration c;
+    ASSERT_TRUE(CalibrateHandheld(s.sensor.log, options, &c)) << c.message;
+    EXPECT_EQ(c.accel.model.parameterization, AccelParameterization::kScaleMisalignment);
+    const Eigen::Matrix3d accel_e =
+        s.sensor.accel_truth.upper.inverse() - Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d gyro_e =
+        s.sensor.gyro_truth.matrix.inverse() * s.sensor.accel_truth.rotation -
+        Eigen::Matrix3d::Identity();
+    std::vector<double> truth;
+    for (int i = 0; i < 3; ++i) truth.push_back(s.sensor.accel_truth.bias(i));
+    for (const auto& [r, k] : layout.accel().matrix_entries) truth.push_back(accel_e(r, k));
+    for (int i = 0; i < 3; ++i) truth.push_back(s.sensor.gyro_truth.bias(i));
+    for (const auto& [r, k] : layout.gyro().matrix_entries) truth.push_back(gyro_e(r, k));
+    ASSERT_EQ(c.convergence.entries.size(), truth.size());
+    for (size_t j = 0; j < truth.size(); ++j) {
+      const ConvergenceEntry& e = c.convergence.entries[j];
+      const double z = (e.value - truth[j]) / e.sigma_final;
+      EXPECT_LT(std::fabs(z), 3.5) << e.name << " seed " << seed;
+      // Bias and scale converge as without cross-axis terms; the cross-axis
+      // terms shrink to 10-20 % of their prior in a minute.
+      if (e.name.find("_cross_") == std::string::npos) {
+        EXPECT_TRUE(e.converged) << e.name << " seed " << seed;
+      } else {
+        EXPECT_LT(e.sigma_final, 0.3 * e.sigma_initial) << e.name << " seed " << seed;
+      }
+      sum_z2 += z * z;
+      ++count;
+    }
+  }
+  const double rms = std::sqrt(sum_z2 / count);
+  EXPECT_GT(rms, 0.7);
+  EXPECT_LT(rms, 1.4);
 }
 
 TEST(HandheldKalman, RejectsBadInput) {
@@ -258,6 +300,58 @@ TEST(HandheldKalman, RejectsBadInput) {
   bad.earth_rate = true;
   EXPECT_FALSE(bad.IsValid(&error));
   EXPECT_NE(error.find("latitude"), std::string::npos) << error;
+}
+
+TEST(HandheldKalman, RealFerrarisSessionAgreesWithStaticReferences) {
+  const std::string dir = testing_util::RealDataDir();
+  if (dir.empty()) GTEST_SKIP() << "no real data folder";
+  const std::string session = dir + "/ferraris_nilspod/session.csv";
+  auto calibrate = [&](const std::string& config_name, Calibration* c) {
+    Config config;
+    std::string error;
+    ASSERT_TRUE(
+        LoadConfigFile(testing_util::SourceDir() + "/configs/" + config_name, &config, &error))
+        << error;
+    PipelineInput input;
+    ASSERT_TRUE(ReadImuLog(session, config.input, &input.log, &error)) << error;
+    ASSERT_TRUE(RunCalibration(config, input, c)) << c->message;
+  };
+  Calibration handheld, faces;
+  calibrate("ferraris_nilspod_handheld.yaml", &handheld);
+  calibrate("ferraris_nilspod.yaml", &faces);
+  // The accelerometer against the six-face magnitude fit of the same session
+  // (m/s^2 and scale factor). Observed: 0.02 m/s^2 and 0.0015; the filter's
+  // own sigmas (about 0.001 and 1e-4) are too small on this recording (see
+  // README: unmodelled cross-axis terms and a unit carried between faces).
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(handheld.accel.model.bias(i), faces.accel.model.bias(i), 0.03) << i;
+    EXPECT_NEAR(handheld.accel.model.upper(i, i), faces.accel.model.matrix()(i, i), 0.003) << i;
+  }
+  // The gyroscope bias against its mean over the six still faces (deg/s;
+  // the Earth rate is below 0.005 deg/s). Observed: up to 0.07 deg/s.
+  std::ifstream in(dir + "/ferraris_nilspod/sections.json");
+  const nlohmann::json sections = nlohmann::json::parse(in);
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(testing_util::SourceDir() + "/configs/ferraris_nilspod.yaml", &config,
+                             &error));
+  ImuLog log;
+  ASSERT_TRUE(ReadImuLog(session, config.input, &log, &error)) << error;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (const char* face : {"x_p", "x_a", "y_p", "y_a", "z_p", "z_a"}) {
+    for (int i = sections[face]["start"].get<int>(); i < sections[face]["end"].get<int>(); ++i) {
+      sum += log.gyro[i];
+      ++count;
+    }
+  }
+  const Eigen::Vector3d still_mean = sum / count;
+  ASSERT_TRUE(handheld.gyro.estimated);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(handheld.gyro.model.bias(i), still_mean(i), 0.1) << i;
+    // Scale within 5 % of the factory's deg/s.
+    EXPECT_NEAR(handheld.gyro.model.matrix(i, i), M_PI / 180.0, 0.05 * M_PI / 180.0) << i;
+  }
 }
 
 }  // namespace

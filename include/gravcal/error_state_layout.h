@@ -45,6 +45,14 @@ struct SensorErrorTerms {
   static SensorErrorTerms ScaleOnly();
   // Scale factors and all six cross-axis terms.
   static SensorErrorTerms ScaleAndCrossAxis();
+  // Scale factors and the upper-triangular cross-axis terms (0,1), (0,2),
+  // (1,2): E upper triangular, so the sensor's x axis and xy plane define
+  // the body frame (the gauge-free choice of accel_model.h). Gravity and
+  // pseudo-measurements cannot see a rotation of all sensor axes together,
+  // so with full cross-axis terms on both sensors three combinations are
+  // not determined; this form for the accelerometer with the full form for
+  // the gyroscope leaves none.
+  static SensorErrorTerms ScaleAndUpperCrossAxis();
 
   // Entries inside 0..2 and not repeated.
   bool IsValid(std::string* error) const;
