@@ -186,7 +186,6 @@ class Filter {
   // Zero-velocity and zero-position pseudo-measurements, Joseph form,
   // closed-loop feedback. Returns the normalised innovation squared.
   double Update() {
-    const int n = layout_.size();
     const NavigationState& nav = strapdown_.state();
     Eigen::Matrix<double, 6, 1> z;
     z << nav.velocity, nav.position;
@@ -208,7 +207,6 @@ class Filter {
     p.noalias() += k * r.asDiagonal() * k.transpose();
     p_ = 0.5 * (p + p.transpose());
     Feedback(x);
-    (void)n;
     return nis;
   }
 
@@ -351,6 +349,133 @@ std::string Format(double v) {
   s.precision(3);
   s << v;
   return s.str();
+}
+
+// Fills the convergence report from the first pass's history (criterion in
+// HandheldKalmanOptions) and warns about each state the motion did not
+// determine; returns their names.
+std::vector<std::string> ReportConvergence(const Filter& filter, const ErrorStateLayout& layout,
+                                           const HandheldKalmanOptions& options, Calibration* c) {
+  const Eigen::MatrixXd& p = filter.covariance();
+  const Eigen::MatrixXd& p0 = filter.initial_covariance();
+  const int n = layout.size();
+  std::ostringstream criterion;
+  criterion << "on the first (causal) filter pass: converged at the first epoch from which on "
+               "both the distance of the estimate from its final value and its standard "
+               "deviation stay below "
+            << options.convergence_fraction
+            << " times the prior standard deviation; a state whose final standard deviation is "
+               "above that is not determined";
+  c->convergence.criterion = criterion.str();
+  const EstimateHistory& history = c->history;
+  const int first_sensor = layout.offset(StateBlock::kAccelBias);
+  const size_t rows = history.rows();
+  const size_t cols = history.columns.size();
+  std::vector<std::string> unexcited;
+  for (int j = first_sensor; j < n; ++j) {
+    ConvergenceEntry e;
+    e.name = layout.names()[j];
+    const bool bias = e.name.find("_bias_") != std::string::npos;
+    const bool accel = e.name.rfind("accel", 0) == 0;
+    e.unit = bias ? (accel ? "m/s^2" : "rad/s") : "fraction";
+    e.value = filter.SensorValue(j);
+    e.sigma_initial = std::sqrt(p0(j, j));
+    e.sigma_final = std::sqrt(std::max(p(j, j), 0.0));
+    const bool excited = e.sigma_final <= options.convergence_fraction * e.sigma_initial;
+    if (excited) {
+      const size_t col = 1 + 2 * static_cast<size_t>(j - first_sensor);
+      // On the first (causal) pass, against its own final value.
+      const double* last = &history.values[(rows - 1) * cols];
+      const double tolerance = options.convergence_fraction * e.sigma_initial;
+      size_t first_good = rows;
+      while (first_good > 0) {
+        const double* row = &history.values[(first_good - 1) * cols];
+        const bool inside =
+            std::fabs(row[col] - last[col]) <= tolerance && row[col + 1] <= tolerance;
+        if (!inside) break;
+        --first_good;
+      }
+      e.converged = first_good < rows;
+      if (e.converged) e.time = history.values[first_good * cols];
+    } else {
+      unexcited.push_back(e.name);
+      std::ostringstream s;
+      s << e.name << " not determined: its standard deviation only went from "
+        << Format(e.sigma_initial) << " to " << Format(e.sigma_final) << " " << e.unit
+        << " (the reported value is mostly the prior); the recording lacks "
+        << MissingMotion(e.name);
+      c->warnings.push_back(s.str());
+    }
+    c->convergence.entries.push_back(e);
+  }
+  return unexcited;
+}
+
+// One sensor's result in the calibration models: f = s (I + E)^-1 (v - b / s)
+// is a = M (v - b_raw) with M = s (I + E)^-1 and b_raw = b / s (same for the
+// gyroscope). Jacobians: db_raw/db = 1 / s, dM/dE_rc = -(1/s) M e_r e_c^T M.
+// Entries of M that no estimated entry of E moves get NaN std.
+struct SensorResult {
+  Vec3 bias;
+  Mat3 matrix;
+  Vec3 bias_std;
+  Mat3 matrix_std;
+  Eigen::MatrixXd covariance;
+  std::vector<std::string> names;
+};
+
+SensorResult ToCalibrationModel(const SensorEstimate& est, double scale, int bias_offset,
+                                int matrix_offset, const SensorErrorTerms& terms,
+                                const Eigen::MatrixXd& p) {
+  SensorResult out;
+  out.bias = est.bias / scale;
+  out.matrix = scale * est.inverse;
+  const int ne = static_cast<int>(terms.matrix_entries.size());
+  // Which entries of M move: all those reached by some estimated entry.
+  bool moves[3][3] = {};
+  for (const auto& [r, col] : terms.matrix_entries) {
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        if (out.matrix(i, r) != 0.0 && out.matrix(col, k) != 0.0) moves[i][k] = true;
+      }
+    }
+  }
+  std::vector<std::pair<int, int>> outputs;
+  out.names.clear();
+  for (int i = 0; i < 3; ++i) out.names.push_back(std::string("bias_") + kAxes[i]);
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      if (moves[i][k]) {
+        outputs.emplace_back(i, k);
+        out.names.push_back(std::string("m_") + kAxes[i] + kAxes[k]);
+      }
+    }
+  }
+  const int no = 3 + static_cast<int>(outputs.size());
+  Eigen::MatrixXd jac = Eigen::MatrixXd::Zero(no, 3 + ne);
+  jac.topLeftCorner<3, 3>() = Mat3::Identity() / scale;
+  for (size_t o = 0; o < outputs.size(); ++o) {
+    const auto [i, k] = outputs[o];
+    for (int e = 0; e < ne; ++e) {
+      const auto [r, col] = terms.matrix_entries[e];
+      jac(3 + static_cast<int>(o), 3 + e) = -out.matrix(i, r) * out.matrix(col, k) / scale;
+    }
+  }
+  Eigen::MatrixXd source(3 + ne, 3 + ne);
+  std::vector<int> index;
+  for (int i = 0; i < 3; ++i) index.push_back(bias_offset + i);
+  for (int e = 0; e < ne; ++e) index.push_back(matrix_offset + e);
+  for (int a = 0; a < 3 + ne; ++a) {
+    for (int b = 0; b < 3 + ne; ++b) source(a, b) = p(index[a], index[b]);
+  }
+  out.covariance = jac * source * jac.transpose();
+  for (int i = 0; i < 3; ++i) out.bias_std(i) = std::sqrt(out.covariance(i, i));
+  out.matrix_std.setConstant(NAN);
+  for (size_t o = 0; o < outputs.size(); ++o) {
+    out.matrix_std(outputs[o].first, outputs[o].second) =
+        std::sqrt(out.covariance(3 + static_cast<int>(o), 3 + static_cast<int>(o)));
+  }
+  return out;
 }
 
 }  // namespace
@@ -575,120 +700,17 @@ bool CalibrateHandheld(const ImuLog& log, const HandheldKalmanOptions& options,
     c.warnings.push_back(s.str());
   }
 
-  // Convergence and excitation per sensor state.
+  const std::vector<std::string> unexcited = ReportConvergence(*filter, layout, options, &c);
   const Eigen::MatrixXd& p = filter->covariance();
-  const Eigen::MatrixXd& p0 = filter->initial_covariance();
-  std::ostringstream criterion;
-  criterion << "on the first (causal) filter pass: converged at the first epoch from which on "
-               "both the distance of the estimate from its final value and its standard "
-               "deviation stay below "
-            << options.convergence_fraction
-            << " times the prior standard deviation; a state whose final standard deviation is "
-               "above that is not determined";
-  c.convergence.criterion = criterion.str();
-  const size_t rows = history.rows();
-  const size_t cols = history.columns.size();
-  std::vector<std::string> unexcited;
-  for (int j = first_sensor; j < n; ++j) {
-    ConvergenceEntry e;
-    e.name = layout.names()[j];
-    const bool bias = e.name.find("_bias_") != std::string::npos;
-    const bool accel = e.name.rfind("accel", 0) == 0;
-    e.unit = bias ? (accel ? "m/s^2" : "rad/s") : "fraction";
-    e.value = filter->SensorValue(j);
-    e.sigma_initial = std::sqrt(p0(j, j));
-    e.sigma_final = std::sqrt(std::max(p(j, j), 0.0));
-    const bool excited = e.sigma_final <= options.convergence_fraction * e.sigma_initial;
-    if (excited) {
-      const size_t col = 1 + 2 * static_cast<size_t>(j - first_sensor);
-      // On the first (causal) pass, against its own final value.
-      const double* last = &history.values[(rows - 1) * cols];
-      const double tolerance = options.convergence_fraction * e.sigma_initial;
-      size_t first_good = rows;
-      while (first_good > 0) {
-        const double* row = &history.values[(first_good - 1) * cols];
-        const bool inside =
-            std::fabs(row[col] - last[col]) <= tolerance && row[col + 1] <= tolerance;
-        if (!inside) break;
-        --first_good;
-      }
-      e.converged = first_good < rows;
-      if (e.converged) e.time = history.values[first_good * cols];
-    } else {
-      unexcited.push_back(e.name);
-      std::ostringstream s;
-      s << e.name << " not determined: its standard deviation only went from "
-        << Format(e.sigma_initial) << " to " << Format(e.sigma_final) << " " << e.unit
-        << " (the reported value is mostly the prior); the recording lacks "
-        << MissingMotion(e.name);
-      c.warnings.push_back(s.str());
-    }
-    c.convergence.entries.push_back(e);
-  }
-
-  // Results in the calibration models: f = s_a (I + E_a)^-1 (v - b_a / s_a)
-  // gives a = M (v - b) with M = s_a (I + E_a)^-1 and b = b_a / s_a; same for
-  // the gyroscope. Jacobians: db/db_a = 1 / s, dM/dE_rc = -(1/s) M e_r e_c^T M.
-  auto convert = [&](const SensorEstimate& est, double scale, StateBlock bias_block,
-                     StateBlock matrix_block, const SensorErrorTerms& terms, Vec3* bias,
-                     Mat3* matrix, Vec3* bias_std, Mat3* matrix_std, Eigen::MatrixXd* covariance,
-                     std::vector<std::string>* names) {
-    *bias = est.bias / scale;
-    *matrix = scale * est.inverse;
-    const int nb = layout.offset(bias_block);
-    const int nm = layout.offset(matrix_block);
-    const int ne = static_cast<int>(terms.matrix_entries.size());
-    // Which entries of M move: all those reached by some estimated entry.
-    bool moves[3][3] = {};
-    for (const auto& [r, col] : terms.matrix_entries) {
-      for (int i = 0; i < 3; ++i) {
-        for (int k = 0; k < 3; ++k) {
-          if ((*matrix)(i, r) != 0.0 && (*matrix)(col, k) != 0.0) moves[i][k] = true;
-        }
-      }
-    }
-    std::vector<std::pair<int, int>> outputs;
-    names->clear();
-    for (int i = 0; i < 3; ++i) names->push_back(std::string("bias_") + kAxes[i]);
-    for (int i = 0; i < 3; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        if (moves[i][k]) {
-          outputs.emplace_back(i, k);
-          names->push_back(std::string("m_") + kAxes[i] + kAxes[k]);
-        }
-      }
-    }
-    const int no = 3 + static_cast<int>(outputs.size());
-    Eigen::MatrixXd jac = Eigen::MatrixXd::Zero(no, 3 + ne);
-    jac.topLeftCorner<3, 3>() = Mat3::Identity() / scale;
-    for (size_t o = 0; o < outputs.size(); ++o) {
-      const auto [i, k] = outputs[o];
-      for (int e = 0; e < ne; ++e) {
-        const auto [r, col] = terms.matrix_entries[e];
-        jac(3 + static_cast<int>(o), 3 + e) = -(*matrix)(i, r) * (*matrix)(col, k) / scale;
-      }
-    }
-    Eigen::MatrixXd source(3 + ne, 3 + ne);
-    std::vector<int> index;
-    for (int i = 0; i < 3; ++i) index.push_back(nb + i);
-    for (int e = 0; e < ne; ++e) index.push_back(nm + e);
-    for (int a = 0; a < 3 + ne; ++a) {
-      for (int b = 0; b < 3 + ne; ++b) source(a, b) = p(index[a], index[b]);
-    }
-    *covariance = jac * source * jac.transpose();
-    for (int i = 0; i < 3; ++i) (*bias_std)(i) = std::sqrt((*covariance)(i, i));
-    matrix_std->setConstant(NAN);
-    for (size_t o = 0; o < outputs.size(); ++o) {
-      (*matrix_std)(outputs[o].first, outputs[o].second) =
-          std::sqrt((*covariance)(3 + static_cast<int>(o), 3 + static_cast<int>(o)));
-    }
-  };
-
-  Vec3 accel_bias;
-  Mat3 accel_matrix;
-  convert(filter->accel(), sa, StateBlock::kAccelBias, StateBlock::kAccelMatrix, layout.accel(),
-          &accel_bias, &accel_matrix, &c.accel.bias_std, &c.accel.matrix_std, &c.accel.covariance,
-          &c.accel.covariance_names);
+  const SensorResult accel =
+      ToCalibrationModel(filter->accel(), sa, layout.offset(StateBlock::kAccelBias),
+                         layout.offset(StateBlock::kAccelMatrix), layout.accel(), p);
+  c.accel.bias_std = accel.bias_std;
+  c.accel.matrix_std = accel.matrix_std;
+  c.accel.covariance = accel.covariance;
+  c.accel.covariance_names = accel.names;
+  const Vec3& accel_bias = accel.bias;
+  const Mat3& accel_matrix = accel.matrix;
   // Diagonal E: the `scale` model; upper-triangular E (the accelerometer
   // axes define the body frame): `scale_misalignment`; otherwise `affine`.
   const bool accel_upper =
@@ -705,10 +727,16 @@ bool CalibrateHandheld(const ImuLog& log, const HandheldKalmanOptions& options,
     c.message = log.source + ": the estimated accelerometer matrix is singular";
     return false;
   }
+  const SensorResult gyro =
+      ToCalibrationModel(filter->gyro(), sg, layout.offset(StateBlock::kGyroBias),
+                         layout.offset(StateBlock::kGyroMatrix), layout.gyro(), p);
   c.gyro.estimated = true;
-  convert(filter->gyro(), sg, StateBlock::kGyroBias, StateBlock::kGyroMatrix, layout.gyro(),
-          &c.gyro.model.bias, &c.gyro.model.matrix, &c.gyro.bias_std, &c.gyro.matrix_std,
-          &c.gyro.covariance, &c.gyro.covariance_names);
+  c.gyro.model.bias = gyro.bias;
+  c.gyro.model.matrix = gyro.matrix;
+  c.gyro.bias_std = gyro.bias_std;
+  c.gyro.matrix_std = gyro.matrix_std;
+  c.gyro.covariance = gyro.covariance;
+  c.gyro.covariance_names = gyro.names;
 
   // |a| - g over the initial still period, before (nominal scale) and after.
   const double before = f_mean.norm() - c.gravity;
