@@ -36,26 +36,28 @@ bool SensorErrorTerms::IsValid(std::string* error) const {
   return true;
 }
 
-ErrorStateLayout::ErrorStateLayout(const SensorErrorTerms& accel, const SensorErrorTerms& gyro)
+ErrorStateLayout::ErrorStateLayout(const SensorErrorTerms& accel, const SensorErrorTerms& gyro,
+                                   bool lever_arm)
     : accel_(accel), gyro_(gyro) {
-  const int sizes[7] = {3,
+  const int sizes[8] = {3,
                         3,
                         3,
                         3,
                         static_cast<int>(accel.matrix_entries.size()),
                         3,
-                        static_cast<int>(gyro.matrix_entries.size())};
-  static const char* const kPrefix[7] = {"attitude", "velocity",  "position", "accel_bias",
-                                         "accel",    "gyro_bias", "gyro"};
+                        static_cast<int>(gyro.matrix_entries.size()),
+                        lever_arm ? 3 : 0};
+  static const char* const kPrefix[8] = {"attitude", "velocity",  "position", "accel_bias",
+                                         "accel",    "gyro_bias", "gyro",     "lever_arm"};
   const char* axes = "xyz";
-  for (int b = 0; b < 7; ++b) {
+  for (int b = 0; b < 8; ++b) {
     offset_[b] = size_;
     size_of_[b] = sizes[b];
     size_ += sizes[b];
     const bool matrix = b == static_cast<int>(StateBlock::kAccelMatrix) ||
                         b == static_cast<int>(StateBlock::kGyroMatrix);
     if (!matrix) {
-      for (int i = 0; i < 3; ++i) names_.push_back(std::string(kPrefix[b]) + "_" + axes[i]);
+      for (int i = 0; i < sizes[b]; ++i) names_.push_back(std::string(kPrefix[b]) + "_" + axes[i]);
       continue;
     }
     const SensorErrorTerms& terms = b == static_cast<int>(StateBlock::kAccelMatrix) ? accel : gyro;

@@ -82,6 +82,7 @@ class Filter {
     a_.setIdentity();
     q_.setZero();
     joseph_.setZero(n, n);
+    h_.setZero(6, n);
   }
 
   StrapdownOptions MakeStrapdownOptions() const {
@@ -98,6 +99,8 @@ class Filter {
   void Initialize(const Vec3& f_mean, const SensorEstimate& accel, const SensorEstimate& gyro) {
     accel_ = accel;
     gyro_ = gyro;
+    lever_.setZero();
+    rate_.setZero();
     const Vec3 f0 = accel_.Correct(f_mean);
     const Eigen::Quaterniond q0 = LevelAttitude(f0);
     NavigationState start;
@@ -123,6 +126,9 @@ class Filter {
     };
     set_matrix(StateBlock::kAccelMatrix, layout_.accel(), options_.accel_scale_std);
     set_matrix(StateBlock::kGyroMatrix, layout_.gyro(), options_.gyro_scale_std);
+    if (layout_.block_size(StateBlock::kLeverArm) > 0) {
+      set(StateBlock::kLeverArm, options_.lever_arm_std);
+    }
     // phi = phi_independent + L C0 df, df = -(I + E)^-1 (db_a + dE_a f0),
     // with phi_x = -(C0 df)_y / g and phi_y = (C0 df)_x / g.
     const double g = f0.norm();
@@ -137,6 +143,11 @@ class Filter {
       const auto [r, c] = layout_.accel().matrix_entries[j];
       t.block<3, 1>(0, am + static_cast<int>(j)) = -lc.col(r) * f0(c);
     }
+    // With a lever arm the navigation origin is the turning point and the
+    // sensor starts at C0 r, estimated 0: dp0 = -C0 r = C0 dr.
+    if (layout_.block_size(StateBlock::kLeverArm) > 0) {
+      t.block<3, 3>(6, layout_.offset(StateBlock::kLeverArm)) = q0.toRotationMatrix();
+    }
     p_ = t * prior.asDiagonal() * t.transpose();
     p_initial_ = p_;
   }
@@ -149,6 +160,7 @@ class Filter {
     const Vec3 w1 = gyro_.Correct(w1_m);
     StrapdownStep s;
     strapdown_.Step(dt, f0, w0, f1, w1, &s);
+    rate_ = w1;
     Accumulate(s);
     elapsed_ += dt;
   }
@@ -187,22 +199,45 @@ class Filter {
   // closed-loop feedback. Returns the normalised innovation squared.
   double Update() {
     const NavigationState& nav = strapdown_.state();
+    const Mat3& c = strapdown_.attitude_matrix();
+    // The point held still: the sensor, or with a lever arm r the point the
+    // unit turns about, at p - C r with velocity v - C (w x r). To first
+    // order (u = C (w x r)):
+    //   z_v = dv - [u x] phi - C [r x] (I+E_g)^-1 (db_g + dE_g w) - C [w x] dr
+    //   z_p = dp - [(C r) x] phi - C dr
+    const Vec3 u = c * rate_.cross(lever_);
     Eigen::Matrix<double, 6, 1> z;
-    z << nav.velocity, nav.position;
+    z << nav.velocity - u, nav.position - c * lever_;
+    h_.setZero();
+    h_.block<3, 3>(0, 3).setIdentity();
+    h_.block<3, 3>(3, 6).setIdentity();
+    const int lever = layout_.offset(StateBlock::kLeverArm);
+    if (layout_.block_size(StateBlock::kLeverArm) > 0) {
+      h_.block<3, 3>(0, 0) = -Skew(u);
+      h_.block<3, 3>(3, 0) = -Skew(c * lever_);
+      const Mat3 kr = -c * Skew(lever_) * gyro_.inverse;
+      h_.block<3, 3>(0, layout_.offset(StateBlock::kGyroBias)) = kr;
+      const int gm = layout_.offset(StateBlock::kGyroMatrix);
+      for (size_t j = 0; j < layout_.gyro().matrix_entries.size(); ++j) {
+        const auto [r, col] = layout_.gyro().matrix_entries[j];
+        h_.block<3, 1>(0, gm + static_cast<int>(j)) = kr.col(r) * rate_(col);
+      }
+      h_.block<3, 3>(0, lever) = -c * Skew(rate_);
+      h_.block<3, 3>(3, lever) = -c;
+    }
     Eigen::Matrix<double, 6, 1> r;
     r << Vec3::Constant(options_.velocity_noise * options_.velocity_noise),
         Vec3::Constant(options_.position_noise * options_.position_noise);
-    // H selects states 3..8 (velocity and position errors).
-    Eigen::Matrix<double, 6, 6> s = p_.block<6, 6>(3, 3);
+    const Eigen::Matrix<double, Eigen::Dynamic, 6> pht = p_ * h_.transpose();
+    Eigen::Matrix<double, 6, 6> s = h_ * pht;
     s.diagonal() += r;
     const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(s);
-    const Eigen::Matrix<double, Eigen::Dynamic, 6> pht = p_.middleCols<6>(3);
     const Eigen::Matrix<double, Eigen::Dynamic, 6> k = llt.solve(pht.transpose()).transpose();
     const double nis = z.dot(llt.solve(z));
     const Eigen::VectorXd x = k * z;
     // Joseph form: P = (I - K H) P (I - K H)^T + K R K^T.
     joseph_.setIdentity();
-    joseph_.middleCols<6>(3) -= k;
+    joseph_.noalias() -= k * h_;
     Eigen::MatrixXd p = joseph_ * p_ * joseph_.transpose();
     p.noalias() += k * r.asDiagonal() * k.transpose();
     p_ = 0.5 * (p + p.transpose());
@@ -222,6 +257,8 @@ class Filter {
     const int am = layout_.offset(StateBlock::kAccelMatrix);
     const int gb = layout_.offset(StateBlock::kGyroBias);
     const int gm = layout_.offset(StateBlock::kGyroMatrix);
+    const int lever = layout_.offset(StateBlock::kLeverArm);
+    if (state >= lever) return lever_(state - lever);
     if (state >= gm) {
       const auto [r, c] = layout_.gyro().matrix_entries[state - gm];
       return gyro_.e(r, c);
@@ -298,6 +335,9 @@ class Filter {
       const auto [r, c] = layout_.gyro().matrix_entries[j];
       gyro_.e(r, c) -= x(gm + static_cast<int>(j));
     }
+    if (layout_.block_size(StateBlock::kLeverArm) > 0) {
+      lever_ -= x.segment<3>(layout_.offset(StateBlock::kLeverArm));
+    }
     accel_.Refresh();
     gyro_.Refresh();
   }
@@ -311,6 +351,11 @@ class Filter {
   Eigen::MatrixXd p_;
   Eigen::MatrixXd p_initial_;
   Eigen::MatrixXd joseph_;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> h_;
+  // Lever arm estimate (zero when not estimated) and the latest corrected
+  // body rate.
+  Vec3 lever_ = Vec3::Zero();
+  Vec3 rate_ = Vec3::Zero();
   // Accumulated since the last epoch: navigation transition, navigation <-
   // sensor transition, navigation process noise.
   Mat9 a_;
@@ -329,7 +374,9 @@ std::string MissingMotion(const std::string& name) {
       others += others.empty() ? std::string(1, kAxes[i]) : std::string(" or ") + kAxes[i];
   }
   std::ostringstream s;
-  if (name.find("_cross_") != std::string::npos) {
+  if (name.rfind("lever_arm", 0) == 0) {
+    s << "turns about the axes other than " << axis;
+  } else if (name.find("_cross_") != std::string::npos) {
     s << "rotations about all three axes while each is horizontal";
   } else if (accel) {
     s << "the " << axis << " axis pointing up and down: turn the unit about its " << others
@@ -377,7 +424,8 @@ std::vector<std::string> ReportConvergence(const Filter& filter, const ErrorStat
     e.name = layout.names()[j];
     const bool bias = e.name.find("_bias_") != std::string::npos;
     const bool accel = e.name.rfind("accel", 0) == 0;
-    e.unit = bias ? (accel ? "m/s^2" : "rad/s") : "fraction";
+    const bool lever = e.name.rfind("lever_arm", 0) == 0;
+    e.unit = lever ? "m" : bias ? (accel ? "m/s^2" : "rad/s") : "fraction";
     e.value = filter.SensorValue(j);
     e.sigma_initial = std::sqrt(p0(j, j));
     e.sigma_final = std::sqrt(std::max(p(j, j), 0.0));
@@ -507,6 +555,7 @@ bool HandheldKalmanOptions::IsValid(std::string* error) const {
       !positive("hk_gyro_scale_std", gyro_scale_std) ||
       !positive("hk_cross_axis_std", cross_axis_std) ||
       !positive("hk_initial_attitude_std", initial_attitude_std) ||
+      !positive("hk_lever_arm_std", lever_arm_std) ||
       !positive("hk_convergence_fraction", convergence_fraction)) {
     return false;
   }
@@ -607,10 +656,11 @@ bool CalibrateHandheld(const ImuLog& log, const HandheldKalmanOptions& options,
     c.warnings.push_back(s.str());
   }
 
-  const ErrorStateLayout layout(options.accel_terms, options.gyro_terms);
+  const ErrorStateLayout layout(options.accel_terms, options.gyro_terms,
+                                options.estimate_lever_arm);
   const int n = layout.size();
   const int first_sensor = layout.offset(StateBlock::kAccelBias);
-  const int sensor_count = n - first_sensor;
+  const int sensor_count = layout.offset(StateBlock::kLeverArm) - first_sensor;
   // History: t, then value and std of each sensor state.
   EstimateHistory& history = c.history;
   history.columns.push_back("t");

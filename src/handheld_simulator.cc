@@ -290,6 +290,7 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
   Vec3 lever_direction;
   for (int i = 0; i < 3; ++i) lever_direction(i) = n01(rng);
   const Vec3 lever = motion.lever_arm * lever_direction.normalized();
+  out.lever_arm = lever;
 
   const double rate_hz = sensor.sample_rate;
   const double samples = std::floor(total_seconds * rate_hz) + 1.0;

@@ -267,6 +267,54 @@ TEST(HandheldKalman, CrossAxisTermsRecoverAMisalignedImu) {
   EXPECT_LT(rms, 1.4);
 }
 
+TEST(HandheldKalman, LeverArmIsEstimatedWhenAsked) {
+  // The sensor 3 cm from the point the hand turns about: its centripetal
+  // acceleration and circular motion look like accelerometer errors to the
+  // paper's model (error/sigma RMS up to about 3.8); with hk_lever_arm the
+  // pseudo-measurements hold the turning point still and r is a state.
+  const SimulatorOptions sensor = FilterSensor();
+  MotionOptions motion;
+  motion.lever_arm = 0.03;
+  HandheldKalmanOptions options = MatchingOptions(sensor);
+  double sum_z2_without = 0.0;
+  double sum_z2_with = 0.0;
+  int count = 0;
+  for (int seed = 1; seed <= 10; ++seed) {
+    MotionSession s;
+    std::string error;
+    ASSERT_TRUE(SimulateMotion(sensor, motion, seed, &s, &error)) << error;
+    const std::vector<double> truth = TruthVector(s.sensor);
+    Calibration without, with;
+    options.estimate_lever_arm = false;
+    ASSERT_TRUE(CalibrateHandheld(s.sensor.log, options, &without)) << without.message;
+    options.estimate_lever_arm = true;
+    ASSERT_TRUE(CalibrateHandheld(s.sensor.log, options, &with)) << with.message;
+    ASSERT_EQ(with.convergence.entries.size(), 15u);
+    for (int j = 0; j < 15; ++j) {
+      const ConvergenceEntry& e = with.convergence.entries[j];
+      const double t = j < 12 ? truth[j] : s.lever_arm(j - 12);
+      const double z = (e.value - t) / e.sigma_final;
+      EXPECT_LT(std::fabs(z), 3.5) << e.name << " seed " << seed;
+      if (j >= 12) {
+        EXPECT_EQ(e.unit, "m");
+        EXPECT_LT(e.sigma_final, 0.005) << e.name;
+        continue;
+      }
+      sum_z2_with += z * z;
+      const ConvergenceEntry& w = without.convergence.entries[j];
+      sum_z2_without += std::pow((w.value - t) / w.sigma_final, 2);
+      ++count;
+    }
+  }
+  const double rms_with = std::sqrt(sum_z2_with / count);
+  const double rms_without = std::sqrt(sum_z2_without / count);
+  std::printf("lever arm 3 cm: error/sigma RMS %.2f without, %.2f with hk_lever_arm\n", rms_without,
+              rms_with);
+  EXPECT_GT(rms_without, 1.4);
+  EXPECT_GT(rms_with, 0.6);
+  EXPECT_LT(rms_with, 1.3);
+}
+
 TEST(HandheldKalman, RejectsBadInput) {
   const SimulatorOptions sensor = FilterSensor();
   MotionSession s;
@@ -320,15 +368,18 @@ TEST(HandheldKalman, RealFerrarisSessionAgreesWithStaticReferences) {
   calibrate("ferraris_nilspod_handheld.yaml", &handheld);
   calibrate("ferraris_nilspod.yaml", &faces);
   // The accelerometer against the six-face magnitude fit of the same session
-  // (m/s^2 and scale factor). Observed: 0.02 m/s^2 and 0.0015; the filter's
-  // own sigmas (about 0.001 and 1e-4) are too small on this recording (see
-  // README: unmodelled cross-axis terms and a unit carried between faces).
+  // (m/s^2 and scale factor). Observed with the config's cross-axis terms and
+  // lever arm: 0.004 m/s^2 and 0.0004 (the paper's diagonal model: 0.02 and
+  // 0.0015).
+  EXPECT_NEAR(handheld.refinement.chi2 / handheld.refinement.dof, 1.0, 0.5);
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(handheld.accel.model.bias(i), faces.accel.model.bias(i), 0.03) << i;
-    EXPECT_NEAR(handheld.accel.model.upper(i, i), faces.accel.model.matrix()(i, i), 0.003) << i;
+    EXPECT_NEAR(handheld.accel.model.bias(i), faces.accel.model.bias(i), 0.01) << i;
+    EXPECT_NEAR(handheld.accel.model.upper(i, i), faces.accel.model.matrix()(i, i), 0.001) << i;
   }
   // The gyroscope bias against its mean over the six still faces (deg/s;
-  // the Earth rate is below 0.005 deg/s). Observed: up to 0.07 deg/s.
+  // the Earth rate cancels over opposite faces). Observed: 0.009, 0.002 and
+  // 0.04 deg/s, the last 20 times the filter's sigma: something this model
+  // still lacks on the z gyroscope.
   std::ifstream in(dir + "/ferraris_nilspod/sections.json");
   const nlohmann::json sections = nlohmann::json::parse(in);
   Config config;
@@ -348,7 +399,7 @@ TEST(HandheldKalman, RealFerrarisSessionAgreesWithStaticReferences) {
   const Eigen::Vector3d still_mean = sum / count;
   ASSERT_TRUE(handheld.gyro.estimated);
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(handheld.gyro.model.bias(i), still_mean(i), 0.1) << i;
+    EXPECT_NEAR(handheld.gyro.model.bias(i), still_mean(i), 0.06) << i;
     // Scale within 5 % of the factory's deg/s.
     EXPECT_NEAR(handheld.gyro.model.matrix(i, i), M_PI / 180.0, 0.05 * M_PI / 180.0) << i;
   }

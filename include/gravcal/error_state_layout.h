@@ -14,7 +14,8 @@
 //
 // The state vector is
 //   [ attitude error phi (3), velocity error (3), position error (3),
-//     accel bias (3), accel E entries (n_a), gyro bias (3), gyro E entries (n_g) ]
+//     accel bias (3), accel E entries (n_a), gyro bias (3), gyro E entries (n_g),
+//     lever arm (0 or 3) ]
 // 21 states for the paper's model (n_a = n_g = 3, the diagonals). Adding the
 // cross-axis terms is a matter of listing more entries: the filter takes
 // every offset and size from this layout.
@@ -35,6 +36,9 @@ enum class StateBlock {
   kAccelMatrix,
   kGyroBias,
   kGyroMatrix,
+  // Optional: the sensor's position relative to the point the unit turns
+  // about, body frame, m (size 0 when not estimated).
+  kLeverArm,
 };
 
 struct SensorErrorTerms {
@@ -64,7 +68,7 @@ class ErrorStateLayout {
   static constexpr int kNavigationSize = 9;
 
   ErrorStateLayout(const SensorErrorTerms& accel = SensorErrorTerms(),
-                   const SensorErrorTerms& gyro = SensorErrorTerms());
+                   const SensorErrorTerms& gyro = SensorErrorTerms(), bool lever_arm = false);
 
   int size() const { return size_; }
   int offset(StateBlock block) const { return offset_[static_cast<int>(block)]; }
@@ -74,14 +78,14 @@ class ErrorStateLayout {
 
   // One name per state: attitude_x, velocity_x, position_x, accel_bias_x,
   // accel_scale_x (diagonal entry) or accel_cross_xy (entry x, y),
-  // gyro_bias_x, gyro_scale_x, gyro_cross_xy.
+  // gyro_bias_x, gyro_scale_x, gyro_cross_xy, lever_arm_x.
   const std::vector<std::string>& names() const { return names_; }
 
  private:
   SensorErrorTerms accel_;
   SensorErrorTerms gyro_;
-  int offset_[7];
-  int size_of_[7];
+  int offset_[8];
+  int size_of_[8];
   int size_ = 0;
   std::vector<std::string> names_;
 };

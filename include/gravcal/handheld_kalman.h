@@ -50,12 +50,17 @@
 // errors: phi_x = -(C df)_y / g, phi_y = (C df)_x / g. P0 = T D T^T with D the
 // independent priors and T carrying that dependence.
 //
+// Beyond the paper (both off by default): cross-axis terms (accel_terms,
+// gyro_terms) and the lever arm r, the sensor's offset from the point the
+// hand turns about; with r the pseudo-measurements hold that point still:
+//   z_v = v_hat - C_hat (w_hat x r_hat),   z_p = p_hat - C_hat r_hat,
+// linearised in Filter::Update.
+//
 // What it determines: bias and scale of both sensors (12 numbers), with
-// standard deviations from the final covariance of the last pass (`passes`).
-// It cannot determine the
-// cross-axis terms (not in the paper's model; the layout can take them) and
-// nothing about a sensor error the motion did not excite: those keep a
-// standard deviation near their prior and a warning names the missing motion.
+// standard deviations from the final covariance of the last pass (`passes`),
+// and with the options above the cross-axis terms and r. It cannot determine
+// anything the motion did not excite: those keep a standard deviation near
+// their prior and a warning names the missing motion.
 #ifndef GRAVCAL_HANDHELD_KALMAN_H_
 #define GRAVCAL_HANDHELD_KALMAN_H_
 
@@ -125,6 +130,12 @@ struct HandheldKalmanOptions {
   // the previous pass's sensor estimates, which removes the second-order
   // errors of starting far from the truth (see handheld_kalman.cc).
   int passes = 2;
+  // Also estimate the lever arm r: the sensor's position relative to the
+  // point the hand turns about (body frame, m). The pseudo-measurements then
+  // hold that point still instead of the sensor: position p - C r and
+  // velocity v - C (w x r). Off in the paper's model; prior lever_arm_std.
+  bool estimate_lever_arm = false;
+  double lever_arm_std = 0.05;
   // Which sensor error terms are estimated (the paper: scale factors only).
   SensorErrorTerms accel_terms;
   SensorErrorTerms gyro_terms;

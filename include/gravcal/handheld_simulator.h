@@ -81,6 +81,9 @@ struct MotionSession {
   std::vector<Eigen::Quaterniond> attitude;
   std::vector<Eigen::Vector3d> position;
   std::vector<Eigen::Vector3d> velocity;
+  // The sensor's position relative to the point the hand turns about, body
+  // frame, m (MotionOptions::lever_arm in a random direction).
+  Eigen::Vector3d lever_arm = Eigen::Vector3d::Zero();
   // rate_table profile: the constant-rate segments with their true rates.
   std::vector<RateTableSegment> segments;
 };
