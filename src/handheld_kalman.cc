@@ -72,10 +72,19 @@ struct NavigationStep {
   }
 };
 
+StrapdownOptions StrapdownFor(const HandheldKalmanOptions& options, double gravity) {
+  StrapdownOptions s;
+  s.gravity = gravity;
+  s.earth_rate = options.earth_rate;
+  s.latitude_deg = options.gravity.latitude;
+  return s;
+}
+
+// The error-state filter over one pass of the log (see handheld_kalman.h).
 class Filter {
  public:
   Filter(const HandheldKalmanOptions& options, double gravity, const ErrorStateLayout& layout)
-      : options_(options), layout_(layout), gravity_(gravity), strapdown_(MakeStrapdownOptions()) {
+      : options_(options), layout_(layout), strapdown_(StrapdownFor(options, gravity)) {
     const int n = layout_.size();
     p_.setZero(n, n);
     b_.setZero(9, n - 9);
@@ -83,14 +92,6 @@ class Filter {
     q_.setZero();
     joseph_.setZero(n, n);
     h_.setZero(6, n);
-  }
-
-  StrapdownOptions MakeStrapdownOptions() const {
-    StrapdownOptions s;
-    s.gravity = gravity_;
-    s.earth_rate = options_.earth_rate;
-    s.latitude_deg = options_.gravity.latitude;
-    return s;
   }
 
   // Starts from sensor estimates (accel, gyro) at the coarse levelling of
@@ -344,7 +345,6 @@ class Filter {
 
   const HandheldKalmanOptions& options_;
   const ErrorStateLayout& layout_;
-  const double gravity_;
   Strapdown strapdown_;
   SensorEstimate accel_;
   SensorEstimate gyro_;
