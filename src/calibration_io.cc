@@ -112,9 +112,41 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
                    {"chi2", f.chi2},
                    {"dof", f.dof},
                    {"message", f.message}};
+  // Issue 4: per-parameter convergence of recursive methods.
+  if (!c.convergence.entries.empty()) {
+    json entries = json::object();
+    for (const ConvergenceEntry& e : c.convergence.entries) {
+      entries[e.name] = {{"value", Number(e.value)},
+                         {"unit", e.unit},
+                         {"sigma_initial", Number(e.sigma_initial)},
+                         {"sigma_final", Number(e.sigma_final)},
+                         {"converged", e.converged},
+                         {"time_s", Number(e.time)}};
+    }
+    out["convergence"] = {{"criterion", c.convergence.criterion}, {"parameters", entries}};
+  }
   out["warnings"] = c.warnings;
   out["message"] = c.message;
   return out.dump(2) + "\n";
+}
+
+bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error) {
+  const EstimateHistory& h = calibration.history;
+  if (h.rows() == 0) {
+    *error = path + ": method '" + calibration.method + "' has no time history to write";
+    return false;
+  }
+  std::ostringstream s;
+  s.precision(10);
+  for (size_t c = 0; c < h.columns.size(); ++c) s << (c ? "," : "") << h.columns[c];
+  s << "\n";
+  for (size_t r = 0; r < h.rows(); ++r) {
+    for (size_t c = 0; c < h.columns.size(); ++c) {
+      s << (c ? "," : "") << h.values[r * h.columns.size() + c];
+    }
+    s << "\n";
+  }
+  return WriteFileAtomically(path, s.str(), error);
 }
 
 bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,

@@ -151,7 +151,8 @@ const std::vector<KeyHandler>& Handlers() {
       GRAVCAL_STRING(
           "method", "general", method,
           "calibration method: twelve_position (multi-position magnitude fit), ten_position "
-          "(patent, self-aligned), known_attitude (fixture attitudes, --attitudes)"),
+          "(patent, self-aligned), known_attitude (fixture attitudes, --attitudes), "
+          "handheld_kalman (21-state Kalman filter on a handheld log)"),
       GRAVCAL_BOOL("output_covariance", "general", output_covariance,
                    "write accel.covariance into the calibration JSON"),
       // Input.
@@ -361,12 +362,99 @@ const std::vector<KeyHandler>& Handlers() {
                      "zero-velocity measurement standard deviation, m/s"),
       GRAVCAL_BOOL("align_use_gyro", "alignment", ten_position.alignment.use_gyro,
                    "use the gyroscope in the alignment when the log has one"),
-      GRAVCAL_DOUBLE("gyro_nominal_scale", "alignment", ten_position.gyro_nominal_scale,
-                     "rad/s per raw gyroscope unit, for the alignment (1 = rad/s)"),
       GRAVCAL_DOUBLE("sim_latitude", "simulator", simulation.latitude_deg,
                      "the gyroscope senses Earth rate at this latitude, degrees (null = off)"),
       GRAVCAL_DOUBLE("sim_attitude_noise", "simulator", simulation.fixture_attitude_noise_deg,
                      "noise of the fixture attitudes simulate writes (attitudes.csv), degrees"),
+      // Issue 4: handheld Kalman calibration and motion simulator.
+      {{"gyro_nominal_scale", "gyro",
+        "rad/s per raw gyroscope unit before calibration (1 = rad/s, 0.0174533 = deg/s), "
+        "for the alignment and the handheld Kalman filter"},
+       [](const YAML::Node& n, Config* c, std::string* e) {
+         double v = 0.0;
+         if (!GetDouble(n, &v, e)) return false;
+         c->ten_position.gyro_nominal_scale = v;
+         c->handheld.gyro_nominal_scale = v;
+         return true;
+       },
+       [](const Config& c) { return Fmt(c.handheld.gyro_nominal_scale); }},
+      GRAVCAL_DOUBLE("hk_still_seconds", "handheld_kalman", handheld.still_seconds,
+                     "initial still period for roll and pitch, s"),
+      GRAVCAL_INT("hk_passes", "handheld_kalman", handheld.passes,
+                  "passes over the log; later ones start from the previous estimates"),
+      GRAVCAL_DOUBLE("hk_update_interval", "handheld_kalman", handheld.update_interval,
+                     "time between zero-velocity/position updates, s (~ hand motion correlation)"),
+      GRAVCAL_DOUBLE("hk_velocity_noise", "handheld_kalman", handheld.velocity_noise,
+                     "how fast the hand moves the unit, m/s (zero-velocity measurement noise)"),
+      GRAVCAL_DOUBLE("hk_position_noise", "handheld_kalman", handheld.position_noise,
+                     "how far the hand moves the unit, m (zero-position measurement noise)"),
+      GRAVCAL_DOUBLE("hk_accel_noise_density", "handheld_kalman", handheld.accel_noise_density,
+                     "accelerometer noise density, m/s^2/sqrt(Hz) (Allan deviation at 1 s)"),
+      GRAVCAL_DOUBLE("hk_gyro_noise_density", "handheld_kalman", handheld.gyro_noise_density,
+                     "gyroscope noise density, rad/s/sqrt(Hz) (Allan deviation at 1 s)"),
+      GRAVCAL_DOUBLE("hk_accel_bias_walk", "handheld_kalman", handheld.accel_bias_walk,
+                     "accelerometer bias random walk, m/s^2/sqrt(s) (0 = constant)"),
+      GRAVCAL_DOUBLE("hk_gyro_bias_walk", "handheld_kalman", handheld.gyro_bias_walk,
+                     "gyroscope bias random walk, rad/s/sqrt(s) (0 = constant)"),
+      GRAVCAL_DOUBLE("hk_accel_bias_std", "handheld_kalman", handheld.accel_bias_std,
+                     "prior accelerometer bias, m/s^2"),
+      GRAVCAL_DOUBLE("hk_accel_scale_std", "handheld_kalman", handheld.accel_scale_std,
+                     "prior accelerometer scale-factor error (fraction)"),
+      GRAVCAL_DOUBLE("hk_gyro_bias_std", "handheld_kalman", handheld.gyro_bias_std,
+                     "prior gyroscope bias, rad/s"),
+      GRAVCAL_DOUBLE("hk_gyro_scale_std", "handheld_kalman", handheld.gyro_scale_std,
+                     "prior gyroscope scale-factor error (fraction)"),
+      {{"hk_cross_axis", "handheld_kalman",
+        "also estimate cross-axis terms (accelerometer upper-triangular, gyroscope full)"},
+       [](const YAML::Node& n, Config* c, std::string* e) {
+         bool on = false;
+         if (!GetBool(n, &on, e)) return false;
+         c->handheld.accel_terms =
+             on ? SensorErrorTerms::ScaleAndUpperCrossAxis() : SensorErrorTerms::ScaleOnly();
+         c->handheld.gyro_terms =
+             on ? SensorErrorTerms::ScaleAndCrossAxis() : SensorErrorTerms::ScaleOnly();
+         return true;
+       },
+       [](const Config& c) {
+         return std::string(c.handheld.gyro_terms.matrix_entries.size() > 3 ? "true" : "false");
+       }},
+      GRAVCAL_DOUBLE("hk_cross_axis_std", "handheld_kalman", handheld.cross_axis_std,
+                     "prior cross-axis term (with hk_cross_axis), rad"),
+      GRAVCAL_BOOL("hk_lever_arm", "handheld_kalman", handheld.estimate_lever_arm,
+                   "also estimate the sensor's offset from the point the hand turns about"),
+      GRAVCAL_DOUBLE("hk_lever_arm_std", "handheld_kalman", handheld.lever_arm_std,
+                     "prior lever arm (with hk_lever_arm), m"),
+      GRAVCAL_DOUBLE("hk_initial_attitude_std", "handheld_kalman", handheld.initial_attitude_std,
+                     "initial roll/pitch error beyond the accelerometer's, rad"),
+      GRAVCAL_BOOL("hk_earth_rate", "handheld_kalman", handheld.earth_rate,
+                   "include the Earth rate (needs latitude)"),
+      GRAVCAL_DOUBLE("hk_convergence_fraction", "handheld_kalman", handheld.convergence_fraction,
+                     "converged once estimate (vs final) and sigma stay below this x prior sigma; "
+                     "not determined when the final sigma is above it"),
+      GRAVCAL_STRING("sim_motion", "motion simulator", sim_motion,
+                     "simulate: handheld, turntable, vertical or rate_table (empty = sim_scheme)"),
+      GRAVCAL_DOUBLE("hh_initial_still", "motion simulator", motion.initial_still_seconds,
+                     "still at the start, s"),
+      GRAVCAL_DOUBLE("hh_final_still", "motion simulator", motion.final_still_seconds,
+                     "still at the end, s"),
+      GRAVCAL_DOUBLE("hh_seconds_per_axis", "motion simulator", motion.seconds_per_axis,
+                     "turning time per axis (rate table: per direction), s"),
+      GRAVCAL_DOUBLE("hh_rate", "motion simulator", motion.rate_dps, "mean turning rate, deg/s"),
+      GRAVCAL_DOUBLE("hh_rate_variation", "motion simulator", motion.rate_variation,
+                     "handheld: relative variation of the hand's rate"),
+      GRAVCAL_DOUBLE("hh_axis_wobble", "motion simulator", motion.axis_wobble_deg,
+                     "handheld: rms wobble of the turning axis, deg"),
+      GRAVCAL_DOUBLE("hh_sway", "motion simulator", motion.sway, "hand sway, m rms per axis"),
+      GRAVCAL_DOUBLE("hh_sway_hz", "motion simulator", motion.sway_hz,
+                     "highest hand sway frequency, Hz"),
+      GRAVCAL_DOUBLE("hh_tremor", "motion simulator", motion.tremor,
+                     "hand tremor (8-12 Hz), m/s^2 rms per axis"),
+      GRAVCAL_DOUBLE("hh_angular_tremor", "motion simulator", motion.angular_tremor,
+                     "hand tremor (8-12 Hz), rad/s rms per axis"),
+      GRAVCAL_INT("hh_rounds", "motion simulator", motion.rounds,
+                  "times through the x, y, z turns"),
+      GRAVCAL_DOUBLE("hh_lever_arm", "motion simulator", motion.lever_arm,
+                     "sensor distance from the point the hand turns about, m"),
   };
   return handlers;
 }
@@ -395,12 +483,25 @@ bool SetNode(const std::string& key, const YAML::Node& node, Config* config, std
 }  // namespace
 
 bool Config::IsValid(std::string* error) const {
-  if (method != "twelve_position" && method != "ten_position" && method != "known_attitude") {
+  if (method != "twelve_position" && method != "ten_position" && method != "known_attitude" &&
+      method != "handheld_kalman") {
     *error = "key 'method': unknown method '" + method +
-             "' (available: twelve_position, ten_position, known_attitude)";
+             "' (available: twelve_position, ten_position, known_attitude, handheld_kalman)";
     return false;
   }
   std::string what;
+  if (method == "handheld_kalman") {
+    HandheldKalmanOptions h = handheld;
+    h.gravity = calibration.gravity;
+    h.accel_nominal_scale = calibration.nominal_scale;
+    if (!h.IsValid(error)) return false;
+  }
+  MotionProfile profile;
+  if (!sim_motion.empty() && !FromString(sim_motion, &profile)) {
+    *error = "key 'sim_motion': must be empty, handheld, turntable, vertical or rate_table";
+    return false;
+  }
+  if (!motion.IsValid(error)) return false;
   if (!input.IsValid(&what)) {
     *error = "input: " + what;
     return false;

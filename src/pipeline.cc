@@ -1,6 +1,7 @@
 #include "gravcal/pipeline.h"
 
 #include "gravcal/gyro_calibration.h"
+#include "gravcal/handheld_kalman.h"
 #include "gravcal/known_attitude.h"
 #include "gravcal/ten_position.h"
 
@@ -26,6 +27,14 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
   }
   if (config.method == "known_attitude") {
     return CalibrateKnownAttitude(input.log, input.attitudes_path, config.calibration, calibration);
+  }
+  if (config.method == "handheld_kalman") {
+    HandheldKalmanOptions options = config.handheld;
+    options.gravity = config.calibration.gravity;
+    options.accel_nominal_scale = config.calibration.nominal_scale;
+    const bool ok = CalibrateHandheld(input.log, options, calibration);
+    calibration->method = config.method;
+    return ok;
   }
   calibration->message = "key 'method': unknown method '" + config.method + "'";
   return false;

@@ -8,6 +8,8 @@
 #include <random>
 #include <sstream>
 
+#include "gravcal/gravity.h"
+
 namespace gravcal {
 namespace {
 
@@ -255,9 +257,8 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   // Earth rotation in the navigation frame (East-North-Up), when on.
   Eigen::Vector3d earth_rate_nav = Eigen::Vector3d::Zero();
   if (std::isfinite(options.latitude_deg)) {
-    constexpr double kEarthRotation = 7.2921151467e-5;
     const double lat = options.latitude_deg * kPi / 180.0;
-    earth_rate_nav = kEarthRotation * Eigen::Vector3d(0.0, std::cos(lat), std::sin(lat));
+    earth_rate_nav = kEarthRate * Eigen::Vector3d(0.0, std::cos(lat), std::sin(lat));
   }
   const double accel_noise = options.accel_noise * s.accel_units_per_si;
   const double gyro_noise = options.gyro_noise * s.gyro_units_per_si;

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -250,6 +251,64 @@ TEST_F(CliTest, CalibratesTheGyroscopeAndRejectsALogWithoutOne) {
   EXPECT_NE(bad.err.find("nogyro.csv: the log has no gyroscope columns"), std::string::npos)
       << bad.err;
   EXPECT_FALSE(Exists(missing));
+}
+
+// Issue 4: the handheld Kalman method end to end, from a simulated handheld
+// session in counts, with the time history.
+TEST_F(CliTest, HandheldKalmanWritesCalibrationAndHistory) {
+  const std::string sim = dir_ + "/handheld";
+  RunResult r =
+      Run("simulate --sim_motion handheld --sim_accel_misalignment 0 "
+          "--sim_gyro_misalignment 0 --seed 3 --output-dir " +
+          sim);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string config = testing_util::SourceDir() + "/configs/handheld_kalman.yaml";
+  const std::string calib = dir_ + "/calib.json";
+  const std::string history = dir_ + "/history.csv";
+  const std::string scales =
+      " --nominal_scale 0.00059855 --gyro_nominal_scale 0.000133231 "
+      "--gravity 9.80665 ";
+  r = Run("calibrate --input " + sim + "/raw.csv --config " + config + scales + "--output " +
+          calib + " --history " + history);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(Slurp(calib));
+  const nlohmann::json truth = nlohmann::json::parse(Slurp(sim + "/truth.json"));
+  EXPECT_EQ(j["method"], "handheld_kalman");
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(j["gyro"]["bias"][i].get<double>(), truth["gyro"]["bias"][i].get<double>(),
+                4.0 * j["gyro"]["std"]["bias"][i].get<double>());
+    EXPECT_NEAR(j["accel"]["matrix"][i][i].get<double>(),
+                truth["accel"]["matrix"][i][i].get<double>(),
+                4.0 * j["accel"]["std"]["matrix"][i][i].get<double>());
+  }
+  EXPECT_TRUE(j["convergence"]["parameters"]["accel_bias_x"]["converged"].get<bool>());
+  const std::string csv = Slurp(history);
+  EXPECT_EQ(csv.rfind("t,accel_bias_x,accel_bias_x_std,", 0), 0u) << csv.substr(0, 80);
+  EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 100);
+
+  // --history with a method that has none: one line, no output at all.
+  const std::string calib2 = dir_ + "/calib2.json";
+  const std::string history2 = dir_ + "/history2.csv";
+  r = Run("calibrate --input " + Simulated() + " --config " + Config() + " --output " + calib2 +
+          " --history " + history2);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("no time history"), std::string::npos) << r.err;
+  EXPECT_FALSE(Exists(calib2));
+  EXPECT_FALSE(Exists(history2));
+  // A history that cannot be written: no calibration file either.
+  r = Run("calibrate --input " + sim + "/raw.csv --config " + config + scales + "--output " +
+          calib2 + " --history " + dir_ + "/missing/history.csv");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("missing/history.csv"), std::string::npos) << r.err;
+  EXPECT_FALSE(Exists(calib2));
+  // A log without a gyroscope.
+  std::string still = "t,ax,ay,az\n";
+  for (int i = 0; i < 1000; ++i) still += std::to_string(0.01 * i) + ",0.1,0.2,9.8\n";
+  r = Run("calibrate --input " + Write("still.csv", still) + " --config " + config + " --output " +
+          calib2);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("needs a gyroscope"), std::string::npos) << r.err;
+  EXPECT_FALSE(Exists(calib2));
 }
 
 }  // namespace

@@ -119,6 +119,34 @@ struct PositionReport {
   double pitch_std_deg = NAN;
 };
 
+// Issue 4: results of recursive estimators (the handheld Kalman filter).
+// Time history: one row per filter epoch, `columns` names them (first "t",
+// seconds), values row-major. Empty for batch methods.
+struct EstimateHistory {
+  std::vector<std::string> columns;
+  std::vector<double> values;
+  size_t rows() const { return columns.empty() ? 0 : values.size() / columns.size(); }
+};
+
+// When each estimated parameter converged, by the method's stated criterion.
+struct ConvergenceEntry {
+  std::string name;
+  // Final estimate and its standard deviation at the start and at the end,
+  // in the method's own units (see `unit`).
+  double value = NAN;
+  double sigma_initial = NAN;
+  double sigma_final = NAN;
+  std::string unit;
+  // Seconds from the start of the log; NaN when it did not converge.
+  double time = NAN;
+  bool converged = false;
+};
+
+struct ConvergenceReport {
+  std::string criterion;
+  std::vector<ConvergenceEntry> entries;
+};
+
 struct Calibration {
   bool success = false;
   // The refinement ran and did not converge (the coarse result is kept).
@@ -141,6 +169,9 @@ struct Calibration {
   std::string solver_name;
   std::vector<std::string> warnings;
   std::string message = "Calibrate was not called";
+  // Issue 4: filled by recursive methods only.
+  EstimateHistory history;
+  ConvergenceReport convergence;
 };
 
 // From a raw log: detects the static positions, then CalibrateFromPositions.

@@ -20,6 +20,11 @@ std::string CalibrationToJson(const Calibration& calibration, bool include_covar
 bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,
                           const std::string& path, std::string* error);
 
+// Issue 4: the time history of a recursive method (calibration.history) as
+// CSV: a header row with the column names, then one row per epoch. Fails
+// (naming the path) when there is no history or the file cannot be written.
+bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error);
+
 // What `apply` needs from a calibration file: the accelerometer model and,
 // when the file has one, the gyroscope model.
 struct LoadedCalibration {

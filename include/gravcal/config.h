@@ -14,6 +14,8 @@
 
 #include "gravcal/calibration.h"
 #include "gravcal/gyro_calibration.h"
+#include "gravcal/handheld_kalman.h"
+#include "gravcal/handheld_simulator.h"
 #include "gravcal/log_reader.h"
 #include "gravcal/simulator.h"
 #include "gravcal/ten_position.h"
@@ -35,6 +37,13 @@ struct Config {
   TenPositionOptions ten_position;
   // Write accel.covariance into the calibration JSON.
   bool output_covariance = true;
+  // Issue 4: the handheld Kalman calibration (method handheld_kalman; its
+  // gravity and accelerometer nominal scale come from `calibration`), and
+  // the motion simulator used by `gravcal simulate` when sim_motion names a
+  // profile (empty = the multi-position scheme).
+  HandheldKalmanOptions handheld;
+  MotionOptions motion;
+  std::string sim_motion;
 
   bool IsValid(std::string* error) const;
 };

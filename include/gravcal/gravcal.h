@@ -30,5 +30,11 @@
 #include "gravcal/static_alignment.h"
 #include "gravcal/static_detector.h"
 #include "gravcal/ten_position.h"
+// Issue 4: handheld Kalman calibration.
+#include "gravcal/error_state_layout.h"
+#include "gravcal/handheld_kalman.h"
+#include "gravcal/handheld_simulator.h"
+#include "gravcal/rate_table.h"
+#include "gravcal/strapdown.h"
 
 #endif  // GRAVCAL_GRAVCAL_H_

@@ -15,6 +15,8 @@
 namespace gravcal {
 
 constexpr double kStandardGravity = 9.80665;
+// Earth rotation rate, rad/s (WGS84: 7.292115e-5; the IERS value below).
+constexpr double kEarthRate = 7.2921151467e-5;
 
 // Normal gravity in m/s^2 at geodetic latitude (degrees, -90..90) and
 // ellipsoidal height (metres).

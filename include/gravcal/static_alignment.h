@@ -51,10 +51,9 @@
 #include <string>
 #include <vector>
 
-namespace gravcal {
+#include "gravcal/gravity.h"
 
-// Earth rotation rate, rad/s.
-constexpr double kEarthRate = 7.2921151467e-5;
+namespace gravcal {
 
 struct StaticAlignmentOptions {
   // Local gravity, m/s^2.

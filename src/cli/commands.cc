@@ -8,6 +8,7 @@
 #include "gravcal/attitude_fixture.h"
 #include "gravcal/calibration.h"
 #include "gravcal/calibration_io.h"
+#include "gravcal/handheld_simulator.h"
 #include "gravcal/log_reader.h"
 #include "gravcal/pipeline.h"
 #include "gravcal/simulator.h"
@@ -112,7 +113,9 @@ int RunCalibrate(const CommandArgs& args) {
   PrintWarnings(c);
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
+  if (!args.history.empty() && !WriteHistoryCsv(c, args.history, &error)) return Fail(error);
   if (!WriteCalibrationJson(c, args.config.output_covariance, args.output, &error)) {
+    if (!args.history.empty()) std::remove(args.history.c_str());
     return Fail(error);
   }
   std::fprintf(stderr, "gravcal: %s; |a| - g rms %.5f -> %.5f m/s^2; wrote %s\n", c.message.c_str(),
@@ -143,7 +146,17 @@ int RunSimulate(const CommandArgs& args) {
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
   SimulatedSession session;
-  if (!Simulate(args.config.simulation, args.seed, &session, &error)) return Fail(error);
+  if (!args.config.sim_motion.empty()) {
+    MotionOptions motion = args.config.motion;
+    FromString(args.config.sim_motion, &motion.profile);
+    MotionSession moving;
+    if (!SimulateMotion(args.config.simulation, motion, args.seed, &moving, &error)) {
+      return Fail(error);
+    }
+    session = std::move(moving.sensor);
+  } else if (!Simulate(args.config.simulation, args.seed, &session, &error)) {
+    return Fail(error);
+  }
   mkdir(args.output_dir.c_str(), 0755);
   struct stat st;
   if (stat(args.output_dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {

@@ -20,6 +20,8 @@ struct CommandArgs {
   std::string config_path;
   // known_attitude: the attitudes CSV.
   std::string attitudes;
+  // calibrate: the time history CSV of recursive methods (--history).
+  std::string history;
   uint64_t seed = 1;
   // batch and merge-summaries.
   std::string manifest;

@@ -33,6 +33,7 @@ DEFINE_double(outlier_sigmas, gravcal::FleetOptions().outlier_sigmas,
 DEFINE_int32(outlier_min_units, gravcal::FleetOptions().min_units,
              "batch: fewest calibrated units for the outlier check");
 DEFINE_string(attitudes, "", "known_attitude: CSV of each static position's roll and pitch");
+DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
 
 namespace {
 
@@ -48,8 +49,9 @@ const std::vector<CommandInfo>& Commands() {
        "simulate a twelve-position session in raw counts, calibrate it, print estimate vs truth",
        {"config", "seed"}},
       {"calibrate",
-       "calibrate the accelerometer from a multi-position log",
-       {"input", "config", "output", "attitudes"}},
+       "calibrate the accelerometer from a multi-position log (or, with method "
+       "handheld_kalman, both sensors from a handheld log)",
+       {"input", "config", "output", "attitudes", "history"}},
       {"apply",
        "apply a calibration to a raw log, writing SI units",
        {"calibration", "input", "output"}},
@@ -208,6 +210,7 @@ int main(int argc, char** argv) {
   args.outlier_min_units = FLAGS_outlier_min_units;
   args.positional = positional;
   args.attitudes = FLAGS_attitudes;
+  args.history = FLAGS_history;
 
   if (command == "demo") return gravcal::cli::RunDemo(args);
   if (command == "calibrate") return gravcal::cli::RunCalibrate(args);
