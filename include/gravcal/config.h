@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gravcal/calibration.h"
+#include "gravcal/discovery.h"
 #include "gravcal/log_reader.h"
 #include "gravcal/simulator.h"
 
@@ -27,6 +28,10 @@ struct Config {
   SimulatorOptions simulation;
   // Write accel.covariance into the calibration JSON.
   bool output_covariance = true;
+  // Issue 6: effects beyond the textbook model fitted by `calibrate` (and
+  // already in the baseline of `discover`), and the discovery workflow.
+  std::vector<Effect> effects;
+  DiscoveryOptions discovery;
 
   bool IsValid(std::string* error) const;
 };

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "gravcal/accel_model.h"
+#include "gravcal/calibration.h"
 #include "gravcal/gyro_model.h"
 #include "gravcal/model_effects.h"
 #include "gravcal/position.h"
@@ -136,6 +137,16 @@ double AccelSigma(const EffectFitResult& fit, const StaticObservation& observati
 // squared norm.
 Eigen::Vector3d GyroResidual(const EffectFitResult& fit, const StaticObservation& observation,
                              const Eigen::Vector3d& force, double* whitened_squared);
+
+// Adds `effects` to a finished calibration of `log` (CalibrateAccelerometer
+// with `options`): fits the model with them from the calibration's model and
+// replaces the accelerometer bias, U, their standard deviations and
+// covariance, the residuals, and (for gyroscope effects) the gyroscope bias;
+// fills calibration->effects. The rotation R is kept. Returns false with
+// calibration->message when the effects cannot be fitted (not identified by
+// the positions, no temperature, no gyroscope, too few positions).
+bool FitCalibrationEffects(const ImuLog& log, const CalibrationOptions& options,
+                           const std::vector<Effect>& effects, Calibration* calibration);
 
 }  // namespace gravcal
 

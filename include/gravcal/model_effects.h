@@ -119,6 +119,14 @@ struct EffectEstimate {
   std::string unit;
 };
 
+// The effects of a calibration (calibration JSON key `effects`).
+struct EffectCalibration {
+  std::vector<EffectEstimate> estimates;
+  // T_ref (degrees C; NaN without temperature) and t_ref (s, log time).
+  double reference_temperature = NAN;
+  double reference_time = NAN;
+};
+
 // ---------------------------------------------------------------------------
 // The terms, templated so that Ceres autodiff residuals can use them. Each
 // works on one 3-vector in place.

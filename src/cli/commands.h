@@ -17,6 +17,8 @@ struct CommandArgs {
   std::string output_dir;
   std::string calibration;
   std::string config_path;
+  // discover: the HTML report to write (optional).
+  std::string report;
   uint64_t seed = 1;
 };
 
@@ -24,6 +26,7 @@ int RunDemo(const CommandArgs& args);
 int RunCalibrate(const CommandArgs& args);
 int RunApply(const CommandArgs& args);
 int RunSimulate(const CommandArgs& args);
+int RunDiscover(const CommandArgs& args);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

@@ -21,6 +21,7 @@ DEFINE_string(output_dir, "", "folder to write simulated raw.csv and truth.json 
 DEFINE_string(config, "", "YAML config file (configs/*.yaml)");
 DEFINE_string(calibration, "", "calibration JSON to apply");
 DEFINE_uint64(seed, 1, "random seed of the simulator");
+DEFINE_string(report, "", "HTML report to write (discover)");
 
 namespace {
 
@@ -42,6 +43,9 @@ const std::vector<CommandInfo>& Commands() {
        "apply a calibration to a raw log, writing SI units",
        {"calibration", "input", "output"}},
       {"simulate", "simulate a session: raw.csv and truth.json", {"config", "seed", "output_dir"}},
+      {"discover",
+       "find the effects the model misses: discovery.json and an HTML report",
+       {"input", "config", "output", "report"}},
       {"help", "list commands, or the flags and config keys of one: gravcal help <command>", {}},
   };
   return commands;
@@ -171,9 +175,11 @@ int main(int argc, char** argv) {
   args.output_dir = FLAGS_output_dir;
   args.calibration = FLAGS_calibration;
   args.seed = FLAGS_seed;
+  args.report = FLAGS_report;
 
   if (command == "demo") return gravcal::cli::RunDemo(args);
   if (command == "calibrate") return gravcal::cli::RunCalibrate(args);
   if (command == "apply") return gravcal::cli::RunApply(args);
+  if (command == "discover") return gravcal::cli::RunDiscover(args);
   return gravcal::cli::RunSimulate(args);
 }
