@@ -337,6 +337,8 @@ const std::vector<KeyHandler>& Handlers() {
                     [](auto* c) { return &c->discovery.candidates; }),
       GRAVCAL_DOUBLE("discovery_significance", "effects", discovery.significance,
                      "family-wise significance level of one discovery step"),
+      GRAVCAL_DOUBLE("discovery_min_bic_gain", "effects", discovery.min_bic_gain,
+                     "BIC decrease a candidate must bring (10 = very strong evidence)"),
       GRAVCAL_DOUBLE("discovery_ambiguity_bic", "effects", discovery.ambiguity_bic,
                      "candidates within this delta BIC of the best are reported as ambiguous"),
       GRAVCAL_INT("discovery_max_steps", "effects", discovery.max_steps,

@@ -412,6 +412,10 @@ bool DiscoveryOptions::IsValid(std::string* error) const {
     *error = "discovery_significance: must be between 0 and 1";
     return false;
   }
+  if (!(min_bic_gain >= 0.0)) {
+    *error = "discovery_min_bic_gain: must be zero or positive";
+    return false;
+  }
   if (!(ambiguity_bic >= 0.0)) {
     *error = "discovery_ambiguity_bic: must be zero or positive";
     return false;
@@ -628,7 +632,9 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
       std::ostringstream why;
       why.precision(3);
       if (!(c.p_value < alpha)) why << "p = " << c.p_value << " not below " << alpha << "; ";
-      if (!(c.delta_bic < 0.0)) why << "delta BIC = " << c.delta_bic << " not negative; ";
+      if (!(c.delta_bic < -options.min_bic_gain)) {
+        why << "delta BIC = " << c.delta_bic << " not below " << -options.min_bic_gain << "; ";
+      }
       if (!(after < before)) {
         why << "cross-validated gap " << after << " sigma not below " << before << "; ";
       }

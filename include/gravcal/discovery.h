@@ -18,8 +18,8 @@
 //    - delta BIC = (chi2_new - chi2_old) / phi + p ln(n);
 //    - leave-one-position-out cross-validation: every position predicted by
 //      a fit without it; the effect must lower the cross-validated gap.
-//    Significant = p below significance / (candidates tried), delta BIC < 0
-//    and a smaller cross-validated gap. The significant candidate with the
+//    Significant = p below significance / (candidates tried), delta BIC
+//    below -min_bic_gain and a smaller cross-validated gap. The significant candidate with the
 //    lowest delta BIC is named; others within ambiguity_bic of it explain
 //    the data almost as well and are reported as ambiguous with advice on
 //    the recording that would separate them.
@@ -50,6 +50,10 @@ struct DiscoveryOptions {
   // Family-wise significance level of one step (divided among the
   // candidates tried).
   double significance = 0.01;
+  // A candidate must lower the BIC by at least this much: 10 is "very
+  // strong" evidence on the Kass-Raftery scale (6 "strong"). Borderline
+  // evidence would make the verdict flip when one position is left out.
+  double min_bic_gain = 10.0;
   // Candidates whose delta BIC is within this of the best are ambiguous.
   double ambiguity_bic = 10.0;
   // Most effects added.
