@@ -369,39 +369,53 @@ std::vector<Eigen::Vector3d> Residuals(const EffectFitResult& fit, bool accel) {
   return r;
 }
 
-// The plot's regressor: temperature, time, or the fitted effect's own
-// contribution to the residual (orientation effects).
+// The plots' x values: the effect's regressor (temperature, time) and the
+// fitted effect's own contribution to each position's residual (for the
+// accelerometer the change of |a| - g it makes, in component 0; for the
+// gyroscope its offset per axis). Orientation effects have no scalar
+// regressor: their contribution is it (its norm for the gyroscope).
 void FillRegressor(const Context& ctx, const EffectFitResult& with, Effect e, DiscoveryStep* step) {
   const std::vector<StaticObservation>& obs = *ctx.observations;
   const EffectInfo& info = Info(e);
-  step->regressor.clear();
-  if (info.regressor == EffectRegressor::kTemperature) {
-    step->regressor_name = "temperature, degC";
-    for (const StaticObservation& o : obs) step->regressor.push_back(o.temperature());
-    return;
-  }
-  if (info.regressor == EffectRegressor::kTime) {
-    step->regressor_name = "time, s";
-    for (const StaticObservation& o : obs) step->regressor.push_back(o.time());
-    return;
-  }
-  step->regressor_name = std::string("fitted ") + info.name + " contribution";
   EffectFitResult without = with;
   if (e == Effect::kAccelMisalignment) {
     without.accel.upper(0, 1) = without.accel.upper(0, 2) = without.accel.upper(1, 2) = 0.0;
   }
   without.effects.erase(std::remove(without.effects.begin(), without.effects.end(), e),
                         without.effects.end());
+  step->regressor.clear();
+  step->contribution.clear();
   for (size_t k = 0; k < obs.size(); ++k) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
     if (info.sensor == EffectSensor::kAccelerometer) {
-      step->regressor.push_back(AccelResidual(without, obs[k], ctx.gravity, nullptr) -
-                                AccelResidual(with, obs[k], ctx.gravity, nullptr));
+      c(0) = AccelResidual(without, obs[k], ctx.gravity, nullptr) -
+             AccelResidual(with, obs[k], ctx.gravity, nullptr);
     } else {
-      // The largest component of G f.
-      const Eigen::Vector3d c =
-          GyroOffset(with.parameters, {e}, with.forces[k], obs[k].temperature(), obs[k].time());
-      step->regressor.push_back(c.norm());
+      c = GyroOffset(with.parameters, {e}, with.forces[k], obs[k].temperature(), obs[k].time());
     }
+    step->contribution.push_back(c);
+    switch (info.regressor) {
+      case EffectRegressor::kTemperature:
+        step->regressor.push_back(obs[k].temperature());
+        break;
+      case EffectRegressor::kTime:
+        step->regressor.push_back(obs[k].time());
+        break;
+      case EffectRegressor::kOrientation:
+        step->regressor.push_back(info.sensor == EffectSensor::kAccelerometer ? c(0) : c.norm());
+        break;
+    }
+  }
+  switch (info.regressor) {
+    case EffectRegressor::kTemperature:
+      step->regressor_name = "temperature, degC";
+      break;
+    case EffectRegressor::kTime:
+      step->regressor_name = "time, s";
+      break;
+    case EffectRegressor::kOrientation:
+      step->regressor_name = std::string("fitted ") + info.name + " contribution";
+      break;
   }
 }
 

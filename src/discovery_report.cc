@@ -369,6 +369,32 @@ std::string CandidatesTable(const std::vector<CandidateScore>& scores) {
   return s.str();
 }
 
+// Residuals before and after a step against its regressor (or against the
+// effect's own contribution), one pair of series per axis.
+std::vector<Series> BeforeAfter(const DiscoveryStep& s, bool accel, bool against_contribution) {
+  std::vector<Series> series;
+  const char* colors_before[3] = {"#9bb7d6", "#d6b79b", "#a8d69b"};
+  const char* colors_after[3] = {"#1f4e8c", "#8c4e1f", "#2f7a1f"};
+  for (int axis = 0; axis < (accel ? 1 : 3); ++axis) {
+    Series b, a;
+    const std::string suffix = accel ? "" : std::string(" ") + "xyz"[axis];
+    b.name = "before" + suffix;
+    a.name = "after" + suffix;
+    b.color = colors_before[axis];
+    a.color = colors_after[axis];
+    for (size_t k = 0; k < s.regressor.size(); ++k) {
+      const double x = against_contribution ? s.contribution[k](axis) : s.regressor[k];
+      b.x.push_back(x);
+      a.x.push_back(x);
+      b.y.push_back(s.residual_before[k](axis));
+      a.y.push_back(s.residual_after[k](axis));
+    }
+    series.push_back(b);
+    series.push_back(a);
+  }
+  return series;
+}
+
 }  // namespace
 
 std::string DiscoveryToJson(const DiscoveryResult& r) {
@@ -513,27 +539,13 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
         << "</td></tr>";
     }
     h << "</table>";
-    std::vector<Series> series;
-    const char* colors_before[3] = {"#9bb7d6", "#d6b79b", "#a8d69b"};
-    const char* colors_after[3] = {"#1f4e8c", "#8c4e1f", "#2f7a1f"};
-    for (int axis = 0; axis < (accel ? 1 : 3); ++axis) {
-      Series b, a;
-      const std::string suffix = accel ? "" : std::string(" ") + "xyz"[axis];
-      b.name = "before" + suffix;
-      a.name = "after" + suffix;
-      b.color = colors_before[axis];
-      a.color = colors_after[axis];
-      for (size_t k = 0; k < s.regressor.size(); ++k) {
-        b.x.push_back(s.regressor[k]);
-        a.x.push_back(s.regressor[k]);
-        b.y.push_back(s.residual_before[k](axis));
-        a.y.push_back(s.residual_after[k](axis));
-      }
-      series.push_back(b);
-      series.push_back(a);
+    const std::string y = accel ? "|a| - g, m/s^2" : "gyro residual, raw units";
+    h << Scatter("residual against " + s.regressor_name, s.regressor_name, y,
+                 BeforeAfter(s, accel, false));
+    if (Info(s.effect).regressor != EffectRegressor::kOrientation) {
+      h << Scatter("residual against the fitted effect", "fitted effect contribution", y,
+                   BeforeAfter(s, accel, true));
     }
-    h << Scatter("residual against " + s.regressor_name, s.regressor_name,
-                 accel ? "|a| - g, m/s^2" : "gyro residual, raw units", series);
     h << "<h3>Candidates tried</h3>" << CandidatesTable(s.candidates) << "\n";
   }
 

@@ -31,7 +31,7 @@ bool IsAccelEffect(Effect e) { return Info(e).sensor == EffectSensor::kAccelerom
 
 ceres::Solver::Options SolverOptions(const EffectFitOptions& o) {
   ceres::Solver::Options s;
-  s.linear_solver_type = ceres::DENSE_QR;
+  s.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   s.max_num_iterations = o.max_iterations;
   s.function_tolerance = o.function_tolerance;
   s.gradient_tolerance = o.gradient_tolerance;
@@ -198,11 +198,12 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
     double jb[3], ju[6], je[4][3];
     double* jacobians[6] = {jb, ju, je[0], je[1], je[2], je[3]};
     const double* params[6] = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
-    if (!owned[k]->Evaluate(params, &r, jacobians)) {
+    if (!owned[k]->Evaluate(params, &r, options.compute_covariance ? jacobians : nullptr)) {
       result->message = "accelerometer effect fit: the model has no value at a position";
       return false;
     }
     fit.chi2 += r * r;
+    if (!options.compute_covariance) continue;
     int col = 0;
     for (int i = 0; i < 3; ++i) jacobian(k, col++) = jb[i];
     for (int i : upper_free) jacobian(k, col++) = ju[i];
@@ -320,9 +321,10 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
     double jb[9], jg[27], jt[9], jd[9];
     double* jacobians[4] = {jb, jg, jt, jd};
     const double* params[4] = {bias, g, temperature_bias, drift};
-    owned[k]->Evaluate(params, r, jacobians);
+    owned[k]->Evaluate(params, r, options.compute_covariance ? jacobians : nullptr);
     for (int row = 0; row < 3; ++row) {
       fit.chi2 += r[row] * r[row];
+      if (!options.compute_covariance) continue;
       int col = 0;
       for (int i = 0; i < 3; ++i) jacobian(3 * k + row, col++) = jb[3 * row + i];
       if (on_g) {

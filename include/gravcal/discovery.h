@@ -181,6 +181,10 @@ struct DiscoveryStep {
   std::vector<double> regressor;
   std::vector<Eigen::Vector3d> residual_before;
   std::vector<Eigen::Vector3d> residual_after;
+  // The fitted effect's own contribution to each position's residual (the
+  // accelerometer's in component 0): the residual before lies along it,
+  // the residual after does not.
+  std::vector<Eigen::Vector3d> contribution;
 };
 
 struct Ambiguity {
