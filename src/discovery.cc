@@ -419,6 +419,123 @@ void FillRegressor(const Context& ctx, const EffectFitResult& with, Effect e, Di
   }
 }
 
+// The likelihood-ratio p-value and delta BIC of every candidate tried.
+// The noise scale: when the current model extended by all candidates of a
+// sensor at once fits that sensor's data to its own noise (chi2 test, p >=
+// 0.01), the per-position sigmas are right and each candidate is tested
+// against them (chi-square); otherwise the data show noise (or an effect)
+// beyond the catalogue, and each candidate's statistic is divided by the
+// dispersion phi = chi2 / dof its extended model leaves, and referred to
+// F(p, dof). (Dividing by each candidate's own phi alone would count the
+// other missing effects as noise: two effects hidden together could then
+// both go unnamed.)
+void ScoreCandidates(const Context& ctx, const ModelAssessment& current,
+                     const std::vector<EffectFitResult>& fits, double log_n,
+                     std::vector<CandidateScore>* scores) {
+  for (EffectSensor sensor : {EffectSensor::kAccelerometer, EffectSensor::kGyroscope}) {
+    const bool accel = sensor == EffectSensor::kAccelerometer;
+    std::vector<Effect> all = current.effects;
+    int count = 0;
+    int last = -1;
+    for (size_t i = 0; i < scores->size(); ++i) {
+      if ((*scores)[i].tried && IsAccel((*scores)[i].effect) == accel) {
+        all.push_back((*scores)[i].effect);
+        ++count;
+        last = static_cast<int>(i);
+      }
+    }
+    if (count == 0) continue;
+    bool noise_fits = false;
+    EffectFitResult joint;
+    const EffectFitResult* richest = &fits[last];
+    if (count == 1 || Fit(ctx, *ctx.observations, all, current.fit, accel, !accel, true, &joint)) {
+      if (count > 1) richest = &joint;
+      const SensorFitSummary& f = accel ? richest->accel_fit : richest->gyro_fit;
+      const int dof = f.num_residuals - f.rank;
+      noise_fits = dof >= 1 && ChiSquareUpperTail(f.chi2, dof) >= 0.01;
+    }
+    for (size_t i = 0; i < scores->size(); ++i) {
+      CandidateScore& c = (*scores)[i];
+      if (!c.tried || IsAccel(c.effect) != accel) continue;
+      const SensorFitSummary& ext = accel ? fits[i].accel_fit : fits[i].gyro_fit;
+      const int dof1 = ext.dof();
+      c.dispersion = noise_fits || dof1 <= 0 ? 1.0 : std::max(1.0, ext.chi2 / dof1);
+      if (!(c.delta_chi2 > 0.0)) {
+        c.p_value = 1.0;
+      } else if (c.dispersion > 1.0) {
+        c.p_value = FUpperTail(c.delta_chi2 / c.dof / c.dispersion, c.dof, dof1);
+      } else {
+        c.p_value = ChiSquareUpperTail(c.delta_chi2, c.dof);
+      }
+      c.delta_bic = -c.delta_chi2 / c.dispersion + c.dof * log_n;
+    }
+  }
+}
+
+// When no candidate is significant on its own but some pass the likelihood
+// ratio and BIC and fail only the cross-validation, two effects may be
+// masking each other: each alone leaves the other's large residual, which
+// dominates the left-out predictions. Tries those candidates in pairs of
+// the same sensor: a pair counts when together they lower the
+// cross-validated gap and each adds significantly (chi2 test at `alpha`)
+// on top of the other. The member of the best such pair (lowest
+// cross-validated gap) with the lower delta BIC alone is named; the index
+// of its score, or -1.
+int PairLookAhead(const Context& ctx, const ModelAssessment& current, double alpha,
+                  const DiscoveryOptions& options, std::vector<CandidateScore>* scores) {
+  std::vector<int> masked;
+  for (size_t i = 0; i < scores->size(); ++i) {
+    const CandidateScore& c = (*scores)[i];
+    if (c.tried && c.p_value < alpha && c.delta_bic < -options.min_bic_gain) {
+      masked.push_back(static_cast<int>(i));
+    }
+  }
+  int best = -1;
+  double best_cv = INFINITY;
+  std::string partner;
+  for (size_t a = 0; a < masked.size(); ++a) {
+    for (size_t b = a + 1; b < masked.size(); ++b) {
+      CandidateScore& ca = (*scores)[masked[a]];
+      CandidateScore& cb = (*scores)[masked[b]];
+      const bool accel = IsAccel(ca.effect);
+      if (IsAccel(cb.effect) != accel) continue;
+      std::vector<Effect> pair = current.effects;
+      pair.push_back(ca.effect);
+      pair.push_back(cb.effect);
+      EffectFitResult fit;
+      if (!Fit(ctx, *ctx.observations, pair, current.fit, accel, !accel, false, &fit)) continue;
+      const SensorFitSummary& now = accel ? current.fit.accel_fit : current.fit.gyro_fit;
+      const double chi2 = accel ? fit.accel_fit.chi2 : fit.gyro_fit.chi2;
+      // chi2 with only A = chi2_now - delta_chi2_A; B adds that minus chi2.
+      const double adds_b = now.chi2 - ca.delta_chi2 - chi2;
+      const double adds_a = now.chi2 - cb.delta_chi2 - chi2;
+      if (!(ChiSquareUpperTail(adds_b, cb.dof) < alpha) ||
+          !(ChiSquareUpperTail(adds_a, ca.dof) < alpha)) {
+        continue;
+      }
+      Gap cv = current.cv_gap;
+      if (!CrossValidate(ctx, pair, fit, Info(ca.effect).sensor, &cv, nullptr, nullptr)) continue;
+      const double before = accel ? current.cv_gap.accel_sigma : current.cv_gap.gyro_sigma;
+      const double after = accel ? cv.accel_sigma : cv.gyro_sigma;
+      if (!(after < before) || !(after < best_cv)) continue;
+      best_cv = after;
+      const bool a_first = ca.delta_bic <= cb.delta_bic;
+      best = a_first ? masked[a] : masked[b];
+      partner = ToString(a_first ? cb.effect : ca.effect);
+    }
+  }
+  if (best >= 0) {
+    CandidateScore& c = (*scores)[best];
+    c.significant = true;
+    std::ostringstream why;
+    why.precision(3);
+    why << "significant together with " << partner << " (cross-validated gap " << best_cv
+        << " sigma with both); alone: " << c.reason;
+    c.reason = why.str();
+  }
+  return best;
+}
+
 }  // namespace
 
 bool DiscoveryOptions::IsValid(std::string* error) const {
@@ -559,7 +676,6 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
     }
     std::vector<CandidateScore> scores;
     std::vector<EffectFitResult> fits;
-    std::vector<Gap> cv_gaps;
     for (Effect e : candidates) {
       CandidateScore c;
       c.effect = e;
@@ -612,16 +728,6 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
       c.tried = true;
       c.dof = Info(e).num_parameters;
       c.delta_chi2 = now.chi2 - ext.chi2;
-      const int dof1 = ext.dof();
-      c.dispersion = dof1 > 0 ? std::max(1.0, ext.chi2 / dof1) : 1.0;
-      if (!(c.delta_chi2 > 0.0)) {
-        c.p_value = 1.0;
-      } else if (c.dispersion > 1.0) {
-        c.p_value = FUpperTail(c.delta_chi2 / c.dof / c.dispersion, c.dof, dof1);
-      } else {
-        c.p_value = ChiSquareUpperTail(c.delta_chi2, c.dof);
-      }
-      c.delta_bic = -c.delta_chi2 / c.dispersion + c.dof * log_n;
       c.gap = InSampleGap(fit, ctx.has_gyro);
       if (!accel) c.gap.accel = current.gap.accel, c.gap.accel_sigma = current.gap.accel_sigma;
       if (accel) c.gap.gyro = current.gap.gyro, c.gap.gyro_sigma = current.gap.gyro_sigma;
@@ -633,6 +739,7 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
       scores.push_back(c);
       fits.push_back(fit);
     }
+    ScoreCandidates(ctx, current, fits, log_n, &scores);
     int tried = 0;
     for (const CandidateScore& c : scores) tried += c.tried ? 1 : 0;
     const double alpha = options.significance / std::max(1, tried);
@@ -659,6 +766,7 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
         best = static_cast<int>(i);
       }
     }
+    if (best < 0) best = PairLookAhead(ctx, current, alpha, options, &scores);
     if (best < 0) {
       r.final_candidates = scores;
       break;

@@ -49,6 +49,7 @@ void CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, SensorFitSummary* f
   const ObservabilityReport obs =
       AnalyzeObservability(jacobian, fit->parameter_names, kRankTolerance);
   fit->undetermined = obs.undetermined;
+  fit->rank = obs.rank;
   const int n = static_cast<int>(jacobian.cols());
   // Column scaling keeps the units out of the conditioning.
   Eigen::VectorXd scale = jacobian.colwise().norm().transpose();

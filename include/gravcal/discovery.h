@@ -12,17 +12,20 @@
 // 4. Try every candidate effect of the catalogue (model_effects.h): refit
 //    with it (Ceres) and score it by
 //    - a likelihood-ratio test on that sensor's chi2 with dof = the effect's
-//      parameter count; when the extended model still leaves chi2 / dof =
-//      phi > 1 (noise the samples do not show, e.g. hand tremor), the
-//      statistic is divided by phi and referred to F(p, dof);
+//      parameter count, against the positions' own noise; when even the
+//      model with every candidate of the sensor leaves more than that noise
+//      (noise the samples do not show, e.g. hand tremor), the statistic is
+//      divided by phi = chi2 / dof of the extended model and referred to
+//      F(p, dof) instead;
 //    - delta BIC = (chi2_new - chi2_old) / phi + p ln(n);
 //    - leave-one-position-out cross-validation: every position predicted by
 //      a fit without it; the effect must lower the cross-validated gap.
 //    Significant = p below significance / (candidates tried), delta BIC
-//    below -min_bic_gain and a smaller cross-validated gap. The significant candidate with the
-//    lowest delta BIC is named; others within ambiguity_bic of it explain
-//    the data almost as well and are reported as ambiguous with advice on
-//    the recording that would separate them.
+//    below -min_bic_gain and a smaller cross-validated gap. The significant
+//    candidate with the lowest delta BIC is named; others of the same
+//    sensor within ambiguity_bic of it explain the data almost as well and
+//    are reported as ambiguous with advice on the recording that would
+//    separate them.
 // 5. Add it; the extended model is the new baseline; repeat until nothing
 //    is significant.
 //

@@ -88,8 +88,11 @@ struct SensorFitSummary {
   std::vector<std::string> parameter_names;
   // (J^T J)^-1 of the free parameters, parameter_names order.
   Eigen::MatrixXd covariance;
-  // Parameters the positions do not determine (null space of J).
+  // Parameters the positions do not determine (null space of J), and the
+  // rank of J (num_parameters when all are determined; only computed with
+  // the covariance).
   std::vector<std::string> undetermined;
+  int rank = 0;
   int iterations = 0;
 };
 

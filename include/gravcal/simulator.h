@@ -84,8 +84,9 @@ struct SimulatorOptions {
   // and the gyroscope u = M_g^-1 (w + G f + gamma dT + eta t) + b_g, with
   // dT = temperature - effect_reference_temperature and t the session time.
   // Typical MEMS magnitudes (consumer parts such as the BMI160 and
-  // MPU-6050, datasheets and published calibrations): k2 of 1e-5 to 1e-4
-  // per m/s^2 (100-1000 ug/g^2); accelerometer bias tempco 0.5-2 mg/K
+  // MPU-6050, datasheets and published calibrations): k2 of 1e-5 to
+  // 2.5e-4 per m/s^2 (100-2500 ug/g^2; consumer parts specify about 0.5 % of
+  // full scale nonlinearity); accelerometer bias tempco 0.5-2 mg/K
   // (0.005-0.02 m/s^2/K); scale tempco 0.01-0.03 %/K; warm-up bias drift of a
   // few mg over minutes (1e-5 to 1e-4 m/s^2/s); gyroscope g-sensitivity
   // about 0.1 deg/s/g (1.8e-4 rad/s per m/s^2); gyroscope bias tempco
