@@ -18,6 +18,9 @@ namespace {
 
 bool IsAccel(Effect e) { return Info(e).sensor == EffectSensor::kAccelerometer; }
 
+// Leverage above which a position counts as not predictable by the others.
+constexpr double kMaxLeverage = 0.99;
+
 // What every fit in one discovery run shares.
 struct Context {
   const std::vector<StaticObservation>* observations = nullptr;
@@ -83,7 +86,15 @@ bool CrossValidate(const Context& ctx, const std::vector<Effect>& effects,
   double s = 0.0, w = 0.0;
   std::vector<double> ar(n, NAN);
   std::vector<Eigen::Vector3d> gr(n, Eigen::Vector3d::Constant(NAN));
+  // A position with leverage near 1 is not predicted by the others: leave
+  // it out of the gap rather than let one undetermined fold swamp it.
+  const std::vector<double>& leverage = accel ? full.accel_fit.leverage : full.gyro_fit.leverage;
+  int unpredictable = 0;
   for (size_t j = 0; j < n; ++j) {
+    if (j < leverage.size() && leverage[j] > kMaxLeverage) {
+      ++unpredictable;
+      continue;
+    }
     subset.clear();
     for (size_t k = 0; k < n; ++k) {
       if (k != j) subset.push_back(obs[k]);
@@ -102,13 +113,17 @@ bool CrossValidate(const Context& ctx, const std::vector<Effect>& effects,
       w += w2;
     }
   }
+  const double used = static_cast<double>(n - unpredictable);
+  if (used < 1.0) return false;
   if (accel) {
-    cv->accel = std::sqrt(s / n);
-    cv->accel_sigma = std::sqrt(w / n);
+    cv->accel = std::sqrt(s / used);
+    cv->accel_sigma = std::sqrt(w / used);
+    cv->accel_unpredictable = unpredictable;
     if (accel_residuals) *accel_residuals = ar;
   } else {
-    cv->gyro = std::sqrt(s / (3.0 * n));
-    cv->gyro_sigma = std::sqrt(w / (3.0 * n));
+    cv->gyro = std::sqrt(s / (3.0 * used));
+    cv->gyro_sigma = std::sqrt(w / (3.0 * used));
+    cv->gyro_unpredictable = unpredictable;
     if (gyro_residuals) *gyro_residuals = gr;
   }
   return true;
@@ -503,7 +518,7 @@ int PairLookAhead(const Context& ctx, const ModelAssessment& current, double alp
       pair.push_back(ca.effect);
       pair.push_back(cb.effect);
       EffectFitResult fit;
-      if (!Fit(ctx, *ctx.observations, pair, current.fit, accel, !accel, false, &fit)) continue;
+      if (!Fit(ctx, *ctx.observations, pair, current.fit, accel, !accel, true, &fit)) continue;
       const SensorFitSummary& now = accel ? current.fit.accel_fit : current.fit.gyro_fit;
       const double chi2 = accel ? fit.accel_fit.chi2 : fit.gyro_fit.chi2;
       // chi2 with only A = chi2_now - delta_chi2_A; B adds that minus chi2.

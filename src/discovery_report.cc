@@ -36,7 +36,9 @@ json GapJson(const Gap& g) {
           {"accel_sigma", Number(g.accel_sigma)},
           {"gyro", Number(g.gyro)},
           {"gyro_unit", "raw gyro units"},
-          {"gyro_sigma", Number(g.gyro_sigma)}};
+          {"gyro_sigma", Number(g.gyro_sigma)},
+          {"accel_unpredictable_positions", g.accel_unpredictable},
+          {"gyro_unpredictable_positions", g.gyro_unpredictable}};
 }
 
 std::string ModelName(const ModelAssessment& m) {

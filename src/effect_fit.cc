@@ -44,8 +44,10 @@ ceres::Solver::Options SolverOptions(const EffectFitOptions& o) {
 
 // (J^T J)^-1 of a whitened Jacobian, with the undetermined parameters (null
 // space) named and their rows and columns NaN; the rest from the
-// pseudo-inverse.
-void CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, SensorFitSummary* fit) {
+// pseudo-inverse. Also the leverage of each position (rows_per_position
+// consecutive rows).
+void CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, int rows_per_position,
+                            SensorFitSummary* fit) {
   const ObservabilityReport obs =
       AnalyzeObservability(jacobian, fit->parameter_names, kRankTolerance);
   fit->undetermined = obs.undetermined;
@@ -71,6 +73,15 @@ void CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, SensorFitSummary* f
     inverse = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
   }
   fit->covariance = scale.cwiseInverse().asDiagonal() * inverse * scale.cwiseInverse().asDiagonal();
+  fit->leverage.clear();
+  for (int k = 0; k * rows_per_position < jacobian.rows(); ++k) {
+    double h = 0.0;
+    for (int r = 0; r < rows_per_position; ++r) {
+      const Eigen::RowVectorXd row = scaled.row(k * rows_per_position + r);
+      h = std::max(h, (row * inverse * row.transpose())(0, 0));
+    }
+    fit->leverage.push_back(h);
+  }
   for (const std::string& name : obs.undetermined) {
     const auto it = std::find(fit->parameter_names.begin(), fit->parameter_names.end(), name);
     const int i = static_cast<int>(it - fit->parameter_names.begin());
@@ -229,7 +240,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   result->parameters.accel_bias_drift = Eigen::Vector3d(blocks[3]);
 
   if (options.compute_covariance) {
-    CovarianceFromJacobian(jacobian, &fit);
+    CovarianceFromJacobian(jacobian, 1, &fit);
     // Back to raw units: b = c + s b', U = U' / s; the effects are in SI.
     Eigen::VectorXd d = Eigen::VectorXd::Ones(np);
     d.head<3>().setConstant(norm.scale);
@@ -348,7 +359,7 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   result->parameters.gyro_temperature_bias = Eigen::Vector3d(temperature_bias);
   result->parameters.gyro_bias_drift = Eigen::Vector3d(drift);
   if (options.compute_covariance) {
-    CovarianceFromJacobian(jacobian, &fit);
+    CovarianceFromJacobian(jacobian, 3, &fit);
     for (int i = 0; i < 3; ++i) result->gyro_bias_std(i) = StdOf(fit, fit.parameter_names[i]);
   }
   result->gyro_residuals.resize(n);

@@ -81,6 +81,10 @@ struct Gap {
   // In units of the noise: rms of the whitened residuals.
   double accel_sigma = NAN;
   double gyro_sigma = NAN;
+  // Cross-validated gaps only: positions left out of them because the
+  // others do not determine the model without them (leverage near 1).
+  int accel_unpredictable = 0;
+  int gyro_unpredictable = 0;
 };
 
 // One position: measured minus simulated.

@@ -93,6 +93,11 @@ struct SensorFitSummary {
   // the covariance).
   std::vector<std::string> undetermined;
   int rank = 0;
+  // Leverage of each position, diag of J (J^T J)^+ J^T (the largest of its
+  // three rows for the gyroscope): near 1, the other positions do not
+  // determine the model without it, so it cannot be predicted by them.
+  // Only computed with the covariance.
+  std::vector<double> leverage;
   int iterations = 0;
 };
 
