@@ -699,10 +699,10 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
       c.reason =
           NotApplicable(ctx, current.effects, e, options, now.num_residuals, now.num_parameters);
       if (!c.reason.empty()) {
-        if (c.reason != "already in the model" &&
+        // Warn once per effect; "already in the model / baseline" is no news.
+        if (c.reason.rfind("already", 0) != 0 &&
             std::find(untestable_warned.begin(), untestable_warned.end(), Info(e).name) ==
-                untestable_warned.end() &&
-            c.reason.rfind("already", 0) != 0) {
+                untestable_warned.end()) {
           untestable_warned.push_back(Info(e).name);
           r.warnings.push_back(std::string(Info(e).name) +
                                " cannot be tested in this session: " + c.reason);
@@ -744,8 +744,14 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
       c.dof = Info(e).num_parameters;
       c.delta_chi2 = now.chi2 - ext.chi2;
       c.gap = InSampleGap(fit, ctx.has_gyro);
-      if (!accel) c.gap.accel = current.gap.accel, c.gap.accel_sigma = current.gap.accel_sigma;
-      if (accel) c.gap.gyro = current.gap.gyro, c.gap.gyro_sigma = current.gap.gyro_sigma;
+      // The other sensor's part was not refitted: its gap is the current one.
+      if (accel) {
+        c.gap.gyro = current.gap.gyro;
+        c.gap.gyro_sigma = current.gap.gyro_sigma;
+      } else {
+        c.gap.accel = current.gap.accel;
+        c.gap.accel_sigma = current.gap.accel_sigma;
+      }
       c.cv_gap = current.cv_gap;
       if (!CrossValidate(ctx, extended, fit, Info(e).sensor, &c.cv_gap, nullptr, nullptr)) {
         c.reason = "cross-validation failed (a fold could not be fitted)";
@@ -822,10 +828,7 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
     std::vector<Effect> extended = current.effects;
     extended.push_back(chosen.effect);
     ModelAssessment next;
-    if (!Assess(ctx, extended, fits[best],
-                {chosen.effect == Effect::kAccelMisalignment || accel ? EffectSensor::kAccelerometer
-                                                                      : EffectSensor::kGyroscope},
-                &current, &next)) {
+    if (!Assess(ctx, extended, fits[best], {Info(chosen.effect).sensor}, &current, &next)) {
       r.message = "refit with " + std::string(ToString(chosen.effect)) + ": " + next.fit.message;
       return false;
     }

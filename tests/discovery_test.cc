@@ -29,20 +29,6 @@ constexpr double kGSensitivity = 9e-5;
 constexpr double kGyroTemperatureBias = 1.7e-4;
 constexpr double kGyroDrift = 1e-5;
 
-// 24 random poses held 10 s during a warm-up from 20 to 35 degC (time
-// constant 120 s): temperature and time both vary and are not proportional.
-SimulatorOptions Session() {
-  SimulatorOptions o;
-  o.scheme = "random:24";
-  o.hold_seconds = 10.0;
-  o.initial_still_seconds = 5.0;
-  o.rotation_seconds = 2.0;
-  o.temperature_start = 20.0;
-  o.temperature_end = 35.0;
-  o.temperature_tau = 120.0;
-  return o;
-}
-
 struct Outcome {
   DiscoveryResult result;
   bool ok = false;
@@ -109,54 +95,54 @@ void ExpectFound(const Tally& t) {
 constexpr int kSeeds = 20;
 
 TEST(Discovery, FindsAccelQuadraticNonlinearity) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   sim.accel_quadratic_std = kQuadratic;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelQuadratic));
 }
 
 TEST(Discovery, FindsAccelTemperatureBias) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   sim.accel_temperature_bias_std = kTemperatureBias;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelTemperatureBias));
 }
 
 TEST(Discovery, FindsAccelTemperatureScale) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   sim.accel_temperature_scale_std = kTemperatureScale;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelTemperatureScale));
 }
 
 TEST(Discovery, FindsAccelBiasDrift) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   sim.accel_bias_drift_std = kBiasDrift;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelBiasDrift));
 }
 
 TEST(Discovery, FindsAccelMisalignmentMissingFromScaleBaseline) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelMisalignment, AccelParameterization::kScale));
 }
 
 TEST(Discovery, FindsGyroGSensitivity) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   sim.gyro_g_sensitivity_std = kGSensitivity;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroGSensitivity));
 }
 
 TEST(Discovery, FindsGyroTemperatureBias) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   sim.gyro_temperature_bias_std = kGyroTemperatureBias;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroTemperatureBias));
 }
 
 TEST(Discovery, FindsGyroBiasDrift) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   sim.gyro_bias_drift_std = kGyroDrift;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroBiasDrift));
 }
 
 TEST(Discovery, NamesNothingWithoutHiddenEffect) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   Tally t;
   for (int seed = 1; seed <= kSeeds; ++seed) {
     const Outcome run = Discover(sim, seed);
@@ -181,10 +167,10 @@ TEST(Discovery, NamesNothingWithoutHiddenEffect) {
 // other tests, the quadratic's residual sometimes tips a bias drift in time
 // ahead of the bias tempco, which that session can barely tell apart.
 TEST(Discovery, FindsTwoHiddenEffectsLargerFirst) {
-  SimulatorOptions a = Session();
+  SimulatorOptions a = testing_util::WarmUpSession();
   a.temperature_tau = 60.0;
   a.accel_temperature_bias_std = 3.0 * kTemperatureBias;
-  SimulatorOptions b = Session();
+  SimulatorOptions b = testing_util::WarmUpSession();
   b.accel_quadratic_std = 1.5 * kQuadratic;
   SimulatorOptions both = a;
   both.accel_quadratic_std = b.accel_quadratic_std;
@@ -213,7 +199,7 @@ TEST(Discovery, FindsTwoHiddenEffectsLargerFirst) {
 // temperature and one linear in time fit the data equally. The report must
 // say so, with advice, instead of silently picking one.
 TEST(Discovery, ReportsTemperatureVersusTimeAmbiguityInMonotonicWarmUp) {
-  SimulatorOptions sim = Session();
+  SimulatorOptions sim = testing_util::WarmUpSession();
   sim.temperature_tau = 3000.0;
   sim.accel_temperature_bias_std = 5.0 * kTemperatureBias;
   int reported = 0;

@@ -6,6 +6,7 @@
 #include <ceres/autodiff_cost_function.h>
 #include <gtest/gtest.h>
 
+#include <map>
 #include <random>
 
 #include "effect_residual.h"
@@ -131,63 +132,91 @@ TEST(Statistics, FUpperTailMatchesKnownValues) {
   EXPECT_NEAR(FUpperTail(2.228 * 2.228, 1, 10), 0.05, 2e-4);
 }
 
-// calibrate with effects on simulated sessions: the estimates agree with
-// the truth within the reported standard deviations (rms of error / std in
-// [0.7, 1.4] over 30 seeds) for the accelerometer bias tempco and the
-// gyroscope g-sensitivity (in raw gyroscope units per m/s^2: M_g^-1 G R,
-// R the accelerometer's housing rotation, since f = R a).
-TEST(EffectFit, CalibrateEstimatesEffectsWithHonestSigmas) {
-  Config config;
-  config.effects = {Effect::kAccelTemperatureBias, Effect::kGyroGSensitivity};
-  SimulatorOptions& sim = config.simulation;
-  sim.scheme = "random:24";
-  sim.hold_seconds = 10.0;
-  sim.rotation_seconds = 2.0;
-  sim.temperature_start = 20.0;
-  sim.temperature_end = 35.0;
-  sim.temperature_tau = 120.0;
-  sim.accel_temperature_bias_std = 0.005;
-  sim.gyro_g_sensitivity_std = 1.8e-4;
-  const int seeds = 30;
-  double beta_ratio = 0.0, g_ratio = 0.0;
-  int beta_count = 0, g_count = 0;
+// rms over seeds and parameters of (estimate - truth) / std for each
+// effect calibrate fits on simulated sessions with `sim`'s effects.
+// Gyroscope truths are in raw gyroscope units: M_g^-1 G R for G (R the
+// accelerometer's housing rotation, since f = R a), M_g^-1 gamma for the
+// tempco.
+std::map<Effect, double> ErrorOverSigma(const SimulatorOptions& sim,
+                                        const std::vector<Effect>& effects, int seeds) {
+  std::map<Effect, double> sum;
+  std::map<Effect, int> count;
   for (int seed = 1; seed <= seeds; ++seed) {
     SimulatedSession session;
     std::string error;
-    ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
-    Config c = config;
-    c.calibration.gravity.gravity = session.gravity;
+    EXPECT_TRUE(Simulate(sim, seed, &session, &error)) << error;
+    Config config;
+    config.effects = effects;
+    config.calibration.gravity.gravity = session.gravity;
     PipelineInput input;
     input.log = session.log;
     Calibration calibration;
-    ASSERT_TRUE(RunCalibration(c, input, &calibration)) << calibration.message;
-    ASSERT_EQ(calibration.effects.estimates.size(), 2u);
-    const Eigen::Matrix3d g_truth = session.gyro_truth.matrix.inverse() *
-                                    session.gyro_g_sensitivity * session.accel_truth.rotation;
+    EXPECT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
+    const Eigen::Matrix3d gyro_inverse = session.gyro_truth.matrix.inverse();
+    const Eigen::Matrix3d g_truth =
+        gyro_inverse * session.gyro_g_sensitivity * session.accel_truth.rotation;
     for (const EffectEstimate& e : calibration.effects.estimates) {
-      for (size_t i = 0; i < e.values.size(); ++i) {
-        ASSERT_TRUE(std::isfinite(e.std[i])) << e.names[i];
-        if (e.effect == Effect::kAccelTemperatureBias) {
-          const double z = (e.values[i] - session.effects.accel_temperature_bias(i)) / e.std[i];
-          beta_ratio += z * z;
-          ++beta_count;
-        } else {
-          const double z = (e.values[i] - g_truth(i / 3, i % 3)) / e.std[i];
-          g_ratio += z * z;
-          ++g_count;
+      std::vector<double> truth = session.effects.Values(e.effect);
+      if (e.effect == Effect::kGyroGSensitivity) {
+        truth.clear();
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 3; ++c) truth.push_back(g_truth(r, c));
         }
+      } else if (e.effect == Effect::kGyroTemperatureBias) {
+        const Eigen::Vector3d t = gyro_inverse * session.effects.gyro_temperature_bias;
+        truth = {t(0), t(1), t(2)};
+      } else if (e.effect == Effect::kGyroBiasDrift) {
+        const Eigen::Vector3d t = gyro_inverse * session.effects.gyro_bias_drift;
+        truth = {t(0), t(1), t(2)};
+      }
+      for (size_t i = 0; i < e.values.size(); ++i) {
+        EXPECT_TRUE(std::isfinite(e.std[i])) << e.names[i];
+        const double z = (e.values[i] - truth[i]) / e.std[i];
+        sum[e.effect] += z * z;
+        ++count[e.effect];
       }
     }
-    EXPECT_TRUE(calibration.gyro.estimated);
   }
-  beta_ratio = std::sqrt(beta_ratio / beta_count);
-  g_ratio = std::sqrt(g_ratio / g_count);
-  std::printf("rms error/std: accel_temperature_bias %.3f, gyro_g_sensitivity %.3f\n", beta_ratio,
-              g_ratio);
-  EXPECT_GT(beta_ratio, 0.7);
-  EXPECT_LT(beta_ratio, 1.4);
-  EXPECT_GT(g_ratio, 0.7);
-  EXPECT_LT(g_ratio, 1.4);
+  for (auto& [effect, s] : sum) {
+    s = std::sqrt(s / count[effect]);
+    std::printf("%s: rms error/std %.3f\n", ToString(effect), s);
+  }
+  return sum;
+}
+
+// calibrate with effects: the estimates agree with the truth within the
+// reported standard deviations (rms of error / std in [0.7, 1.4] over 30
+// seeds).
+TEST(EffectFit, CalibrateEstimatesEffectsWithHonestSigmas) {
+  SimulatorOptions sim = testing_util::WarmUpSession();
+  sim.accel_temperature_bias_std = 0.005;
+  sim.gyro_g_sensitivity_std = 1.8e-4;
+  const std::map<Effect, double> ratio =
+      ErrorOverSigma(sim, {Effect::kAccelTemperatureBias, Effect::kGyroGSensitivity}, 30);
+  ASSERT_EQ(ratio.size(), 2u);
+  for (const auto& [effect, r] : ratio) {
+    EXPECT_GT(r, 0.7) << ToString(effect);
+    EXPECT_LT(r, 1.4) << ToString(effect);
+  }
+}
+
+TEST(EffectFit, CalibrateEstimatesThreeAccelAndTwoGyroEffectsWithHonestSigmas) {
+  SimulatorOptions sim = testing_util::WarmUpSession();
+  sim.accel_quadratic_std = 1.5e-4;
+  sim.accel_temperature_scale_std = 1e-4;
+  sim.accel_bias_drift_std = 8e-5;
+  sim.gyro_temperature_bias_std = 1.7e-4;
+  sim.gyro_bias_drift_std = 1e-5;
+  const std::map<Effect, double> ratio = ErrorOverSigma(
+      sim,
+      {Effect::kAccelQuadratic, Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift,
+       Effect::kGyroTemperatureBias, Effect::kGyroBiasDrift},
+      30);
+  ASSERT_EQ(ratio.size(), 5u);
+  for (const auto& [effect, r] : ratio) {
+    EXPECT_GT(r, 0.7) << ToString(effect);
+    EXPECT_LT(r, 1.4) << ToString(effect);
+  }
 }
 
 TEST(EffectFit, EffectsTheLogCannotSupportFailWithTheirName) {
