@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <functional>
 
@@ -155,6 +156,52 @@ TEST(Discovery, NamesNothingWithoutHiddenEffect) {
     }
   }
   EXPECT_GE(t.named_nothing, 0.9 * t.seeds) << t.named_nothing << " of " << t.seeds;
+}
+
+// A log with neither gyroscope nor temperature: the effects that need them
+// are not tried, with a warning naming why, and the rest still work.
+TEST(Discovery, SaysWhatALogWithoutGyroscopeOrTemperatureCannotTest) {
+  SimulatorOptions sim = testing_util::WarmUpSession();
+  sim.accel_quadratic_std = kQuadratic;
+  SimulatedSession session;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, 1, &session, &error)) << error;
+  session.log.gyro.clear();
+  session.log.temperature.clear();
+  CalibrationOptions calibration;
+  calibration.gravity.gravity = session.gravity;
+  DiscoveryResult r;
+  ASSERT_TRUE(DiscoverEffects(session.log, calibration, {}, DiscoveryOptions(), &r)) << r.message;
+  ASSERT_FALSE(r.named().empty());
+  EXPECT_EQ(r.named().front(), Effect::kAccelQuadratic);
+  std::string warnings;
+  for (const std::string& w : r.warnings) warnings += w + "\n";
+  EXPECT_NE(warnings.find("gyro_g_sensitivity cannot be tested in this session: the log has no "
+                          "gyroscope"),
+            std::string::npos)
+      << warnings;
+  EXPECT_NE(warnings.find("accel_temperature_bias cannot be tested in this session: the log has "
+                          "no temperature"),
+            std::string::npos)
+      << warnings;
+  EXPECT_TRUE(std::isnan(r.baseline.gap.gyro));
+}
+
+TEST(Discovery, InvalidOptionsAndTooFewPositionsFailWithAMessage) {
+  SimulatedSession session;
+  std::string error;
+  ASSERT_TRUE(Simulate(SimulatorOptions(), 1, &session, &error)) << error;
+  CalibrationOptions calibration;
+  DiscoveryOptions options;
+  options.significance = 1.5;
+  DiscoveryResult r;
+  EXPECT_FALSE(DiscoverEffects(session.log, calibration, {}, options, &r));
+  EXPECT_NE(r.message.find("discovery_significance"), std::string::npos) << r.message;
+  SimulatorOptions six;
+  six.scheme = "six";
+  ASSERT_TRUE(Simulate(six, 1, &session, &error)) << error;
+  EXPECT_FALSE(DiscoverEffects(session.log, calibration, {}, DiscoveryOptions(), &r));
+  EXPECT_NE(r.message.find("needs at least 9"), std::string::npos) << r.message;
 }
 
 // Two effects hidden: an accelerometer bias tempco of 0.6 mg/K and a
