@@ -70,6 +70,21 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
     }
     out["gyro"] = gyro;
   }
+  // Issue 6: effects beyond the textbook model, by catalogue name.
+  if (!c.effects.estimates.empty()) {
+    json effects = {{"reference_temperature", Number(c.effects.reference_temperature)},
+                    {"reference_time", Number(c.effects.reference_time)}};
+    for (const EffectEstimate& e : c.effects.estimates) {
+      json values = json::array(), stds = json::array();
+      for (size_t i = 0; i < e.values.size(); ++i) {
+        values.push_back(Number(e.values[i]));
+        stds.push_back(Number(i < e.std.size() ? e.std[i] : NAN));
+      }
+      effects[ToString(e.effect)] = {
+          {"parameters", e.names}, {"value", values}, {"std", stds}, {"unit", e.unit}};
+    }
+    out["effects"] = effects;
+  }
   out["gravity"] = {{"value", c.gravity}, {"source", c.gravity_source}};
   auto summary = [](const ResidualSummary& s) {
     return json{{"rms", Number(s.rms)}, {"max", Number(s.max)}};

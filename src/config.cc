@@ -146,6 +146,18 @@ bool GetEnum(const YAML::Node& n, Enum* v, const char* choices, std::string* err
         [](const Config& c) { return std::string(ToString(c.field)); } \
   }
 
+// Issue 6: a key holding a list of effect names; `field(config)` points at
+// the list (for a Config* and a const Config*).
+template <typename Field>
+KeyHandler EffectListKey(const char* name, const char* help, Field field) {
+  return {{name, "effects", help},
+          [field](const YAML::Node& n, Config* c, std::string* e) {
+            std::vector<std::string> names;
+            return GetStringList(n, &names, e) && ParseEffects(names, field(c), e);
+          },
+          [field](const Config& c) { return ListText(EffectNames(*field(&c))); }};
+}
+
 const std::vector<KeyHandler>& Handlers() {
   static const std::vector<KeyHandler> handlers = {
       GRAVCAL_STRING(
@@ -455,6 +467,42 @@ const std::vector<KeyHandler>& Handlers() {
                   "times through the x, y, z turns"),
       GRAVCAL_DOUBLE("hh_lever_arm", "motion simulator", motion.lever_arm,
                      "sensor distance from the point the hand turns about, m"),
+      // Issue 6: model effects and the discovery workflow.
+      EffectListKey("effects",
+                    "effects added to the model by name (README: effect catalogue), e.g. "
+                    "[accel_temperature_bias]",
+                    [](auto* c) { return &c->effects; }),
+      EffectListKey("discovery_candidates", "effects discover tries; empty = the whole catalogue",
+                    [](auto* c) { return &c->discovery.candidates; }),
+      GRAVCAL_DOUBLE("discovery_significance", "effects", discovery.significance,
+                     "family-wise significance level of one discovery step"),
+      GRAVCAL_DOUBLE("discovery_min_bic_gain", "effects", discovery.min_bic_gain,
+                     "BIC decrease a candidate must bring (10 = very strong evidence)"),
+      GRAVCAL_DOUBLE("discovery_ambiguity_bic", "effects", discovery.ambiguity_bic,
+                     "candidates within this delta BIC of the best are reported as ambiguous"),
+      GRAVCAL_INT("discovery_max_steps", "effects", discovery.max_steps,
+                  "most effects discover adds"),
+      GRAVCAL_INT("discovery_min_dof", "effects", discovery.min_dof,
+                  "residual dof an extended model must keep"),
+      GRAVCAL_DOUBLE("discovery_min_temperature_range", "effects", discovery.min_temperature_range,
+                     "degC the positions must span for temperature effects to be tried"),
+      GRAVCAL_DOUBLE("sim_accel_quadratic", "simulator", simulation.accel_quadratic_std,
+                     "truth k2 spread per axis, 1/(m/s^2)"),
+      GRAVCAL_DOUBLE("sim_accel_temperature_bias", "simulator",
+                     simulation.accel_temperature_bias_std,
+                     "truth accelerometer bias tempco spread, m/s^2/degC"),
+      GRAVCAL_DOUBLE("sim_accel_temperature_scale", "simulator",
+                     simulation.accel_temperature_scale_std,
+                     "truth accelerometer scale tempco spread, 1/degC"),
+      GRAVCAL_DOUBLE("sim_accel_bias_drift", "simulator", simulation.accel_bias_drift_std,
+                     "truth accelerometer bias drift spread, m/s^2/s"),
+      GRAVCAL_DOUBLE("sim_gyro_temperature_bias", "simulator", simulation.gyro_temperature_bias_std,
+                     "truth gyroscope bias tempco spread, rad/s/degC"),
+      GRAVCAL_DOUBLE("sim_gyro_bias_drift", "simulator", simulation.gyro_bias_drift_std,
+                     "truth gyroscope bias drift spread, rad/s/s"),
+      GRAVCAL_DOUBLE("sim_effect_reference_temperature", "simulator",
+                     simulation.effect_reference_temperature,
+                     "temperature at which the simulated temperature terms are zero, degC"),
   };
   return handlers;
 }
@@ -515,6 +563,10 @@ bool Config::IsValid(std::string* error) const {
     return false;
   }
   if (method == "ten_position" && !ten_position.IsValid(&what)) {
+    *error = what;
+    return false;
+  }
+  if (!discovery.IsValid(&what)) {
     *error = what;
     return false;
   }

@@ -1,5 +1,6 @@
 #include "gravcal/pipeline.h"
 
+#include "gravcal/effect_fit.h"
 #include "gravcal/gyro_calibration.h"
 #include "gravcal/handheld_kalman.h"
 #include "gravcal/known_attitude.h"
@@ -16,7 +17,16 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
   }
   // One branch per method; each fills the same Calibration.
   if (config.method == "twelve_position") {
-    const bool ok = CalibrateAccelerometer(input.log, config.calibration, calibration);
+    // accel_misalignment on a scale baseline is the scale_misalignment model.
+    CalibrationOptions options = config.calibration;
+    if (Contains(config.effects, Effect::kAccelMisalignment) &&
+        options.refinement.parameterization == AccelParameterization::kScale) {
+      options.refinement.parameterization = AccelParameterization::kScaleMisalignment;
+    }
+    bool ok = CalibrateAccelerometer(input.log, options, calibration);
+    if (ok && !config.effects.empty()) {
+      ok = FitCalibrationEffects(input.log, options, config.effects, calibration);
+    }
     calibration->method = config.method;
     if (!ok || config.gyro.parameterization == GyroParameterization::kNone) return ok;
     return AddGyroscopeCalibration(input.log, config.calibration.detector, config.gyro,

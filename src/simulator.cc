@@ -167,6 +167,26 @@ struct HandProfile {
   }
 };
 
+// The effect truths, from a stream of their own (see SimulatorOptions).
+void DrawEffects(const SimulatorOptions& o, uint64_t seed, SimulatedSession* s) {
+  std::mt19937_64 rng(seed ^ 0x6a09e667f3bcc909ULL);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  auto draw3 = [&](double std) -> Eigen::Vector3d {
+    return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)) * std;
+  };
+  EffectParameters& e = s->effects;
+  e.reference_temperature = o.effect_reference_temperature;
+  e.reference_time = 0.0;
+  e.accel_quadratic = draw3(o.accel_quadratic_std);
+  e.accel_temperature_bias = draw3(o.accel_temperature_bias_std);
+  e.accel_temperature_scale = draw3(o.accel_temperature_scale_std);
+  e.accel_bias_drift = draw3(o.accel_bias_drift_std);
+  for (int r = 0; r < 3; ++r) e.gyro_g_sensitivity.row(r) = draw3(o.gyro_g_sensitivity_std);
+  s->gyro_g_sensitivity = e.gyro_g_sensitivity;
+  e.gyro_temperature_bias = draw3(o.gyro_temperature_bias_std);
+  e.gyro_bias_drift = draw3(o.gyro_bias_drift_std);
+}
+
 bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSession* session,
                   std::string* error) {
   auto fail = [&](const std::string& what) {
@@ -198,6 +218,14 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   s.gyro_truth =
       GyroModel::Random(gyro_scale, options.gyro_scale_std, options.gyro_misalignment_std,
                         options.gyro_bias_std / gyro_scale, &rng);
+  DrawEffects(options, seed, &s);
+  const bool accel_effects =
+      options.accel_quadratic_std > 0.0 || options.accel_temperature_bias_std > 0.0 ||
+      options.accel_temperature_scale_std > 0.0 || options.accel_bias_drift_std > 0.0;
+  const bool gyro_effects = options.gyro_g_sensitivity_std > 0.0 ||
+                            options.gyro_temperature_bias_std > 0.0 ||
+                            options.gyro_bias_drift_std > 0.0;
+  const Eigen::Matrix3d upper_inverse = s.accel_truth.upper.inverse();
   const Eigen::Matrix3d accel_inverse = s.accel_truth.matrix().inverse();
   const Eigen::Matrix3d gyro_inverse = s.gyro_truth.matrix.inverse();
   if (s.accel_truth.upper.diagonal().minCoeff() <= 0.0 || !accel_inverse.allFinite() ||
@@ -224,16 +252,10 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   const long first_still = SampleCount(options.initial_still_seconds + options.hold_seconds, rate);
   const long hold = SampleCount(options.hold_seconds, rate);
   const bool hand = options.rotation_profile == "hand";
-  // The hand profiles and G draw from a stream of their own, so switching
-  // them on leaves every other number of a seed unchanged.
+  // The hand profiles draw from a stream of their own (G with the other
+  // effects in DrawEffects), so switching them on leaves every other number
+  // of a seed unchanged.
   std::mt19937_64 extra_rng(seed ^ 0xc2b2ae3d27d4eb4fULL);
-  if (options.gyro_g_sensitivity_std > 0.0) {
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) {
-        s.gyro_g_sensitivity(r, c) = options.gyro_g_sensitivity_std * n01(extra_rng);
-      }
-    }
-  }
   std::vector<HandProfile> profiles(pose_count > 0 ? pose_count - 1 : 0);
   std::vector<long> rotation(profiles.size(), SampleCount(options.rotation_seconds, rate));
   for (size_t k = 0; k < profiles.size() && hand; ++k) {
@@ -275,9 +297,29 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
 
   // Writes sample i from the true specific force and body rate.
   auto emit = [&](size_t i, const Eigen::Vector3d& force, const Eigen::Vector3d& body_rate) {
-    Eigen::Vector3d v = accel_inverse * force + s.accel_truth.bias;
-    Eigen::Vector3d u =
-        gyro_inverse * (body_rate + s.gyro_g_sensitivity * force) + s.gyro_truth.bias;
+    const double t = static_cast<double>(i) * dt;
+    const double temperature =
+        options.temperature_end + (options.temperature_start - options.temperature_end) *
+                                      std::exp(-t / options.temperature_tau);
+    // The effect terms only when switched on, so that sessions without them
+    // stay bit-identical.
+    Eigen::Vector3d v;
+    if (accel_effects) {
+      const Eigen::Vector3d sensed =
+          ApplyAccelEffects(s.effects, s.accel_truth.rotation.transpose() * force, temperature, t);
+      v = upper_inverse * sensed + s.accel_truth.bias;
+    } else {
+      v = accel_inverse * force + s.accel_truth.bias;
+    }
+    Eigen::Vector3d u;
+    if (gyro_effects) {
+      const double dT = temperature - s.effects.reference_temperature;
+      u = gyro_inverse * (body_rate + s.gyro_g_sensitivity * force +
+                          s.effects.gyro_temperature_bias * dT + s.effects.gyro_bias_drift * t) +
+          s.gyro_truth.bias;
+    } else {
+      u = gyro_inverse * body_rate + s.gyro_truth.bias;
+    }
     if (accel_noise > 0.0) v += accel_noise * normal3();
     if (gyro_noise > 0.0) u += gyro_noise * normal3();
     if (accel_walk > 0.0) {
@@ -292,13 +334,10 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
       v = v.array().round();
       u = u.array().round();
     }
-    const double t = static_cast<double>(i) * dt;
     log.t[i] = t;
     log.accel[i] = v;
     log.gyro[i] = u;
-    log.temperature[i] =
-        options.temperature_end + (options.temperature_start - options.temperature_end) *
-                                      std::exp(-t / options.temperature_tau);
+    log.temperature[i] = temperature;
   };
 
   s.poses.resize(pose_count);
@@ -452,6 +491,13 @@ bool SimulatorOptions::IsValid(std::string* error) const {
     return fail("latitude_deg", latitude_deg, "must be NaN (off) or within -90..90");
   }
   if (!non_negative("fixture_attitude_noise_deg", fixture_attitude_noise_deg)) return false;
+  if (!non_negative("accel_quadratic_std", accel_quadratic_std)) return false;
+  if (!non_negative("accel_temperature_bias_std", accel_temperature_bias_std)) return false;
+  if (!at_most("accel_temperature_scale_std", accel_temperature_scale_std, 0.01)) return false;
+  if (!non_negative("accel_bias_drift_std", accel_bias_drift_std)) return false;
+  if (!non_negative("gyro_temperature_bias_std", gyro_temperature_bias_std)) return false;
+  if (!non_negative("gyro_bias_drift_std", gyro_bias_drift_std)) return false;
+  if (!finite("effect_reference_temperature", effect_reference_temperature)) return false;
 
   const double samples =
       (initial_still_seconds + hold_seconds +
@@ -598,7 +644,23 @@ std::string TruthToJson(const SimulatedSession& session, const SimulatorOptions&
                     {"temperature_tau", o.temperature_tau},
                     {"latitude_deg", std::isfinite(o.latitude_deg) ? nlohmann::json(o.latitude_deg)
                                                                    : nlohmann::json(nullptr)},
-                    {"fixture_attitude_noise_deg", o.fixture_attitude_noise_deg}};
+                    {"fixture_attitude_noise_deg", o.fixture_attitude_noise_deg},
+                    {"accel_quadratic_std", o.accel_quadratic_std},
+                    {"accel_temperature_bias_std", o.accel_temperature_bias_std},
+                    {"accel_temperature_scale_std", o.accel_temperature_scale_std},
+                    {"accel_bias_drift_std", o.accel_bias_drift_std},
+                    {"gyro_temperature_bias_std", o.gyro_temperature_bias_std},
+                    {"gyro_bias_drift_std", o.gyro_bias_drift_std},
+                    {"effect_reference_temperature", o.effect_reference_temperature}};
+    const EffectParameters& e = session.effects;
+    j["effects"] = {{"reference_temperature", e.reference_temperature},
+                    {"accel_quadratic_nonlinearity", ToJson(e.accel_quadratic)},
+                    {"accel_temperature_bias", ToJson(e.accel_temperature_bias)},
+                    {"accel_temperature_scale", ToJson(e.accel_temperature_scale)},
+                    {"accel_bias_drift", ToJson(e.accel_bias_drift)},
+                    {"gyro_g_sensitivity", ToJson(session.gyro_g_sensitivity)},
+                    {"gyro_temperature_bias", ToJson(e.gyro_temperature_bias)},
+                    {"gyro_bias_drift", ToJson(e.gyro_bias_drift)}};
     return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
   } catch (const std::exception&) {
     return "{}";

@@ -49,7 +49,55 @@ double GammaContinuedFraction(double a, double x) {
   return std::exp(-x + a * std::log(x) - LogGamma(a)) * h;
 }
 
+// Continued fraction of the regularised incomplete beta I_x(a, b), Lentz's
+// method: 1 / (1 + d1 / (1 + d2 / (1 + ...))) with
+// d_2m+1 = -(a + m)(a + b + m) x / ((a + 2m)(a + 2m + 1)),
+// d_2m = m (b - m) x / ((a + 2m - 1)(a + 2m)).
+double BetaContinuedFraction(double a, double b, double x) {
+  const double tiny = 1e-300;
+  double c = 1.0;
+  double d = 1.0 - (a + b) * x / (a + 1.0);
+  if (std::fabs(d) < tiny) d = tiny;
+  d = 1.0 / d;
+  double h = d;
+  for (int m = 1; m < 1000; ++m) {
+    const double m2 = 2.0 * m;
+    double an = m * (b - m) * x / ((a + m2 - 1.0) * (a + m2));
+    d = 1.0 + an * d;
+    if (std::fabs(d) < tiny) d = tiny;
+    c = 1.0 + an / c;
+    if (std::fabs(c) < tiny) c = tiny;
+    d = 1.0 / d;
+    h *= d * c;
+    an = -(a + m) * (a + b + m) * x / ((a + m2) * (a + m2 + 1.0));
+    d = 1.0 + an * d;
+    if (std::fabs(d) < tiny) d = tiny;
+    c = 1.0 + an / c;
+    if (std::fabs(c) < tiny) c = tiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::fabs(delta - 1.0) < 1e-15) break;
+  }
+  return h;
+}
+
+// I_x(a, b).
+double RegularizedBeta(double a, double b, double x) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
+                                a * std::log(x) + b * std::log1p(-x));
+  if (x < (a + 1.0) / (a + b + 2.0)) return front * BetaContinuedFraction(a, b, x) / a;
+  return 1.0 - front * BetaContinuedFraction(b, a, 1.0 - x) / b;
+}
+
 }  // namespace
+
+double FUpperTail(double f, int d1, int d2) {
+  if (d1 <= 0 || d2 <= 0 || !(f > 0.0)) return 1.0;
+  return RegularizedBeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
 
 double ChiSquareUpperTail(double x, int dof) {
   if (dof <= 0) return 1.0;

@@ -10,6 +10,10 @@ namespace gravcal {
 // upper incomplete gamma function, series / continued fraction).
 double ChiSquareUpperTail(double x, int dof);
 
+// P(X > f) for X ~ F(d1, d2) (regularised incomplete beta function,
+// continued fraction).
+double FUpperTail(double f, int d1, int d2);
+
 // Median of the values (copy taken).
 double Median(std::vector<double> values);
 

@@ -311,5 +311,75 @@ TEST_F(CliTest, HandheldKalmanWritesCalibrationAndHistory) {
   EXPECT_FALSE(Exists(calib2));
 }
 
+// Issue 6: discover on a session with a hidden accelerometer bias tempco
+// names it in discovery.json and the HTML report, and calibrate then fits
+// it; bad input gives one line and writes nothing.
+TEST_F(CliTest, DiscoverNamesHiddenEffectAndCalibrateFitsIt) {
+  const std::string sim = dir_ + "/warm";
+  const std::string sim_flags =
+      " --sim_scheme random:24 --sim_temperature_start 20 --sim_temperature_end 35"
+      " --sim_temperature_tau 120 --sim_accel_temperature_bias 0.005";
+  RunResult r = Run("simulate --config " + Config() + sim_flags + " --seed 3 --output-dir " + sim);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string json_path = dir_ + "/discovery.json";
+  const std::string html_path = dir_ + "/discovery.html";
+  r = Run("discover --input " + sim + "/raw.csv --config " + Config() + " --output " + json_path +
+          " --report " + html_path);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  for (const char* key : {"baseline", "steps", "ambiguous", "final_model", "verdict"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_TRUE(j["baseline"]["gap"]["accel"].is_number());
+  EXPECT_TRUE(j["baseline"]["cv_gap"]["accel"].is_number());
+  ASSERT_GE(j["steps"].size(), 1u);
+  const nlohmann::json& step = j["steps"][0];
+  EXPECT_EQ(step["effect"], "accel_temperature_bias");
+  EXPECT_EQ(step["parameters"].size(), 3u);
+  EXPECT_TRUE(step["parameters"][0]["std"].is_number());
+  for (const char* key : {"p_value", "delta_bic", "gap_before", "gap_after", "cv_gap_before",
+                          "cv_gap_after", "description"}) {
+    EXPECT_TRUE(step.contains(key)) << key;
+  }
+  EXPECT_LT(step["cv_gap_after"].get<double>(), 0.5 * step["cv_gap_before"].get<double>());
+  EXPECT_FALSE(step["where"]["summary"].get<std::string>().empty());
+  EXPECT_NE(j["verdict"].get<std::string>().find("accel_temperature_bias"), std::string::npos);
+  const std::string html = Slurp(html_path);
+  EXPECT_NE(html.find("<svg"), std::string::npos);
+  EXPECT_EQ(html.find("src="), std::string::npos);
+  EXPECT_EQ(html.find("href="), std::string::npos);
+
+  const std::string calib = dir_ + "/calib.json";
+  r = Run("calibrate --input " + sim + "/raw.csv --config " + Config() +
+          " --effects [accel_temperature_bias] --output " + calib);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream cin(calib);
+  const nlohmann::json c = nlohmann::json::parse(cin);
+  ASSERT_TRUE(c["effects"].contains("accel_temperature_bias"));
+  EXPECT_EQ(c["effects"]["accel_temperature_bias"]["value"].size(), 3u);
+  EXPECT_TRUE(c["effects"]["accel_temperature_bias"]["std"][2].is_number());
+}
+
+TEST_F(CliTest, DiscoverBadInputGivesOneLineAndNoOutput) {
+  const std::string json_path = dir_ + "/discovery.json";
+  const std::string html_path = dir_ + "/discovery.html";
+  RunResult r = Run("discover --input " + dir_ + "/missing.csv --config " + Config() +
+                    " --output " + json_path + " --report " + html_path);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("missing.csv"), std::string::npos);
+  const std::string config = Write("bad.yaml", "method: twelve_position\neffects: [temp_bias]\n");
+  r = Run("discover --input " + Simulated() + " --config " + config + " --output " + json_path);
+  EXPECT_EQ(r.exit_code, 1);
+  const std::string line = OneLine(r);
+  EXPECT_NE(line.find("bad.yaml:2"), std::string::npos) << line;
+  EXPECT_NE(line.find("temp_bias"), std::string::npos) << line;
+  r = Run("discover --input " + Simulated() + " --config " + Config());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("--output"), std::string::npos);
+  EXPECT_FALSE(Exists(json_path));
+  EXPECT_FALSE(Exists(html_path));
+}
+
 }  // namespace
 }  // namespace gravcal

@@ -16,6 +16,7 @@
 #include "gravcal/accel_model.h"
 #include "gravcal/position.h"
 #include "gravcal/refinement.h"
+#include "gravcal/simulator.h"
 
 namespace gravcal {
 namespace testing_util {
@@ -95,6 +96,21 @@ inline std::string RealDataDir() {
 }
 
 inline std::string SourceDir() { return GRAVCAL_SOURCE_DIR; }
+
+// Issue 6: 24 random poses held 10 s during a warm-up from 20 to 35 degC
+// (time constant 120 s), so temperature and time both vary and are not
+// proportional: the session in which hidden effects are looked for.
+inline SimulatorOptions WarmUpSession() {
+  SimulatorOptions o;
+  o.scheme = "random:24";
+  o.hold_seconds = 10.0;
+  o.initial_still_seconds = 5.0;
+  o.rotation_seconds = 2.0;
+  o.temperature_start = 20.0;
+  o.temperature_end = 35.0;
+  o.temperature_tau = 120.0;
+  return o;
+}
 
 }  // namespace testing_util
 }  // namespace gravcal

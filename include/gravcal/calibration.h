@@ -21,6 +21,7 @@
 #include "gravcal/gravity.h"
 #include "gravcal/gyro_model.h"
 #include "gravcal/imu_log.h"
+#include "gravcal/model_effects.h"
 #include "gravcal/newton_solver.h"
 #include "gravcal/position.h"
 #include "gravcal/refinement.h"
@@ -153,6 +154,9 @@ struct Calibration {
   bool not_converged = false;
   AccelCalibration accel;
   GyroCalibration gyro;
+  // Effects beyond the textbook model (config key `effects`); empty when
+  // none were asked for.
+  EffectCalibration effects;
   // The method that produced this result (config key `method`).
   std::string method = "twelve_position";
   double gravity = kStandardGravity;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gravcal/calibration.h"
+#include "gravcal/discovery.h"
 #include "gravcal/gyro_calibration.h"
 #include "gravcal/handheld_kalman.h"
 #include "gravcal/handheld_simulator.h"
@@ -44,6 +45,10 @@ struct Config {
   HandheldKalmanOptions handheld;
   MotionOptions motion;
   std::string sim_motion;
+  // Issue 6: effects beyond the textbook model fitted by `calibrate` (and
+  // already in the baseline of `discover`), and the discovery workflow.
+  std::vector<Effect> effects;
+  DiscoveryOptions discovery;
 
   bool IsValid(std::string* error) const;
 };

@@ -24,6 +24,7 @@
 #include "gravcal/accel_model.h"
 #include "gravcal/gyro_model.h"
 #include "gravcal/imu_log.h"
+#include "gravcal/model_effects.h"
 
 namespace gravcal {
 
@@ -97,6 +98,36 @@ struct SimulatorOptions {
   // session (WriteFixtureAttitudes) get N(0, this) degrees of noise, and
   // this is the uncertainty they state (at least 0.001 deg).
   double fixture_attitude_noise_deg = 0.0;
+  // Effects beyond the textbook model (model_effects.h), all off (0) by
+  // default. Each coefficient is drawn N(0, std) per axis (per element for
+  // G) from a random stream of its own, so switching one on changes neither
+  // the others nor the rest of the session. The accelerometer terms act in
+  // the orthogonalised sensor frame, s = R^T f:
+  //   v = U^-1 m + b,  m_i = (1 + c_i dT) (s_i + k2_i s_i^2) + beta_i dT + delta_i t,
+  // and the gyroscope u = M_g^-1 (w + G f + gamma dT + eta t) + b_g, with
+  // dT = temperature - effect_reference_temperature and t the session time.
+  // Typical MEMS magnitudes (consumer parts such as the BMI160 and
+  // MPU-6050, datasheets and published calibrations): k2 of 1e-5 to
+  // 2.5e-4 per m/s^2 (100-2500 ug/g^2; consumer parts specify about 0.5 % of
+  // full scale nonlinearity); accelerometer bias tempco 0.5-2 mg/K
+  // (0.005-0.02 m/s^2/K); scale tempco 0.01-0.03 %/K; warm-up bias drift of a
+  // few mg over minutes (1e-5 to 1e-4 m/s^2/s); gyroscope g-sensitivity
+  // about 0.1 deg/s/g (1.8e-4 rad/s per m/s^2); gyroscope bias tempco
+  // 0.01-0.05 deg/s/K (2e-4 to 9e-4 rad/s/K).
+  // k2 per axis, 1/(m/s^2).
+  double accel_quadratic_std = 0.0;
+  // beta per axis, m/s^2 per degree C.
+  double accel_temperature_bias_std = 0.0;
+  // c per axis, fraction per degree C.
+  double accel_temperature_scale_std = 0.0;
+  // delta per axis, m/s^2 per second.
+  double accel_bias_drift_std = 0.0;
+  // gamma per axis, rad/s per degree C.
+  double gyro_temperature_bias_std = 0.0;
+  // eta per axis, rad/s per second.
+  double gyro_bias_drift_std = 0.0;
+  // The temperature at which the temperature terms are zero, degrees C.
+  double effect_reference_temperature = 25.0;
 
   bool IsValid(std::string* error) const;
 };
@@ -116,14 +147,17 @@ struct SimulatedSession {
   ImuLog log;
   AccelModel accel_truth;
   GyroModel gyro_truth;
-  // Truth g-sensitivity G, rad/s per m/s^2 (zero unless
-  // gyro_g_sensitivity_std > 0).
-  Eigen::Matrix3d gyro_g_sensitivity = Eigen::Matrix3d::Zero();
   std::vector<SimulatedPose> poses;
   double gravity = 9.80665;
   // Raw units per m/s^2 (accelerometer) and per rad/s (gyroscope).
   double accel_units_per_si = 1.0;
   double gyro_units_per_si = 1.0;
+  // The truth of the effects (SimulatorOptions above): G in rad/s per m/s^2
+  // (body frame f), zero unless gyro_g_sensitivity_std is set; `effects`
+  // holds every term in SI (gyroscope terms in rad/s, before M_g^-1),
+  // reference_temperature = effect_reference_temperature, reference_time 0.
+  Eigen::Matrix3d gyro_g_sensitivity = Eigen::Matrix3d::Zero();
+  EffectParameters effects;
   uint64_t seed = 0;
 };
 

@@ -22,6 +22,8 @@ struct CommandArgs {
   std::string attitudes;
   // calibrate: the time history CSV of recursive methods (--history).
   std::string history;
+  // discover: the HTML report to write (optional).
+  std::string report;
   uint64_t seed = 1;
   // batch and merge-summaries.
   std::string manifest;
@@ -45,6 +47,7 @@ int RunSimulate(const CommandArgs& args);
 int RunBatch(const CommandArgs& args);
 // 0 merged; 1 bad input (nothing written).
 int RunMergeSummaries(const CommandArgs& args);
+int RunDiscover(const CommandArgs& args);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

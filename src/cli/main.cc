@@ -34,6 +34,7 @@ DEFINE_int32(outlier_min_units, gravcal::FleetOptions().min_units,
              "batch: fewest calibrated units for the outlier check");
 DEFINE_string(attitudes, "", "known_attitude: CSV of each static position's roll and pitch");
 DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
+DEFINE_string(report, "", "HTML report to write (discover)");
 
 namespace {
 
@@ -67,6 +68,9 @@ const std::vector<CommandInfo>& Commands() {
        "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
        "shard1/ shard2/ ...",
        {"output_dir", "outlier_sigmas", "outlier_min_units"}},
+      {"discover",
+       "find the effects the model misses: discovery.json and an HTML report",
+       {"input", "config", "output", "report"}},
       {"help", "list commands, or the flags and config keys of one: gravcal help <command>", {}},
   };
   return commands;
@@ -211,11 +215,13 @@ int main(int argc, char** argv) {
   args.positional = positional;
   args.attitudes = FLAGS_attitudes;
   args.history = FLAGS_history;
+  args.report = FLAGS_report;
 
   if (command == "demo") return gravcal::cli::RunDemo(args);
   if (command == "calibrate") return gravcal::cli::RunCalibrate(args);
   if (command == "apply") return gravcal::cli::RunApply(args);
   if (command == "batch") return gravcal::cli::RunBatch(args);
   if (command == "merge-summaries") return gravcal::cli::RunMergeSummaries(args);
+  if (command == "discover") return gravcal::cli::RunDiscover(args);
   return gravcal::cli::RunSimulate(args);
 }

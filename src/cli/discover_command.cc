@@ -1,0 +1,44 @@
+// gravcal discover: the model discrepancy workflow (discovery.h) on one log,
+// writing discovery.json and, with --report, the HTML report.
+#include <cstdio>
+
+#include "cli/commands.h"
+#include "gravcal/discovery.h"
+#include "gravcal/discovery_report.h"
+#include "gravcal/log_reader.h"
+
+namespace gravcal {
+namespace cli {
+
+int RunDiscover(const CommandArgs& args) {
+  if (args.input.empty()) return Fail("discover needs --input <raw log>");
+  if (args.output.empty()) return Fail("discover needs --output <discovery.json>");
+  std::string error;
+  if (!args.config.IsValid(&error)) return Fail(error);
+  ImuLog log;
+  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  DiscoveryResult result;
+  if (!DiscoverEffects(log, args.config.calibration, args.config.effects, args.config.discovery,
+                       &result)) {
+    return Fail(result.message);
+  }
+  for (const std::string& w : result.warnings) {
+    std::fprintf(stderr, "gravcal: warning: %s\n", w.c_str());
+  }
+  if (!WriteFileAtomically(args.output, DiscoveryToJson(result), &error)) return Fail(error);
+  if (!args.report.empty() && !WriteFileAtomically(args.report, DiscoveryToHtml(result), &error)) {
+    std::remove(args.output.c_str());
+    return Fail(error);
+  }
+  for (size_t i = 0; i < result.steps.size(); ++i) {
+    const DiscoveryStep& s = result.steps[i];
+    std::fprintf(stderr, "gravcal: step %zu: %s (p = %.3g, delta BIC %.1f)\n", i + 1,
+                 ToString(s.effect), s.p_value, s.delta_bic);
+  }
+  std::fprintf(stderr, "gravcal: %s; wrote %s%s%s\n", result.verdict.c_str(), args.output.c_str(),
+               args.report.empty() ? "" : " and ", args.report.c_str());
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace gravcal

@@ -1,0 +1,252 @@
+// The effect catalogue's terms and the fit of the model with effects:
+// forward/inverse round trips, a Jacobian check, estimates against simulator
+// truth with honest standard deviations, and bad input.
+#include "gravcal/effect_fit.h"
+
+#include <ceres/autodiff_cost_function.h>
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+
+#include "effect_residual.h"
+#include "gravcal/config.h"
+#include "gravcal/pipeline.h"
+#include "gravcal/simulator.h"
+#include "statistics.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+EffectParameters RandomParameters(std::mt19937_64* rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  auto v = [&](double s) -> Eigen::Vector3d {
+    return Eigen::Vector3d(n(*rng), n(*rng), n(*rng)) * s;
+  };
+  EffectParameters p;
+  p.accel_quadratic = v(2e-4);
+  p.accel_temperature_bias = v(0.01);
+  p.accel_temperature_scale = v(3e-4);
+  p.accel_bias_drift = v(1e-4);
+  p.reference_temperature = 25.0;
+  p.reference_time = 100.0;
+  return p;
+}
+
+std::vector<Effect> AllAccelEffects() {
+  return {Effect::kAccelQuadratic, Effect::kAccelTemperatureBias, Effect::kAccelTemperatureScale,
+          Effect::kAccelBiasDrift};
+}
+
+TEST(ModelEffects, CorrectionInvertsTheSensorModel) {
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 200; ++i) {
+    const EffectParameters p = RandomParameters(&rng);
+    const Eigen::Vector3d s = 9.8 * testing_util::RandomDirection(&rng);
+    const double temperature = 15.0 + 0.1 * i;
+    const double time = 3.0 * i;
+    const Eigen::Vector3d m = ApplyAccelEffects(p, s, temperature, time);
+    Eigen::Vector3d a;
+    ASSERT_TRUE(CorrectAccel(p, AllAccelEffects(), m, temperature, time, &a));
+    EXPECT_LT((a - s).norm(), 1e-12);
+    EXPECT_GT((m - s).norm(), 0.0);
+  }
+}
+
+TEST(ModelEffects, ZeroParametersAndUnknownTemperatureAreTheIdentity) {
+  EffectParameters zero;
+  const Eigen::Vector3d s(1.0, -2.0, 9.0);
+  EXPECT_EQ(ApplyAccelEffects(zero, s, 40.0, 50.0), s);
+  std::mt19937_64 rng(4);
+  EffectParameters p = RandomParameters(&rng);
+  p.accel_quadratic.setZero();
+  p.accel_bias_drift.setZero();
+  // No temperature column: the temperature terms are off.
+  EXPECT_EQ(ApplyAccelEffects(p, s, NAN, p.reference_time), s);
+}
+
+TEST(ModelEffects, NamesRoundTripAndUnknownNamesAreErrors) {
+  for (const EffectInfo& info : EffectCatalogue()) {
+    Effect e;
+    ASSERT_TRUE(FromString(info.name, &e));
+    EXPECT_EQ(e, info.effect);
+    EXPECT_EQ(static_cast<int>(info.parameter_names.size()), info.num_parameters);
+  }
+  std::vector<Effect> effects;
+  std::string error;
+  EXPECT_TRUE(ParseEffects({"accel_bias_drift", "accel_bias_drift"}, &effects, &error));
+  EXPECT_EQ(effects.size(), 1u);
+  EXPECT_FALSE(ParseEffects({"accel_bias_drfit"}, &effects, &error));
+  EXPECT_NE(error.find("accel_bias_drfit"), std::string::npos) << error;
+  EXPECT_NE(error.find("accel_bias_drift"), std::string::npos) << error;
+}
+
+// The autodiff Jacobian of the residual against central differences.
+TEST(EffectResidual, JacobianMatchesNumericDifferences) {
+  std::mt19937_64 rng(5);
+  const EffectParameters p = RandomParameters(&rng);
+  const Eigen::Vector3d raw(310.0, -1200.0, 15800.0);
+  std::unique_ptr<ceres::CostFunction> cost(
+      AccelEffectResidual::Create(raw, 6.0, -40.0, 9.81, 0.001));
+  double bias[3] = {20.0, -30.0, 45.0};
+  double upper[6] = {6.0e-4, 2e-6, -3e-6, 6.1e-4, 1e-6, 5.9e-4};
+  double blocks[4][3];
+  const Eigen::Vector3d* values[4] = {&p.accel_quadratic, &p.accel_temperature_bias,
+                                      &p.accel_temperature_scale, &p.accel_bias_drift};
+  for (int b = 0; b < 4; ++b) {
+    for (int i = 0; i < 3; ++i) blocks[b][i] = (*values[b])(i);
+  }
+  double* params[6] = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
+  const int sizes[6] = {3, 6, 3, 3, 3, 3};
+  const double kStep[6] = {1e-3, 1e-10, 1e-5, 1e-6, 1e-6, 1e-6};
+  double r;
+  double jac[6][6];
+  double* jacobians[6] = {jac[0], jac[1], jac[2], jac[3], jac[4], jac[5]};
+  ASSERT_TRUE(cost->Evaluate(params, &r, jacobians));
+  for (int b = 0; b < 6; ++b) {
+    for (int i = 0; i < sizes[b]; ++i) {
+      const double x = params[b][i];
+      // Steps that move |a| by 1e-7 m/s^2 or more: large enough for the
+      // rounding of |a| (about 1e-15 m/s^2), small enough for the curvature.
+      const double h = kStep[b];
+      double rp, rm;
+      params[b][i] = x + h;
+      cost->Evaluate(params, &rp, nullptr);
+      params[b][i] = x - h;
+      cost->Evaluate(params, &rm, nullptr);
+      params[b][i] = x;
+      const double numeric = (rp - rm) / (2.0 * h);
+      EXPECT_NEAR(jac[b][i], numeric, 1e-5 * std::max(1.0, std::fabs(jac[b][i])))
+          << "block " << b << " entry " << i;
+    }
+  }
+}
+
+TEST(Statistics, FUpperTailMatchesKnownValues) {
+  // Values from the F distribution tables.
+  EXPECT_NEAR(FUpperTail(3.8625, 3, 20), 0.025, 2e-4);
+  EXPECT_NEAR(FUpperTail(2.0, 9, 27), 0.0794, 5e-4);
+  EXPECT_NEAR(FUpperTail(1.0, 5, 5), 0.5, 1e-12);
+  // F(1, d) is the square of Student's t: P(F > t^2) = 2 P(T > t).
+  EXPECT_NEAR(FUpperTail(2.228 * 2.228, 1, 10), 0.05, 2e-4);
+}
+
+// rms over seeds and parameters of (estimate - truth) / std for each
+// effect calibrate fits on simulated sessions with `sim`'s effects.
+// Gyroscope truths are in raw gyroscope units: M_g^-1 G R for G (R the
+// accelerometer's housing rotation, since f = R a), M_g^-1 gamma for the
+// tempco.
+std::map<Effect, double> ErrorOverSigma(const SimulatorOptions& sim,
+                                        const std::vector<Effect>& effects, int seeds) {
+  std::map<Effect, double> sum;
+  std::map<Effect, int> count;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    SimulatedSession session;
+    std::string error;
+    EXPECT_TRUE(Simulate(sim, seed, &session, &error)) << error;
+    Config config;
+    config.effects = effects;
+    config.calibration.gravity.gravity = session.gravity;
+    PipelineInput input;
+    input.log = session.log;
+    Calibration calibration;
+    EXPECT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
+    const Eigen::Matrix3d gyro_inverse = session.gyro_truth.matrix.inverse();
+    const Eigen::Matrix3d g_truth =
+        gyro_inverse * session.gyro_g_sensitivity * session.accel_truth.rotation;
+    for (const EffectEstimate& e : calibration.effects.estimates) {
+      std::vector<double> truth = session.effects.Values(e.effect);
+      if (e.effect == Effect::kGyroGSensitivity) {
+        truth.clear();
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 3; ++c) truth.push_back(g_truth(r, c));
+        }
+      } else if (e.effect == Effect::kGyroTemperatureBias) {
+        const Eigen::Vector3d t = gyro_inverse * session.effects.gyro_temperature_bias;
+        truth = {t(0), t(1), t(2)};
+      } else if (e.effect == Effect::kGyroBiasDrift) {
+        const Eigen::Vector3d t = gyro_inverse * session.effects.gyro_bias_drift;
+        truth = {t(0), t(1), t(2)};
+      }
+      for (size_t i = 0; i < e.values.size(); ++i) {
+        EXPECT_TRUE(std::isfinite(e.std[i])) << e.names[i];
+        const double z = (e.values[i] - truth[i]) / e.std[i];
+        sum[e.effect] += z * z;
+        ++count[e.effect];
+      }
+    }
+  }
+  for (auto& [effect, s] : sum) {
+    s = std::sqrt(s / count[effect]);
+    std::printf("%s: rms error/std %.3f\n", ToString(effect), s);
+  }
+  return sum;
+}
+
+// calibrate with effects: the estimates agree with the truth within the
+// reported standard deviations (rms of error / std in [0.7, 1.4] over 30
+// seeds).
+TEST(EffectFit, CalibrateEstimatesEffectsWithHonestSigmas) {
+  SimulatorOptions sim = testing_util::WarmUpSession();
+  sim.accel_temperature_bias_std = 0.005;
+  sim.gyro_g_sensitivity_std = 1.8e-4;
+  const std::map<Effect, double> ratio =
+      ErrorOverSigma(sim, {Effect::kAccelTemperatureBias, Effect::kGyroGSensitivity}, 30);
+  ASSERT_EQ(ratio.size(), 2u);
+  for (const auto& [effect, r] : ratio) {
+    EXPECT_GT(r, 0.7) << ToString(effect);
+    EXPECT_LT(r, 1.4) << ToString(effect);
+  }
+}
+
+TEST(EffectFit, CalibrateEstimatesThreeAccelAndTwoGyroEffectsWithHonestSigmas) {
+  SimulatorOptions sim = testing_util::WarmUpSession();
+  sim.accel_quadratic_std = 1.5e-4;
+  sim.accel_temperature_scale_std = 1e-4;
+  sim.accel_bias_drift_std = 8e-5;
+  sim.gyro_temperature_bias_std = 1.7e-4;
+  sim.gyro_bias_drift_std = 1e-5;
+  const std::map<Effect, double> ratio = ErrorOverSigma(
+      sim,
+      {Effect::kAccelQuadratic, Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift,
+       Effect::kGyroTemperatureBias, Effect::kGyroBiasDrift},
+      30);
+  ASSERT_EQ(ratio.size(), 5u);
+  for (const auto& [effect, r] : ratio) {
+    EXPECT_GT(r, 0.7) << ToString(effect);
+    EXPECT_LT(r, 1.4) << ToString(effect);
+  }
+}
+
+TEST(EffectFit, EffectsTheLogCannotSupportFailWithTheirName) {
+  SimulatorOptions sim;
+  SimulatedSession session;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, 1, &session, &error)) << error;
+  Config config;
+  config.calibration.gravity.gravity = session.gravity;
+  PipelineInput input;
+  input.log = session.log;
+  input.log.temperature.clear();
+  config.effects = {Effect::kAccelTemperatureScale};
+  Calibration c;
+  EXPECT_FALSE(RunCalibration(config, input, &c));
+  EXPECT_NE(c.message.find("accel_temperature_scale"), std::string::npos) << c.message;
+  EXPECT_NE(c.message.find("temperature"), std::string::npos) << c.message;
+
+  // Constant temperature: the tempco is not determined by the positions.
+  input.log = session.log;
+  Calibration d;
+  EXPECT_FALSE(RunCalibration(config, input, &d));
+  EXPECT_NE(d.message.find("do not determine"), std::string::npos) << d.message;
+
+  // Twelve positions cannot carry 9 + 3 + 3 accelerometer parameters.
+  config.effects = {Effect::kAccelQuadratic, Effect::kAccelBiasDrift};
+  Calibration e;
+  EXPECT_FALSE(RunCalibration(config, input, &e));
+  EXPECT_NE(e.message.find("needs at least 15"), std::string::npos) << e.message;
+}
+
+}  // namespace
+}  // namespace gravcal
