@@ -16,13 +16,13 @@
 #include <sstream>
 
 #include "accel_uncertainty.h"
-#include "robust_loss.h"
 #include "gravcal/gravity_magnitude_residual.h"
 #include "gravcal/gyro_rotation_residual.h"
 #include "gravcal/gyro_static_residual.h"
 #include "gravcal/observability.h"
 #include "gravcal/position.h"
 #include "normalization.h"
+#include "robust_loss.h"
 #include "statistics.h"
 
 namespace gravcal {
@@ -516,12 +516,14 @@ AccelModel AccelAt(const std::vector<double>& x, const Layout& layout, const Acc
 }
 
 // Weights of every residual at x: fills directions, tangent bases and
-// square-root information of the rotations (and their sigma in degrees) and
-// the static poses' square-root information.
+// square-root information of the rotations (and their sigma in degrees, and
+// the integrated attitude change R(dq) of each) and the static poses'
+// square-root information.
 bool Weigh(const Prepared& prep, const Layout& layout, const std::vector<double>& x,
            const AccelModel& accel_now, const Normalization& norm,
            std::vector<GyroRotationData>* rotations, std::vector<double>* sigma_deg,
-           std::vector<Eigen::Matrix3d>* static_information, std::string* error) {
+           std::vector<Eigen::Matrix3d>* turns, std::vector<Eigen::Matrix3d>* static_information,
+           std::string* error) {
   const Eigen::Matrix3d m =
       Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&x[layout.matrix]);
   const double* g = layout.g >= 0 ? &x[layout.g] : nullptr;
@@ -530,6 +532,7 @@ bool Weigh(const Prepared& prep, const Layout& layout, const std::vector<double>
   const Eigen::Matrix3d am = accel_now.matrix();
   rotations->clear();
   sigma_deg->clear();
+  turns->clear();
   for (size_t j = 0; j < prep.segments.size(); ++j) {
     const Segment& seg = prep.segments[j];
     GyroRotationData d = prep.rotations[j];
@@ -573,6 +576,7 @@ bool Weigh(const Prepared& prep, const Layout& layout, const std::vector<double>
       return false;
     }
     sigma_deg->push_back(std::sqrt(cov2.trace()) * kRadToDeg);
+    turns->push_back(rn);
     rotations->push_back(d);
   }
   static_information->clear();
@@ -783,8 +787,9 @@ void WarnUndetermined(const std::vector<std::string>& names, std::vector<std::st
 // parameters when the accelerometer is held (not joint): S C_a S^T, with
 // S = -(J_x^T J_x)^-1 J_x^T J_a the first-order change of the estimate
 // with the accelerometer's (b_a', free U') (normalised units), J_a from the
-// joint form of the rotation residuals.
-Eigen::MatrixXd AccelContribution(const Built& built, const FreeColumns& free, const Layout& layout,
+// joint form of the rotation residuals; jx is the whitened Jacobian of all
+// residuals in the free columns.
+Eigen::MatrixXd AccelContribution(const Eigen::MatrixXd& jx, const Layout& layout,
                                   const Prepared& prep,
                                   const std::vector<GyroRotationData>& rotations,
                                   std::vector<double>* x, const AccelModel& accel,
@@ -792,7 +797,6 @@ Eigen::MatrixXd AccelContribution(const Built& built, const FreeColumns& free, c
                                   const Eigen::MatrixXd& accel_covariance) {
   const std::vector<int> free_upper = FreeUpperIndices(accel.parameterization);
   const int na = 3 + static_cast<int>(free_upper.size());
-  const Eigen::MatrixXd jx = AmbientJacobian(built, layout, x) * free.basis;
   Eigen::MatrixXd ja = Eigen::MatrixXd::Zero(jx.rows(), na);
   const AccelModel an = norm.Apply(accel);
   double accel_bias[3] = {an.bias(0), an.bias(1), an.bias(2)};
@@ -827,6 +831,42 @@ Eigen::MatrixXd AccelContribution(const Built& built, const FreeColumns& free, c
   const Eigen::MatrixXd information = jx.transpose() * jx;
   const Eigen::MatrixXd sensitivity = -information.ldlt().solve(jx.transpose() * ja);
   return sensitivity * ca * sensitivity.transpose();
+}
+
+// Consecutive rotations k (pose s -> e) and k + 1 (pose e -> f) share the
+// measured direction d_e: r_k = W_k E_k (R_k^T d_s - d_e) and r_{k+1} =
+// W_{k+1} E_{k+1} (R_{k+1}^T d_e - d_f), so their whitened residuals are
+// correlated, Cov(r_k, r_{k+1}) = -W_k E_k C_e R_{k+1} E_{k+1}^T W_{k+1}^T
+// (C_e the covariance of d_e), while the fit weighs them as independent.
+// The estimate's covariance is then the sandwich A J^T (I + D) J A, with
+// A = (J^T J)^-1 what the fit reports and D these off-diagonal blocks; this
+// returns the correction A J^T D J A (free columns, normalised units).
+// Generalised least squares with the full covariance would change the
+// estimate by far less than its sigma (the shared direction noise is a few
+// per cent of the integrated gyroscope noise), so only the reported
+// uncertainty is corrected. j is the whitened Jacobian of all residuals in
+// the free columns (rows: static poses, then rotations, in Build's order).
+Eigen::MatrixXd SharedPoseCorrection(const Eigen::MatrixXd& j, const Prepared& prep,
+                                     const std::vector<GyroRotationData>& rotations,
+                                     const std::vector<Eigen::Matrix3d>& turns,
+                                     const AccelModel& accel, const Eigen::MatrixXd& covariance) {
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(j.rows(), j.rows());
+  const int first_row = 3 * static_cast<int>(prep.static_gyro.size());
+  const Eigen::Matrix3d am = accel.matrix();
+  for (size_t k = 0; k + 1 < prep.segments.size(); ++k) {
+    if (prep.segments[k].to != prep.segments[k + 1].from) continue;
+    const Position& shared = prep.positions[prep.segments[k].to];
+    const Eigen::Matrix3d ce =
+        DirectionCovariance(am, accel.Apply(shared.raw_mean), shared.raw_mean_cov);
+    const Eigen::Matrix2d block = -rotations[k].sqrt_information * rotations[k].tangent * ce *
+                                  turns[k + 1] * rotations[k + 1].tangent.transpose() *
+                                  rotations[k + 1].sqrt_information.transpose();
+    const int row = first_row + 2 * static_cast<int>(k);
+    d.block<2, 2>(row, row + 2) = block;
+    d.block<2, 2>(row + 2, row) = block.transpose();
+  }
+  const Eigen::MatrixXd ja = j * covariance;
+  return ja.transpose() * d * ja;
 }
 
 }  // namespace
@@ -911,7 +951,7 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
   std::vector<bool> held(layout.size, false);
   std::vector<GyroRotationData> rotations;
   std::vector<double> sigma_deg;
-  std::vector<Eigen::Matrix3d> static_information;
+  std::vector<Eigen::Matrix3d> turns, static_information;
   Built built;
   FreeColumns free;
   ceres::Solver::Summary summary;
@@ -921,8 +961,8 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     pending = false;
     const AccelModel accel_now = AccelAt(x, layout, accel, norm);
-    if (!Weigh(prep, layout, x, accel_now, norm, &rotations, &sigma_deg, &static_information,
-               &error)) {
+    if (!Weigh(prep, layout, x, accel_now, norm, &rotations, &sigma_deg, &turns,
+               &static_information, &error)) {
       r.message = error;
       return false;
     }
@@ -1042,9 +1082,11 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> tangent(nf, nf);
     if (covariance.Compute(built.free_blocks, built.problem.get()) &&
         covariance.GetCovarianceMatrixInTangentSpace(built.free_blocks, tangent.data())) {
+      const Eigen::MatrixXd jacobian = AmbientJacobian(built, layout, &x) * free.basis;
+      tangent += SharedPoseCorrection(jacobian, prep, rotations, turns, accel_final, tangent);
       if (layout.accel_bias < 0 && accel_covariance.size() > 0) {
-        tangent += AccelContribution(built, free, layout, prep, rotations, &x, accel, norm,
-                                     accel_covariance);
+        tangent +=
+            AccelContribution(jacobian, layout, prep, rotations, &x, accel, norm, accel_covariance);
       }
       const Eigen::MatrixXd ambient =
           to_si.asDiagonal() * free.basis * tangent * free.basis.transpose() * to_si.asDiagonal();
