@@ -1,7 +1,8 @@
 // Gyroscope calibration from the rotations between static poses
 // (gyro_calibration.h): the integrator, sigmas against the spread over many
 // simulated seeds, the residual per rotation, the g-sensitivity, the joint
-// fit, a missing rotation axis, bad input, and the pipeline.
+// fit, a missing rotation axis, bad input, the pipeline, and the agreement
+// with the rate-table and handheld Kalman calibrations of the same IMU.
 #include "gravcal/gyro_calibration.h"
 
 #include <gtest/gtest.h>
@@ -17,7 +18,10 @@
 #include "gravcal/calibration_io.h"
 #include "gravcal/config.h"
 #include "gravcal/gyro_rotation_residual.h"
+#include "gravcal/handheld_kalman.h"
+#include "gravcal/handheld_simulator.h"
 #include "gravcal/pipeline.h"
+#include "gravcal/rate_table.h"
 #include "gravcal/simulator.h"
 #include "gravcal/static_detector.h"
 
@@ -458,14 +462,144 @@ TEST(GyroCalibration, DISABLED_SigmaMatchesSpreadOverManySeeds) {
   }
 }
 
-// Cross-checks against the rate-table baseline and the handheld Kalman
-// calibration (issue 5: "results agree ... within their uncertainties").
-// Those calibrations are being written on other branches; once merged, run
-// them on the same simulated IMU as here (HandSession(), seeds 1..30) and
-// check |M_this - M_other| against sqrt(sigma_this^2 + sigma_other^2) per
-// entry (the Kalman filter estimates diagonal scale only: compare those).
-TEST(GyroCalibration, DISABLED_AgreesWithRateTableAndHandheldKalman) {
-  GTEST_SKIP() << "enable when the rate-table and Kalman calibrations are on main";
+// One estimate of the six numbers all three gyroscope calibrations give
+// (bias x, y, z in raw units; diagonal of M_g in rad/s per raw unit, in the
+// rotations method's frame, the calibrated accelerometer's) with their
+// standard deviations.
+struct GyroEstimate {
+  const char* name = "";
+  Eigen::Matrix<double, 6, 1> value, sigma;
+};
+
+GyroEstimate Estimate(const char* name, const GyroModel& model, const Eigen::Vector3d& bias_std,
+                      const Eigen::Matrix3d& matrix_std) {
+  GyroEstimate e;
+  e.name = name;
+  e.value << model.bias, model.matrix.diagonal();
+  e.sigma << bias_std, matrix_std.diagonal();
+  return e;
+}
+
+// An estimate of M_g in another frame, brought into the frame T rotates
+// into: T M. Its covariance (bias_x..z, m_xx, m_xy, ..., m_zz) is carried
+// through that linear map, d(T M)_ii = sum_k T_ik dM_ki; the bias is in raw
+// units and needs nothing.
+GyroEstimate Rotated(const char* name, const GyroModel& model, const Eigen::MatrixXd& covariance,
+                     const Eigen::Matrix3d& t) {
+  EXPECT_EQ(covariance.rows(), 12) << name;
+  Eigen::Matrix<double, 6, 12> jacobian = Eigen::Matrix<double, 6, 12>::Zero();
+  for (int i = 0; i < 3; ++i) {
+    jacobian(i, i) = 1.0;
+    for (int k = 0; k < 3; ++k) jacobian(3 + i, 3 + 3 * k + i) = t(i, k);
+  }
+  const Eigen::Matrix<double, 6, 6> cov = jacobian * covariance * jacobian.transpose();
+  GyroEstimate e;
+  e.name = name;
+  e.value << model.bias, (t * model.matrix).diagonal();
+  e.sigma = cov.diagonal().cwiseSqrt();
+  return e;
+}
+
+// Cross-check of issue 5 ("results agree ... within their uncertainties"):
+// seed `seed` of `sensor` calibrated three ways, (a) from the rotations
+// between the twelve poses (hand rotations, full model), (b) on a rate
+// table, (c) with the handheld Kalman filter (bias and scale, plus the
+// cross-axis terms when `cross_axis`). Simulate and SimulateMotion draw the
+// truth sensors first, from the same generator and options, so one seed is
+// one IMU (checked). The comparison is in the calibrated accelerometer's
+// frame, R_a^T times the body frame (MatrixInAccelFrame): the rotations
+// method's and, with cross-axis terms, the filter's; the rate table works in
+// the body frame and is rotated. Every pair agrees within 4 sigma of the
+// difference, and every estimate within 4 sigma of the truth.
+void ExpectThreeWaysAgree(const SimulatorOptions& sensor, bool cross_axis, uint64_t seed) {
+  // (a) Rotations between static poses.
+  GyroCalibrationOptions rotation_options;
+  rotation_options.parameterization = GyroParameterization::kFull;
+  const GyroRun run = CalibrateSimulated(sensor, seed, rotation_options);
+  ASSERT_TRUE(run.ok);
+  const Eigen::Matrix3d& accel_rotation = run.session.accel_truth.rotation;
+  // (b) Rate table.
+  MotionOptions table;
+  table.profile = MotionProfile::kRateTable;
+  table.rate_dps = 60.0;
+  table.seconds_per_axis = 20.0;
+  MotionSession rate_session;
+  std::string error;
+  ASSERT_TRUE(SimulateMotion(sensor, table, seed, &rate_session, &error)) << error;
+  RateTableResult rate;
+  ASSERT_TRUE(CalibrateRateTable(rate_session.sensor.log, rate_session.segments, &rate))
+      << rate.message;
+  // (c) Handheld Kalman filter, its noise settings matching the sensor.
+  MotionSession hand_session;
+  ASSERT_TRUE(SimulateMotion(sensor, MotionOptions(), seed, &hand_session, &error)) << error;
+  HandheldKalmanOptions kalman_options;
+  kalman_options.gravity.gravity = sensor.gravity;
+  kalman_options.accel_nominal_scale = 1.0 / hand_session.sensor.accel_units_per_si;
+  kalman_options.gyro_nominal_scale = 1.0 / hand_session.sensor.gyro_units_per_si;
+  kalman_options.accel_noise_density = sensor.accel_noise / std::sqrt(sensor.sample_rate);
+  kalman_options.gyro_noise_density = sensor.gyro_noise / std::sqrt(sensor.sample_rate);
+  if (cross_axis) {
+    kalman_options.accel_terms = SensorErrorTerms::ScaleAndUpperCrossAxis();
+    kalman_options.gyro_terms = SensorErrorTerms::ScaleAndCrossAxis();
+  }
+  Calibration kalman;
+  ASSERT_TRUE(CalibrateHandheld(hand_session.sensor.log, kalman_options, &kalman))
+      << kalman.message;
+
+  // One IMU.
+  const GyroModel& truth = run.session.gyro_truth;
+  for (const MotionSession* m : {&rate_session, &hand_session}) {
+    ASSERT_EQ(m->sensor.gyro_truth.bias, truth.bias);
+    ASSERT_EQ(m->sensor.gyro_truth.matrix, truth.matrix);
+    ASSERT_EQ(m->sensor.accel_truth.matrix(), run.session.accel_truth.matrix());
+  }
+  const GyroEstimate estimates[3] = {
+      Estimate("rotations", run.gyro.model, run.gyro.bias_std, run.gyro.matrix_std),
+      Rotated("rate table", rate.gyro.model, rate.gyro.covariance, accel_rotation.transpose()),
+      Estimate("kalman", kalman.gyro.model, kalman.gyro.bias_std, kalman.gyro.matrix_std)};
+  Eigen::Matrix<double, 6, 1> truth_value;
+  truth_value << truth.bias, MatrixInAccelFrame(run.session).diagonal();
+  const char* names[6] = {"b_x", "b_y", "b_z", "m_xx", "m_yy", "m_zz"};
+  for (int j = 0; j < 6; ++j) {
+    std::printf("seed %d %-4s truth %.6g", static_cast<int>(seed), names[j], truth_value(j));
+    for (const GyroEstimate& e : estimates) {
+      ASSERT_TRUE(std::isfinite(e.sigma(j))) << e.name << " " << names[j];
+      std::printf(" | %s %.6g +- %.2g (%+.2f sigma)", e.name, e.value(j), e.sigma(j),
+                  (e.value(j) - truth_value(j)) / e.sigma(j));
+      EXPECT_LE(std::fabs(e.value(j) - truth_value(j)), 4.0 * e.sigma(j))
+          << "seed " << seed << " " << e.name << " " << names[j];
+    }
+    std::printf("\n");
+    for (int a = 0; a < 3; ++a) {
+      for (int b = a + 1; b < 3; ++b) {
+        const GyroEstimate& x = estimates[a];
+        const GyroEstimate& y = estimates[b];
+        const double combined = std::hypot(x.sigma(j), y.sigma(j));
+        EXPECT_LE(std::fabs(x.value(j) - y.value(j)), 4.0 * combined)
+            << "seed " << seed << " " << names[j] << ": " << x.name << " " << x.value(j) << " vs "
+            << y.name << " " << y.value(j) << ", combined sigma " << combined;
+      }
+    }
+  }
+}
+
+// The IMU the filter's model (the paper's: bias and scale) describes, no
+// misalignment. With the simulator's default 0.005 rad that model is biased
+// by up to 44 sigma here (seeds 1-3; benchmarks/RESULTS.md,
+// HandheldKalman.CrossAxisTermsRecoverAMisalignedImu), while the other two
+// still agree with each other and the truth: hence the second test.
+TEST(GyroCalibration, AgreesWithRateTableAndHandheldKalman) {
+  SimulatorOptions sensor = HandSession();
+  sensor.accel_misalignment_std = 0.0;
+  sensor.gyro_misalignment_std = 0.0;
+  for (uint64_t seed = 1; seed <= 3; ++seed) ExpectThreeWaysAgree(sensor, false, seed);
+}
+
+// A misaligned IMU (simulator defaults), the filter with its cross-axis
+// terms: it then works in the accelerometer's frame like the rotations
+// method.
+TEST(GyroCalibration, AgreesWithRateTableAndCrossAxisKalmanWhenMisaligned) {
+  for (uint64_t seed = 1; seed <= 3; ++seed) ExpectThreeWaysAgree(HandSession(), true, seed);
 }
 
 }  // namespace
