@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "accel_uncertainty.h"
+#include "calibration_gravity.h"
 #include "gravcal/housing_rotation.h"
 #include "statistics.h"
 
@@ -131,15 +132,7 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
     c.message = error;
     return false;
   }
-  if (!ResolveGravity(options.gravity, &c.gravity, &c.gravity_source, &error)) {
-    c.message = error;
-    return false;
-  }
-  if (c.gravity_source == "standard") {
-    c.warnings.push_back(
-        "using standard gravity 9.80665 m/s^2: local gravity differs by up to 0.3 %, which goes "
-        "into the scale factors; give gravity, or latitude and height");
-  }
+  if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
   const AccelParameterization p = options.refinement.parameterization;
   const int needed = p == AccelParameterization::kScale ? 6 : 9;
   if (static_cast<int>(positions.size()) < needed) {
@@ -263,7 +256,7 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
 }
 
 bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options,
-                            Calibration* calibration) {
+                            Calibration* calibration, std::vector<StaticInterval>* intervals) {
   CHECK(calibration != nullptr);
   *calibration = Calibration();
   std::string error;
@@ -281,6 +274,7 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
     return false;
   }
   const std::vector<Position> positions = PositionsFromIntervals(detection.intervals);
+  if (intervals != nullptr) *intervals = detection.intervals;
   const bool ok = CalibrateFromPositions(positions, options, calibration);
   if (!ok && !log.source.empty()) calibration->message = log.source + ": " + calibration->message;
   return ok;

@@ -528,18 +528,17 @@ Eigen::Vector3d GyroResidual(const EffectFitResult& fit, const StaticObservation
 
 namespace gravcal {
 
-bool FitCalibrationEffects(const ImuLog& log, const CalibrationOptions& options,
-                           const std::vector<Effect>& effects, Calibration* calibration) {
+bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>& intervals,
+                           const CalibrationOptions& options, const std::vector<Effect>& effects,
+                           Calibration* calibration) {
   Calibration& c = *calibration;
   auto fail = [&](const std::string& what) {
     c.success = false;
     c.message = (log.source.empty() ? "" : log.source + ": ") + what;
     return false;
   };
-  StaticDetection detection;
-  if (!DetectStaticIntervals(log, options.detector, &detection)) return fail(detection.message);
   const std::vector<StaticObservation> observations =
-      ObservationsFromIntervals(detection.intervals, log.has_gyro());
+      ObservationsFromIntervals(intervals, log.has_gyro());
   const int n = static_cast<int>(observations.size());
   bool has_temperature = n > 0;
   EffectParameters start;

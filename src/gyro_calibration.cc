@@ -1186,7 +1186,7 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
   return true;
 }
 
-bool AddGyroscopeCalibration(const ImuLog& log, const StaticDetectorOptions& detector,
+bool AddGyroscopeCalibration(const ImuLog& log, const std::vector<StaticInterval>& intervals,
                              const GyroCalibrationOptions& options, Calibration* calibration) {
   CHECK(calibration != nullptr);
   Calibration& c = *calibration;
@@ -1196,15 +1196,11 @@ bool AddGyroscopeCalibration(const ImuLog& log, const StaticDetectorOptions& det
     return false;
   };
   if (!c.success) return fail("the gyroscope needs a calibrated accelerometer first");
-  StaticDetection detection;
-  if (!DetectStaticIntervals(log, detector, &detection)) {
-    return fail(log.source + ": " + detection.message);
-  }
   GyroCalibrationResult g;
   const Eigen::MatrixXd accel_covariance =
       c.refinement.covariance_available ? c.refinement.covariance : Eigen::MatrixXd();
-  if (!CalibrateGyroscope(log, detection.intervals, c.accel.model, accel_covariance, c.gravity,
-                          options, &g)) {
+  if (!CalibrateGyroscope(log, intervals, c.accel.model, accel_covariance, c.gravity, options,
+                          &g)) {
     for (const std::string& w : g.warnings) c.warnings.push_back(w);
     return fail(g.message);
   }

@@ -9,6 +9,7 @@
 #include <memory>
 #include <sstream>
 
+#include "calibration_gravity.h"
 #include "gravcal/strapdown.h"
 
 namespace gravcal {
@@ -598,15 +599,7 @@ bool CalibrateHandheld(const ImuLog& log, const HandheldKalmanOptions& options,
                 "gyro_path)";
     return false;
   }
-  if (!ResolveGravity(options.gravity, &c.gravity, &c.gravity_source, &error)) {
-    c.message = error;
-    return false;
-  }
-  if (c.gravity_source == "standard") {
-    c.warnings.push_back(
-        "using standard gravity 9.80665 m/s^2: local gravity differs by up to 0.3 %, which goes "
-        "into the accelerometer scale factors; give gravity, or latitude and height");
-  }
+  if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
   const size_t count = log.size();
   const double duration = count > 1 ? log.t.back() - log.t.front() : 0.0;
   // The still window, and enough log after it for at least a few updates.

@@ -23,14 +23,15 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
         options.refinement.parameterization == AccelParameterization::kScale) {
       options.refinement.parameterization = AccelParameterization::kScaleMisalignment;
     }
-    bool ok = CalibrateAccelerometer(input.log, options, calibration);
+    // Detected once; the effect and gyroscope steps reuse the intervals.
+    std::vector<StaticInterval> intervals;
+    bool ok = CalibrateAccelerometer(input.log, options, calibration, &intervals);
     if (ok && !config.effects.empty()) {
-      ok = FitCalibrationEffects(input.log, options, config.effects, calibration);
+      ok = FitCalibrationEffects(input.log, intervals, options, config.effects, calibration);
     }
     calibration->method = config.method;
     if (!ok || config.gyro.parameterization == GyroParameterization::kNone) return ok;
-    return AddGyroscopeCalibration(input.log, config.calibration.detector, config.gyro,
-                                   calibration);
+    return AddGyroscopeCalibration(input.log, intervals, config.gyro, calibration);
   }
   if (config.method == "ten_position") {
     return CalibrateTenPosition(input.log, config.calibration, config.ten_position, calibration);

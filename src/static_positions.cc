@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "calibration_gravity.h"
 #include "gravcal/refinement.h"
 #include "statistics.h"
 
@@ -16,15 +17,7 @@ bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
     c.message = error;
     return false;
   }
-  if (!ResolveGravity(options.gravity, &c.gravity, &c.gravity_source, &error)) {
-    c.message = error;
-    return false;
-  }
-  if (c.gravity_source == "standard") {
-    c.warnings.push_back(
-        "using standard gravity 9.80665 m/s^2: local gravity differs by up to 0.3 %, which goes "
-        "into the scale factors; give gravity, or latitude and height");
-  }
+  if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
   StaticDetection detection;
   if (!DetectStaticIntervals(log, options.detector, &detection)) {
     c.message = log.source + ": " + detection.message;

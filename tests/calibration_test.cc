@@ -176,11 +176,9 @@ TEST_P(RealData, Calibrates) {
   if (dir.empty()) GTEST_SKIP() << "no ../shared/data/real";
   const RealCase& rc = GetParam();
   Config config;
-  std::string error;
-  ASSERT_TRUE(LoadConfigFile(testing_util::SourceDir() + "/configs/" + rc.config, &config, &error))
-      << error;
   ImuLog log;
-  ASSERT_TRUE(ReadImuLog(dir + "/" + rc.file, config.input, &log, &error)) << error;
+  std::string error;
+  ASSERT_TRUE(testing_util::LoadRealSession(rc.config, rc.file, &config, &log, &error)) << error;
   Calibration c;
   ASSERT_TRUE(CalibrateAccelerometer(log, config.calibration, &c)) << c.message;
   // Distinct orientations: calibrated directions more than 10 degrees apart

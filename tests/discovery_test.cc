@@ -290,11 +290,9 @@ TEST_P(DiscoveryRealData, RunsAndIsStableWhenOnePositionIsLeftOut) {
   if (dir.empty()) GTEST_SKIP() << "no ../shared/data/real";
   const RealCase& rc = GetParam();
   Config config;
-  std::string error;
-  ASSERT_TRUE(LoadConfigFile(testing_util::SourceDir() + "/configs/" + rc.config, &config, &error))
-      << error;
   ImuLog log;
-  ASSERT_TRUE(ReadImuLog(dir + "/" + rc.file, config.input, &log, &error)) << error;
+  std::string error;
+  ASSERT_TRUE(testing_util::LoadRealSession(rc.config, rc.file, &config, &log, &error)) << error;
   DiscoveryResult full;
   ASSERT_TRUE(DiscoverEffects(log, config.calibration, config.effects, config.discovery, &full))
       << full.message;

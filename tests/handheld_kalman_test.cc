@@ -380,15 +380,13 @@ TEST(HandheldKalman, RejectsBadInput) {
 TEST(HandheldKalman, RealFerrarisSessionAgreesWithStaticReferences) {
   const std::string dir = testing_util::RealDataDir();
   if (dir.empty()) GTEST_SKIP() << "no real data folder";
-  const std::string session = dir + "/ferraris_nilspod/session.csv";
+  const std::string session = "ferraris_nilspod/session.csv";
   auto calibrate = [&](const std::string& config_name, Calibration* c) {
     Config config;
-    std::string error;
-    ASSERT_TRUE(
-        LoadConfigFile(testing_util::SourceDir() + "/configs/" + config_name, &config, &error))
-        << error;
     PipelineInput input;
-    ASSERT_TRUE(ReadImuLog(session, config.input, &input.log, &error)) << error;
+    std::string error;
+    ASSERT_TRUE(testing_util::LoadRealSession(config_name, session, &config, &input.log, &error))
+        << error;
     ASSERT_TRUE(RunCalibration(config, input, c)) << c->message;
   };
   Calibration handheld, faces;
@@ -410,11 +408,11 @@ TEST(HandheldKalman, RealFerrarisSessionAgreesWithStaticReferences) {
   std::ifstream in(dir + "/ferraris_nilspod/sections.json");
   const nlohmann::json sections = nlohmann::json::parse(in);
   Config config;
-  std::string error;
-  ASSERT_TRUE(LoadConfigFile(testing_util::SourceDir() + "/configs/ferraris_nilspod.yaml", &config,
-                             &error));
   ImuLog log;
-  ASSERT_TRUE(ReadImuLog(session, config.input, &log, &error)) << error;
+  std::string error;
+  ASSERT_TRUE(
+      testing_util::LoadRealSession("ferraris_nilspod.yaml", session, &config, &log, &error))
+      << error;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int count = 0;
   for (const char* face : {"x_p", "x_a", "y_p", "y_a", "z_p", "z_a"}) {

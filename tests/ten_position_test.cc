@@ -114,13 +114,12 @@ TEST(TenPosition, RealMpu6050TenPoses) {
   const std::string dir = testing_util::RealDataDir();
   if (dir.empty()) GTEST_SKIP() << "no real data folder";
   Config config;
-  std::string error;
-  ASSERT_TRUE(
-      LoadConfigFile(testing_util::SourceDir() + "/configs/mpu6050_ten_pose.yaml", &config, &error))
-      << error;
   PipelineInput input;
   input.source = dir + "/mpu6050_ten_pose/session.csv";
-  ASSERT_TRUE(ReadImuLog(input.source, config.input, &input.log, &error)) << error;
+  std::string error;
+  ASSERT_TRUE(testing_util::LoadRealSession("mpu6050_ten_pose.yaml", "mpu6050_ten_pose/session.csv",
+                                            &config, &input.log, &error))
+      << error;
   Calibration twelve;
   ASSERT_TRUE(RunCalibration(config, input, &twelve)) << twelve.message;
   config.method = "ten_position";

@@ -14,6 +14,9 @@
 #include <vector>
 
 #include "gravcal/accel_model.h"
+#include "gravcal/config.h"
+#include "gravcal/imu_log.h"
+#include "gravcal/log_reader.h"
 #include "gravcal/position.h"
 #include "gravcal/refinement.h"
 #include "gravcal/simulator.h"
@@ -96,6 +99,14 @@ inline std::string RealDataDir() {
 }
 
 inline std::string SourceDir() { return GRAVCAL_SOURCE_DIR; }
+
+// A real recording with its shipped config: loads configs/<config_name>,
+// then reads <RealDataDir()>/<file> with the config's input settings.
+inline bool LoadRealSession(const std::string& config_name, const std::string& file, Config* config,
+                            ImuLog* log, std::string* error) {
+  return LoadConfigFile(SourceDir() + "/configs/" + config_name, config, error) &&
+         ReadImuLog(RealDataDir() + "/" + file, config->input, log, error);
+}
 
 // Issue 6: 24 random poses held 10 s during a warm-up from 20 to 35 degC
 // (time constant 120 s), so temperature and time both vary and are not

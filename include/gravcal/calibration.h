@@ -179,8 +179,11 @@ struct Calibration {
 };
 
 // From a raw log: detects the static positions, then CalibrateFromPositions.
+// `intervals`, when given, receives the detected static intervals, so that
+// later steps on the same log (gyroscope, effects) need not detect again.
 bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options,
-                            Calibration* calibration);
+                            Calibration* calibration,
+                            std::vector<StaticInterval>* intervals = nullptr);
 
 // From positions already extracted. Returns false with a one-line message
 // on invalid options, too few positions (how many found, how many needed),

@@ -147,14 +147,14 @@ Eigen::Vector3d GyroResidual(const EffectFitResult& fit, const StaticObservation
                              const Eigen::Vector3d& force, double* whitened_squared);
 
 // Adds `effects` to a finished calibration of `log` (CalibrateAccelerometer
-// with `options`): fits the model with them from the calibration's model and
-// replaces the accelerometer bias, U, their standard deviations and
-// covariance, the residuals, and (for gyroscope effects) the gyroscope bias;
-// fills calibration->effects. The rotation R is kept. Returns false with
-// calibration->message when the effects cannot be fitted (not identified by
-// the positions, no temperature, no gyroscope, too few positions).
-bool FitCalibrationEffects(const ImuLog& log, const CalibrationOptions& options,
-                           const std::vector<Effect>& effects, Calibration* calibration);
+// with `options`, which detected `intervals`): fits the model with them from the calibration's
+// model and replaces the accelerometer bias, U, their standard deviations and covariance, the
+// residuals, and (for gyroscope effects) the gyroscope bias; fills calibration->effects. The
+// rotation R is kept. Returns false with calibration->message when the effects cannot be fitted
+// (not identified by the positions, no temperature, no gyroscope, too few positions).
+bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>& intervals,
+                           const CalibrationOptions& options, const std::vector<Effect>& effects,
+                           Calibration* calibration);
 
 }  // namespace gravcal
 

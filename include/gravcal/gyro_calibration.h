@@ -174,15 +174,15 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
                         GyroCalibrationResult* result);
 
 // The gyroscope step of a multi-position calibration: after the
-// accelerometer (calibration->success), detects the static intervals of
-// `log` with `detector`, runs CalibrateGyroscope with calibration->accel and
+// accelerometer (calibration->success) and its static `intervals` of `log`,
+// runs CalibrateGyroscope with calibration->accel and
 // fills calibration->gyro (estimated = true, the residual per rotation, the
 // g-sensitivity as extra values g_sensitivity_xx .. g_sensitivity_zz in
 // rad/s per m/s^2) and its warnings; with options.joint it also replaces the
 // accelerometer's bias, U and their uncertainties by the joint fit's.
 // Returns false with calibration->message (and success = false) when the
 // gyroscope cannot be calibrated; nothing of the gyroscope is filled then.
-bool AddGyroscopeCalibration(const ImuLog& log, const StaticDetectorOptions& detector,
+bool AddGyroscopeCalibration(const ImuLog& log, const std::vector<StaticInterval>& intervals,
                              const GyroCalibrationOptions& options, Calibration* calibration);
 
 }  // namespace gravcal
