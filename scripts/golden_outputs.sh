@@ -43,7 +43,8 @@ run_sim twelve_position_newton configs/twelve_position.yaml --solver newton
 run_sim twelve_position_gyro configs/twelve_position_gyro.yaml
 run_sim ten_position configs/ten_position.yaml
 run_sim known_attitude configs/known_attitude.yaml
-run_sim handheld_kalman configs/handheld_kalman.yaml
+run_sim handheld_kalman configs/handheld_kalman.yaml \
+  --nominal_scale 0.00059855 --gyro_nominal_scale 0.000133231 --gravity 9.80665
 run_sim discovery_effects configs/discovery.yaml
 
 real="$root/../shared/data/real"
