@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/batch.h"
-#include "gravcal/config.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/simulator.h"
+#include "gravcal/workflows/batch.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
 namespace {

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/discovery.h"
-#include "gravcal/simulator.h"
+#include "gravcal/workflows/discovery.h"
+#include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
 namespace {

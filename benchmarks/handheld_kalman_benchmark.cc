@@ -7,10 +7,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "gravcal/calibration.h"
-#include "gravcal/handheld_kalman.h"
-#include "gravcal/handheld_simulator.h"
-#include "gravcal/rate_table.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/methods/handheld_kalman.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/methods/rate_table.h"
 
 namespace gravcal {
 namespace {

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string>
 
-#include "gravcal/log_reader.h"
+#include "gravcal/io/log_reader.h"
 
 namespace gravcal {
 namespace {

@@ -18,11 +18,11 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/accel_model.h"
-#include "gravcal/coarse_fit.h"
-#include "gravcal/newton_solver.h"
-#include "gravcal/position.h"
-#include "gravcal/refinement.h"
+#include "gravcal/core/accel_model.h"
+#include "gravcal/estimation/coarse_fit.h"
+#include "gravcal/estimation/newton_solver.h"
+#include "gravcal/core/position.h"
+#include "gravcal/estimation/refinement.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -6,8 +6,8 @@
 #include <random>
 #include <vector>
 
-#include "gravcal/position.h"
-#include "gravcal/static_detector.h"
+#include "gravcal/core/position.h"
+#include "gravcal/detection/static_detector.h"
 
 namespace gravcal {
 namespace {

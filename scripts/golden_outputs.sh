@@ -25,7 +25,7 @@ print(json.dumps(walk(json.load(open(sys.argv[1]))), indent=1, sort_keys=True))'
 
 cd "$root"
 "$g" demo --config configs/twelve_position.yaml > "$out/demo.txt" 2>&1 || true
-sed -i -E '/(time|seconds|ms)/d' "$out/demo.txt"
+sed -i -E -e '/(time|seconds)/d' -e 's/[0-9.]+ (us|ms|s);/<time>;/' "$out/demo.txt"
 
 run_sim() {  # name config [extra calibrate flags...]
   local name=$1 cfg=$2; shift 2

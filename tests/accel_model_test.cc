@@ -1,4 +1,4 @@
-#include "gravcal/accel_model.h"
+#include "gravcal/core/accel_model.h"
 
 #include <gtest/gtest.h>
 

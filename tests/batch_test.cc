@@ -1,7 +1,7 @@
 // Batch calibration: the library API (CalibrateBatch), the manifest, the
 // fleet statistics, and `gravcal batch` / `gravcal merge-summaries` end to end
 // on a dozen short simulated units, some of them bad.
-#include "gravcal/batch.h"
+#include "gravcal/workflows/batch.h"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -22,13 +22,13 @@
 #include <thread>
 #include <vector>
 
-#include "gravcal/batch_manifest.h"
-#include "gravcal/calibration_io.h"
-#include "gravcal/config.h"
-#include "gravcal/fleet_summary.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/pipeline.h"
-#include "gravcal/simulator.h"
+#include "gravcal/workflows/batch_manifest.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
 namespace gravcal {

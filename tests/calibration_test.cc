@@ -1,14 +1,14 @@
 // The whole pipeline on simulated sessions (simulator -> static detection ->
 // coarse fit -> refinement) and on the real recordings.
-#include "gravcal/calibration.h"
+#include "gravcal/methods/twelve_position.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
-#include "gravcal/config.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/simulator.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
 namespace gravcal {

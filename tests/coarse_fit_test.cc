@@ -1,4 +1,4 @@
-#include "gravcal/coarse_fit.h"
+#include "gravcal/estimation/coarse_fit.h"
 
 #include <gtest/gtest.h>
 

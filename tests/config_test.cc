@@ -1,7 +1,7 @@
 // Config: the YAML file and flag layer. Every shipped config must load and
 // validate; every kind of bad input must fail with a message naming the file
 // and line or the key, and leave the config untouched.
-#include "gravcal/config.h"
+#include "gravcal/workflows/config.h"
 
 #include <gtest/gtest.h>
 

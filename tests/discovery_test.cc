@@ -1,6 +1,6 @@
 // The model discrepancy workflow on simulated sessions in which an effect is
 // hidden (the workflow is not told which), and on the real recordings.
-#include "gravcal/discovery.h"
+#include "gravcal/workflows/discovery.h"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <functional>
 
-#include "gravcal/config.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/simulator.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
 namespace gravcal {

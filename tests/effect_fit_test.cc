@@ -1,7 +1,7 @@
 // The effect catalogue's terms and the fit of the model with effects:
 // forward/inverse round trips, a Jacobian check, estimates against simulator
 // truth with honest standard deviations, and bad input.
-#include "gravcal/effect_fit.h"
+#include "gravcal/methods/effect_fit.h"
 
 #include <ceres/autodiff_cost_function.h>
 #include <gtest/gtest.h>
@@ -9,11 +9,11 @@
 #include <map>
 #include <random>
 
-#include "effect_residual.h"
-#include "gravcal/config.h"
-#include "gravcal/pipeline.h"
-#include "gravcal/simulator.h"
-#include "statistics.h"
+#include "residuals/effect_residual.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/simulation/simulator.h"
+#include "util/statistics.h"
 #include "test_util.h"
 
 namespace gravcal {

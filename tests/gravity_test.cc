@@ -1,4 +1,4 @@
-#include "gravcal/gravity.h"
+#include "gravcal/core/gravity.h"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // simulated seeds, the residual per rotation, the g-sensitivity, the joint
 // fit, a missing rotation axis, bad input, the pipeline, and the agreement
 // with the rate-table and handheld Kalman calibrations of the same IMU.
-#include "gravcal/gyro_calibration.h"
+#include "gravcal/methods/gyro_calibration.h"
 
 #include <gtest/gtest.h>
 
@@ -14,16 +14,16 @@
 #include <iostream>
 #include <random>
 
-#include "gravcal/calibration.h"
-#include "gravcal/calibration_io.h"
-#include "gravcal/config.h"
-#include "gravcal/gyro_rotation_residual.h"
-#include "gravcal/handheld_kalman.h"
-#include "gravcal/handheld_simulator.h"
-#include "gravcal/pipeline.h"
-#include "gravcal/rate_table.h"
-#include "gravcal/simulator.h"
-#include "gravcal/static_detector.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/residuals/gyro_rotation_residual.h"
+#include "gravcal/methods/handheld_kalman.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/methods/rate_table.h"
+#include "gravcal/simulation/simulator.h"
+#include "gravcal/detection/static_detector.h"
 
 namespace gravcal {
 namespace {

@@ -1,4 +1,4 @@
-#include "gravcal/handheld_kalman.h"
+#include "gravcal/methods/handheld_kalman.h"
 
 #include <gtest/gtest.h>
 
@@ -8,12 +8,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "gravcal/calibration_io.h"
-#include "gravcal/config.h"
-#include "gravcal/handheld_simulator.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/pipeline.h"
-#include "gravcal/strapdown.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/estimation/strapdown.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -1,11 +1,11 @@
-#include "gravcal/handheld_simulator.h"
+#include "gravcal/simulation/handheld_simulator.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
-#include "gravcal/config.h"
+#include "gravcal/workflows/config.h"
 
 namespace gravcal {
 namespace {

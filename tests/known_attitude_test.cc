@@ -1,7 +1,7 @@
 // Known-attitude calibration: all twelve parameters within their reported
 // uncertainty over many simulated sessions, and bad attitude files rejected
 // with a message naming the file and line (library and command line).
-#include "gravcal/known_attitude.h"
+#include "gravcal/methods/known_attitude.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -11,9 +11,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "gravcal/attitude_fixture.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/simulator.h"
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/simulation/simulated_attitudes.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
 namespace gravcal {

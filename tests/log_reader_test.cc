@@ -1,4 +1,4 @@
-#include "gravcal/log_reader.h"
+#include "gravcal/io/log_reader.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>

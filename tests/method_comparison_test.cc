@@ -12,12 +12,13 @@
 #include <fstream>
 #include <map>
 
-#include "gravcal/attitude_fixture.h"
-#include "gravcal/config.h"
-#include "gravcal/known_attitude.h"
-#include "gravcal/pipeline.h"
-#include "gravcal/refinement.h"
-#include "gravcal/simulator.h"
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/simulation/simulated_attitudes.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/methods/known_attitude.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/estimation/refinement.h"
+#include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -1,11 +1,11 @@
 // RunCalibration: the one entry point shared by `calibrate`, `batch` and
 // library users gives exactly what the method's own function gives.
-#include "gravcal/pipeline.h"
+#include "gravcal/workflows/pipeline.h"
 
 #include <gtest/gtest.h>
 
-#include "gravcal/calibration_io.h"
-#include "gravcal/simulator.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
 namespace {

@@ -1,10 +1,10 @@
-#include "gravcal/rate_table.h"
+#include "gravcal/methods/rate_table.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "gravcal/handheld_simulator.h"
+#include "gravcal/simulation/handheld_simulator.h"
 
 namespace gravcal {
 namespace {

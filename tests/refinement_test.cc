@@ -1,13 +1,13 @@
-#include "gravcal/refinement.h"
+#include "gravcal/estimation/refinement.h"
 
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
-#include "gravcal/calibration.h"
-#include "gravcal/coarse_fit.h"
-#include "gravcal/gravity_magnitude_residual.h"
-#include "gravcal/newton_solver.h"
-#include "gravcal/observability.h"
+#include "gravcal/core/calibration.h"
+#include "gravcal/estimation/coarse_fit.h"
+#include "gravcal/residuals/gravity_magnitude_residual.h"
+#include "gravcal/estimation/newton_solver.h"
+#include "gravcal/estimation/observability.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -1,4 +1,4 @@
-#include "gravcal/simulator.h"
+#include "gravcal/simulation/simulator.h"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
 // Static alignment: roll and pitch against the simulator's truth, with the
 // reported standard deviations matching the spread seen over many seeds.
-#include "gravcal/static_alignment.h"
+#include "gravcal/estimation/static_alignment.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "gravcal/simulator.h"
+#include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
 namespace {

@@ -1,4 +1,4 @@
-#include "gravcal/static_detector.h"
+#include "gravcal/detection/static_detector.h"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/log_reader.h"
-#include "gravcal/position.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/core/position.h"
 #include "test_util.h"
 
 namespace gravcal {

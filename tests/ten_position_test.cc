@@ -1,7 +1,7 @@
 // Ten-position (patent) calibration: what the self-aligned method recovers
 // (bias, scale, non-orthogonality in the sensor frame) with honest sigmas,
 // and what it cannot (the off-diagonal of K as elements: null std, warning).
-#include "gravcal/ten_position.h"
+#include "gravcal/methods/ten_position.h"
 
 #include <gtest/gtest.h>
 
@@ -9,10 +9,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "gravcal/config.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/pipeline.h"
-#include "gravcal/simulator.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
 namespace gravcal {

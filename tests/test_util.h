@@ -13,13 +13,13 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/accel_model.h"
-#include "gravcal/config.h"
-#include "gravcal/imu_log.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/position.h"
-#include "gravcal/refinement.h"
-#include "gravcal/simulator.h"
+#include "gravcal/core/accel_model.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/core/imu_log.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/core/position.h"
+#include "gravcal/estimation/refinement.h"
+#include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
 namespace testing_util {

@@ -1,44 +1,63 @@
-// gravcal/gravcal.h: the whole public API of gravcal in one include.
+// gravcal/gravcal.h: the whole public API of gravcal in one include, wing by
+// wing from the bottom (shared types) to the top (workflows); see
+// docs/architecture.md.
 #ifndef GRAVCAL_GRAVCAL_H_
 #define GRAVCAL_GRAVCAL_H_
 
-#include "gravcal/accel_model.h"
-#include "gravcal/attitude_fixture.h"
-#include "gravcal/batch.h"
-#include "gravcal/batch_manifest.h"
-#include "gravcal/calibration.h"
-#include "gravcal/calibration_io.h"
-#include "gravcal/coarse_fit.h"
-#include "gravcal/config.h"
-#include "gravcal/discovery.h"
-#include "gravcal/discovery_report.h"
-#include "gravcal/effect_fit.h"
-#include "gravcal/fleet_summary.h"
-#include "gravcal/gravity.h"
-#include "gravcal/gravity_magnitude_residual.h"
-#include "gravcal/gyro_calibration.h"
-#include "gravcal/gyro_model.h"
-#include "gravcal/gyro_rotation_residual.h"
-#include "gravcal/gyro_static_residual.h"
-#include "gravcal/housing_rotation.h"
-#include "gravcal/imu_log.h"
-#include "gravcal/known_attitude.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/model_effects.h"
-#include "gravcal/newton_solver.h"
-#include "gravcal/observability.h"
-#include "gravcal/pipeline.h"
-#include "gravcal/position.h"
-#include "gravcal/refinement.h"
-#include "gravcal/simulator.h"
-#include "gravcal/static_alignment.h"
-#include "gravcal/static_detector.h"
-#include "gravcal/ten_position.h"
-// Issue 4: handheld Kalman calibration.
-#include "gravcal/error_state_layout.h"
-#include "gravcal/handheld_kalman.h"
-#include "gravcal/handheld_simulator.h"
-#include "gravcal/rate_table.h"
-#include "gravcal/strapdown.h"
+// core
+#include "gravcal/core/accel_model.h"
+#include "gravcal/core/calibration.h"
+#include "gravcal/core/gravity.h"
+#include "gravcal/core/gyro_model.h"
+#include "gravcal/core/imu_log.h"
+#include "gravcal/core/model_effects.h"
+#include "gravcal/core/position.h"
+#include "gravcal/core/rate_table_segment.h"
+#include "gravcal/core/solver_result.h"
 
+// detection
+#include "gravcal/detection/static_detector.h"
+
+// residuals
+#include "gravcal/residuals/gravity_magnitude_residual.h"
+#include "gravcal/residuals/gyro_rotation_residual.h"
+#include "gravcal/residuals/gyro_static_residual.h"
+
+// estimation
+#include "gravcal/estimation/coarse_fit.h"
+#include "gravcal/estimation/error_state_layout.h"
+#include "gravcal/estimation/housing_rotation.h"
+#include "gravcal/estimation/newton_solver.h"
+#include "gravcal/estimation/observability.h"
+#include "gravcal/estimation/refinement.h"
+#include "gravcal/estimation/static_alignment.h"
+#include "gravcal/estimation/strapdown.h"
+
+// io
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/io/log_reader.h"
+
+// simulation
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulated_attitudes.h"
+#include "gravcal/simulation/simulator.h"
+
+// methods
+#include "gravcal/methods/effect_fit.h"
+#include "gravcal/methods/gyro_calibration.h"
+#include "gravcal/methods/handheld_kalman.h"
+#include "gravcal/methods/known_attitude.h"
+#include "gravcal/methods/rate_table.h"
+#include "gravcal/methods/ten_position.h"
+#include "gravcal/methods/twelve_position.h"
+
+// workflows
+#include "gravcal/workflows/batch.h"
+#include "gravcal/workflows/batch_manifest.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/discovery.h"
+#include "gravcal/workflows/discovery_report.h"
+#include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/pipeline.h"
 #endif  // GRAVCAL_GRAVCAL_H_

@@ -5,13 +5,14 @@
 #include <cmath>
 #include <cstdio>
 
-#include "gravcal/attitude_fixture.h"
-#include "gravcal/calibration.h"
-#include "gravcal/calibration_io.h"
-#include "gravcal/handheld_simulator.h"
-#include "gravcal/log_reader.h"
-#include "gravcal/pipeline.h"
-#include "gravcal/simulator.h"
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/simulation/simulated_attitudes.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
 namespace cli {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/config.h"
+#include "gravcal/workflows/config.h"
 
 namespace gravcal {
 namespace cli {

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "cli/commands.h"
-#include "gravcal/config.h"
-#include "gravcal/fleet_summary.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/fleet_summary.h"
 
 DEFINE_string(input, "", "raw log to read");
 DEFINE_string(output, "", "file to write (calibration JSON or corrected CSV)");

@@ -1,0 +1,80 @@
+// gravcal/core/solver_result.h: what the estimation steps return, shared by
+// the methods and the calibration result: the observability of the magnitude
+// model, the coarse fit's result and the refinement's result, with the robust
+// loss they can use.
+#ifndef GRAVCAL_CORE_SOLVER_RESULT_H_
+#define GRAVCAL_CORE_SOLVER_RESULT_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "gravcal/core/accel_model.h"
+
+namespace gravcal {
+
+enum class LossType { kNone, kHuber, kCauchy, kSoftL1, kArctan, kTukey };
+const char* ToString(LossType loss);
+// Accepts "none", "huber", "cauchy", "soft_l1", "arctan", "tukey".
+bool FromString(const std::string& name, LossType* loss);
+
+struct ObservabilityReport {
+  int rank = 0;
+  int columns = 0;
+  // Singular values of the column-scaled Jacobian, descending.
+  Eigen::VectorXd singular_values;
+  // Unit null-space directions in parameter space (columns), unscaled.
+  Eigen::MatrixXd null_space;
+  // Names of the parameters that take part in a null direction.
+  std::vector<std::string> undetermined;
+  // One line per null direction, e.g. "bias_z - 0.71 u_zz".
+  std::vector<std::string> descriptions;
+  bool full_rank() const { return rank == columns; }
+};
+
+enum class CoarseMethod { kSixPosition, kEllipsoid };
+const char* ToString(CoarseMethod method);
+
+struct CoarseFitResult {
+  AccelModel model;
+  CoarseMethod method = CoarseMethod::kSixPosition;
+  // Nominal up axis used for each position (-1 = none).
+  std::vector<int> nominal_up;
+  int axis_positions = 0;
+  std::string message = "CoarseFit was not called";
+};
+
+struct RefinementResult {
+  AccelModel model;
+  bool converged = false;
+  int iterations = 0;
+  // The solver's own word on why it stopped.
+  std::string termination;
+  double solve_seconds = 0.0;
+  // 0.5 * sum of squared whitened residuals (before any loss).
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int num_residuals = 0;
+  // Free parameters in the magnitude fit (6 or 9).
+  int num_parameters = 0;
+  // Sum of squared whitened residuals and its degrees of freedom: chi2 / dof
+  // near 1 means the sigmas and the model fit the data.
+  double chi2 = 0.0;
+  int dof = 0;
+  // Covariance of the free parameters, in parameter_names order.
+  bool covariance_available = false;
+  Eigen::MatrixXd covariance;
+  std::vector<std::string> parameter_names;
+  ObservabilityReport observability;
+  // Per position: |a_k| - g before (initial model) and after, m/s^2, and
+  // the sigma used.
+  std::vector<double> residuals_before;
+  std::vector<double> residuals_after;
+  std::vector<double> sigmas;
+  std::vector<std::string> warnings;
+  std::string message = "Refine was not called";
+};
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_CORE_SOLVER_RESULT_H_

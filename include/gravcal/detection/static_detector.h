@@ -1,0 +1,81 @@
+// gravcal/detection/static_detector.h: finds the intervals in which the IMU was still.
+//
+// A window_seconds window is quiet when the variance of the accelerometer in
+// it (summed over the three axes, raw units squared) is below threshold_factor
+// times the noise floor the data itself shows, and so is the gyroscope's
+// (gyro_threshold_factor) where the log has one: the `noise_quantile` quantile
+// of the windowed variance over the whole log, at most max_floor_ratio times
+// the white noise seen in sample-to-sample differences (so that a log with no
+// still period yields none). The samples of quiet windows are static. No
+// threshold is in physical units, so raw counts, volts and m/s^2 all work with
+// the defaults. Runs of static samples, with settle seconds trimmed from each
+// edge, at least min_duration long, are the static intervals. Neighbouring
+// intervals whose mean accelerometer vectors point the same way (within
+// merge_angle_deg), less than merge_gap_windows windows apart, are merged when
+// the merged interval as a whole is still below the thresholds: a brief bump
+// does not split a pose in two, but a real pick-up-and-put-down in the same
+// orientation leaves two intervals rather than averaging the motion in.
+// The gyroscope only vetoes clear rotation: a hand-held pose shows tremor of
+// 100-250 times the gyroscope's table noise floor (while its accelerometer
+// variance stays within 2-5 times the floor), so its factor is much larger.
+#ifndef GRAVCAL_DETECTION_STATIC_DETECTOR_H_
+#define GRAVCAL_DETECTION_STATIC_DETECTOR_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "gravcal/core/imu_log.h"
+#include "gravcal/core/position.h"
+
+namespace gravcal {
+
+struct StaticDetectorOptions {
+  // Length of the moving variance window, seconds.
+  double window_seconds = 1.0;
+  // Quantile of the windowed variance taken as the noise floor.
+  double noise_quantile = 0.1;
+  // A window is static when its variance is below this times the floor.
+  double threshold_factor = 6.0;
+  // The same for the gyroscope variance (see above: tremor is not motion).
+  double gyro_threshold_factor = 500.0;
+  // The floor is at most this times the white-noise variance seen in the
+  // sample-to-sample differences, so that a log with no still period at all
+  // (whose quietest windows still move) yields no interval. 0 = off.
+  double max_floor_ratio = 4.0;
+  // Shortest static interval kept, seconds (after trimming).
+  double min_duration_seconds = 2.0;
+  // Trimmed from each end of a static run, seconds.
+  double settle_seconds = 0.3;
+  // Use the gyroscope variance as well, when the log has a gyroscope.
+  bool use_gyro = true;
+  // Adjacent intervals closer than this in direction are one pose, degrees.
+  double merge_angle_deg = 3.0;
+  // ... and only when the gap between them is shorter than this many windows
+  // (and the merged interval is still quiet).
+  double merge_gap_windows = 2.0;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct StaticDetection {
+  std::vector<StaticInterval> intervals;
+  // The noise floor and threshold actually used (variance, raw units^2).
+  double accel_noise_floor = 0.0;
+  double accel_threshold = 0.0;
+  double gyro_noise_floor = 0.0;
+  double gyro_threshold = 0.0;
+  std::string message = "Detection was not run";
+};
+
+// Computes the statistics of samples [begin, end) of the log.
+StaticInterval MakeInterval(const ImuLog& log, size_t begin, size_t end);
+
+// Returns false (with detection->message saying why) on invalid options or a
+// log too short for one window. Finding no interval is not an error.
+bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& options,
+                           StaticDetection* detection);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_DETECTION_STATIC_DETECTOR_H_

@@ -1,0 +1,85 @@
+// gravcal/io/log_reader.h: reads raw IMU logs from text files.
+//
+// The data contract (README, "Raw log CSV"):
+// - CSV: a header row naming the columns; `t` (seconds, increasing), `ax`,
+//   `ay`, `az` required; `gx`, `gy`, `gz`, `temp` optional; other columns are
+//   ignored. Lines starting with '#' are comments; blank lines are skipped.
+// - Whitespace-separated text without a header: `columns` gives the names in
+//   file order (e.g. {"t", "ax", "ay", "az"}); a second file `gyro_path` in
+//   the same layout ({"t", "gx", "gy", "gz"}) may hold the gyroscope, sharing
+//   the timestamps of the first.
+// Files written by other tools rarely use these names: `rename` maps a
+// contract name to the name in the file's header (ax -> acc_x), skip_lines
+// drops metadata lines before the header, and a log without a time column gets
+// t = index / sample_rate.
+//
+// Every error names the file and line: "session.csv:17: column 'ay': 'abc' is
+// not a number".
+#ifndef GRAVCAL_IO_LOG_READER_H_
+#define GRAVCAL_IO_LOG_READER_H_
+
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gravcal/core/imu_log.h"
+
+namespace gravcal {
+
+enum class LogFormat {
+  // Comma separated with a header row.
+  kCsv,
+  // Whitespace separated, no header row; `columns` names the columns.
+  kWhitespace,
+};
+
+const char* ToString(LogFormat format);
+// Accepts "csv", "whitespace".
+bool FromString(const std::string& name, LogFormat* format);
+
+struct LogReaderOptions {
+  LogFormat format = LogFormat::kCsv;
+  // Column names in file order. Required for kWhitespace; for kCsv, when not
+  // empty it replaces the header row's names.
+  std::vector<std::string> columns;
+  // Contract name -> name used in the file, e.g. {"ax", "acc_x"}.
+  std::map<std::string, std::string> rename;
+  // Lines dropped at the top of the file before the header (metadata).
+  int skip_lines = 0;
+  // When > 0 and the file has no time column, t = index / sample_rate.
+  double sample_rate = 0.0;
+  // t in the file is multiplied by this (1e-9 for nanoseconds).
+  double time_scale = 1.0;
+  // Optional second file holding the gyroscope (kWhitespace layout, columns
+  // gyro_columns), sample for sample with the first.
+  std::string gyro_path;
+  std::vector<std::string> gyro_columns = {"t", "gx", "gy", "gz"};
+
+  bool IsValid(std::string* error) const;
+};
+
+// Reads `path` into `log`. On failure returns false, leaves `log` unchanged
+// and sets `error` to one line naming the file and line.
+bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
+                std::string* error);
+
+// Same as ReadImuLog on text already in memory; `name` is used in messages.
+bool ParseImuLog(std::string_view text, const std::string& name, const LogReaderOptions& options,
+                 ImuLog* log, std::string* error);
+
+// Writes the log as contract CSV (t,ax,ay,az[,gx,gy,gz][,temp]) with full
+// precision, atomically (temporary file, then rename).
+bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* error);
+
+// Reads a whole file into `bytes`; errors name the file ("x.csv: cannot
+// open: No such file or directory").
+bool ReadFileBytes(const std::string& path, std::string* bytes, std::string* error);
+
+// Writes `contents` to `path` through a temporary file in the same directory
+// and a rename, so a failure never leaves a partial file.
+bool WriteFileAtomically(const std::string& path, const std::string& contents, std::string* error);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_IO_LOG_READER_H_

@@ -1,0 +1,249 @@
+// gravcal/residuals/gyro_rotation_residual.h: the per-rotation Ceres residual of the
+// gyroscope calibration between static poses (Tedaldi et al. 2014,
+// METHODS.md section 4), and the integrator it uses.
+//
+// Frames: the body frame is the calibrated accelerometer's (a = M_a (v - b_a),
+// accel_model.h); the gyroscope model maps into it. A rotation k runs from
+// static pose s to static pose e. Its gyroscope samples u_0 .. u_{n-1} at
+// times t_0 .. t_{n-1} start with the last sample of pose s and end with the
+// first sample of pose e, so the whole motion lies inside [t_0, t_{n-1}]
+// (the unit is still at both ends: neither a time offset of the gyroscope
+// nor its sampling phase changes the integral).
+//
+//   w_i   = M_g (u_i - b_g) - G f_i                         rad/s, body
+//   phi_i = h_i (-w_{i-1} + 13 w_i + 13 w_{i+1} - w_{i+2}) / 24
+//           + h_i^2 (w_i x w_{i+1}) / 12,  h_i = t_{i+1} - t_i    rad
+//   dq    = exp(phi_0) * exp(phi_1) * ... * exp(phi_{n-2})
+//   d^    = R(dq)^T d_s
+//   r_k   = W_k E_k (d^ - d_e)                               2 values
+//
+// phi_i is the two-term Magnus expansion of the step with the rate
+// interpolated by the cubic through four samples (the second term is the
+// coning correction): fourth order in the sample interval, where the
+// trapezoid rule is second order once the axis moves (at the first and last
+// step, where the unit is still, the trapezoid is used). The cubic assumes
+// evenly spaced samples. dq is the attitude of the body
+// at pose e relative to pose s (Hamilton, q_e = q_s * dq). d_s and d_e are
+// the unit directions of the specific force at the two poses, from the
+// calibrated accelerometer: d = M_a (v - b_a) / |M_a (v - b_a)|. Since the
+// specific force at rest is fixed in the navigation frame, f_e = R(dq)^T f_s:
+// a right gyroscope model turns d_s into d_e. f_i is the calibrated specific
+// force at sample i (m/s^2) and G (rad/s per m/s^2) the g-sensitivity.
+// E_k (2x3) spans the plane perpendicular to d_e (fixed at the start), so
+// E_k (d^ - d_e) is the direction error in rad to first order; W_k (2x2) is
+// its square-root information from the noise of d_s, d_e and of the
+// integrated gyroscope, so r_k is dimensionless with unit variance.
+//
+// Parameter blocks: b_g (3, raw units), M_g (9, row-major, rad/s per raw
+// unit), optionally G (9, row-major), and for a joint accelerometer fit the
+// accelerometer bias b_a (3) and upper-triangular U (6, accel_model.h; M_a =
+// R U with the housing rotation R held). Without the accelerometer blocks
+// d_s and d_e are constants.
+#ifndef GRAVCAL_RESIDUALS_GYRO_ROTATION_RESIDUAL_H_
+#define GRAVCAL_RESIDUALS_GYRO_ROTATION_RESIDUAL_H_
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+namespace gravcal {
+
+// The data of one rotation, in the units the parameters use.
+struct GyroRotationData {
+  // Sample times (s) and raw gyroscope vectors of the rotation.
+  std::vector<double> t;
+  std::vector<Eigen::Vector3d> gyro;
+  // Calibrated specific force at each sample, m/s^2 (for G; may be empty
+  // when G is not estimated).
+  std::vector<Eigen::Vector3d> force;
+  // Start and end directions (unit), used when the accelerometer is fixed.
+  Eigen::Vector3d start_direction = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d end_direction = Eigen::Vector3d::UnitZ();
+  // Mean raw accelerometer vectors of the two poses, used by the joint fit.
+  Eigen::Vector3d start_raw = Eigen::Vector3d::Zero();
+  Eigen::Vector3d end_raw = Eigen::Vector3d::Zero();
+  // Housing rotation R of the accelerometer (held in the joint fit).
+  Eigen::Matrix3d accel_rotation = Eigen::Matrix3d::Identity();
+  // E_k: rows span the plane perpendicular to the end direction.
+  Eigen::Matrix<double, 2, 3> tangent = Eigen::Matrix<double, 2, 3>::Zero();
+  // W_k: square-root information of E_k (d^ - d_e).
+  Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();
+};
+
+// Weights of w_{i-1}, w_i, w_{i+1}, w_{i+2} in the first Magnus term of step
+// i (0 <= i < n - 1) of the scheme above: the integral over [t_i, t_{i+1}]
+// of the cubic through the four samples, h (-1, 13, 13, -1) / 24, and the
+// trapezoid h (0, 1, 1, 0) / 2 at the first and last step. Summed over the
+// steps every inner sample weighs h, as in the trapezoid rule, so the
+// correction costs no noise.
+inline void GyroStepWeights(const std::vector<double>& t, size_t i, double weights[4]) {
+  const size_t n = t.size();
+  const double h = t[i + 1] - t[i];
+  const bool inner = i >= 1 && i + 2 < n;
+  const double edge = inner ? -h / 24.0 : 0.0;
+  weights[0] = edge;
+  weights[1] = 0.5 * h - edge;
+  weights[2] = 0.5 * h - edge;
+  weights[3] = edge;
+}
+
+// Integrates the calibrated rate over the samples (the scheme above) into
+// dq = (w, x, y, z). bias, matrix and g_sensitivity as in the parameter
+// blocks; g_sensitivity may be null (G = 0). When path is not null it
+// receives the attitude at every sample relative to the first (4 values per
+// sample, data.t.size() samples).
+template <typename T>
+void IntegrateGyroRotation(const GyroRotationData& data, const T* bias, const T* matrix,
+                           const T* g_sensitivity, T* dq, T* path = nullptr) {
+  dq[0] = T(1.0);
+  dq[1] = dq[2] = dq[3] = T(0.0);
+  const size_t n = data.t.size();
+  if (path != nullptr && n > 0) {
+    for (int j = 0; j < 4; ++j) path[j] = dq[j];
+  }
+  if (n < 2) return;
+  auto rate = [&](size_t i, T* w) {
+    const Eigen::Vector3d& u = data.gyro[i];
+    const T d[3] = {T(u(0)) - bias[0], T(u(1)) - bias[1], T(u(2)) - bias[2]};
+    for (int r = 0; r < 3; ++r) {
+      w[r] = matrix[3 * r] * d[0] + matrix[3 * r + 1] * d[1] + matrix[3 * r + 2] * d[2];
+      if (g_sensitivity != nullptr) {
+        const Eigen::Vector3d& f = data.force[i];
+        w[r] -= g_sensitivity[3 * r] * f(0) + g_sensitivity[3 * r + 1] * f(1) +
+                g_sensitivity[3 * r + 2] * f(2);
+      }
+    }
+  };
+  // w[k] holds the rate of sample i - 1 + k (k = 0..3), a window that
+  // slides by one sample per step.
+  T w[4][3];
+  rate(0, w[1]);
+  rate(1, w[2]);
+  if (n > 2) rate(2, w[3]);
+  for (int j = 0; j < 3; ++j) w[0][j] = w[1][j];
+  for (size_t i = 0; i + 1 < n; ++i) {
+    const double h = data.t[i + 1] - data.t[i];
+    double c[4];
+    GyroStepWeights(data.t, i, c);
+    const T coning(h * h / 12.0);
+    const T* a = w[1];
+    const T* b = w[2];
+    T phi[3];
+    for (int j = 0; j < 3; ++j) phi[j] = c[1] * a[j] + c[2] * b[j];
+    if (c[0] != 0.0) {
+      for (int j = 0; j < 3; ++j) phi[j] += c[0] * w[0][j] + c[3] * w[3][j];
+    }
+    phi[0] += coning * (a[1] * b[2] - a[2] * b[1]);
+    phi[1] += coning * (a[2] * b[0] - a[0] * b[2]);
+    phi[2] += coning * (a[0] * b[1] - a[1] * b[0]);
+    T step[4], next[4];
+    ceres::AngleAxisToQuaternion(phi, step);
+    ceres::QuaternionProduct(dq, step, next);
+    for (int j = 0; j < 4; ++j) dq[j] = next[j];
+    if (path != nullptr) {
+      for (int j = 0; j < 4; ++j) path[4 * (i + 1) + j] = dq[j];
+    }
+    // Slide the window.
+    for (int k = 0; k < 3; ++k) {
+      for (int j = 0; j < 3; ++j) w[k][j] = w[k + 1][j];
+    }
+    if (i + 3 < n) rate(i + 3, w[3]);
+  }
+}
+
+struct GyroRotationResidual {
+  explicit GyroRotationResidual(GyroRotationData data) : data_(std::move(data)) {}
+
+  // Accelerometer fixed, G = 0.
+  template <typename T>
+  bool operator()(const T* const bias, const T* const matrix, T* residual) const {
+    return Evaluate<T>(bias, matrix, nullptr, nullptr, nullptr, residual);
+  }
+  // Accelerometer fixed, G estimated.
+  template <typename T>
+  bool operator()(const T* const bias, const T* const matrix, const T* const g_sensitivity,
+                  T* residual) const {
+    return Evaluate<T>(bias, matrix, g_sensitivity, nullptr, nullptr, residual);
+  }
+  // Joint with the accelerometer, G = 0.
+  template <typename T>
+  bool operator()(const T* const bias, const T* const matrix, const T* const accel_bias,
+                  const T* const accel_upper, T* residual) const {
+    return Evaluate<T>(bias, matrix, nullptr, accel_bias, accel_upper, residual);
+  }
+  // Joint with the accelerometer, G estimated.
+  template <typename T>
+  bool operator()(const T* const bias, const T* const matrix, const T* const g_sensitivity,
+                  const T* const accel_bias, const T* const accel_upper, T* residual) const {
+    return Evaluate<T>(bias, matrix, g_sensitivity, accel_bias, accel_upper, residual);
+  }
+
+  // The cost function for the blocks above: (b_g, M_g[, G][, b_a, U]).
+  static ceres::CostFunction* Create(GyroRotationData data, bool g_sensitivity, bool joint) {
+    auto* functor = new GyroRotationResidual(std::move(data));
+    if (g_sensitivity && joint) {
+      return new ceres::AutoDiffCostFunction<GyroRotationResidual, 2, 3, 9, 9, 3, 6>(functor);
+    }
+    if (g_sensitivity) {
+      return new ceres::AutoDiffCostFunction<GyroRotationResidual, 2, 3, 9, 9>(functor);
+    }
+    if (joint) return new ceres::AutoDiffCostFunction<GyroRotationResidual, 2, 3, 9, 3, 6>(functor);
+    return new ceres::AutoDiffCostFunction<GyroRotationResidual, 2, 3, 9>(functor);
+  }
+
+ private:
+  // d = R U (v - b) / |R U (v - b)|.
+  template <typename T>
+  void Direction(const Eigen::Vector3d& raw, const T* accel_bias, const T* upper, T* d) const {
+    const T e0 = T(raw(0)) - accel_bias[0];
+    const T e1 = T(raw(1)) - accel_bias[1];
+    const T e2 = T(raw(2)) - accel_bias[2];
+    const T a[3] = {upper[0] * e0 + upper[1] * e1 + upper[2] * e2, upper[3] * e1 + upper[4] * e2,
+                    upper[5] * e2};
+    using std::sqrt;
+    const T norm = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    const Eigen::Matrix3d& r = data_.accel_rotation;
+    for (int i = 0; i < 3; ++i) d[i] = (r(i, 0) * a[0] + r(i, 1) * a[1] + r(i, 2) * a[2]) / norm;
+  }
+
+  template <typename T>
+  bool Evaluate(const T* bias, const T* matrix, const T* g_sensitivity, const T* accel_bias,
+                const T* accel_upper, T* residual) const {
+    T start[3], end[3];
+    if (accel_bias != nullptr) {
+      Direction(data_.start_raw, accel_bias, accel_upper, start);
+      Direction(data_.end_raw, accel_bias, accel_upper, end);
+    } else {
+      for (int i = 0; i < 3; ++i) {
+        start[i] = T(data_.start_direction(i));
+        end[i] = T(data_.end_direction(i));
+      }
+    }
+    T dq[4];
+    IntegrateGyroRotation<T>(data_, bias, matrix, g_sensitivity, dq);
+    // R(dq)^T d_s: rotate by the conjugate.
+    const T conjugate[4] = {dq[0], -dq[1], -dq[2], -dq[3]};
+    T predicted[3];
+    ceres::UnitQuaternionRotatePoint(conjugate, start, predicted);
+    T e[2];
+    for (int j = 0; j < 2; ++j) {
+      e[j] = T(0.0);
+      for (int i = 0; i < 3; ++i) e[j] += data_.tangent(j, i) * (predicted[i] - end[i]);
+    }
+    const Eigen::Matrix2d& w = data_.sqrt_information;
+    residual[0] = w(0, 0) * e[0] + w(0, 1) * e[1];
+    residual[1] = w(1, 0) * e[0] + w(1, 1) * e[1];
+    return true;
+  }
+
+  const GyroRotationData data_;
+};
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_RESIDUALS_GYRO_ROTATION_RESIDUAL_H_

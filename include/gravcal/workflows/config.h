@@ -1,0 +1,82 @@
+// gravcal/workflows/config.h: the YAML configuration shared by the command-line tool
+// and library users.
+//
+// Keys are flat, one name per setting, so the same name works in the YAML
+// file and as a command-line flag (`gravity: 9.81744` or `--gravity
+// 9.81744`). Simulator keys start with `sim_`. A key that does not exist is
+// an error naming it (and the line in a file); so is a value of the wrong
+// type or out of range. `gravcal help` lists every key with its default.
+#ifndef GRAVCAL_WORKFLOWS_CONFIG_H_
+#define GRAVCAL_WORKFLOWS_CONFIG_H_
+
+#include <string>
+#include <vector>
+
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/workflows/discovery.h"
+#include "gravcal/methods/gyro_calibration.h"
+#include "gravcal/methods/handheld_kalman.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulator.h"
+#include "gravcal/methods/ten_position.h"
+
+namespace gravcal {
+
+struct Config {
+  // Calibration method: "twelve_position" is the multi-position magnitude
+  // calibration (any number of positions), "ten_position" the patent's
+  // self-aligned method (ten_position.h), "known_attitude" the calibration
+  // from a fixture's attitudes (known_attitude.h).
+  std::string method = "twelve_position";
+  LogReaderOptions input;
+  CalibrationOptions calibration;
+  SimulatorOptions simulation;
+  // Gyroscope from the rotations between the poses (gyro_model != none).
+  GyroCalibrationOptions gyro;
+  // Issue 3: the ten-position method's alignment settings.
+  TenPositionOptions ten_position;
+  // Write accel.covariance into the calibration JSON.
+  bool output_covariance = true;
+  // Issue 4: the handheld Kalman calibration (method handheld_kalman; its
+  // gravity and accelerometer nominal scale come from `calibration`), and
+  // the motion simulator used by `gravcal simulate` when sim_motion names a
+  // profile (empty = the multi-position scheme).
+  HandheldKalmanOptions handheld;
+  MotionOptions motion;
+  std::string sim_motion;
+  // Issue 6: effects beyond the textbook model fitted by `calibrate` (and
+  // already in the baseline of `discover`), and the discovery workflow.
+  std::vector<Effect> effects;
+  DiscoveryOptions discovery;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct ConfigKey {
+  std::string name;
+  std::string section;
+  std::string help;
+};
+
+// Every key, in the order `gravcal help` lists them.
+const std::vector<ConfigKey>& ConfigKeys();
+bool IsConfigKey(const std::string& name);
+
+// Current value of a key as YAML text (for help and reports).
+std::string ConfigValueText(const Config& config, const std::string& key);
+
+// Applies a YAML file on top of `config`. Errors: "<file>:<line>: ...".
+bool LoadConfigFile(const std::string& path, Config* config, std::string* error);
+// Same on text in memory; `name` is used in messages.
+bool LoadConfigText(const std::string& text, const std::string& name, Config* config,
+                    std::string* error);
+
+// Sets one key from a value written as YAML ("9.81", "huber", "[t, ax]").
+// Errors name the key.
+bool SetConfigValue(const std::string& key, const std::string& value, Config* config,
+                    std::string* error);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_WORKFLOWS_CONFIG_H_

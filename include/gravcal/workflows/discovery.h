@@ -1,0 +1,246 @@
+// gravcal/workflows/discovery.h: the model discrepancy workflow (`gravcal discover`).
+//
+// 1. Fit the baseline (the configured parameterisation plus any effects the
+//    config switches on) to the static positions: accelerometer magnitudes
+//    and, where the log has one, mean gyroscope readings (effect_fit.h).
+// 2. Simulate the session with it: the reading the model predicts for every
+//    position, accelerometer (the raw vector of magnitude g along the
+//    measured direction) and gyroscope.
+// 3. Locate the disagreement: measured minus simulated, per position and
+//    grouped by dominant axis, specific-force level, time and temperature,
+//    each in units of the noise that position's own samples show.
+// 4. Try every candidate effect of the catalogue (model_effects.h): refit
+//    with it (Ceres) and score it by
+//    - a likelihood-ratio test on that sensor's chi2 with dof = the effect's
+//      parameter count, against the positions' own noise; when even the
+//      model with every candidate of the sensor leaves more than that noise
+//      (noise the samples do not show, e.g. hand tremor), the statistic is
+//      divided by phi = chi2 / dof of the extended model and referred to
+//      F(p, dof) instead;
+//    - delta BIC = (chi2_new - chi2_old) / phi + p ln(n);
+//    - leave-one-position-out cross-validation: every position predicted by
+//      a fit without it; the effect must lower the cross-validated gap.
+//    Significant = p below significance / (candidates tried), delta BIC
+//    below -min_bic_gain and a smaller cross-validated gap. The significant
+//    candidate with the lowest delta BIC is named; others of the same
+//    sensor within ambiguity_bic of it explain the data almost as well and
+//    are reported as ambiguous with advice on the recording that would
+//    separate them.
+// 5. Add it; the extended model is the new baseline; repeat until nothing
+//    is significant.
+//
+// The gap is the rms of measured minus simulated: |a| - g over positions for
+// the accelerometer (m/s^2), the gyroscope residual over positions and axes
+// (raw units); each also in units of the noise (rms of whitened residuals,
+// 1 = at the noise level).
+#ifndef GRAVCAL_WORKFLOWS_DISCOVERY_H_
+#define GRAVCAL_WORKFLOWS_DISCOVERY_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/methods/effect_fit.h"
+#include "gravcal/core/imu_log.h"
+#include "gravcal/core/model_effects.h"
+
+namespace gravcal {
+
+struct DiscoveryOptions {
+  // Candidates to try; empty = the whole catalogue.
+  std::vector<Effect> candidates;
+  // Family-wise significance level of one step (divided among the
+  // candidates tried).
+  double significance = 0.01;
+  // A candidate must lower the BIC by at least this much: 10 is "very
+  // strong" evidence on the Kass-Raftery scale (6 "strong"). Borderline
+  // evidence would make the verdict flip when one position is left out.
+  double min_bic_gain = 10.0;
+  // Candidates whose delta BIC is within this of the best are ambiguous.
+  double ambiguity_bic = 10.0;
+  // Most effects added.
+  int max_steps = 4;
+  // Residual degrees of freedom an extended model must keep (the
+  // leave-one-out folds need at least one).
+  int min_dof = 2;
+  // Temperature effects are only tried when the positions span this many
+  // degrees C.
+  double min_temperature_range = 0.5;
+  // Positions listed in each `where`.
+  int where_count = 3;
+
+  bool IsValid(std::string* error) const;
+};
+
+// rms of measured minus simulated; NaN where the sensor is absent.
+struct Gap {
+  // m/s^2 (|a| - g) and raw gyroscope units.
+  double accel = NAN;
+  double gyro = NAN;
+  // In units of the noise: rms of the whitened residuals.
+  double accel_sigma = NAN;
+  double gyro_sigma = NAN;
+  // Cross-validated gaps only: positions left out of them because the
+  // others do not determine the model without them (leverage near 1).
+  int accel_unpredictable = 0;
+  int gyro_unpredictable = 0;
+};
+
+// One position: measured minus simulated.
+struct PositionDisagreement {
+  int index = 0;
+  double time = 0.0;
+  double temperature = NAN;
+  // The calibrated specific-force axis nearest vertical ("+z") and the
+  // fraction of g on it.
+  std::string axis;
+  double axis_level = 0.0;
+  // Raw accelerometer reading measured and simulated (the model's reading
+  // for this position), and |a| - g in m/s^2 and in sigma.
+  Eigen::Vector3d accel_measured = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_simulated = Eigen::Vector3d::Zero();
+  double accel_residual = 0.0;
+  double accel_z = 0.0;
+  // Gyroscope measured, simulated, residual (raw units) and per axis in
+  // sigma; zero when absent.
+  Eigen::Vector3d gyro_measured = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_simulated = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_residual = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_z = Eigen::Vector3d::Zero();
+};
+
+// The disagreement over one group of positions (rms in sigma).
+struct GroupDisagreement {
+  // "axis", "force_level", "time", "temperature".
+  std::string by;
+  std::string group;
+  int count = 0;
+  double accel_sigma = NAN;
+  double gyro_sigma = NAN;
+};
+
+struct Disagreement {
+  std::vector<PositionDisagreement> positions;
+  std::vector<GroupDisagreement> groups;
+  // Positions that disagree most (indices), per sensor.
+  std::vector<int> worst_accel;
+  std::vector<int> worst_gyro;
+  // Whitened sum of squares, its dof and its chi-square p-value.
+  double accel_chi2 = 0.0;
+  int accel_dof = 0;
+  double accel_p = 1.0;
+  double gyro_chi2 = 0.0;
+  int gyro_dof = 0;
+  double gyro_p = 1.0;
+  // One line for people.
+  std::string summary;
+};
+
+// One model: its fit and gaps.
+struct ModelAssessment {
+  AccelParameterization parameterization = AccelParameterization::kScaleMisalignment;
+  std::vector<Effect> effects;
+  EffectFitResult fit;
+  Gap gap;
+  Gap cv_gap;
+  // Left-out prediction residuals (|a| - g, and gyroscope e) per position.
+  std::vector<double> cv_accel_residuals;
+  std::vector<Eigen::Vector3d> cv_gyro_residuals;
+};
+
+struct CandidateScore {
+  Effect effect = Effect::kAccelQuadratic;
+  bool tried = false;
+  bool significant = false;
+  // Why not tried, or why not significant; empty when named.
+  std::string reason;
+  int dof = 0;
+  double delta_chi2 = NAN;
+  // chi2 / dof of the extended model, at least 1.
+  double dispersion = 1.0;
+  double p_value = NAN;
+  double delta_bic = NAN;
+  Gap gap;
+  Gap cv_gap;
+};
+
+struct DiscoveryStep {
+  Effect effect = Effect::kAccelQuadratic;
+  EffectEstimate estimate;
+  double p_value = NAN;
+  double delta_bic = NAN;
+  int dof = 0;
+  // Of the sensor the effect belongs to (and the other, unchanged).
+  Gap gap_before;
+  Gap gap_after;
+  Gap cv_gap_before;
+  Gap cv_gap_after;
+  // Where the model before this step disagreed.
+  Disagreement where;
+  std::vector<CandidateScore> candidates;
+  std::vector<Effect> ambiguous_with;
+  // For the plot: the effect's regressor per position (temperature, time,
+  // or the fitted effect's own contribution for orientation effects), and
+  // the residuals before and after (|a| - g in m/s^2; for gyroscope
+  // effects the three axes, raw units).
+  std::string regressor_name;
+  std::vector<double> regressor;
+  std::vector<Eigen::Vector3d> residual_before;
+  std::vector<Eigen::Vector3d> residual_after;
+  // The fitted effect's own contribution to each position's residual (the
+  // accelerometer's in component 0): the residual before lies along it,
+  // the residual after does not.
+  std::vector<Eigen::Vector3d> contribution;
+};
+
+struct Ambiguity {
+  std::vector<Effect> effects;
+  std::vector<double> delta_bic;
+  int step = 0;
+  std::string advice;
+};
+
+struct DiscoveryResult {
+  bool success = false;
+  std::string source;
+  double gravity = kStandardGravity;
+  std::string gravity_source;
+  std::vector<StaticObservation> observations;
+  ModelAssessment baseline;
+  Disagreement baseline_where;
+  std::vector<DiscoveryStep> steps;
+  std::vector<Ambiguity> ambiguous;
+  ModelAssessment final_model;
+  Disagreement final_where;
+  // The scores of the last round, the one in which nothing was significant
+  // (empty when stopped by max_steps).
+  std::vector<CandidateScore> final_candidates;
+  // "no significant missing effect" when nothing was named.
+  std::string verdict;
+  std::vector<std::string> warnings;
+  double seconds = 0.0;
+  std::string message = "Discover was not called";
+
+  // The named effects, in order.
+  std::vector<Effect> named() const;
+};
+
+// From a raw log: static detection, then DiscoverFromObservations.
+// `calibration` gives the detector, gravity, baseline parameterisation and
+// nominal axes; `baseline_effects` effects already in the model.
+bool DiscoverEffects(const ImuLog& log, const CalibrationOptions& calibration,
+                     const std::vector<Effect>& baseline_effects, const DiscoveryOptions& options,
+                     DiscoveryResult* result);
+
+// Returns false with a one-line message on invalid options, too few
+// positions for the baseline, or a baseline fit that fails; finding
+// nothing is a success with verdict "no significant missing effect".
+bool DiscoverFromObservations(const std::vector<StaticObservation>& observations,
+                              const CalibrationOptions& calibration,
+                              const std::vector<Effect>& baseline_effects,
+                              const DiscoveryOptions& options, DiscoveryResult* result);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_WORKFLOWS_DISCOVERY_H_

@@ -1,0 +1,35 @@
+// gravcal/workflows/pipeline.h: one entry point that runs whichever calibration method
+// a Config names, on one unit's data. `gravcal calibrate`, `gravcal batch`
+// and library users all go through RunCalibration, so a unit calibrated in a
+// batch gets exactly the result it would get alone.
+#ifndef GRAVCAL_WORKFLOWS_PIPELINE_H_
+#define GRAVCAL_WORKFLOWS_PIPELINE_H_
+
+#include <string>
+
+#include "gravcal/core/calibration.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/core/imu_log.h"
+
+namespace gravcal {
+
+// What one unit brings besides the configuration.
+struct PipelineInput {
+  // The raw log (accelerometer, and gyroscope when the method uses it).
+  ImuLog log;
+  // Name used in messages (the input path, or a unit id).
+  std::string source = "input";
+  // Method-specific side inputs (paths); empty when not used.
+  // known_attitude: the per-position attitude CSV (--attitudes).
+  std::string attitudes_path;
+};
+
+// Runs config.method on the input. Returns false with a one-line
+// calibration->message on bad input, a method that cannot determine what it
+// must, or no convergence (calibration->not_converged). Never prints, never
+// exits.
+bool RunCalibration(const Config& config, const PipelineInput& input, Calibration* calibration);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_WORKFLOWS_PIPELINE_H_

@@ -1,0 +1,376 @@
+#include "gravcal/detection/static_detector.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+namespace gravcal {
+namespace {
+
+// The median interval and the quantiles are taken on at most this many
+// evenly strided values: exact for logs up to this size, a close estimate
+// (and much faster) beyond.
+constexpr size_t kMaxQuantileValues = size_t{1} << 14;
+
+// MakeInterval looks for the accelerometer resolution in this many samples.
+constexpr size_t kResolutionSamples = 256;
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+
+// The q quantile of values[0, stride, 2 stride, ...] (all of them when there
+// are at most kMaxQuantileValues); uses `scratch`.
+template <typename T>
+double StridedQuantile(const T* values, size_t size, double q, std::vector<double>* scratch) {
+  if (size == 0) return 0.0;
+  const size_t stride = std::max<size_t>(1, (size + kMaxQuantileValues - 1) / kMaxQuantileValues);
+  scratch->clear();
+  for (size_t i = 0; i < size; i += stride) scratch->push_back(values[i]);
+  const size_t k =
+      std::min(scratch->size() - 1, static_cast<size_t>(q * static_cast<double>(scratch->size())));
+  std::nth_element(scratch->begin(), scratch->begin() + k, scratch->end());
+  return (*scratch)[k];
+}
+
+// Moving-window variance of one 3-axis signal: var[k] = sum over the axes of
+// the (population) variance of x[k, k+w), for k in [0, n - w]. One pass of
+// running sums of deviations from a reference sample that is renewed every
+// block (so neither cancellation nor rounding drift builds up; the block
+// restarts cost 1/16 extra). Returns false when the signal is not finite.
+bool WindowVariance(const std::vector<Eigen::Vector3d>& x, size_t w, float* var) {
+  // x and y in one SSE2 register pair (Array2d), z scalar.
+  using A2 = Eigen::Array2d;
+  const size_t num_windows = x.size() - w + 1;
+  const double* p = x[0].data();  // contiguous: 3 doubles per sample
+  const size_t block = std::max<size_t>(16 * w, 4096);
+  const double inv_w = 1.0 / static_cast<double>(w);
+  const double inv_w2 = inv_w * inv_w;
+  for (size_t k0 = 0; k0 < num_windows; k0 += block) {
+    const A2 r01 = Eigen::Map<const A2>(p + 3 * k0);
+    const double r2 = p[3 * k0 + 2];
+    A2 s01 = A2::Zero(), q01 = A2::Zero();
+    double s2 = 0.0, q2 = 0.0;
+    for (size_t i = k0; i < k0 + w; ++i) {
+      const A2 d01 = Eigen::Map<const A2>(p + 3 * i) - r01;
+      const double d2 = p[3 * i + 2] - r2;
+      s01 += d01;
+      q01 += d01 * d01;
+      s2 += d2;
+      q2 += d2 * d2;
+    }
+    const size_t k_last = std::min(num_windows, k0 + block) - 1;
+    for (size_t k = k0;; ++k) {
+      const A2 m = s01 * s01;
+      const double v = (q01[0] + q01[1] + q2) * inv_w - (m[0] + m[1] + s2 * s2) * inv_w2;
+      var[k] = static_cast<float>(v > 0.0 ? v : 0.0);
+      if (k == k_last) break;
+      const double* out = p + 3 * k;
+      const double* in = p + 3 * (k + w);
+      const A2 o01 = Eigen::Map<const A2>(out) - r01;
+      const A2 i01 = Eigen::Map<const A2>(in) - r01;
+      const double o2 = out[2] - r2, i2 = in[2] - r2;
+      s01 += i01 - o01;
+      q01 += (i01 - o01) * (i01 + o01);
+      s2 += i2 - o2;
+      q2 += (i2 - o2) * (i2 + o2);
+    }
+    // Every sample of the block entered the sums, and NaN and infinity stick.
+    if (!std::isfinite(s01.sum() + s2 + q01.sum() + q2)) return false;
+  }
+  return true;
+}
+
+// Half the mean squared sample-to-sample difference (summed over the axes) in
+// non-overlapping blocks of w samples, at most kMaxWhiteBlocks of them evenly
+// spread: the white-noise variance, which smooth motion barely raises.
+constexpr size_t kMaxWhiteBlocks = 1024;
+void WhiteNoise(const std::vector<Eigen::Vector3d>& x, size_t w, std::vector<double>* white) {
+  const size_t num_blocks = x.size() / w;
+  const size_t stride = std::max<size_t>(1, (num_blocks + kMaxWhiteBlocks - 1) / kMaxWhiteBlocks);
+  const double scale = 0.5 / static_cast<double>(w - 1);
+  white->clear();
+  for (size_t b = 0; b < num_blocks; b += stride) {
+    double sum = 0.0;
+    for (size_t i = b * w + 1; i < (b + 1) * w; ++i) sum += (x[i] - x[i - 1]).squaredNorm();
+    white->push_back(sum * scale);
+  }
+}
+
+// Smallest nonzero step between consecutive samples, per axis (0 if none).
+Eigen::Vector3d SmallestStep(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end) {
+  Eigen::Array3d step = Eigen::Array3d::Constant(std::numeric_limits<double>::infinity());
+  for (size_t i = begin + 1; i < end; ++i) {
+    const Eigen::Array3d d = (x[i] - x[i - 1]).array().abs();
+    step = (d > 0.0).select(d.min(step), step);
+  }
+  return (step.isFinite()).select(step, 0.0).matrix();
+}
+
+// The noise floor of one signal: the quantile of the windowed variance, at
+// most max_floor_ratio times the white-noise level, and never zero while the
+// data change at all.
+double NoiseFloor(const float* var, size_t num_windows, const std::vector<Eigen::Vector3d>& x,
+                  size_t w, const StaticDetectorOptions& options, std::vector<double>* scratch) {
+  double floor = StridedQuantile(var, num_windows, options.noise_quantile, scratch);
+  if (options.max_floor_ratio > 0.0) {
+    std::vector<double> white;
+    WhiteNoise(x, w, &white);
+    const double white_floor =
+        StridedQuantile(white.data(), white.size(), options.noise_quantile, scratch);
+    if (white_floor > 0.0) floor = std::min(floor, options.max_floor_ratio * white_floor);
+  }
+  if (floor <= 0.0) {
+    // Quantised data with many identical samples: the variance of uniform
+    // quantisation error, step^2 / 12 per axis.
+    const Eigen::Vector3d step = SmallestStep(x, 0, x.size());
+    floor = step.squaredNorm() / 12.0;
+  }
+  return floor;
+}
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double na = a.norm();
+  const double nb = b.norm();
+  if (na <= 0.0 || nb <= 0.0) return 180.0;
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
+}
+
+bool Fail(StaticDetection* detection, const std::string& message) {
+  detection->message = message;
+  return false;
+}
+
+}  // namespace
+
+bool StaticDetectorOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& what) {
+    if (error) *error = "StaticDetectorOptions: " + what;
+    return false;
+  };
+  if (!(std::isfinite(window_seconds) && window_seconds > 0.0))
+    return fail("window_seconds must be positive (got " + Num(window_seconds) + ")");
+  if (!(noise_quantile > 0.0 && noise_quantile < 1.0))
+    return fail("noise_quantile must be in (0, 1) (got " + Num(noise_quantile) + ")");
+  if (!(std::isfinite(threshold_factor) && threshold_factor >= 1.0))
+    return fail("threshold_factor must be at least 1 (got " + Num(threshold_factor) + ")");
+  if (!(std::isfinite(gyro_threshold_factor) && gyro_threshold_factor >= 1.0))
+    return fail("gyro_threshold_factor must be at least 1 (got " + Num(gyro_threshold_factor) +
+                ")");
+  if (!(std::isfinite(max_floor_ratio) && max_floor_ratio >= 0.0))
+    return fail("max_floor_ratio must be 0 (off) or positive (got " + Num(max_floor_ratio) + ")");
+  if (!(std::isfinite(min_duration_seconds) && min_duration_seconds >= 0.0))
+    return fail("min_duration_seconds must be >= 0 (got " + Num(min_duration_seconds) + ")");
+  if (!(std::isfinite(settle_seconds) && settle_seconds >= 0.0))
+    return fail("settle_seconds must be >= 0 (got " + Num(settle_seconds) + ")");
+  if (!(merge_angle_deg >= 0.0 && merge_angle_deg <= 180.0))
+    return fail("merge_angle_deg must be in [0, 180] (got " + Num(merge_angle_deg) + ")");
+  if (!(std::isfinite(merge_gap_windows) && merge_gap_windows >= 0.0))
+    return fail("merge_gap_windows must be >= 0 (got " + Num(merge_gap_windows) + ")");
+  return true;
+}
+
+StaticInterval MakeInterval(const ImuLog& log, size_t begin, size_t end) {
+  StaticInterval s;
+  end = std::min(end, log.size());
+  begin = std::min(begin, end);
+  s.begin = begin;
+  s.end = end;
+  s.temperature_mean = std::numeric_limits<double>::quiet_NaN();
+  if (begin >= end || log.accel.size() < end) return s;
+  s.t_begin = log.t[begin];
+  s.t_end = log.t[end - 1];
+  const double count = static_cast<double>(end - begin);
+
+  // One pass of sums of deviations from the first sample: within an interval
+  // they are of the order of the spread, so there is no cancellation even
+  // with raw counts far from zero.
+  auto stats = [&](const std::vector<Eigen::Vector3d>& x, Eigen::Vector3d* mean,
+                   Eigen::Matrix3d* cov, Eigen::Vector3d* step) {
+    using A2 = Eigen::Array2d;  // x and y packed, z scalar
+    const double* p = x[0].data();
+    const A2 r01 = Eigen::Map<const A2>(p + 3 * begin);
+    const double r2 = p[3 * begin + 2];
+    A2 s01 = A2::Zero(), c_diag01 = A2::Zero(), c_z01 = A2::Zero();
+    double s2 = 0.0, c01 = 0.0, c22 = 0.0;
+    for (size_t i = begin; i < end; ++i) {
+      const A2 d01 = Eigen::Map<const A2>(p + 3 * i) - r01;
+      const double d2 = p[3 * i + 2] - r2;
+      s01 += d01;
+      c_diag01 += d01 * d01;
+      c_z01 += d01 * d2;
+      s2 += d2;
+      c01 += d01[0] * d01[1];
+      c22 += d2 * d2;
+    }
+    const double s0 = s01[0], s1 = s01[1];
+    const double c00 = c_diag01[0], c11 = c_diag01[1], c02 = c_z01[0], c12 = c_z01[1];
+    const double inf = std::numeric_limits<double>::infinity();
+    double m0 = inf, m1 = inf, m2 = inf;
+    if (step) {
+      // The resolution shows within a few hundred samples: scan no more.
+      for (size_t i = begin + 1; i < std::min(end, begin + kResolutionSamples); ++i) {
+        const double a0 = std::abs(p[3 * i] - p[3 * i - 3]);
+        const double a1 = std::abs(p[3 * i + 1] - p[3 * i - 2]);
+        const double a2 = std::abs(p[3 * i + 2] - p[3 * i - 1]);
+        m0 = (a0 > 0.0 && a0 < m0) ? a0 : m0;
+        m1 = (a1 > 0.0 && a1 < m1) ? a1 : m1;
+        m2 = (a2 > 0.0 && a2 < m2) ? a2 : m2;
+      }
+      *step = Eigen::Vector3d(m0 < inf ? m0 : 0.0, m1 < inf ? m1 : 0.0, m2 < inf ? m2 : 0.0);
+    }
+    const Eigen::Vector3d s(s0, s1, s2);
+    *mean = Eigen::Vector3d(r01[0], r01[1], r2) + s / count;
+    Eigen::Matrix3d c;
+    c << c00, c01, c02, c01, c11, c12, c02, c12, c22;
+    c -= s * s.transpose() / count;
+    *cov = end - begin > 1 ? Eigen::Matrix3d(c / (count - 1.0)) : Eigen::Matrix3d::Zero();
+  };
+  stats(log.accel, &s.accel_mean, &s.accel_cov, &s.accel_resolution);
+  if (log.gyro.size() >= end) stats(log.gyro, &s.gyro_mean, &s.gyro_cov, nullptr);
+  if (log.temperature.size() >= end) {
+    double sum = 0.0;
+    for (size_t i = begin; i < end; ++i) sum += log.temperature[i];
+    s.temperature_mean = sum / count;
+  }
+  return s;
+}
+
+bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& options,
+                           StaticDetection* detection) {
+  if (detection == nullptr) return false;
+  *detection = StaticDetection();
+  std::string error;
+  if (!options.IsValid(&error)) return Fail(detection, error);
+
+  const std::string name = log.source.empty() ? std::string("log") : log.source;
+  const size_t n = log.size();
+  if (log.accel.size() != n)
+    return Fail(detection, name + ": accelerometer and time have different lengths");
+  const bool has_gyro = !log.gyro.empty();
+  if (has_gyro && log.gyro.size() != n)
+    return Fail(detection, name + ": gyroscope and time have different lengths");
+  if (!log.temperature.empty() && log.temperature.size() != n)
+    return Fail(detection, name + ": temperature and time have different lengths");
+  if (n < 3) return Fail(detection, name + ": " + std::to_string(n) + " samples are too few");
+
+  // Median sample interval (on a strided subsample of the intervals).
+  std::vector<double> scratch;
+  for (size_t i = 1; i < n; ++i) {
+    if (!(log.t[i] > log.t[i - 1]) || !std::isfinite(log.t[i]))
+      return Fail(detection, name + ": sample " + std::to_string(i) +
+                                 ": time is not finite or does not increase");
+  }
+  {
+    const size_t stride =
+        std::max<size_t>(1, (n - 1 + kMaxQuantileValues - 1) / kMaxQuantileValues);
+    for (size_t i = 1; i < n; i += stride) scratch.push_back(log.t[i] - log.t[i - 1]);
+    std::nth_element(scratch.begin(), scratch.begin() + scratch.size() / 2, scratch.end());
+  }
+  const double dt = scratch[scratch.size() / 2];
+  // Durations in samples, at most n + 1 (no overflow for absurd durations).
+  auto to_samples = [dt, n](double seconds) {
+    const double samples = seconds / dt;
+    return samples < static_cast<double>(n) ? static_cast<size_t>(std::llround(samples)) : n + 1;
+  };
+  const size_t w = std::max<size_t>(2, to_samples(options.window_seconds));
+  if (n < w) {
+    return Fail(detection, name + ": " + std::to_string(n) + " samples are shorter than one " +
+                               Num(options.window_seconds) + " s window (" + std::to_string(w) +
+                               " samples)");
+  }
+
+  // Windowed variances (float: half the memory traffic, ample precision for
+  // a threshold) and noise floors.
+  const size_t num_windows = n - w + 1;
+  // Not value-initialised: every element is written.
+  std::unique_ptr<float[]> accel_var(new float[num_windows]);
+  std::unique_ptr<float[]> gyro_var;
+  if (!WindowVariance(log.accel, w, accel_var.get()))
+    return Fail(detection, name + ": accelerometer values are not finite");
+  detection->accel_noise_floor =
+      NoiseFloor(accel_var.get(), num_windows, log.accel, w, options, &scratch);
+  detection->accel_threshold = options.threshold_factor * detection->accel_noise_floor;
+  const bool use_gyro = has_gyro && options.use_gyro;
+  if (use_gyro) {
+    gyro_var.reset(new float[num_windows]);
+    if (!WindowVariance(log.gyro, w, gyro_var.get()))
+      return Fail(detection, name + ": gyroscope values are not finite");
+    detection->gyro_noise_floor =
+        NoiseFloor(gyro_var.get(), num_windows, log.gyro, w, options, &scratch);
+    detection->gyro_threshold = options.gyro_threshold_factor * detection->gyro_noise_floor;
+  }
+
+  // Static runs: the union of the quiet windows' samples.
+  struct Run {
+    size_t begin, end;
+  };
+  std::vector<Run> runs;
+  const double accel_threshold = detection->accel_threshold;
+  const double gyro_threshold = detection->gyro_threshold;
+  for (size_t k = 0; k < num_windows;) {
+    auto quiet = [&](size_t j) {
+      return accel_var[j] <= accel_threshold && (!use_gyro || gyro_var[j] <= gyro_threshold);
+    };
+    if (!quiet(k)) {
+      ++k;
+      continue;
+    }
+    const size_t first = k;
+    while (k < num_windows && quiet(k)) ++k;
+    // Quiet windows less than w apart share samples: one run.
+    if (!runs.empty() && first <= runs.back().end) {
+      runs.back().end = k - 1 + w;
+    } else {
+      runs.push_back({first, k - 1 + w});
+    }
+  }
+
+  // Trim the settling time at each end, merge neighbours that are the same
+  // pose across a short gap, keep what is long enough.
+  const size_t settle = to_samples(options.settle_seconds);
+  const size_t min_count = std::max<size_t>(1, to_samples(options.min_duration_seconds));
+  const double max_gap = options.merge_gap_windows * static_cast<double>(w);
+  std::vector<StaticInterval> pieces;
+  for (const Run& run : runs) {
+    if (run.end - run.begin <= 2 * settle) continue;
+    pieces.push_back(MakeInterval(log, run.begin + settle, run.end - settle));
+  }
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    StaticInterval current = pieces[i];
+    while (i + 1 < pieces.size()) {
+      const StaticInterval& next = pieces[i + 1];
+      if (!(static_cast<double>(next.begin - current.end) < max_gap) ||
+          !(AngleDeg(current.accel_mean, next.accel_mean) < options.merge_angle_deg)) {
+        break;
+      }
+      // The merged interval includes the gap; it must still look still as a
+      // whole, so that a real pick-up-and-put-down is not averaged in.
+      StaticInterval merged = MakeInterval(log, current.begin, next.end);
+      if (!(merged.accel_cov.trace() <= accel_threshold) ||
+          (use_gyro && !(merged.gyro_cov.trace() <= gyro_threshold))) {
+        break;
+      }
+      current = merged;
+      ++i;
+    }
+    if (current.count() >= min_count) detection->intervals.push_back(current);
+  }
+
+  std::ostringstream msg;
+  msg << name << ": " << detection->intervals.size() << " static interval"
+      << (detection->intervals.size() == 1 ? "" : "s") << " (window " << w
+      << " samples, accel threshold " << Num(accel_threshold);
+  if (use_gyro) msg << ", gyro threshold " << Num(gyro_threshold);
+  msg << ")";
+  detection->message = msg.str();
+  return true;
+}
+
+}  // namespace gravcal

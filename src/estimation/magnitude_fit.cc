@@ -1,0 +1,57 @@
+#include "estimation/magnitude_fit.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace gravcal {
+
+double WhitenedSumOfSquares(const std::vector<double>& residuals,
+                            const std::vector<double>& sigmas) {
+  double s = 0.0;
+  for (size_t k = 0; k < residuals.size(); ++k) {
+    const double w = residuals[k] / sigmas[k];
+    s += w * w;
+  }
+  return s;
+}
+
+bool StartMagnitudeFit(const std::vector<Position>& positions, const AccelModel& initial,
+                       double gravity, AccelParameterization p, const std::string& fit,
+                       AccelModel* model, RefinementResult* result) {
+  if (!(gravity > 0.0)) {
+    result->message = "gravity must be positive";
+    return false;
+  }
+  const int num_parameters = 3 + static_cast<int>(FreeUpperIndices(p).size());
+  const int n = static_cast<int>(positions.size());
+  if (n < num_parameters) {
+    std::ostringstream s;
+    s << fit << " of '" << ToString(p) << "' needs at least " << num_parameters
+      << " static positions, found " << n;
+    result->message = s.str();
+    return false;
+  }
+  *model = initial;
+  model->parameterization = p;
+  if (p == AccelParameterization::kScale) {
+    model->upper(0, 1) = model->upper(0, 2) = model->upper(1, 2) = 0.0;
+  }
+  result->sigmas = MagnitudeSigmas(positions, *model);
+  for (int k = 0; k < n; ++k) {
+    if (!(result->sigmas[k] > 0.0) || !std::isfinite(result->sigmas[k])) {
+      std::ostringstream s;
+      s << "position " << k << " has no usable noise estimate (sigma = " << result->sigmas[k]
+        << "); it needs more than one sample";
+      result->message = s.str();
+      return false;
+    }
+  }
+  result->residuals_before = MagnitudeResiduals(positions, *model, gravity);
+  result->initial_cost = 0.5 * WhitenedSumOfSquares(result->residuals_before, result->sigmas);
+  result->num_residuals = n;
+  result->num_parameters = num_parameters;
+  result->parameter_names = MagnitudeParameterNames(p);
+  return true;
+}
+
+}  // namespace gravcal

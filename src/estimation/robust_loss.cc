@@ -1,0 +1,23 @@
+#include "estimation/robust_loss.h"
+
+namespace gravcal {
+
+ceres::LossFunction* MakeLoss(LossType type, double scale) {
+  switch (type) {
+    case LossType::kNone:
+      return nullptr;
+    case LossType::kHuber:
+      return new ceres::HuberLoss(scale);
+    case LossType::kCauchy:
+      return new ceres::CauchyLoss(scale);
+    case LossType::kSoftL1:
+      return new ceres::SoftLOneLoss(scale);
+    case LossType::kArctan:
+      return new ceres::ArctanLoss(scale);
+    case LossType::kTukey:
+      return new ceres::TukeyLoss(scale);
+  }
+  return nullptr;
+}
+
+}  // namespace gravcal

@@ -1,0 +1,263 @@
+#include "gravcal/io/calibration_io.h"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "gravcal/io/log_reader.h"
+
+namespace gravcal {
+namespace {
+
+using nlohmann::json;
+
+json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json Vector(const Eigen::Vector3d& v) {
+  return json::array({Number(v(0)), Number(v(1)), Number(v(2))});
+}
+
+json Matrix(const Eigen::MatrixXd& m) {
+  json rows = json::array();
+  for (int r = 0; r < m.rows(); ++r) {
+    json row = json::array();
+    for (int c = 0; c < m.cols(); ++c) row.push_back(Number(m(r, c)));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
+  json accel;
+  accel["model"] = ToString(c.accel.model.parameterization);
+  accel["bias"] = Vector(c.accel.model.bias);
+  accel["matrix"] = Matrix(c.accel.model.matrix());
+  accel["upper"] = Matrix(c.accel.model.upper);
+  accel["rotation"] = Matrix(c.accel.model.rotation);
+  accel["std"] = {{"bias", Vector(c.accel.bias_std)}, {"matrix", Matrix(c.accel.matrix_std)}};
+  if (include_covariance && c.accel.covariance.size() > 0) {
+    accel["covariance"] = {{"parameters", c.accel.covariance_names},
+                           {"matrix", Matrix(c.accel.covariance)}};
+  }
+  if (c.accel.model.parameterization == AccelParameterization::kAffine) {
+    accel["placement_error_deg"] = Number(c.accel.tilt_rms * 180.0 / M_PI);
+  }
+  json out;
+  out["method"] = c.method;
+  out["accel"] = accel;
+  if (c.gyro.estimated) {
+    json gyro;
+    gyro["bias"] = Vector(c.gyro.model.bias);
+    gyro["matrix"] = Matrix(c.gyro.model.matrix);
+    gyro["std"] = {{"bias", Vector(c.gyro.bias_std)}, {"matrix", Matrix(c.gyro.matrix_std)}};
+    if (include_covariance && c.gyro.covariance.size() > 0) {
+      gyro["covariance"] = {{"parameters", c.gyro.covariance_names},
+                            {"matrix", Matrix(c.gyro.covariance)}};
+    }
+    json extra = json::object();
+    for (size_t i = 0; i < c.gyro.extra_names.size(); ++i) {
+      extra[c.gyro.extra_names[i]] = {{"value", Number(c.gyro.extra_values[i])},
+                                      {"std", Number(c.gyro.extra_std[i])}};
+    }
+    if (!extra.empty()) gyro["extra"] = extra;
+    if (!c.gyro.rotation_residual_deg.empty()) {
+      json r = json::array();
+      for (double v : c.gyro.rotation_residual_deg) r.push_back(Number(v));
+      gyro["rotation_residual_deg"] = r;
+    }
+    out["gyro"] = gyro;
+  }
+  // Issue 6: effects beyond the textbook model, by catalogue name.
+  if (!c.effects.estimates.empty()) {
+    json effects = {{"reference_temperature", Number(c.effects.reference_temperature)},
+                    {"reference_time", Number(c.effects.reference_time)}};
+    for (const EffectEstimate& e : c.effects.estimates) {
+      json values = json::array(), stds = json::array();
+      for (size_t i = 0; i < e.values.size(); ++i) {
+        values.push_back(Number(e.values[i]));
+        stds.push_back(Number(i < e.std.size() ? e.std[i] : NAN));
+      }
+      effects[ToString(e.effect)] = {
+          {"parameters", e.names}, {"value", values}, {"std", stds}, {"unit", e.unit}};
+    }
+    out["effects"] = effects;
+  }
+  out["gravity"] = {{"value", c.gravity}, {"source", c.gravity_source}};
+  auto summary = [](const ResidualSummary& s) {
+    return json{{"rms", Number(s.rms)}, {"max", Number(s.max)}};
+  };
+  out["residual"] = {{"unit", "m/s^2"},
+                     {"quantity", "|a| - g over static positions"},
+                     {"before", summary(c.residual_nominal)},
+                     {"coarse", summary(c.residual_coarse)},
+                     {"after", summary(c.residual_refined)}};
+  json positions = json::array();
+  for (const PositionReport& r : c.positions) {
+    json p = {{"t_begin", r.position.t_begin},
+              {"t_end", r.position.t_end},
+              {"samples", r.position.sample_count},
+              {"raw_mean", Vector(r.position.raw_mean)},
+              {"raw_std", Vector(r.raw_std)},
+              {"nominal_up", NominalAxisName(r.nominal_up)},
+              {"residual_before", Number(r.residual_before)},
+              {"residual_after", Number(r.residual_after)},
+              {"sigma", Number(r.sigma)}};
+    // Only the methods that use an attitude per position have one.
+    if (std::isfinite(r.roll_deg) && std::isfinite(r.pitch_deg)) {
+      p["attitude_deg"] = {{"roll", r.roll_deg},
+                           {"pitch", r.pitch_deg},
+                           {"roll_std", Number(r.roll_std_deg)},
+                           {"pitch_std", Number(r.pitch_std_deg)}};
+    }
+    positions.push_back(p);
+  }
+  out["positions"] = positions;
+  const RefinementResult& f = c.refinement;
+  out["solver"] = {{"method", c.solver_name},
+                   {"coarse", ToString(c.coarse.method)},
+                   {"iterations", f.iterations},
+                   {"termination", f.termination},
+                   {"converged", f.converged},
+                   {"time_s", f.solve_seconds},
+                   {"initial_cost", f.initial_cost},
+                   {"final_cost", f.final_cost},
+                   {"chi2", f.chi2},
+                   {"dof", f.dof},
+                   {"message", f.message}};
+  // Issue 4: per-parameter convergence of recursive methods.
+  if (!c.convergence.entries.empty()) {
+    json entries = json::object();
+    for (const ConvergenceEntry& e : c.convergence.entries) {
+      entries[e.name] = {{"value", Number(e.value)},
+                         {"unit", e.unit},
+                         {"sigma_initial", Number(e.sigma_initial)},
+                         {"sigma_final", Number(e.sigma_final)},
+                         {"converged", e.converged},
+                         {"time_s", Number(e.time)}};
+    }
+    out["convergence"] = {{"criterion", c.convergence.criterion}, {"parameters", entries}};
+  }
+  out["warnings"] = c.warnings;
+  out["message"] = c.message;
+  return out.dump(2) + "\n";
+}
+
+bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error) {
+  const EstimateHistory& h = calibration.history;
+  if (h.rows() == 0) {
+    *error = path + ": method '" + calibration.method + "' has no time history to write";
+    return false;
+  }
+  std::ostringstream s;
+  s.precision(10);
+  for (size_t c = 0; c < h.columns.size(); ++c) s << (c ? "," : "") << h.columns[c];
+  s << "\n";
+  for (size_t r = 0; r < h.rows(); ++r) {
+    for (size_t c = 0; c < h.columns.size(); ++c) {
+      s << (c ? "," : "") << h.values[r * h.columns.size() + c];
+    }
+    s << "\n";
+  }
+  return WriteFileAtomically(path, s.str(), error);
+}
+
+bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,
+                          const std::string& path, std::string* error) {
+  return WriteFileAtomically(path, CalibrationToJson(calibration, include_covariance), error);
+}
+
+namespace {
+
+bool ReadVector(const json& j, const std::string& key, const std::string& where, Eigen::Vector3d* v,
+                std::string* error) {
+  if (!j.contains(key) || !j[key].is_array() || j[key].size() != 3) {
+    *error = where + ": key '" + key + "' must be an array of 3 numbers";
+    return false;
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!j[key][i].is_number()) {
+      *error = where + ": key '" + key + "' must be an array of 3 numbers";
+      return false;
+    }
+    (*v)(i) = j[key][i].get<double>();
+  }
+  return true;
+}
+
+bool ReadMatrix(const json& j, const std::string& key, const std::string& where, Eigen::Matrix3d* m,
+                std::string* error) {
+  const std::string message = where + ": key '" + key + "' must be a 3x3 array of numbers";
+  if (!j.contains(key) || !j[key].is_array() || j[key].size() != 3) {
+    *error = message;
+    return false;
+  }
+  for (int r = 0; r < 3; ++r) {
+    if (!j[key][r].is_array() || j[key][r].size() != 3) {
+      *error = message;
+      return false;
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (!j[key][r][c].is_number()) {
+        *error = message;
+        return false;
+      }
+      (*m)(r, c) = j[key][r][c].get<double>();
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration,
+                         std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    *error = path + ": cannot open";
+    return false;
+  }
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    *error = path + ": not valid JSON (" + e.what() + ")";
+    return false;
+  }
+  if (!j.is_object() || !j.contains("accel") || !j["accel"].is_object()) {
+    *error = path + ": key 'accel' is missing";
+    return false;
+  }
+  LoadedCalibration out;
+  Eigen::Matrix3d m;
+  Eigen::Vector3d b;
+  if (!ReadVector(j["accel"], "bias", path + ": accel", &b, error) ||
+      !ReadMatrix(j["accel"], "matrix", path + ": accel", &m, error)) {
+    return false;
+  }
+  AccelParameterization p = AccelParameterization::kAffine;
+  if (j["accel"].contains("model") && j["accel"]["model"].is_string()) {
+    FromString(j["accel"]["model"].get<std::string>(), &p);
+  }
+  if (!AccelModel::FromMatrix(b, m, p, &out.accel)) {
+    *error = path + ": accel.matrix is singular or a reflection";
+    return false;
+  }
+  if (j.contains("gyro") && j["gyro"].is_object()) {
+    if (!ReadVector(j["gyro"], "bias", path + ": gyro", &out.gyro.bias, error) ||
+        !ReadMatrix(j["gyro"], "matrix", path + ": gyro", &out.gyro.matrix, error)) {
+      return false;
+    }
+    out.has_gyro = true;
+  }
+  if (j.contains("gravity") && j["gravity"].is_object() && j["gravity"].contains("value") &&
+      j["gravity"]["value"].is_number()) {
+    out.gravity = j["gravity"]["value"].get<double>();
+  }
+  *calibration = out;
+  return true;
+}
+
+}  // namespace gravcal

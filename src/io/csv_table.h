@@ -1,0 +1,42 @@
+// Small CSV tables (batch manifests, batch summaries): comma separated, a
+// field in double quotes may hold commas and "" for a quote, unquoted fields
+// are trimmed of blanks, lines starting with '#' and blank lines are skipped.
+// A quoted field does not span lines. Every cell knows its line and column,
+// so errors can say "units.csv:7:12".
+#ifndef GRAVCAL_SRC_IO_CSV_TABLE_H_
+#define GRAVCAL_SRC_IO_CSV_TABLE_H_
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace gravcal {
+
+struct CsvCell {
+  std::string text;
+  // 1-based character column where the field starts.
+  size_t column = 1;
+};
+
+struct CsvRecord {
+  // 1-based line number.
+  size_t line = 0;
+  std::vector<CsvCell> cells;
+};
+
+// Errors: "<name>:<line>:<column>: <what>".
+bool ParseCsvRecords(std::string_view text, const std::string& name,
+                     std::vector<CsvRecord>* records, std::string* error);
+
+// "<name>:<line>:<column>: " for messages.
+std::string CsvWhere(const std::string& name, size_t line, size_t column);
+
+// The field as written to a CSV file: quoted when it holds a comma, a quote,
+// a '#' at the start, blanks at either end or a line break (replaced by a
+// space).
+std::string CsvField(std::string_view text);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_SRC_IO_CSV_TABLE_H_

@@ -1,0 +1,664 @@
+#include "gravcal/methods/effect_fit.h"
+
+#include <ceres/ceres.h>
+#include <ceres/manifold.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "residuals/effect_residual.h"
+#include "gravcal/estimation/observability.h"
+#include "gravcal/estimation/refinement.h"
+#include "estimation/normalization.h"
+#include "util/statistics.h"
+
+namespace gravcal {
+namespace {
+
+// Relative tolerance of the rank test on the scaled whitened Jacobian: a
+// direction this weak (condition number 1e7) is not determined in practice.
+constexpr double kRankTolerance = 1e-7;
+
+// Indices into the 6-vector of U, row-major upper triangle.
+constexpr int kOffDiagonal[3] = {1, 2, 4};
+
+bool IsAccelEffect(Effect e) { return Info(e).sensor == EffectSensor::kAccelerometer; }
+
+ceres::Solver::Options SolverOptions(const EffectFitOptions& o) {
+  ceres::Solver::Options s;
+  s.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  s.max_num_iterations = o.max_iterations;
+  s.function_tolerance = o.function_tolerance;
+  s.gradient_tolerance = o.gradient_tolerance;
+  s.parameter_tolerance = o.parameter_tolerance;
+  s.logging_type = ceres::SILENT;
+  s.minimizer_progress_to_stdout = false;
+  s.num_threads = 1;
+  return s;
+}
+
+// (J^T J)^-1 of a whitened Jacobian, with the undetermined parameters (null
+// space) named and their rows and columns NaN; the rest from the
+// pseudo-inverse. Also the leverage of each position (rows_per_position
+// consecutive rows).
+void CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, int rows_per_position,
+                            SensorFitSummary* fit) {
+  const ObservabilityReport obs =
+      AnalyzeObservability(jacobian, fit->parameter_names, kRankTolerance);
+  fit->undetermined = obs.undetermined;
+  fit->rank = obs.rank;
+  const int n = static_cast<int>(jacobian.cols());
+  // Column scaling keeps the units out of the conditioning.
+  Eigen::VectorXd scale = jacobian.colwise().norm().transpose();
+  for (int j = 0; j < n; ++j) {
+    if (!(scale(j) > 0.0)) scale(j) = 1.0;
+  }
+  const Eigen::MatrixXd scaled = jacobian * scale.cwiseInverse().asDiagonal();
+  Eigen::MatrixXd inverse;
+  if (obs.full_rank()) {
+    const Eigen::MatrixXd gram = scaled.transpose() * scaled;
+    inverse = gram.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
+  } else {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeThinV);
+    const Eigen::VectorXd s = svd.singularValues();
+    Eigen::VectorXd inv2 = Eigen::VectorXd::Zero(s.size());
+    for (int i = 0; i < s.size(); ++i) {
+      if (s(i) > kRankTolerance * s(0)) inv2(i) = 1.0 / (s(i) * s(i));
+    }
+    inverse = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
+  }
+  fit->covariance = scale.cwiseInverse().asDiagonal() * inverse * scale.cwiseInverse().asDiagonal();
+  fit->leverage.clear();
+  for (int k = 0; k * rows_per_position < jacobian.rows(); ++k) {
+    double h = 0.0;
+    for (int r = 0; r < rows_per_position; ++r) {
+      const Eigen::RowVectorXd row = scaled.row(k * rows_per_position + r);
+      h = std::max(h, (row * inverse * row.transpose())(0, 0));
+    }
+    fit->leverage.push_back(h);
+  }
+  for (const std::string& name : obs.undetermined) {
+    const auto it = std::find(fit->parameter_names.begin(), fit->parameter_names.end(), name);
+    const int i = static_cast<int>(it - fit->parameter_names.begin());
+    fit->covariance.row(i).setConstant(NAN);
+    fit->covariance.col(i).setConstant(NAN);
+  }
+}
+
+double StdOf(const SensorFitSummary& fit, const std::string& name) {
+  const auto it = std::find(fit.parameter_names.begin(), fit.parameter_names.end(), name);
+  if (it == fit.parameter_names.end() || fit.covariance.size() == 0) return NAN;
+  const int i = static_cast<int>(it - fit.parameter_names.begin());
+  const double v = fit.covariance(i, i);
+  return v >= 0.0 ? std::sqrt(v) : NAN;
+}
+
+// Inverse of the lower Cholesky factor of a covariance, with a floor on
+// the diagonal so a constant (quantised) signal still has a finite weight.
+Eigen::Matrix3d Whitening(const Eigen::Matrix3d& covariance) {
+  Eigen::LLT<Eigen::Matrix3d> llt(covariance);
+  if (llt.info() != Eigen::Success) return Eigen::Matrix3d::Constant(NAN);
+  const Eigen::Matrix3d l = llt.matrixL();
+  return l.inverse();
+}
+
+// The accelerometer part. Works in normalised raw units (normalization.h).
+bool FitAccel(const std::vector<StaticObservation>& observations, const AccelModel& initial,
+              const EffectParameters& initial_parameters, double gravity,
+              const EffectFitOptions& options, EffectFitResult* result) {
+  const std::vector<Effect>& effects = options.effects;
+  const bool free_off_diagonal = options.parameterization != AccelParameterization::kScale ||
+                                 Contains(effects, Effect::kAccelMisalignment);
+  std::vector<Position> positions;
+  for (const StaticObservation& o : observations) positions.push_back(o.accel);
+  AccelModel start = initial;
+  if (!free_off_diagonal) {
+    for (int i : kOffDiagonal) {
+      const int r = i == 4 ? 1 : 0;
+      const int c = i == 1 ? 1 : 2;
+      start.upper(r, c) = 0.0;
+    }
+  }
+  result->accel_sigmas = MagnitudeSigmas(positions, start);
+  for (size_t k = 0; k < positions.size(); ++k) {
+    const double s = result->accel_sigmas[k];
+    if (!(s > 0.0) || !std::isfinite(s)) {
+      std::ostringstream msg;
+      msg << "position " << k << " has no usable accelerometer noise estimate (sigma = " << s
+          << ")";
+      result->message = msg.str();
+      return false;
+    }
+  }
+  const Normalization norm = Normalization::For(start);
+  const AccelModel start_n = norm.Apply(start);
+  const std::vector<Position> normalized = norm.Apply(positions);
+
+  double bias[3] = {start_n.bias(0), start_n.bias(1), start_n.bias(2)};
+  double upper[6];
+  start_n.GetUpper(upper);
+  double blocks[4][3];
+  const Effect kBlockEffect[4] = {Effect::kAccelQuadratic, Effect::kAccelTemperatureBias,
+                                  Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift};
+  const Eigen::Vector3d* kInitial[4] = {
+      &initial_parameters.accel_quadratic, &initial_parameters.accel_temperature_bias,
+      &initial_parameters.accel_temperature_scale, &initial_parameters.accel_bias_drift};
+  bool on[4];
+  for (int b = 0; b < 4; ++b) {
+    on[b] = Contains(effects, kBlockEffect[b]);
+    for (int i = 0; i < 3; ++i) blocks[b][i] = on[b] ? (*kInitial[b])(i) : 0.0;
+  }
+
+  // The cost functions are kept (not owned by the problem) to evaluate the
+  // Jacobian at the optimum.
+  std::vector<std::unique_ptr<ceres::CostFunction>> owned;
+  std::vector<double*> parameter_blocks = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
+  ceres::Problem::Options keep;
+  keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(keep);
+  for (size_t k = 0; k < normalized.size(); ++k) {
+    const StaticObservation& o = observations[k];
+    owned.emplace_back(AccelEffectResidual::Create(
+        normalized[k].raw_mean, TemperatureOffset(initial_parameters, o.temperature()),
+        o.time() - initial_parameters.reference_time, gravity, result->accel_sigmas[k]));
+    problem.AddResidualBlock(owned.back().get(), nullptr, parameter_blocks);
+  }
+  if (!free_off_diagonal) {
+    problem.SetManifold(upper, new ceres::SubsetManifold(6, {1, 2, 4}));
+  }
+  for (int b = 0; b < 4; ++b) {
+    if (!on[b]) problem.SetParameterBlockConstant(blocks[b]);
+  }
+  ceres::Solver::Summary summary;
+  ceres::Solve(SolverOptions(options), &problem, &summary);
+  SensorFitSummary& fit = result->accel_fit;
+  fit.fitted = true;
+  fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
+  if (!summary.IsSolutionUsable()) {
+    result->message = "accelerometer effect fit failed: " + summary.message;
+    return false;
+  }
+
+  // Parameter names and the columns of the dense Jacobian.
+  static const char* kUpperNames[6] = {"u_xx", "u_xy", "u_xz", "u_yy", "u_yz", "u_zz"};
+  fit.parameter_names = {"bias_x", "bias_y", "bias_z"};
+  std::vector<int> upper_free;
+  for (int i = 0; i < 6; ++i) {
+    const bool off = i == 1 || i == 2 || i == 4;
+    if (off && !free_off_diagonal) continue;
+    upper_free.push_back(i);
+    fit.parameter_names.push_back(kUpperNames[i]);
+  }
+  for (int b = 0; b < 4; ++b) {
+    if (!on[b]) continue;
+    for (const std::string& n : Info(kBlockEffect[b]).parameter_names) {
+      fit.parameter_names.push_back(n);
+    }
+  }
+  const int np = static_cast<int>(fit.parameter_names.size());
+  const int n = static_cast<int>(normalized.size());
+  Eigen::MatrixXd jacobian(n, np);
+  fit.chi2 = 0.0;
+  for (int k = 0; k < n; ++k) {
+    double r = 0.0;
+    double jb[3], ju[6], je[4][3];
+    double* jacobians[6] = {jb, ju, je[0], je[1], je[2], je[3]};
+    const double* params[6] = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
+    if (!owned[k]->Evaluate(params, &r, options.compute_covariance ? jacobians : nullptr)) {
+      result->message = "accelerometer effect fit: the model has no value at a position";
+      return false;
+    }
+    fit.chi2 += r * r;
+    if (!options.compute_covariance) continue;
+    int col = 0;
+    for (int i = 0; i < 3; ++i) jacobian(k, col++) = jb[i];
+    for (int i : upper_free) jacobian(k, col++) = ju[i];
+    for (int b = 0; b < 4; ++b) {
+      if (!on[b]) continue;
+      for (int i = 0; i < 3; ++i) jacobian(k, col++) = je[b][i];
+    }
+  }
+  fit.num_residuals = n;
+  fit.num_parameters = np;
+
+  AccelModel fitted_n = start_n;
+  fitted_n.bias = Eigen::Vector3d(bias[0], bias[1], bias[2]);
+  fitted_n.SetUpper(upper);
+  result->accel = norm.Undo(fitted_n);
+  if (options.parameterization == AccelParameterization::kScale && free_off_diagonal) {
+    result->accel.parameterization = AccelParameterization::kScaleMisalignment;
+  }
+  result->parameters.accel_quadratic = Eigen::Vector3d(blocks[0]);
+  result->parameters.accel_temperature_bias = Eigen::Vector3d(blocks[1]);
+  result->parameters.accel_temperature_scale = Eigen::Vector3d(blocks[2]);
+  result->parameters.accel_bias_drift = Eigen::Vector3d(blocks[3]);
+
+  if (options.compute_covariance) {
+    CovarianceFromJacobian(jacobian, 1, &fit);
+    // Back to raw units: b = c + s b', U = U' / s; the effects are in SI.
+    Eigen::VectorXd d = Eigen::VectorXd::Ones(np);
+    d.head<3>().setConstant(norm.scale);
+    for (size_t i = 0; i < upper_free.size(); ++i) d(3 + i) = 1.0 / norm.scale;
+    fit.covariance = d.asDiagonal() * fit.covariance * d.asDiagonal();
+    for (int i = 0; i < 3; ++i) result->accel_bias_std(i) = StdOf(fit, fit.parameter_names[i]);
+  }
+
+  result->accel_residuals.resize(n);
+  result->forces.resize(n);
+  for (int k = 0; k < n; ++k) {
+    result->accel_residuals[k] =
+        AccelResidual(*result, observations[k], gravity, &result->forces[k]);
+  }
+  return true;
+}
+
+bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel& initial_gyro,
+             const EffectParameters& initial_parameters, const EffectFitOptions& options,
+             EffectFitResult* result) {
+  const std::vector<Effect>& effects = options.effects;
+  const int n = static_cast<int>(observations.size());
+  std::vector<Eigen::Matrix3d> whitening(n);
+  for (int k = 0; k < n; ++k) {
+    whitening[k] = Whitening(observations[k].gyro_mean_cov);
+    if (!whitening[k].allFinite()) {
+      std::ostringstream msg;
+      msg << "position " << k << " has no usable gyroscope noise estimate";
+      result->message = msg.str();
+      return false;
+    }
+  }
+  double bias[3] = {initial_gyro.bias(0), initial_gyro.bias(1), initial_gyro.bias(2)};
+  double g[9];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) g[3 * r + c] = initial_parameters.gyro_g_sensitivity(r, c);
+  }
+  double temperature_bias[3], drift[3];
+  for (int i = 0; i < 3; ++i) {
+    temperature_bias[i] = initial_parameters.gyro_temperature_bias(i);
+    drift[i] = initial_parameters.gyro_bias_drift(i);
+  }
+  const bool on_g = Contains(effects, Effect::kGyroGSensitivity);
+  const bool on_t = Contains(effects, Effect::kGyroTemperatureBias);
+  const bool on_d = Contains(effects, Effect::kGyroBiasDrift);
+  if (!on_g) std::fill(g, g + 9, 0.0);
+  if (!on_t) std::fill(temperature_bias, temperature_bias + 3, 0.0);
+  if (!on_d) std::fill(drift, drift + 3, 0.0);
+
+  ceres::Problem::Options keep;
+  keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(keep);
+  std::vector<std::unique_ptr<ceres::CostFunction>> owned;
+  for (int k = 0; k < n; ++k) {
+    const StaticObservation& o = observations[k];
+    owned.emplace_back(
+        GyroEffectResidual::Create(o.gyro_mean, whitening[k], result->forces[k],
+                                   TemperatureOffset(initial_parameters, o.temperature()),
+                                   o.time() - initial_parameters.reference_time));
+    problem.AddResidualBlock(owned.back().get(), nullptr, bias, g, temperature_bias, drift);
+  }
+  if (!on_g) problem.SetParameterBlockConstant(g);
+  if (!on_t) problem.SetParameterBlockConstant(temperature_bias);
+  if (!on_d) problem.SetParameterBlockConstant(drift);
+  ceres::Solver::Summary summary;
+  ceres::Solve(SolverOptions(options), &problem, &summary);
+  SensorFitSummary& fit = result->gyro_fit;
+  fit.fitted = true;
+  fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
+  if (!summary.IsSolutionUsable()) {
+    result->message = "gyroscope effect fit failed: " + summary.message;
+    return false;
+  }
+  fit.parameter_names = {"gyro_bias_x", "gyro_bias_y", "gyro_bias_z"};
+  const Effect kGyroEffects[3] = {Effect::kGyroGSensitivity, Effect::kGyroTemperatureBias,
+                                  Effect::kGyroBiasDrift};
+  const bool on[3] = {on_g, on_t, on_d};
+  for (int b = 0; b < 3; ++b) {
+    if (!on[b]) continue;
+    for (const std::string& name : Info(kGyroEffects[b]).parameter_names) {
+      fit.parameter_names.push_back(name);
+    }
+  }
+  const int np = static_cast<int>(fit.parameter_names.size());
+  Eigen::MatrixXd jacobian(3 * n, np);
+  fit.chi2 = 0.0;
+  for (int k = 0; k < n; ++k) {
+    double r[3];
+    double jb[9], jg[27], jt[9], jd[9];
+    double* jacobians[4] = {jb, jg, jt, jd};
+    const double* params[4] = {bias, g, temperature_bias, drift};
+    owned[k]->Evaluate(params, r, options.compute_covariance ? jacobians : nullptr);
+    for (int row = 0; row < 3; ++row) {
+      fit.chi2 += r[row] * r[row];
+      if (!options.compute_covariance) continue;
+      int col = 0;
+      for (int i = 0; i < 3; ++i) jacobian(3 * k + row, col++) = jb[3 * row + i];
+      if (on_g) {
+        for (int i = 0; i < 9; ++i) jacobian(3 * k + row, col++) = jg[9 * row + i];
+      }
+      if (on_t) {
+        for (int i = 0; i < 3; ++i) jacobian(3 * k + row, col++) = jt[3 * row + i];
+      }
+      if (on_d) {
+        for (int i = 0; i < 3; ++i) jacobian(3 * k + row, col++) = jd[3 * row + i];
+      }
+    }
+  }
+  fit.num_residuals = 3 * n;
+  fit.num_parameters = np;
+  result->gyro.bias = Eigen::Vector3d(bias[0], bias[1], bias[2]);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) result->parameters.gyro_g_sensitivity(r, c) = g[3 * r + c];
+  }
+  result->parameters.gyro_temperature_bias = Eigen::Vector3d(temperature_bias);
+  result->parameters.gyro_bias_drift = Eigen::Vector3d(drift);
+  if (options.compute_covariance) {
+    CovarianceFromJacobian(jacobian, 3, &fit);
+    for (int i = 0; i < 3; ++i) result->gyro_bias_std(i) = StdOf(fit, fit.parameter_names[i]);
+  }
+  result->gyro_residuals.resize(n);
+  result->gyro_sigmas.resize(n);
+  for (int k = 0; k < n; ++k) {
+    double w2 = 0.0;
+    result->gyro_residuals[k] = GyroResidual(*result, observations[k], result->forces[k], &w2);
+    result->gyro_sigmas[k] = observations[k].gyro_mean_cov.diagonal().cwiseSqrt();
+  }
+  return true;
+}
+
+void FillEstimates(EffectFitResult* result) {
+  result->estimates.clear();
+  for (Effect e : result->effects) {
+    const EffectInfo& info = Info(e);
+    EffectEstimate est;
+    est.effect = e;
+    est.names = info.parameter_names;
+    est.unit = info.unit;
+    const SensorFitSummary& fit =
+        info.sensor == EffectSensor::kAccelerometer ? result->accel_fit : result->gyro_fit;
+    if (e == Effect::kAccelMisalignment) {
+      const Eigen::Matrix3d& u = result->accel.upper;
+      est.values = {u(0, 1), u(0, 2), u(1, 2)};
+    } else {
+      est.values = result->parameters.Values(e);
+    }
+    for (const std::string& name : est.names) est.std.push_back(StdOf(fit, name));
+    result->estimates.push_back(est);
+  }
+}
+
+}  // namespace
+
+std::vector<StaticObservation> ObservationsFromIntervals(
+    const std::vector<StaticInterval>& intervals, bool has_gyro) {
+  const std::vector<Position> positions = PositionsFromIntervals(intervals);
+  std::vector<StaticObservation> out(positions.size());
+  for (size_t k = 0; k < positions.size(); ++k) {
+    out[k].accel = positions[k];
+    out[k].has_gyro = has_gyro;
+    if (!has_gyro) continue;
+    const StaticInterval& s = intervals[k];
+    out[k].gyro_mean = s.gyro_mean;
+    const double count = static_cast<double>(std::max<size_t>(1, s.count()));
+    Eigen::Matrix3d cov = s.gyro_cov / count;
+    // A constant (quantised) gyroscope: its mean is known to the rounding,
+    // a twelfth of a step squared; the step is a count when the means are
+    // integers, else about a millionth of the largest mean.
+    const bool integers = (s.gyro_mean.array() == s.gyro_mean.array().round()).all();
+    const double step = integers ? 1.0 : 1e-6 * std::max(1.0, s.gyro_mean.cwiseAbs().maxCoeff());
+    for (int a = 0; a < 3; ++a) {
+      if (!(cov(a, a) > 0.0)) cov(a, a) = step * step / 12.0 / count;
+    }
+    out[k].gyro_mean_cov = cov;
+  }
+  return out;
+}
+
+bool EffectFitOptions::IsValid(std::string* error) const {
+  if (max_iterations < 1) {
+    *error = "effect fit: max_iterations must be at least 1";
+    return false;
+  }
+  if (!(function_tolerance > 0.0) || !(gradient_tolerance > 0.0) || !(parameter_tolerance > 0.0)) {
+    *error = "effect fit: tolerances must be positive";
+    return false;
+  }
+  return true;
+}
+
+bool FitEffects(const std::vector<StaticObservation>& observations, const AccelModel& initial,
+                const GyroModel& initial_gyro, const EffectParameters& initial_parameters,
+                double gravity, const EffectFitOptions& options, EffectFitResult* result) {
+  *result = EffectFitResult();
+  std::string error;
+  if (!options.IsValid(&error)) {
+    result->message = error;
+    return false;
+  }
+  if (!(gravity > 0.0)) {
+    result->message = "gravity must be positive";
+    return false;
+  }
+  result->effects = options.effects;
+  result->accel = initial;
+  result->gyro = initial_gyro;
+  result->parameters = initial_parameters;
+  const int n = static_cast<int>(observations.size());
+  if (options.fit_accel) {
+    int needed = options.parameterization == AccelParameterization::kScale ? 6 : 9;
+    for (Effect e : options.effects) {
+      if (IsAccelEffect(e) && !(e == Effect::kAccelMisalignment &&
+                                options.parameterization != AccelParameterization::kScale)) {
+        needed += Info(e).num_parameters;
+      }
+    }
+    if (n < needed) {
+      std::ostringstream s;
+      s << "the accelerometer model with " << needed << " parameters needs at least " << needed
+        << " static positions, found " << n;
+      result->message = s.str();
+      return false;
+    }
+    if (!FitAccel(observations, initial, initial_parameters, gravity, options, result)) {
+      return false;
+    }
+  } else {
+    result->accel_residuals.resize(n);
+    result->forces.resize(n);
+    result->accel_sigmas.resize(n);
+    for (int k = 0; k < n; ++k) {
+      result->accel_residuals[k] =
+          AccelResidual(*result, observations[k], gravity, &result->forces[k]);
+      result->accel_sigmas[k] = AccelSigma(*result, observations[k]);
+    }
+  }
+  const bool all_gyro = n > 0 && std::all_of(observations.begin(), observations.end(),
+                                             [](const StaticObservation& o) { return o.has_gyro; });
+  if (options.fit_gyro && all_gyro) {
+    if (!FitGyro(observations, initial_gyro, initial_parameters, options, result)) return false;
+  }
+  FillEstimates(result);
+  std::ostringstream s;
+  s << "fitted " << n << " positions";
+  if (result->accel_fit.fitted) {
+    s << "; accelerometer chi2 " << result->accel_fit.chi2 << " on " << result->accel_fit.dof()
+      << " dof";
+  }
+  if (result->gyro_fit.fitted) {
+    s << "; gyroscope chi2 " << result->gyro_fit.chi2 << " on " << result->gyro_fit.dof() << " dof";
+  }
+  result->message = s.str();
+  return true;
+}
+
+double AccelResidual(const EffectFitResult& fit, const StaticObservation& observation,
+                     double gravity, Eigen::Vector3d* force) {
+  const Eigen::Vector3d m = fit.accel.upper * (observation.accel.raw_mean - fit.accel.bias);
+  Eigen::Vector3d a;
+  if (!CorrectAccel(fit.parameters, fit.effects, m, observation.temperature(), observation.time(),
+                    &a)) {
+    a = m;
+  }
+  if (force != nullptr) *force = a;
+  return a.norm() - gravity;
+}
+
+double AccelSigma(const EffectFitResult& fit, const StaticObservation& observation) {
+  return MagnitudeSigmas({observation.accel}, fit.accel)[0];
+}
+
+Eigen::Vector3d GyroResidual(const EffectFitResult& fit, const StaticObservation& observation,
+                             const Eigen::Vector3d& force, double* whitened_squared) {
+  const Eigen::Vector3d e =
+      observation.gyro_mean - fit.gyro.bias -
+      GyroOffset(fit.parameters, fit.effects, force, observation.temperature(), observation.time());
+  if (whitened_squared != nullptr) {
+    *whitened_squared = e.dot(observation.gyro_mean_cov.ldlt().solve(e));
+  }
+  return e;
+}
+
+}  // namespace gravcal
+
+namespace gravcal {
+
+bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>& intervals,
+                           const CalibrationOptions& options, const std::vector<Effect>& effects,
+                           Calibration* calibration) {
+  Calibration& c = *calibration;
+  auto fail = [&](const std::string& what) {
+    c.success = false;
+    c.message = (log.source.empty() ? "" : log.source + ": ") + what;
+    return false;
+  };
+  const std::vector<StaticObservation> observations =
+      ObservationsFromIntervals(intervals, log.has_gyro());
+  const int n = static_cast<int>(observations.size());
+  bool has_temperature = n > 0;
+  EffectParameters start;
+  GyroModel gyro;
+  double temperature_sum = 0.0, time_sum = 0.0;
+  for (const StaticObservation& o : observations) {
+    has_temperature = has_temperature && std::isfinite(o.temperature());
+    temperature_sum += o.temperature();
+    time_sum += o.time();
+    gyro.bias += o.gyro_mean / n;
+  }
+  start.reference_time = n > 0 ? time_sum / n : 0.0;
+  start.reference_temperature = has_temperature ? temperature_sum / n : NAN;
+  for (Effect e : effects) {
+    const EffectInfo& info = Info(e);
+    if (info.regressor == EffectRegressor::kTemperature && !has_temperature) {
+      return fail(std::string("effect ") + info.name + " needs a temperature column");
+    }
+    if (info.sensor == EffectSensor::kGyroscope && !log.has_gyro()) {
+      return fail(std::string("effect ") + info.name + " needs a gyroscope");
+    }
+  }
+  if (!has_temperature) start.reference_temperature = 0.0;
+  EffectFitOptions fit_options;
+  fit_options.parameterization = options.refinement.parameterization;
+  fit_options.effects = effects;
+  fit_options.fit_gyro = std::any_of(effects.begin(), effects.end(), [](Effect e) {
+    return Info(e).sensor == EffectSensor::kGyroscope;
+  });
+  EffectFitResult fit;
+  if (!FitEffects(observations, c.accel.model, gyro, start, c.gravity, fit_options, &fit)) {
+    return fail("fit with effects: " + fit.message);
+  }
+  std::string undetermined;
+  for (const SensorFitSummary* s : {&fit.accel_fit, &fit.gyro_fit}) {
+    for (const std::string& name : s->undetermined) {
+      undetermined += (undetermined.empty() ? "" : ", ") + name;
+    }
+  }
+  if (!undetermined.empty() && !options.allow_undetermined) {
+    return fail("the positions do not determine " + undetermined +
+                " of the model with effects: record more poses (at several temperatures for "
+                "temperature effects), or set allow_undetermined: true");
+  }
+  if (!fit.accel_fit.converged || (fit.gyro_fit.fitted && !fit.gyro_fit.converged)) {
+    c.not_converged = true;
+    return fail("the fit with effects did not converge");
+  }
+
+  c.accel.model.bias = fit.accel.bias;
+  c.accel.model.upper = fit.accel.upper;
+  c.accel.model.parameterization = fit.accel.parameterization;
+  c.accel.bias_std = fit.accel_bias_std;
+  c.accel.covariance = fit.accel_fit.covariance;
+  c.accel.covariance_names = fit.accel_fit.parameter_names;
+  const bool rotated = !c.accel.model.rotation.isIdentity(0.0);
+  static const char* kUpperNames[3][3] = {
+      {"u_xx", "u_xy", "u_xz"}, {"", "u_yy", "u_yz"}, {"", "", "u_zz"}};
+  for (int r = 0; r < 3; ++r) {
+    for (int col = r; col < 3; ++col) {
+      if (!rotated) c.accel.matrix_std(r, col) = StdOf(fit.accel_fit, kUpperNames[r][col]);
+    }
+  }
+  if (rotated) {
+    c.warnings.push_back(
+        "effects: accel.std.matrix is from the fit without effects (the housing rotation's "
+        "uncertainty is not propagated through the effect fit)");
+  }
+  if (fit.gyro_fit.fitted) {
+    c.gyro.estimated = true;
+    c.gyro.model.bias = fit.gyro.bias;
+    c.gyro.model.matrix.setIdentity();
+    c.gyro.bias_std = fit.gyro_bias_std;
+    c.gyro.matrix_std.setConstant(NAN);
+    c.gyro.covariance = fit.gyro_fit.covariance;
+    c.gyro.covariance_names = fit.gyro_fit.parameter_names;
+    c.warnings.push_back(
+        "gyro: static positions determine the gyroscope bias and the effects only; gyro.matrix "
+        "is the identity (not determined)");
+  }
+  double s = 0.0, m = 0.0;
+  for (double r : fit.accel_residuals) {
+    s += r * r;
+    m = std::max(m, std::fabs(r));
+  }
+  c.residual_refined = {n > 0 ? std::sqrt(s / n) : 0.0, m};
+  if (static_cast<int>(c.positions.size()) == n) {
+    for (int k = 0; k < n; ++k) c.positions[k].residual_after = fit.accel_residuals[k];
+  }
+  // The base fit's verdict on its residuals no longer applies.
+  c.warnings.erase(std::remove_if(c.warnings.begin(), c.warnings.end(),
+                                  [](const std::string& w) {
+                                    return w.find("times the noise level (chi2") !=
+                                           std::string::npos;
+                                  }),
+                   c.warnings.end());
+  if (fit.accel_fit.dof() > 0 &&
+      ChiSquareUpperTail(fit.accel_fit.chi2, fit.accel_fit.dof()) < 1e-3) {
+    std::ostringstream w;
+    w.precision(3);
+    w << "with effects the residuals are still "
+      << std::sqrt(fit.accel_fit.chi2 / fit.accel_fit.dof())
+      << " times the noise level (chi2 = " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof()
+      << " dof): gravcal discover can look for what the model still misses";
+    c.warnings.push_back(w.str());
+  }
+  c.effects.estimates = fit.estimates;
+  c.effects.reference_temperature = has_temperature ? start.reference_temperature : NAN;
+  c.effects.reference_time = start.reference_time;
+  if (!undetermined.empty()) {
+    c.warnings.push_back("the positions do not determine " + undetermined +
+                         " of the model with effects; reported without a number");
+  }
+  std::ostringstream msg;
+  msg << c.message << "; with effects";
+  for (Effect e : effects) msg << " " << ToString(e);
+  msg.precision(3);
+  msg << " (accelerometer chi2 " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof() << " dof)";
+  c.message = msg.str();
+  return true;
+}
+
+}  // namespace gravcal

@@ -1,0 +1,374 @@
+#include "gravcal/methods/known_attitude.h"
+
+#include <ceres/ceres.h>
+#include <ceres/covariance.h>
+#include <glog/logging.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "estimation/robust_loss.h"
+#include "methods/static_positions.h"
+#include "util/statistics.h"
+
+namespace gravcal {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+// Twelve unknowns, three equations per position.
+constexpr int kMinPositions = 4;
+
+// Gravity in the body frame of roll r, pitch p (static_alignment.h):
+//   u(r, p) = (-sin p, sin r cos p, cos r cos p).
+template <typename T>
+void GravityDirection(const T& roll, const T& pitch, T* u) {
+  using std::cos;
+  using std::sin;
+  u[0] = -sin(pitch);
+  u[1] = sin(roll) * cos(pitch);
+  u[2] = cos(roll) * cos(pitch);
+}
+
+// r_k = W_k ( M (v_k - b) - g u(roll_k, pitch_k) ), m/s^2 whitened.
+// b: bias (3, normalised raw units); M: the 3x3 matrix, row-major (9, m/s^2
+// per normalised raw unit); attitude: roll, pitch (2, rad). W_k = L_k^-1,
+// L_k L_k^T the covariance of M (v_k - b) from the position's noise.
+struct GravityVectorResidual {
+  GravityVectorResidual(const Eigen::Vector3d& raw_mean, const Eigen::Matrix3d& whitening,
+                        double gravity)
+      : raw_mean_(raw_mean), whitening_(whitening), gravity_(gravity) {}
+
+  template <typename T>
+  bool operator()(const T* const bias, const T* const m, const T* const attitude,
+                  T* residual) const {
+    T d[3];
+    for (int j = 0; j < 3; ++j) d[j] = T(raw_mean_(j)) - bias[j];
+    T u[3];
+    GravityDirection(attitude[0], attitude[1], u);
+    T e[3];
+    for (int i = 0; i < 3; ++i) {
+      e[i] = m[3 * i] * d[0] + m[3 * i + 1] * d[1] + m[3 * i + 2] * d[2] - T(gravity_) * u[i];
+    }
+    for (int i = 0; i < 3; ++i) {
+      residual[i] =
+          T(whitening_(i, 0)) * e[0] + T(whitening_(i, 1)) * e[1] + T(whitening_(i, 2)) * e[2];
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean,
+                                     const Eigen::Matrix3d& whitening, double gravity) {
+    return new ceres::AutoDiffCostFunction<GravityVectorResidual, 3, 3, 9, 2>(
+        new GravityVectorResidual(raw_mean, whitening, gravity));
+  }
+
+ private:
+  const Eigen::Vector3d raw_mean_;
+  const Eigen::Matrix3d whitening_;
+  const double gravity_;
+};
+
+// p_k = ( (roll - roll_fix) / s_roll, (pitch - pitch_fix) / s_pitch ): the
+// fixture's (or inclinometer's) word on the attitude, radians.
+struct AttitudePriorResidual {
+  explicit AttitudePriorResidual(const KnownAttitude& known) : known_(known) {}
+
+  template <typename T>
+  bool operator()(const T* const attitude, T* residual) const {
+    residual[0] = (attitude[0] - T(known_.roll)) / T(known_.roll_std);
+    residual[1] = (attitude[1] - T(known_.pitch)) / T(known_.pitch_std);
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const KnownAttitude& known) {
+    return new ceres::AutoDiffCostFunction<AttitudePriorResidual, 2, 2>(
+        new AttitudePriorResidual(known));
+  }
+
+ private:
+  const KnownAttitude known_;
+};
+
+std::vector<std::string> ParameterNames() {
+  std::vector<std::string> names = {"bias_x", "bias_y", "bias_z"};
+  const char* axes = "xyz";
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) names.push_back(std::string("m_") + axes[r] + axes[c]);
+  }
+  return names;
+}
+
+}  // namespace
+
+bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
+                                 const std::vector<KnownAttitude>& attitudes,
+                                 const CalibrationOptions& options, Calibration* calibration) {
+  CHECK(calibration != nullptr);
+  Calibration& c = *calibration;
+  c.method = "known_attitude";
+  std::string error;
+  if (!options.IsValid(&error)) {
+    c.message = error;
+    return false;
+  }
+  if (c.gravity_source.empty() &&
+      !ResolveGravity(options.gravity, &c.gravity, &c.gravity_source, &error)) {
+    c.message = error;
+    return false;
+  }
+  const int n = static_cast<int>(positions.size());
+  if (n < kMinPositions) {
+    std::ostringstream s;
+    s << "found " << n << " static positions; the known-attitude method needs at least "
+      << kMinPositions << " (twelve unknowns)";
+    c.message = s.str();
+    return false;
+  }
+  if (attitudes.size() != positions.size()) {
+    c.message = "known_attitude: one attitude per position is needed";
+    return false;
+  }
+  for (int k = 0; k < n; ++k) {
+    const KnownAttitude& a = attitudes[k];
+    if (!std::isfinite(a.roll) || !std::isfinite(a.pitch) || !(a.roll_std > 0.0) ||
+        !(a.pitch_std > 0.0) || !std::isfinite(a.roll_std) || !std::isfinite(a.pitch_std)) {
+      c.message = "known_attitude: attitude " + std::to_string(k) +
+                  " is not finite or has no positive standard deviation";
+      return false;
+    }
+  }
+  const double g = c.gravity;
+
+  // Normalised raw units (v_n = s0 v, s0 = g / mean |v|) keep the problem
+  // well conditioned whatever the raw units are.
+  double mean_norm = 0.0;
+  for (const Position& p : positions) mean_norm += p.raw_mean.norm();
+  const double s0 = g * n / mean_norm;
+
+  // Initial value, linear: g u_k = M v_k + c_off for the fixed attitudes,
+  // normal equations over [v_k; 1], then b = -M^-1 c_off.
+  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+  Eigen::Matrix<double, 4, 3> right = Eigen::Matrix<double, 4, 3>::Zero();
+  for (int k = 0; k < n; ++k) {
+    Eigen::Vector4d row;
+    row << s0 * positions[k].raw_mean, 1.0;
+    double u[3];
+    GravityDirection(attitudes[k].roll, attitudes[k].pitch, u);
+    normal += row * row.transpose();
+    right += row * (g * Eigen::Vector3d(u[0], u[1], u[2])).transpose();
+  }
+  const Eigen::LDLT<Eigen::Matrix4d> ldlt(normal);
+  const Eigen::Matrix<double, 4, 3> x = ldlt.solve(right);
+  const Eigen::Matrix3d m0 = x.topRows<3>().transpose();
+  if (ldlt.info() != Eigen::Success || !x.allFinite() || std::fabs(m0.determinant()) < 1e-12) {
+    c.message =
+        "known_attitude: the positions do not determine the twelve parameters (the gravity "
+        "directions must not all lie in one plane)";
+    return false;
+  }
+  const Eigen::Vector3d b0 = -m0.inverse() * x.row(3).transpose();
+
+  double bias[3] = {b0(0), b0(1), b0(2)};
+  double matrix[9];
+  for (int r = 0; r < 3; ++r) {
+    for (int col = 0; col < 3; ++col) matrix[3 * r + col] = m0(r, col);
+  }
+  std::vector<std::array<double, 2>> attitude(n);
+  std::vector<Eigen::Matrix3d> whitening(n);
+  for (int k = 0; k < n; ++k) {
+    attitude[k] = {attitudes[k].roll, attitudes[k].pitch};
+    const Eigen::Matrix3d cov = m0 * (s0 * s0 * positions[k].raw_mean_cov) * m0.transpose();
+    const Eigen::LLT<Eigen::Matrix3d> llt(cov);
+    if (llt.info() != Eigen::Success) {
+      c.message = "known_attitude: static position " + std::to_string(k) +
+                  " has no usable noise estimate (its covariance is not positive definite)";
+      return false;
+    }
+    whitening[k] = llt.matrixL().solve(Eigen::Matrix3d::Identity());
+  }
+
+  ceres::Problem problem;
+  const RefinementOptions& ro = options.refinement;
+  for (int k = 0; k < n; ++k) {
+    problem.AddResidualBlock(
+        GravityVectorResidual::Create(s0 * positions[k].raw_mean, whitening[k], g),
+        MakeLoss(ro.loss, ro.loss_scale), bias, matrix, attitude[k].data());
+    problem.AddResidualBlock(AttitudePriorResidual::Create(attitudes[k]), nullptr,
+                             attitude[k].data());
+  }
+  // Whitened sum of squares (no loss) at the current parameters.
+  auto chi2 = [&]() {
+    double sum = 0.0;
+    for (int k = 0; k < n; ++k) {
+      double r[3], p[2];
+      const GravityVectorResidual sensor(s0 * positions[k].raw_mean, whitening[k], g);
+      const AttitudePriorResidual prior(attitudes[k]);
+      sensor(bias, matrix, attitude[k].data(), r);
+      prior(attitude[k].data(), p);
+      sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + p[0] * p[0] + p[1] * p[1];
+    }
+    return sum;
+  };
+  RefinementResult& f = c.refinement;
+  f.initial_cost = 0.5 * chi2();
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = ro.max_iterations;
+  solver_options.function_tolerance = ro.function_tolerance;
+  solver_options.gradient_tolerance = ro.gradient_tolerance;
+  solver_options.parameter_tolerance = ro.parameter_tolerance;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  const auto start = std::chrono::steady_clock::now();
+  ceres::Solve(solver_options, &problem, &summary);
+  f.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  f.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  f.termination = ceres::TerminationTypeToString(summary.termination_type);
+  f.converged = summary.termination_type == ceres::CONVERGENCE;
+  f.chi2 = chi2();
+  f.final_cost = 0.5 * f.chi2;
+  f.num_residuals = 5 * n;
+  f.num_parameters = 12;
+  f.dof = 3 * n - 12;
+  f.parameter_names = ParameterNames();
+  c.solver_name = "ceres_levenberg_marquardt (known attitudes)";
+
+  const double scale_back[12] = {1 / s0, 1 / s0, 1 / s0, s0, s0, s0, s0, s0, s0, s0, s0, s0};
+  Eigen::Vector3d b;
+  Eigen::Matrix3d m;
+  for (int i = 0; i < 3; ++i) b(i) = bias[i] * scale_back[i];
+  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = matrix[i] * s0;
+  if (!summary.IsSolutionUsable() || !b.allFinite() || !m.allFinite() ||
+      !AccelModel::FromMatrix(b, m, AccelParameterization::kAffine, &c.accel.model)) {
+    c.not_converged = true;
+    c.message = "known_attitude: the solve failed (" + summary.message + ")";
+    return false;
+  }
+  f.model = c.accel.model;
+
+  std::vector<Eigen::Vector2d> attitude_std(n, Eigen::Vector2d::Constant(NAN));
+  if (ro.compute_covariance) {
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::DENSE_SVD;
+    covariance_options.num_threads = 1;
+    ceres::Covariance covariance(covariance_options);
+    std::vector<std::pair<const double*, const double*>> blocks = {
+        {bias, bias}, {bias, matrix}, {matrix, matrix}};
+    for (int k = 0; k < n; ++k) blocks.push_back({attitude[k].data(), attitude[k].data()});
+    if (covariance.Compute(blocks, &problem)) {
+      double cbb[9], cbm[27], cmm[81];
+      covariance.GetCovarianceBlock(bias, bias, cbb);
+      covariance.GetCovarianceBlock(bias, matrix, cbm);
+      covariance.GetCovarianceBlock(matrix, matrix, cmm);
+      Eigen::MatrixXd cov(12, 12);
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) cov(i, j) = cbb[3 * i + j];
+        for (int j = 0; j < 9; ++j) cov(i, 3 + j) = cov(3 + j, i) = cbm[9 * i + j];
+      }
+      for (int i = 0; i < 9; ++i) {
+        for (int j = 0; j < 9; ++j) cov(3 + i, 3 + j) = cmm[9 * i + j];
+      }
+      for (int i = 0; i < 12; ++i) {
+        for (int j = 0; j < 12; ++j) cov(i, j) *= scale_back[i] * scale_back[j];
+      }
+      f.covariance = cov;
+      f.covariance_available = true;
+      c.accel.covariance = cov;
+      c.accel.covariance_names = f.parameter_names;
+      for (int i = 0; i < 3; ++i) c.accel.bias_std(i) = std::sqrt(cov(i, i));
+      for (int i = 0; i < 9; ++i) c.accel.matrix_std(i / 3, i % 3) = std::sqrt(cov(3 + i, 3 + i));
+      for (int k = 0; k < n; ++k) {
+        double ca[4];
+        covariance.GetCovarianceBlock(attitude[k].data(), attitude[k].data(), ca);
+        attitude_std[k] = Eigen::Vector2d(std::sqrt(ca[0]), std::sqrt(ca[3]));
+      }
+    } else {
+      c.warnings.push_back(
+          "known_attitude: the covariance could not be computed (rank deficient); no standard "
+          "deviations are reported");
+    }
+  }
+  if (f.dof <= 0) {
+    c.warnings.push_back(
+        "known_attitude: as many equations as unknowns; the fit cannot show whether the attitudes "
+        "or the noise estimate are right: record more positions");
+  } else if (ChiSquareUpperTail(f.chi2, f.dof) < 1e-3) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "known_attitude: residuals are " << std::sqrt(f.chi2 / f.dof)
+      << " times what the sensor noise and the stated attitude uncertainties allow (chi2 = "
+      << f.chi2 << " on " << f.dof
+      << " dof): an attitude is wrong or too confident, or a position was disturbed; the "
+         "standard deviations are too small by about that factor";
+    c.warnings.push_back(s.str());
+  }
+
+  AccelModel nominal;
+  nominal.upper = s0 * Eigen::Matrix3d::Identity();
+  ReportPositions(positions, nominal, c.accel.model, g, {}, &c);
+  c.residual_coarse = c.residual_nominal;
+  for (int k = 0; k < n; ++k) {
+    PositionReport& r = c.positions[k];
+    r.roll_deg = attitude[k][0] * kRadToDeg;
+    r.pitch_deg = attitude[k][1] * kRadToDeg;
+    r.roll_std_deg = attitude_std[k](0) * kRadToDeg;
+    r.pitch_std_deg = attitude_std[k](1) * kRadToDeg;
+  }
+  std::ostringstream s;
+  s << (f.converged ? "converged" : "did not converge") << " after " << f.iterations
+    << " iterations (" << f.termination << ")";
+  f.message = s.str();
+  if (!f.converged) {
+    c.not_converged = true;
+    c.message = "known_attitude: the solve " + f.message + ": " + summary.message;
+    return false;
+  }
+  c.success = true;
+  std::ostringstream done;
+  done.precision(3);
+  done << "calibrated 'known_attitude' (all 12 parameters) from " << n << " positions ("
+       << f.message << ", chi2 " << f.chi2 << " on " << f.dof << " dof)";
+  c.message = done.str();
+  return true;
+}
+
+bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path,
+                            const CalibrationOptions& options, Calibration* calibration) {
+  CHECK(calibration != nullptr);
+  *calibration = Calibration();
+  Calibration& c = *calibration;
+  c.method = "known_attitude";
+  if (attitudes_path.empty()) {
+    c.message = "known_attitude needs the attitudes file (--attitudes fixture.csv)";
+    return false;
+  }
+  std::vector<StaticInterval> intervals;
+  std::vector<Position> positions;
+  if (!DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
+  std::vector<FixtureAttitude> rows;
+  std::vector<int> row_of_position;
+  std::string error;
+  if (!ReadFixtureAttitudes(attitudes_path, &rows, &error) ||
+      !MatchFixtureAttitudes(rows, intervals, attitudes_path, &row_of_position, &error)) {
+    c.message = error;
+    return false;
+  }
+  constexpr double kDegToRad = M_PI / 180.0;
+  std::vector<KnownAttitude> attitudes;
+  for (int row : row_of_position) {
+    const FixtureAttitude& r = rows[row];
+    attitudes.push_back({r.roll_deg * kDegToRad, r.pitch_deg * kDegToRad,
+                         r.roll_std_deg * kDegToRad, r.pitch_std_deg * kDegToRad});
+  }
+  const bool ok = CalibrateFromKnownAttitudes(positions, attitudes, options, &c);
+  if (!ok && !log.source.empty()) c.message = log.source + ": " + c.message;
+  return ok;
+}
+
+}  // namespace gravcal

@@ -1,0 +1,71 @@
+#include "methods/static_positions.h"
+
+#include <algorithm>
+
+#include "core/calibration_gravity.h"
+#include "gravcal/estimation/refinement.h"
+#include "util/statistics.h"
+
+namespace gravcal {
+
+bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
+                           Calibration* calibration, std::vector<StaticInterval>* intervals,
+                           std::vector<Position>* positions) {
+  Calibration& c = *calibration;
+  std::string error;
+  if (!options.IsValid(&error) || !log.Validate(&error)) {
+    c.message = error;
+    return false;
+  }
+  if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
+  StaticDetection detection;
+  if (!DetectStaticIntervals(log, options.detector, &detection)) {
+    c.message = log.source + ": " + detection.message;
+    return false;
+  }
+  *intervals = detection.intervals;
+  *positions = PositionsFromIntervals(detection.intervals);
+  return true;
+}
+
+double IntervalSamples(const ImuLog& log, const StaticInterval& interval, double scale,
+                       double gyro_scale, std::vector<Eigen::Vector3d>* force,
+                       std::vector<Eigen::Vector3d>* rate) {
+  force->clear();
+  rate->clear();
+  for (size_t i = interval.begin; i < interval.end; ++i) {
+    force->push_back(scale * log.accel[i]);
+    if (log.has_gyro()) rate->push_back(gyro_scale * log.gyro[i]);
+  }
+  const size_t n = interval.end - interval.begin;
+  return n > 1 ? (log.t[interval.end - 1] - log.t[interval.begin]) / static_cast<double>(n - 1)
+               : 0.0;
+}
+
+void ReportPositions(const std::vector<Position>& positions, const AccelModel& nominal,
+                     const AccelModel& final_model, double gravity,
+                     const std::vector<double>& sigmas, Calibration* calibration) {
+  Calibration& c = *calibration;
+  const std::vector<double> before = MagnitudeResiduals(positions, nominal, gravity);
+  // The final model may have a rotation: |a| uses the full matrix.
+  std::vector<double> after(positions.size());
+  for (size_t k = 0; k < positions.size(); ++k) {
+    after[k] = final_model.Apply(positions[k].raw_mean).norm() - gravity;
+  }
+  c.residual_nominal = {Rms(before), MaxAbs(before)};
+  c.residual_refined = {Rms(after), MaxAbs(after)};
+  c.positions.clear();
+  for (size_t k = 0; k < positions.size(); ++k) {
+    PositionReport r;
+    r.position = positions[k];
+    const double n = static_cast<double>(std::max<size_t>(positions[k].sample_count, 1));
+    r.raw_std = (positions[k].raw_mean_cov.diagonal() * n).cwiseSqrt();
+    r.nominal_up = positions[k].nominal_up;
+    r.residual_before = before[k];
+    r.residual_after = after[k];
+    r.sigma = k < sigmas.size() ? sigmas[k] : NAN;
+    c.positions.push_back(r);
+  }
+}
+
+}  // namespace gravcal

@@ -1,0 +1,219 @@
+#include "gravcal/methods/twelve_position.h"
+
+#include <glog/logging.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <sstream>
+
+#include "estimation/accel_uncertainty.h"
+#include "core/calibration_gravity.h"
+#include "gravcal/estimation/housing_rotation.h"
+#include "util/statistics.h"
+
+namespace gravcal {
+
+const char* ToString(RefinementSolver solver) {
+  switch (solver) {
+    case RefinementSolver::kCeres:
+      return "ceres";
+    case RefinementSolver::kNewton:
+      return "newton";
+  }
+  return "unknown";
+}
+
+bool FromString(const std::string& name, RefinementSolver* solver) {
+  if (name == "ceres") {
+    *solver = RefinementSolver::kCeres;
+  } else if (name == "newton") {
+    *solver = RefinementSolver::kNewton;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool CalibrationOptions::IsValid(std::string* error) const {
+  if (!detector.IsValid(error) || !gravity.IsValid(error) || !coarse.IsValid(error) ||
+      !refinement.IsValid(error)) {
+    return false;
+  }
+  if (!(nominal_scale > 0.0 && std::isfinite(nominal_scale))) {
+    *error = "nominal_scale: must be positive";
+    return false;
+  }
+  for (int up : nominal_up) {
+    if (up < -1 || up > 5) {
+      *error = "nominal_up: entries must be +x, -x, +y, -y, +z, -z or ?";
+      return false;
+    }
+  }
+  return true;
+}
+
+namespace {
+
+ResidualSummary Summarise(const std::vector<double>& r) { return {Rms(r), MaxAbs(r)}; }
+
+}  // namespace
+
+bool CalibrateFromPositions(const std::vector<Position>& positions,
+                            const CalibrationOptions& options, Calibration* calibration) {
+  CHECK(calibration != nullptr);
+  *calibration = Calibration();
+  Calibration& c = *calibration;
+  std::string error;
+  if (!options.IsValid(&error)) {
+    c.message = error;
+    return false;
+  }
+  if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
+  const AccelParameterization p = options.refinement.parameterization;
+  const int needed = p == AccelParameterization::kScale ? 6 : 9;
+  if (static_cast<int>(positions.size()) < needed) {
+    std::ostringstream s;
+    s << "found " << positions.size() << " static positions; the '" << ToString(p)
+      << "' model needs at least " << needed;
+    c.message = s.str();
+    return false;
+  }
+  std::vector<Position> placed = positions;
+  if (!options.nominal_up.empty()) {
+    if (options.nominal_up.size() != positions.size()) {
+      std::ostringstream s;
+      s << "nominal_up: gives " << options.nominal_up.size() << " axes for " << positions.size()
+        << " detected positions";
+      c.message = s.str();
+      return false;
+    }
+    for (size_t k = 0; k < placed.size(); ++k) placed[k].nominal_up = options.nominal_up[k];
+  }
+
+  if (!CoarseFit(placed, c.gravity, p, options.coarse, &c.coarse)) {
+    c.message = c.coarse.message;
+    return false;
+  }
+  for (size_t k = 0; k < placed.size(); ++k) placed[k].nominal_up = c.coarse.nominal_up[k];
+
+  bool ok;
+  if (options.solver == RefinementSolver::kCeres) {
+    ok = Refine(placed, c.coarse.model, c.gravity, options.refinement, &c.refinement);
+    c.solver_name = "ceres_levenberg_marquardt";
+  } else {
+    NewtonOptions newton;
+    newton.parameterization = p;
+    newton.residual = options.newton_residual;
+    newton.max_iterations = options.refinement.max_iterations;
+    newton.compute_covariance = options.refinement.compute_covariance;
+    ok = NewtonRefine(placed, c.coarse.model, c.gravity, newton, &c.refinement);
+    c.solver_name = std::string("newton_") + ToString(options.newton_residual);
+  }
+  if (!ok) {
+    c.message = c.refinement.message;
+    return false;
+  }
+  c.accel.model = c.refinement.model;
+  for (const std::string& w : c.refinement.warnings) c.warnings.push_back(w);
+
+  // Residual summaries.
+  AccelModel nominal;
+  nominal.upper = options.nominal_scale * Eigen::Matrix3d::Identity();
+  c.residual_nominal = Summarise(MagnitudeResiduals(placed, nominal, c.gravity));
+  c.residual_coarse = Summarise(MagnitudeResiduals(placed, c.coarse.model, c.gravity));
+  c.residual_refined = Summarise(MagnitudeResiduals(placed, c.accel.model, c.gravity));
+
+  HousingRotation housing;
+  bool have_housing = false;
+  if (p == AccelParameterization::kAffine) {
+    if (EstimateHousingRotation(placed, c.coarse.nominal_up, c.accel.model, &housing, &error)) {
+      c.accel.model.rotation = housing.rotation;
+      c.accel.tilt_rms = housing.tilt_rms;
+      have_housing = true;
+      std::ostringstream s;
+      s.precision(3);
+      s << "affine: bias, scale and non-orthogonality come from the gravity magnitude; the "
+           "rotation of the sensor axes in the housing comes from the nominal axes of "
+        << housing.positions_used
+        << " axis-aligned positions (placement error seen: " << housing.tilt_rms * 180.0 / M_PI
+        << " deg rms), so its accuracy is that of the placement";
+      c.warnings.push_back(s.str());
+    } else {
+      c.warnings.push_back(
+          "affine: the rotation of the sensor axes in the housing is not "
+          "determined (" +
+          error +
+          "); it is left at identity with no standard "
+          "deviation");
+    }
+  }
+  if (c.refinement.covariance_available) {
+    PropagateUncertainty(c.refinement, have_housing ? &housing : nullptr, &c.accel);
+    if (p == AccelParameterization::kAffine && !have_housing) c.accel.matrix_std.setConstant(NAN);
+  }
+
+  const std::vector<double>& sigmas = c.refinement.sigmas;
+  for (size_t k = 0; k < placed.size(); ++k) {
+    PositionReport r;
+    r.position = placed[k];
+    const double n = static_cast<double>(std::max<size_t>(placed[k].sample_count, 1));
+    r.raw_std = (placed[k].raw_mean_cov.diagonal() * n).cwiseSqrt();
+    r.nominal_up = placed[k].nominal_up;
+    r.residual_before = c.refinement.residuals_before[k];
+    r.residual_after = c.refinement.residuals_after.empty() ? NAN : c.refinement.residuals_after[k];
+    r.sigma = sigmas[k];
+    c.positions.push_back(r);
+  }
+
+  const std::vector<std::string>& undetermined = c.refinement.observability.undetermined;
+  if (!undetermined.empty() && !options.allow_undetermined) {
+    std::string names;
+    for (const std::string& n : undetermined) names += (names.empty() ? "" : ", ") + n;
+    c.message = "the positions do not determine " + names + " of the '" + ToString(p) +
+                "' model: record more poses with other axes up or down, choose a smaller "
+                "parameterization (scale), or set allow_undetermined: true to report them "
+                "without a number";
+    return false;
+  }
+  if (!c.refinement.converged) {
+    c.not_converged = true;
+    c.accel = AccelCalibration();
+    c.accel.model = c.coarse.model;
+    c.message = "refinement did not converge (" + c.refinement.message +
+                "); the coarse result is kept and is not a calibration to trust";
+    return false;
+  }
+  c.success = true;
+  std::ostringstream s;
+  s << "calibrated '" << ToString(p) << "' from " << placed.size() << " positions ("
+    << c.coarse.message << "; refinement " << c.refinement.message << ")";
+  c.message = s.str();
+  return true;
+}
+
+bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options,
+                            Calibration* calibration, std::vector<StaticInterval>* intervals) {
+  CHECK(calibration != nullptr);
+  *calibration = Calibration();
+  std::string error;
+  if (!options.IsValid(&error)) {
+    calibration->message = error;
+    return false;
+  }
+  if (!log.Validate(&error)) {
+    calibration->message = error;
+    return false;
+  }
+  StaticDetection detection;
+  if (!DetectStaticIntervals(log, options.detector, &detection)) {
+    calibration->message = log.source + ": " + detection.message;
+    return false;
+  }
+  const std::vector<Position> positions = PositionsFromIntervals(detection.intervals);
+  if (intervals != nullptr) *intervals = detection.intervals;
+  const bool ok = CalibrateFromPositions(positions, options, calibration);
+  if (!ok && !log.source.empty()) calibration->message = log.source + ": " + calibration->message;
+  return ok;
+}
+
+}  // namespace gravcal

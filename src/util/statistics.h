@@ -1,0 +1,26 @@
+// Private: small statistics helpers.
+#ifndef GRAVCAL_SRC_UTIL_STATISTICS_H_
+#define GRAVCAL_SRC_UTIL_STATISTICS_H_
+
+#include <vector>
+
+namespace gravcal {
+
+// P(X > x) for X ~ chi-square with `dof` degrees of freedom (regularised
+// upper incomplete gamma function, series / continued fraction).
+double ChiSquareUpperTail(double x, int dof);
+
+// P(X > f) for X ~ F(d1, d2) (regularised incomplete beta function,
+// continued fraction).
+double FUpperTail(double f, int d1, int d2);
+
+// Median of the values (copy taken).
+double Median(std::vector<double> values);
+
+// Root mean square and largest absolute value.
+double Rms(const std::vector<double>& values);
+double MaxAbs(const std::vector<double>& values);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_SRC_UTIL_STATISTICS_H_

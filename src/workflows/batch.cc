@@ -1,0 +1,201 @@
+#include "gravcal/workflows/batch.h"
+
+#include <chrono>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "util/content_hash.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/workflows/pipeline.h"
+#include "util/thread_pool.h"
+
+#ifndef GRAVCAL_VERSION
+#error "GRAVCAL_VERSION must be defined by the build (CMakeLists.txt)"
+#endif
+
+namespace gravcal {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double>(to - from).count();
+}
+
+// The numbers of an in-memory log as bytes, for the content hash.
+std::string LogBytes(const ImuLog& log) {
+  std::string bytes;
+  auto add = [&bytes](const double* p, size_t count) {
+    bytes.append(reinterpret_cast<const char*>(p), count * sizeof(double));
+  };
+  add(log.t.data(), log.t.size());
+  for (const Eigen::Vector3d& a : log.accel) add(a.data(), 3);
+  for (const Eigen::Vector3d& w : log.gyro) add(w.data(), 3);
+  add(log.temperature.data(), log.temperature.size());
+  return bytes;
+}
+
+// Reads, hashes and parses one unit, then calibrates it (unless skipped).
+void RunUnit(size_t index, const BatchUnit& unit, const Config& base, const BatchOptions& options,
+             BatchResult* r) {
+  const Clock::time_point start = Clock::now();
+  r->unit = unit.id;
+  // Ends the unit before calibration: all of its time was reading.
+  auto stop = [&](const std::string& message) {
+    r->message = message;
+    r->timings.read_seconds = r->timings.total_seconds = Seconds(start, Clock::now());
+  };
+  std::string error;
+  Config config;
+  if (!EffectiveConfig(unit, base, &config, &error)) return stop(unit.id + ": " + error);
+  std::string log_bytes;
+  std::string gyro_bytes;
+  std::string attitudes_bytes;
+  if (unit.path.empty()) {
+    log_bytes = LogBytes(unit.log);
+  } else if (!ReadFileBytes(unit.path, &log_bytes, &error)) {
+    return stop(error);
+  }
+  if ((!config.input.gyro_path.empty() &&
+       !ReadFileBytes(config.input.gyro_path, &gyro_bytes, &error)) ||
+      (!unit.attitudes_path.empty() &&
+       !ReadFileBytes(unit.attitudes_path, &attitudes_bytes, &error))) {
+    return stop(error);
+  }
+  r->content_hash = UnitContentHash(log_bytes, gyro_bytes, attitudes_bytes, config);
+  if (options.skip && options.skip(index, unit, r->content_hash)) {
+    r->skipped = true;
+    return stop("skipped: the stored result has this content hash");
+  }
+  PipelineInput input;
+  input.attitudes_path = unit.attitudes_path;
+  if (unit.path.empty()) {
+    input.source = unit.id;
+    input.log = unit.log;
+  } else {
+    // Exactly what ReadImuLog does after reading the file.
+    input.source = unit.path;
+    if (!ParseImuLog(log_bytes, unit.path, config.input, &input.log, &error)) return stop(error);
+  }
+  const Clock::time_point read_end = Clock::now();
+  const bool ok = RunCalibration(config, input, &r->calibration);
+  const Clock::time_point end = Clock::now();
+  r->message = r->calibration.message;
+  r->status = ok                             ? BatchStatus::kOk
+              : r->calibration.not_converged ? BatchStatus::kNotConverged
+                                             : BatchStatus::kFailed;
+  r->timings.read_seconds = Seconds(start, read_end);
+  r->timings.solve_seconds = r->calibration.refinement.solve_seconds;
+  r->timings.detect_seconds = std::max(0.0, Seconds(read_end, end) - r->timings.solve_seconds);
+  r->timings.total_seconds = Seconds(start, end);
+}
+
+}  // namespace
+
+const char* GravcalVersion() { return GRAVCAL_VERSION; }
+
+bool EffectiveConfig(const BatchUnit& unit, const Config& base, Config* config,
+                     std::string* error) {
+  Config c = base;
+  for (const auto& [key, value] : unit.overrides) {
+    if (!SetConfigValue(key, value, &c, error)) return false;
+  }
+  if (!c.IsValid(error)) return false;
+  *config = c;
+  return true;
+}
+
+std::string ConfigText(const Config& config) {
+  std::string text;
+  for (const ConfigKey& key : ConfigKeys()) {
+    text += key.name + ": " + ConfigValueText(config, key.name) + "\n";
+  }
+  return text;
+}
+
+const char* ToString(BatchStatus status) {
+  switch (status) {
+    case BatchStatus::kOk:
+      return "ok";
+    case BatchStatus::kFailed:
+      return "failed";
+    case BatchStatus::kNotConverged:
+      return "not_converged";
+  }
+  return "unknown";
+}
+
+bool FromString(const std::string& name, BatchStatus* status) {
+  for (BatchStatus s : {BatchStatus::kOk, BatchStatus::kFailed, BatchStatus::kNotConverged}) {
+    if (name == ToString(s)) {
+      *status = s;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool BatchOptions::IsValid(std::string* error) const {
+  if (threads < 0) {
+    *error = "threads: must be >= 0 (0 = one per core), is " + std::to_string(threads);
+    return false;
+  }
+  return true;
+}
+
+std::string UnitContentHash(const std::string& log_bytes, const std::string& gyro_bytes,
+                            const std::string& attitudes_bytes, const Config& config) {
+  ContentHash hash;
+  hash.Add(GravcalVersion());
+  hash.Add(ConfigText(config));
+  hash.Add(log_bytes);
+  hash.Add(gyro_bytes);
+  hash.Add(attitudes_bytes);
+  return hash.Hex();
+}
+
+bool CalibrateBatch(const std::vector<BatchUnit>& units, const Config& base,
+                    const BatchOptions& options, std::vector<BatchResult>* results,
+                    std::string* error) {
+  if (!options.IsValid(error)) return false;
+  int threads = options.threads;
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  results->assign(units.size(), BatchResult());
+  std::mutex progress_mutex;
+  BatchProgress progress;
+  progress.total = units.size();
+  const Clock::time_point start = Clock::now();
+  ParallelFor(units.size(), threads, [&](size_t i) {
+    BatchResult& r = (*results)[i];
+    try {
+      RunUnit(i, units[i], base, options, &r);
+      if (options.on_result) options.on_result(i, r);
+    } catch (const std::exception& e) {
+      r.status = BatchStatus::kFailed;
+      r.message = units[i].id + ": internal error: " + e.what();
+    } catch (...) {
+      r.status = BatchStatus::kFailed;
+      r.message = units[i].id + ": internal error";
+    }
+    if (!options.keep_calibrations) r.calibration = Calibration();
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    ++progress.done;
+    if (r.skipped) {
+      ++progress.skipped;
+    } else if (r.status != BatchStatus::kOk) {
+      ++progress.failed;
+    }
+    progress.elapsed_seconds = Seconds(start, Clock::now());
+    if (options.progress) {
+      try {
+        options.progress(progress);
+      } catch (...) {
+        // A progress display must not stop the batch.
+      }
+    }
+  });
+  return true;
+}
+
+}  // namespace gravcal

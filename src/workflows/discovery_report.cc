@@ -1,0 +1,570 @@
+#include "gravcal/workflows/discovery_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "util/statistics.h"
+
+namespace gravcal {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json Vector(const Eigen::Vector3d& v) { return {Number(v(0)), Number(v(1)), Number(v(2))}; }
+
+json Matrix(const Eigen::Matrix3d& m) {
+  json rows = json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back(Vector(m.row(r).transpose()));
+  return rows;
+}
+
+bool IsAccel(Effect e) { return Info(e).sensor == EffectSensor::kAccelerometer; }
+
+const char* GapUnit(Effect e) { return IsAccel(e) ? "m/s^2" : "raw gyro units"; }
+
+double Of(const Gap& g, bool accel) { return accel ? g.accel : g.gyro; }
+double SigmaOf(const Gap& g, bool accel) { return accel ? g.accel_sigma : g.gyro_sigma; }
+
+json GapJson(const Gap& g) {
+  return {{"accel", Number(g.accel)},
+          {"accel_unit", "m/s^2"},
+          {"accel_sigma", Number(g.accel_sigma)},
+          {"gyro", Number(g.gyro)},
+          {"gyro_unit", "raw gyro units"},
+          {"gyro_sigma", Number(g.gyro_sigma)},
+          {"accel_unpredictable_positions", g.accel_unpredictable},
+          {"gyro_unpredictable_positions", g.gyro_unpredictable}};
+}
+
+std::string ModelName(const ModelAssessment& m) {
+  std::string name = ToString(m.parameterization);
+  for (Effect e : m.effects) name += std::string(" + ") + ToString(e);
+  return name;
+}
+
+json PositionJson(const PositionDisagreement& p) {
+  return {{"position", p.index},
+          {"time", p.time},
+          {"temperature", Number(p.temperature)},
+          {"axis", p.axis},
+          {"axis_level", p.axis_level},
+          {"accel_residual", p.accel_residual},
+          {"accel_z", p.accel_z},
+          {"gyro_residual", Vector(p.gyro_residual)},
+          {"gyro_z", Vector(p.gyro_z)}};
+}
+
+// `where`: the summary, the worst positions of each sensor and the groups;
+// with every position (measured, simulated) when `detail`.
+json WhereJson(const Disagreement& d, bool detail) {
+  json w;
+  w["summary"] = d.summary;
+  json worst_a = json::array(), worst_g = json::array();
+  for (int k : d.worst_accel) worst_a.push_back(PositionJson(d.positions[k]));
+  for (int k : d.worst_gyro) worst_g.push_back(PositionJson(d.positions[k]));
+  w["accel"] = {{"chi2", d.accel_chi2},
+                {"dof", d.accel_dof},
+                {"p_value", d.accel_p},
+                {"worst_positions", worst_a}};
+  if (d.gyro_dof > 0) {
+    w["gyro"] = {{"chi2", d.gyro_chi2},
+                 {"dof", d.gyro_dof},
+                 {"p_value", d.gyro_p},
+                 {"worst_positions", worst_g}};
+  }
+  json groups = json::array();
+  for (const GroupDisagreement& g : d.groups) {
+    groups.push_back({{"by", g.by},
+                      {"group", g.group},
+                      {"positions", g.count},
+                      {"accel_sigma", Number(g.accel_sigma)},
+                      {"gyro_sigma", Number(g.gyro_sigma)}});
+  }
+  w["groups"] = groups;
+  if (detail) {
+    json all = json::array();
+    for (const PositionDisagreement& p : d.positions) {
+      json j = PositionJson(p);
+      j["accel_measured"] = Vector(p.accel_measured);
+      j["accel_simulated"] = Vector(p.accel_simulated);
+      if (d.gyro_dof > 0) {
+        j["gyro_measured"] = Vector(p.gyro_measured);
+        j["gyro_simulated"] = Vector(p.gyro_simulated);
+      }
+      all.push_back(j);
+    }
+    w["positions"] = all;
+  }
+  return w;
+}
+
+json ParametersJson(const EffectEstimate& e) {
+  json params = json::array();
+  for (size_t i = 0; i < e.names.size(); ++i) {
+    params.push_back({{"name", e.names[i]},
+                      {"value", Number(i < e.values.size() ? e.values[i] : NAN)},
+                      {"std", Number(i < e.std.size() ? e.std[i] : NAN)},
+                      {"unit", e.unit}});
+  }
+  return params;
+}
+
+json CandidatesJson(const std::vector<CandidateScore>& scores) {
+  json out = json::array();
+  for (const CandidateScore& c : scores) {
+    const bool accel = IsAccel(c.effect);
+    json j = {{"effect", ToString(c.effect)}, {"tried", c.tried}, {"significant", c.significant}};
+    if (c.tried) {
+      j["dof"] = c.dof;
+      j["delta_chi2"] = Number(c.delta_chi2);
+      j["dispersion"] = Number(c.dispersion);
+      j["p_value"] = Number(c.p_value);
+      j["delta_bic"] = Number(c.delta_bic);
+      j["gap_after"] = Number(Of(c.gap, accel));
+      j["cv_gap_after"] = Number(Of(c.cv_gap, accel));
+      j["cv_gap_after_sigma"] = Number(SigmaOf(c.cv_gap, accel));
+    }
+    if (!c.reason.empty()) j["reason"] = c.reason;
+    out.push_back(j);
+  }
+  return out;
+}
+
+json ModelJson(const ModelAssessment& m) {
+  json j;
+  j["model"] = ModelName(m);
+  j["parameterization"] = ToString(m.parameterization);
+  j["effects"] = EffectNames(m.effects);
+  j["gap"] = GapJson(m.gap);
+  j["cv_gap"] = GapJson(m.cv_gap);
+  const EffectFitResult& f = m.fit;
+  j["accel"] = {{"bias", Vector(f.accel.bias)},
+                {"bias_std", Vector(f.accel_bias_std)},
+                {"upper", Matrix(f.accel.upper)},
+                {"chi2", f.accel_fit.chi2},
+                {"dof", f.accel_fit.dof()}};
+  if (f.gyro_fit.fitted) {
+    j["gyro"] = {{"bias", Vector(f.gyro.bias)},
+                 {"bias_std", Vector(f.gyro_bias_std)},
+                 {"chi2", f.gyro_fit.chi2},
+                 {"dof", f.gyro_fit.dof()}};
+  }
+  json params = json::object();
+  for (const EffectEstimate& e : f.estimates) params[ToString(e.effect)] = ParametersJson(e);
+  j["parameters"] = params;
+  j["reference_temperature"] = Number(f.parameters.reference_temperature);
+  j["reference_time"] = Number(f.parameters.reference_time);
+  return j;
+}
+
+// ---------------------------------------------------------------------------
+// HTML.
+
+std::string Escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string Num(double v, const char* format = "%.4g") {
+  if (!std::isfinite(v)) return "&ndash;";
+  char b[64];
+  std::snprintf(b, sizeof(b), format, v);
+  return b;
+}
+
+struct Series {
+  std::string name;
+  std::string color;
+  std::vector<double> x;
+  std::vector<double> y;
+};
+
+// Plot frame: 560 x 300 px with margins; maps data to pixels.
+struct Frame {
+  double x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  static constexpr double kW = 560, kH = 300, kL = 70, kR = 20, kT = 30, kB = 45;
+  double X(double x) const { return kL + (x - x0) / (x1 - x0) * (kW - kL - kR); }
+  double Y(double y) const { return kH - kB - (y - y0) / (y1 - y0) * (kH - kT - kB); }
+};
+
+void Range(const std::vector<double>& v, double* lo, double* hi) {
+  for (double x : v) {
+    if (!std::isfinite(x)) continue;
+    *lo = std::min(*lo, x);
+    *hi = std::max(*hi, x);
+  }
+}
+
+void Pad(double* lo, double* hi) {
+  if (!(*hi > *lo)) {
+    const double c = std::isfinite(*lo) ? *lo : 0.0;
+    *lo = c - 1.0;
+    *hi = c + 1.0;
+    return;
+  }
+  const double p = 0.06 * (*hi - *lo);
+  *lo -= p;
+  *hi += p;
+}
+
+std::string Axes(const Frame& f, const std::string& title, const std::string& xlabel,
+                 const std::string& ylabel) {
+  std::ostringstream s;
+  s << "<rect x='" << Frame::kL << "' y='" << Frame::kT << "' width='"
+    << Frame::kW - Frame::kL - Frame::kR << "' height='" << Frame::kH - Frame::kT - Frame::kB
+    << "' fill='none' stroke='#888'/>";
+  for (int i = 0; i <= 4; ++i) {
+    const double xv = f.x0 + (f.x1 - f.x0) * i / 4.0;
+    const double yv = f.y0 + (f.y1 - f.y0) * i / 4.0;
+    s << "<text x='" << f.X(xv) << "' y='" << Frame::kH - Frame::kB + 15
+      << "' font-size='10' text-anchor='middle'>" << Num(xv, "%.3g") << "</text>";
+    s << "<text x='" << Frame::kL - 4 << "' y='" << f.Y(yv) + 3
+      << "' font-size='10' text-anchor='end'>" << Num(yv, "%.3g") << "</text>";
+  }
+  s << "<text x='" << Frame::kW / 2 << "' y='16' font-size='13' text-anchor='middle'>"
+    << Escape(title) << "</text>";
+  s << "<text x='" << (Frame::kL + Frame::kW - Frame::kR) / 2 << "' y='" << Frame::kH - 8
+    << "' font-size='11' text-anchor='middle'>" << Escape(xlabel) << "</text>";
+  s << "<text x='14' y='" << Frame::kH / 2 << "' font-size='11' text-anchor='middle' "
+    << "transform='rotate(-90 14 " << Frame::kH / 2 << ")'>" << Escape(ylabel) << "</text>";
+  return s.str();
+}
+
+std::string Legend(const std::vector<Series>& series) {
+  std::ostringstream s;
+  double x = Frame::kL + 8;
+  for (const Series& sr : series) {
+    s << "<circle cx='" << x << "' cy='" << Frame::kT + 10 << "' r='4' fill='" << sr.color
+      << "'/><text x='" << x + 8 << "' y='" << Frame::kT + 14 << "' font-size='11'>"
+      << Escape(sr.name) << "</text>";
+    x += 16 + 7 * sr.name.size();
+  }
+  return s.str();
+}
+
+std::string Scatter(const std::string& title, const std::string& xlabel, const std::string& ylabel,
+                    const std::vector<Series>& series) {
+  Frame f;
+  f.x0 = f.y0 = INFINITY;
+  f.x1 = f.y1 = -INFINITY;
+  for (const Series& s : series) {
+    Range(s.x, &f.x0, &f.x1);
+    Range(s.y, &f.y0, &f.y1);
+  }
+  f.y0 = std::min(f.y0, 0.0);
+  f.y1 = std::max(f.y1, 0.0);
+  Pad(&f.x0, &f.x1);
+  Pad(&f.y0, &f.y1);
+  std::ostringstream s;
+  s << "<svg xmlns='http://www.w3.org/2000/svg' width='" << Frame::kW << "' height='" << Frame::kH
+    << "'>" << Axes(f, title, xlabel, ylabel);
+  s << "<line x1='" << Frame::kL << "' x2='" << Frame::kW - Frame::kR << "' y1='" << f.Y(0)
+    << "' y2='" << f.Y(0) << "' stroke='#bbb' stroke-dasharray='4 3'/>";
+  for (const Series& sr : series) {
+    for (size_t i = 0; i < sr.x.size() && i < sr.y.size(); ++i) {
+      if (!std::isfinite(sr.x[i]) || !std::isfinite(sr.y[i])) continue;
+      s << "<circle cx='" << f.X(sr.x[i]) << "' cy='" << f.Y(sr.y[i]) << "' r='3.5' fill='"
+        << sr.color << "' fill-opacity='0.8'/>";
+    }
+  }
+  s << Legend(series) << "</svg>";
+  return s.str();
+}
+
+// Bars of a value per position, with dashed lines at +-1 and +-3.
+std::string Bars(const std::string& title, const std::string& ylabel,
+                 const std::vector<double>& values, const std::string& color) {
+  Frame f;
+  f.x0 = -0.5;
+  f.x1 = values.size() - 0.5;
+  f.y0 = -3.5;
+  f.y1 = 3.5;
+  Range(values, &f.y0, &f.y1);
+  Pad(&f.y0, &f.y1);
+  std::ostringstream s;
+  s << "<svg xmlns='http://www.w3.org/2000/svg' width='" << Frame::kW << "' height='" << Frame::kH
+    << "'>" << Axes(f, title, "position", ylabel);
+  for (double level : {-3.0, -1.0, 1.0, 3.0}) {
+    s << "<line x1='" << Frame::kL << "' x2='" << Frame::kW - Frame::kR << "' y1='" << f.Y(level)
+      << "' y2='" << f.Y(level) << "' stroke='" << (std::fabs(level) > 2 ? "#d33" : "#bbb")
+      << "' stroke-dasharray='4 3'/>";
+  }
+  const double w = std::max(1.0, 0.7 * (f.X(1) - f.X(0)));
+  for (size_t k = 0; k < values.size(); ++k) {
+    if (!std::isfinite(values[k])) continue;
+    const double top = std::min(f.Y(values[k]), f.Y(0));
+    s << "<rect x='" << f.X(k) - w / 2 << "' y='" << top << "' width='" << w << "' height='"
+      << std::fabs(f.Y(values[k]) - f.Y(0)) << "' fill='" << color << "'/>";
+  }
+  s << "</svg>";
+  return s.str();
+}
+
+std::string GapCells(const Gap& before, const Gap& after, bool accel) {
+  std::ostringstream s;
+  s << "<td>" << Num(Of(before, accel)) << " &rarr; " << Num(Of(after, accel)) << "</td><td>"
+    << Num(SigmaOf(before, accel), "%.3g") << " &rarr; " << Num(SigmaOf(after, accel), "%.3g")
+    << "</td>";
+  return s.str();
+}
+
+std::string WherePlots(const Disagreement& d, const std::string& label) {
+  std::vector<double> za, zg;
+  for (const PositionDisagreement& p : d.positions) {
+    za.push_back(p.accel_z);
+    zg.push_back(p.gyro_z.norm() / std::sqrt(3.0));
+  }
+  std::string s = Bars(label + ": accelerometer |a| - g per position", "sigma", za, "#3b6ea8");
+  if (d.gyro_dof > 0) {
+    s += Bars(label + ": gyroscope residual per position (rms over axes)", "sigma", zg, "#c07a2c");
+  }
+  return s;
+}
+
+std::string GroupsTable(const Disagreement& d) {
+  std::ostringstream s;
+  s << "<table><tr><th>by</th><th>group</th><th>positions</th><th>accel rms, sigma</th>"
+    << "<th>gyro rms, sigma</th></tr>";
+  for (const GroupDisagreement& g : d.groups) {
+    s << "<tr><td>" << g.by << "</td><td>" << Escape(g.group) << "</td><td>" << g.count
+      << "</td><td>" << Num(g.accel_sigma, "%.3g") << "</td><td>" << Num(g.gyro_sigma, "%.3g")
+      << "</td></tr>";
+  }
+  s << "</table>";
+  return s.str();
+}
+
+std::string CandidatesTable(const std::vector<CandidateScore>& scores) {
+  std::ostringstream s;
+  s << "<table><tr><th>candidate</th><th>p-value</th><th>delta BIC</th><th>CV gap after, "
+       "sigma</th><th>verdict</th></tr>";
+  for (const CandidateScore& c : scores) {
+    const bool accel = IsAccel(c.effect);
+    s << "<tr><td>" << ToString(c.effect) << "</td><td>" << Num(c.p_value, "%.3g") << "</td><td>"
+      << Num(c.delta_bic, "%.1f") << "</td><td>" << Num(SigmaOf(c.cv_gap, accel), "%.3g")
+      << "</td><td>" << (c.significant ? "significant" : Escape(c.reason)) << "</td></tr>";
+  }
+  s << "</table>";
+  return s.str();
+}
+
+// Residuals before and after a step against its regressor (or against the
+// effect's own contribution), one pair of series per axis.
+std::vector<Series> BeforeAfter(const DiscoveryStep& s, bool accel, bool against_contribution) {
+  std::vector<Series> series;
+  const char* colors_before[3] = {"#9bb7d6", "#d6b79b", "#a8d69b"};
+  const char* colors_after[3] = {"#1f4e8c", "#8c4e1f", "#2f7a1f"};
+  for (int axis = 0; axis < (accel ? 1 : 3); ++axis) {
+    Series b, a;
+    const std::string suffix = accel ? "" : std::string(" ") + "xyz"[axis];
+    b.name = "before" + suffix;
+    a.name = "after" + suffix;
+    b.color = colors_before[axis];
+    a.color = colors_after[axis];
+    for (size_t k = 0; k < s.regressor.size(); ++k) {
+      const double x = against_contribution ? s.contribution[k](axis) : s.regressor[k];
+      b.x.push_back(x);
+      a.x.push_back(x);
+      b.y.push_back(s.residual_before[k](axis));
+      a.y.push_back(s.residual_after[k](axis));
+    }
+    series.push_back(b);
+    series.push_back(a);
+  }
+  return series;
+}
+
+}  // namespace
+
+std::string DiscoveryToJson(const DiscoveryResult& r) {
+  json out;
+  out["source"] = r.source;
+  out["gravity"] = {{"value", r.gravity}, {"source", r.gravity_source}};
+  std::vector<double> sa, sg;
+  json positions = json::array();
+  for (size_t k = 0; k < r.observations.size(); ++k) {
+    const StaticObservation& o = r.observations[k];
+    positions.push_back({{"position", k},
+                         {"t_begin", o.accel.t_begin},
+                         {"t_end", o.accel.t_end},
+                         {"samples", o.accel.sample_count},
+                         {"temperature", Number(o.temperature())}});
+    if (k < r.baseline.fit.accel_sigmas.size()) sa.push_back(r.baseline.fit.accel_sigmas[k]);
+    if (k < r.baseline.fit.gyro_sigmas.size()) sg.push_back(r.baseline.fit.gyro_sigmas[k].mean());
+  }
+  out["positions"] = positions;
+  out["noise"] = {{"accel_sigma_median", Number(sa.empty() ? NAN : Median(sa))},
+                  {"accel_unit", "m/s^2 (|a| of a position mean)"},
+                  {"gyro_sigma_median", Number(sg.empty() ? NAN : Median(sg))},
+                  {"gyro_unit", "raw gyro units (one axis of a position mean)"}};
+  json baseline = ModelJson(r.baseline);
+  baseline["disagreement"] = WhereJson(r.baseline_where, true);
+  out["baseline"] = baseline;
+  json steps = json::array();
+  for (const DiscoveryStep& s : r.steps) {
+    const bool accel = IsAccel(s.effect);
+    json j = {{"effect", ToString(s.effect)},
+              {"description", Info(s.effect).description},
+              {"sensor", accel ? "accelerometer" : "gyroscope"},
+              {"parameters", ParametersJson(s.estimate)},
+              {"p_value", Number(s.p_value)},
+              {"delta_bic", Number(s.delta_bic)},
+              {"dof", s.dof},
+              {"gap_unit", GapUnit(s.effect)},
+              {"gap_before", Number(Of(s.gap_before, accel))},
+              {"gap_after", Number(Of(s.gap_after, accel))},
+              {"cv_gap_before", Number(Of(s.cv_gap_before, accel))},
+              {"cv_gap_after", Number(Of(s.cv_gap_after, accel))},
+              {"gap_before_sigma", Number(SigmaOf(s.gap_before, accel))},
+              {"gap_after_sigma", Number(SigmaOf(s.gap_after, accel))},
+              {"cv_gap_before_sigma", Number(SigmaOf(s.cv_gap_before, accel))},
+              {"cv_gap_after_sigma", Number(SigmaOf(s.cv_gap_after, accel))},
+              {"where", WhereJson(s.where, false)},
+              {"ambiguous_with", EffectNames(s.ambiguous_with)},
+              {"candidates", CandidatesJson(s.candidates)}};
+    steps.push_back(j);
+  }
+  out["steps"] = steps;
+  json ambiguous = json::array();
+  for (const Ambiguity& a : r.ambiguous) {
+    ambiguous.push_back({{"effects", EffectNames(a.effects)},
+                         {"delta_bic", a.delta_bic},
+                         {"step", a.step},
+                         {"advice", a.advice}});
+  }
+  out["ambiguous"] = ambiguous;
+  json final_model = ModelJson(r.final_model);
+  final_model["disagreement"] = WhereJson(r.final_where, true);
+  if (!r.final_candidates.empty()) final_model["candidates"] = CandidatesJson(r.final_candidates);
+  out["final_model"] = final_model;
+  out["verdict"] = r.verdict;
+  out["warnings"] = r.warnings;
+  out["message"] = r.message;
+  out["time_s"] = r.seconds;
+  return out.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+}
+
+std::string DiscoveryToHtml(const DiscoveryResult& r) {
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>gravcal discovery: "
+    << Escape(r.source) << "</title><style>"
+    << "body{font-family:sans-serif;max-width:1180px;margin:1em auto;color:#222}"
+    << "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 7px;"
+    << "font-size:13px;text-align:left}th{background:#eee}svg{margin:4px;border:1px solid #eee}"
+    << ".verdict{font-size:1.2em;padding:.5em;background:#eef5ee}.warn{color:#8a4b00}"
+    << "</style></head><body>\n";
+  h << "<h1>Model discrepancy report</h1><p>" << Escape(r.source) << " &mdash; "
+    << r.observations.size() << " static positions, gravity " << Num(r.gravity, "%.6g")
+    << " m/s^2 (" << Escape(r.gravity_source) << "), " << Num(r.seconds * 1e3, "%.1f")
+    << " ms</p>\n";
+  h << "<p class='verdict'><b>Verdict:</b> " << Escape(r.verdict) << "</p>\n";
+
+  h << "<h2>How to read this</h2><p>Each static position's measured reading is compared with the "
+       "reading the fitted model predicts (accelerometer: |a| - g; gyroscope: the mean rate at "
+       "rest). Residuals are in units of the noise that position's own samples show "
+       "(sigma): within +-1 is noise, beyond +-3 (red lines) the model misses something. The "
+       "gap is the rms residual; the cross-validated (CV) gap predicts each position from a fit "
+       "without it, so an effect that only fits noise does not lower it. An effect is named "
+       "when its likelihood-ratio p-value is below the step's level, its delta BIC is negative "
+       "and it lowers the CV gap.</p>\n";
+
+  h << "<h2>Models</h2><table><tr><th>step</th><th>model</th><th>effect</th><th>p-value</th>"
+    << "<th>delta BIC</th><th>gap</th><th>gap, sigma</th><th>CV gap</th><th>CV gap, sigma</th>"
+    << "</tr>";
+  h << "<tr><td>baseline</td><td>" << Escape(ModelName(r.baseline)) << "</td><td></td><td></td>"
+    << "<td></td><td>accel " << Num(r.baseline.gap.accel) << " m/s^2; gyro "
+    << Num(r.baseline.gap.gyro) << "</td><td>" << Num(r.baseline.gap.accel_sigma, "%.3g") << "; "
+    << Num(r.baseline.gap.gyro_sigma, "%.3g") << "</td><td>" << Num(r.baseline.cv_gap.accel) << "; "
+    << Num(r.baseline.cv_gap.gyro) << "</td><td>" << Num(r.baseline.cv_gap.accel_sigma, "%.3g")
+    << "; " << Num(r.baseline.cv_gap.gyro_sigma, "%.3g") << "</td></tr>";
+  for (size_t i = 0; i < r.steps.size(); ++i) {
+    const DiscoveryStep& s = r.steps[i];
+    const bool accel = IsAccel(s.effect);
+    h << "<tr><td>" << i + 1 << "</td><td>+ " << ToString(s.effect) << "</td><td>"
+      << Escape(Info(s.effect).description) << "</td><td>" << Num(s.p_value, "%.3g") << "</td><td>"
+      << Num(s.delta_bic, "%.1f") << "</td>" << GapCells(s.gap_before, s.gap_after, accel)
+      << GapCells(s.cv_gap_before, s.cv_gap_after, accel) << "</tr>";
+  }
+  h << "</table><p>Gaps of a step are for the sensor of its effect ("
+    << "m/s^2 or raw gyro "
+    << "units).</p>\n";
+
+  if (!r.ambiguous.empty()) {
+    h << "<h2>Cannot be told apart in this session</h2><ul>";
+    for (const Ambiguity& a : r.ambiguous) {
+      h << "<li>step " << a.step + 1 << ": ";
+      for (size_t i = 0; i < a.effects.size(); ++i) {
+        h << (i ? " vs " : "") << "<b>" << ToString(a.effects[i]) << "</b> (delta BIC "
+          << Num(a.delta_bic[i], "%.1f") << ")";
+      }
+      h << ". " << Escape(a.advice) << "</li>";
+    }
+    h << "</ul>\n";
+  }
+
+  h << "<h2>Baseline: where the model disagrees</h2><p>" << Escape(r.baseline_where.summary)
+    << "</p>" << WherePlots(r.baseline_where, "baseline") << GroupsTable(r.baseline_where) << "\n";
+
+  for (size_t i = 0; i < r.steps.size(); ++i) {
+    const DiscoveryStep& s = r.steps[i];
+    const bool accel = IsAccel(s.effect);
+    h << "<h2>Step " << i + 1 << ": " << ToString(s.effect) << "</h2><p>"
+      << Escape(Info(s.effect).description)
+      << ". Where the model before this step disagreed: " << Escape(s.where.summary) << "</p>";
+    h << "<table><tr><th>parameter</th><th>value</th><th>std</th><th>unit</th></tr>";
+    for (size_t k = 0; k < s.estimate.names.size(); ++k) {
+      h << "<tr><td>" << s.estimate.names[k] << "</td><td>" << Num(s.estimate.values[k], "%.4g")
+        << "</td><td>" << Num(s.estimate.std[k], "%.2g") << "</td><td>" << Escape(s.estimate.unit)
+        << "</td></tr>";
+    }
+    h << "</table>";
+    const std::string y = accel ? "|a| - g, m/s^2" : "gyro residual, raw units";
+    h << Scatter("residual against " + s.regressor_name, s.regressor_name, y,
+                 BeforeAfter(s, accel, false));
+    if (Info(s.effect).regressor != EffectRegressor::kOrientation) {
+      h << Scatter("residual against the fitted effect", "fitted effect contribution", y,
+                   BeforeAfter(s, accel, true));
+    }
+    h << "<h3>Candidates tried</h3>" << CandidatesTable(s.candidates) << "\n";
+  }
+
+  h << "<h2>Final model: " << Escape(ModelName(r.final_model)) << "</h2><p>"
+    << Escape(r.final_where.summary) << "</p>" << WherePlots(r.final_where, "final")
+    << GroupsTable(r.final_where);
+  if (!r.final_candidates.empty()) {
+    h << "<h3>Candidates of the last round (none significant)</h3>"
+      << CandidatesTable(r.final_candidates);
+  }
+  if (!r.warnings.empty()) {
+    h << "<h2>Warnings</h2><ul>";
+    for (const std::string& w : r.warnings) h << "<li class='warn'>" << Escape(w) << "</li>";
+    h << "</ul>";
+  }
+  h << "\n</body></html>\n";
+  return h.str();
+}
+
+}  // namespace gravcal
