@@ -1,0 +1,164 @@
+// The layering rule of docs/architecture.md, checked on the source tree:
+// every file under include/gravcal/<wing>/ and src/<wing>/ includes only
+// headers of its own wing or of lower wings, public headers include no
+// private header, and every source file lives in a known wing. A violation
+// names the file, the line and the include.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Rank of each wing, bottom to top. Wings of equal rank are siblings and may
+// not include each other.
+const std::map<std::string, int>& WingRanks() {
+  static const std::map<std::string, int> ranks = {
+      {"util", 0},       {"core", 1},    {"detection", 2},  {"residuals", 2},
+      {"estimation", 3}, {"io", 4},      {"simulation", 5}, {"methods", 6},
+      {"workflows", 7},  {"cli", 8},
+  };
+  return ranks;
+}
+
+struct Include {
+  std::string wing;  // empty when the include is not a gravcal header
+  bool is_public = false;
+};
+
+// "gravcal/core/x.h" -> public core; "util/x.h" -> private util; the
+// umbrella "gravcal/gravcal.h" is the top of the public API (rank of
+// workflows).
+Include Classify(const std::string& path) {
+  Include inc;
+  if (path == "gravcal/gravcal.h") {
+    inc.wing = "workflows";
+    inc.is_public = true;
+    return inc;
+  }
+  const size_t slash = path.find('/');
+  if (slash == std::string::npos) return inc;
+  std::string first = path.substr(0, slash);
+  if (first == "gravcal") {
+    inc.is_public = true;
+    const std::string rest = path.substr(slash + 1);
+    const size_t s2 = rest.find('/');
+    first = s2 == std::string::npos ? "" : rest.substr(0, s2);
+  }
+  if (WingRanks().count(first) != 0) inc.wing = first;
+  return inc;
+}
+
+// Violations in the tree at `root` (which has include/gravcal and src).
+std::vector<std::string> CheckLayering(const fs::path& root) {
+  std::vector<std::string> violations;
+  const std::regex include_re("^\\s*#\\s*include\\s+\"([^\"]+)\"");
+  struct Tree {
+    fs::path dir;
+    bool is_public;
+  };
+  for (const Tree& tree : {Tree{root / "include" / "gravcal", true}, Tree{root / "src", false}}) {
+    if (!fs::exists(tree.dir)) continue;
+    for (const auto& entry : fs::recursive_directory_iterator(tree.dir)) {
+      if (!entry.is_regular_file()) continue;
+      const std::string ext = entry.path().extension().string();
+      if (ext != ".h" && ext != ".cc") continue;
+      const fs::path rel = fs::relative(entry.path(), tree.dir);
+      const std::string shown = fs::relative(entry.path(), root).generic_string();
+      if (tree.is_public && rel == "gravcal.h") continue;  // the umbrella
+      const std::string wing = rel.begin()->string();
+      if (WingRanks().count(wing) == 0 || std::distance(rel.begin(), rel.end()) < 2) {
+        violations.push_back(shown + ": not inside a wing folder");
+        continue;
+      }
+      const int rank = WingRanks().at(wing);
+      std::ifstream in(entry.path());
+      std::string line;
+      int line_number = 0;
+      while (std::getline(in, line)) {
+        ++line_number;
+        std::smatch m;
+        if (!std::regex_search(line, m, include_re)) continue;
+        const std::string target = m[1];
+        const Include inc = Classify(target);
+        const std::string where = shown + ":" + std::to_string(line_number) + ": ";
+        if (tree.is_public && !inc.is_public) {
+          violations.push_back(where + "public header includes non-public \"" + target + "\"");
+          continue;
+        }
+        if (inc.wing.empty() || inc.wing == wing) continue;
+        const int target_rank = WingRanks().at(inc.wing);
+        if (target_rank >= rank) {
+          violations.push_back(where + "wing '" + wing + "' includes \"" + target +
+                               "\" of wing '" + inc.wing + "' (" +
+                               (target_rank == rank ? "a sibling" : "a higher wing") + ")");
+        }
+      }
+    }
+  }
+  return violations;
+}
+
+std::string Join(const std::vector<std::string>& lines) {
+  std::string s;
+  for (const std::string& l : lines) s += l + "\n";
+  return s;
+}
+
+TEST(Layering, SourceTreeIncludesOnlyLowerWings) {
+  const fs::path root = testing_util::SourceDir();
+  ASSERT_TRUE(fs::exists(root / "src" / "core")) << root;
+  const std::vector<std::string> violations = CheckLayering(root);
+  EXPECT_TRUE(violations.empty()) << Join(violations);
+}
+
+// The checker itself: a planted upward include, a sibling include, a public
+// header reaching a private one and a file outside the wings are each named.
+TEST(Layering, PlantedViolationsAreNamed) {
+  const fs::path root = fs::path(::testing::TempDir()) /
+                        ("gravcal_layering_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  auto write = [&](const std::string& rel, const std::string& text) {
+    fs::create_directories((root / rel).parent_path());
+    std::ofstream(root / rel) << text;
+  };
+  write("include/gravcal/core/a.h", "#include \"gravcal/methods/b.h\"\n");
+  write("include/gravcal/methods/b.h", "#include \"gravcal/core/a.h\"\n");
+  write("include/gravcal/detection/c.h", "#include <vector>\n#include \"gravcal/residuals/d.h\"\n");
+  write("include/gravcal/residuals/d.h", "#include \"util/so3.h\"\n");
+  write("src/estimation/e.cc", "#include \"gravcal/estimation/e.h\"\n#include \"methods/x.h\"\n");
+  write("src/util/ok.h", "#include <cmath>\n");
+  write("src/loose.cc", "int x;\n");
+  const std::vector<std::string> v = CheckLayering(root);
+  const std::string all = Join(v);
+  EXPECT_EQ(v.size(), 5u) << all;
+  EXPECT_NE(all.find("include/gravcal/core/a.h:1: wing 'core' includes \"gravcal/methods/b.h\""),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("include/gravcal/detection/c.h:2: wing 'detection' includes "
+                     "\"gravcal/residuals/d.h\" of wing 'residuals' (a sibling)"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("include/gravcal/residuals/d.h:1: public header includes non-public"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("src/estimation/e.cc:2: wing 'estimation' includes \"methods/x.h\""),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("src/loose.cc: not inside a wing folder"), std::string::npos) << all;
+  fs::remove_all(root);
+}
+
+}  // namespace
+}  // namespace gravcal
