@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/workflows/batch.h"
-#include "gravcal/workflows/config.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/batch.h"
+#include "gravcal/workflows/config.h"
 
 namespace gravcal {
 namespace {

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/workflows/discovery.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/discovery.h"
 
 namespace gravcal {
 namespace {

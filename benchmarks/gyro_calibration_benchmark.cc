@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/methods/twelve_position.h"
-#include "gravcal/methods/gyro_calibration.h"
-#include "gravcal/simulation/simulator.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/methods/gyro_calibration.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
 namespace {

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "gravcal/methods/twelve_position.h"
 #include "gravcal/methods/handheld_kalman.h"
-#include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/methods/rate_table.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/simulation/handheld_simulator.h"
 
 namespace gravcal {
 namespace {

@@ -19,9 +19,9 @@
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
+#include "gravcal/core/position.h"
 #include "gravcal/estimation/coarse_fit.h"
 #include "gravcal/estimation/newton_solver.h"
-#include "gravcal/core/position.h"
 #include "gravcal/estimation/refinement.h"
 #include "test_util.h"
 

@@ -5,9 +5,9 @@
 
 #include <vector>
 
-#include "gravcal/simulation/simulator.h"
 #include "gravcal/estimation/static_alignment.h"
 #include "gravcal/methods/ten_position.h"
+#include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
 namespace {

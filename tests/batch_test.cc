@@ -22,13 +22,13 @@
 #include <thread>
 #include <vector>
 
-#include "gravcal/workflows/batch_manifest.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/batch_manifest.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
-#include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/pipeline.h"
-#include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -1,14 +1,13 @@
 // The whole pipeline on simulated sessions (simulator -> static detection ->
 // coarse fit -> refinement) and on the real recordings.
-#include "gravcal/methods/twelve_position.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
-#include "gravcal/workflows/config.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/methods/twelve_position.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/config.h"
 #include "test_util.h"
 
 namespace gravcal {

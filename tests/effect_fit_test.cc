@@ -9,12 +9,12 @@
 #include <map>
 #include <random>
 
-#include "residuals/effect_residual.h"
+#include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
-#include "gravcal/simulation/simulator.h"
-#include "util/statistics.h"
+#include "residuals/effect_residual.h"
 #include "test_util.h"
+#include "util/statistics.h"
 
 namespace gravcal {
 namespace {

@@ -14,16 +14,16 @@
 #include <iostream>
 #include <random>
 
-#include "gravcal/methods/twelve_position.h"
-#include "gravcal/io/calibration_io.h"
-#include "gravcal/workflows/config.h"
-#include "gravcal/residuals/gyro_rotation_residual.h"
-#include "gravcal/methods/handheld_kalman.h"
-#include "gravcal/simulation/handheld_simulator.h"
-#include "gravcal/workflows/pipeline.h"
-#include "gravcal/methods/rate_table.h"
-#include "gravcal/simulation/simulator.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/methods/handheld_kalman.h"
+#include "gravcal/methods/rate_table.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/residuals/gyro_rotation_residual.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/pipeline.h"
 
 namespace gravcal {
 namespace {

@@ -8,12 +8,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "gravcal/io/calibration_io.h"
-#include "gravcal/workflows/config.h"
-#include "gravcal/simulation/handheld_simulator.h"
-#include "gravcal/io/log_reader.h"
-#include "gravcal/workflows/pipeline.h"
 #include "gravcal/estimation/strapdown.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/pipeline.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "gravcal/io/attitude_fixture.h"
-#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 

@@ -4,7 +4,6 @@
 // private header, and every source file lives in a known wing. A violation
 // names the file, the line and the include.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -25,9 +24,8 @@ namespace fs = std::filesystem;
 // not include each other.
 const std::map<std::string, int>& WingRanks() {
   static const std::map<std::string, int> ranks = {
-      {"util", 0},       {"core", 1},    {"detection", 2},  {"residuals", 2},
-      {"estimation", 3}, {"io", 4},      {"simulation", 5}, {"methods", 6},
-      {"workflows", 7},  {"cli", 8},
+      {"util", 0}, {"core", 1},       {"detection", 2}, {"residuals", 2}, {"estimation", 3},
+      {"io", 4},   {"simulation", 5}, {"methods", 6},   {"workflows", 7}, {"cli", 8},
   };
   return ranks;
 }
@@ -100,8 +98,8 @@ std::vector<std::string> CheckLayering(const fs::path& root) {
         if (inc.wing.empty() || inc.wing == wing) continue;
         const int target_rank = WingRanks().at(inc.wing);
         if (target_rank >= rank) {
-          violations.push_back(where + "wing '" + wing + "' includes \"" + target +
-                               "\" of wing '" + inc.wing + "' (" +
+          violations.push_back(where + "wing '" + wing + "' includes \"" + target + "\" of wing '" +
+                               inc.wing + "' (" +
                                (target_rank == rank ? "a sibling" : "a higher wing") + ")");
         }
       }
@@ -126,8 +124,8 @@ TEST(Layering, SourceTreeIncludesOnlyLowerWings) {
 // The checker itself: a planted upward include, a sibling include, a public
 // header reaching a private one and a file outside the wings are each named.
 TEST(Layering, PlantedViolationsAreNamed) {
-  const fs::path root = fs::path(::testing::TempDir()) /
-                        ("gravcal_layering_" + std::to_string(::getpid()));
+  const fs::path root =
+      fs::path(::testing::TempDir()) / ("gravcal_layering_" + std::to_string(::getpid()));
   fs::remove_all(root);
   auto write = [&](const std::string& rel, const std::string& text) {
     fs::create_directories((root / rel).parent_path());

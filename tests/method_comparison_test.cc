@@ -12,13 +12,13 @@
 #include <fstream>
 #include <map>
 
-#include "gravcal/io/attitude_fixture.h"
-#include "gravcal/simulation/simulated_attitudes.h"
-#include "gravcal/workflows/config.h"
-#include "gravcal/methods/known_attitude.h"
-#include "gravcal/workflows/pipeline.h"
 #include "gravcal/estimation/refinement.h"
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/methods/known_attitude.h"
+#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/pipeline.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -5,9 +5,9 @@
 
 #include "gravcal/core/calibration.h"
 #include "gravcal/estimation/coarse_fit.h"
-#include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "gravcal/estimation/newton_solver.h"
 #include "gravcal/estimation/observability.h"
+#include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "test_util.h"
 
 namespace gravcal {

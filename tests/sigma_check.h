@@ -30,17 +30,14 @@ constexpr double kSigmaBandProbability = 0.999;
 // The standard normal quantile (Acklam's rational approximation refined by
 // one Halley step; |error| < 1e-12 over (0, 1)).
 inline double NormalQuantile(double p) {
-  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,
-                             -2.759285104469687e+02, 1.383577518672690e+02,
-                             -3.066479806614716e+01, 2.506628277459239e+00};
-  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02,
-                             -1.556989798598866e+02, 6.680131188771972e+01,
-                             -1.328068155288572e+01};
-  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01,
-                             -2.400758277161838e+00, -2.549732539343734e+00,
-                             4.374664141464968e+00,  2.938163982698783e+00};
-  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01,
-                             2.445134137142996e+00, 3.754408661907416e+00};
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,  -2.759285104469687e+02,
+                             1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01, -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
   double x;
   if (p < 0.02425) {
     const double q = std::sqrt(-2.0 * std::log(p));
@@ -160,8 +157,7 @@ class SigmaCheck {
 
   // Every parameter: no seed without a sigma, |mean z| and rms z inside the
   // band for its count. `context` names the method in failure messages.
-  void ExpectHonest(const std::string& context,
-                    double probability = kSigmaBandProbability) const {
+  void ExpectHonest(const std::string& context, double probability = kSigmaBandProbability) const {
     for (const auto& [name, e] : entries_) {
       EXPECT_EQ(e.missing, 0) << context << " " << name << ": " << e.missing
                               << " seeds without a finite sigma";

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/io/log_reader.h"
 #include "gravcal/core/position.h"
+#include "gravcal/io/log_reader.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
-#include "gravcal/workflows/config.h"
 #include "gravcal/core/imu_log.h"
-#include "gravcal/io/log_reader.h"
 #include "gravcal/core/position.h"
 #include "gravcal/estimation/refinement.h"
+#include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/config.h"
 
 namespace gravcal {
 namespace testing_util {

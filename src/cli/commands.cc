@@ -6,13 +6,13 @@
 #include <cstdio>
 
 #include "gravcal/io/attitude_fixture.h"
-#include "gravcal/simulation/simulated_attitudes.h"
-#include "gravcal/methods/twelve_position.h"
 #include "gravcal/io/calibration_io.h"
-#include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/io/log_reader.h"
-#include "gravcal/workflows/pipeline.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/pipeline.h"
 
 namespace gravcal {
 namespace cli {

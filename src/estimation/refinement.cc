@@ -10,10 +10,10 @@
 #include <memory>
 #include <sstream>
 
-#include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "estimation/magnitude_fit.h"
 #include "estimation/normalization.h"
 #include "estimation/robust_loss.h"
+#include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "util/statistics.h"
 
 namespace gravcal {

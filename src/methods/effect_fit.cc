@@ -11,10 +11,10 @@
 #include <memory>
 #include <sstream>
 
-#include "residuals/effect_residual.h"
+#include "estimation/normalization.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/refinement.h"
-#include "estimation/normalization.h"
+#include "residuals/effect_residual.h"
 #include "util/statistics.h"
 
 namespace gravcal {

@@ -16,13 +16,13 @@
 #include <sstream>
 
 #include "estimation/accel_uncertainty.h"
+#include "estimation/normalization.h"
+#include "estimation/robust_loss.h"
+#include "gravcal/core/position.h"
+#include "gravcal/estimation/observability.h"
 #include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "gravcal/residuals/gyro_rotation_residual.h"
 #include "gravcal/residuals/gyro_static_residual.h"
-#include "gravcal/estimation/observability.h"
-#include "gravcal/core/position.h"
-#include "estimation/normalization.h"
-#include "estimation/robust_loss.h"
 #include "util/statistics.h"
 
 namespace gravcal {

@@ -7,10 +7,10 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "gravcal/methods/twelve_position.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/position.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
 

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "estimation/accel_uncertainty.h"
 #include "core/calibration_gravity.h"
+#include "estimation/accel_uncertainty.h"
 #include "gravcal/estimation/housing_rotation.h"
 #include "util/statistics.h"
 

@@ -5,9 +5,9 @@
 #include <mutex>
 #include <thread>
 
-#include "util/content_hash.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/pipeline.h"
+#include "util/content_hash.h"
 #include "util/thread_pool.h"
 
 #ifndef GRAVCAL_VERSION

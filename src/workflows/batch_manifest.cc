@@ -11,8 +11,8 @@
 #include <set>
 #include <system_error>
 
-#include "io/csv_table.h"
 #include "gravcal/io/log_reader.h"
+#include "io/csv_table.h"
 
 namespace gravcal {
 namespace {

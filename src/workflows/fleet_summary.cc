@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "util/content_hash.h"
 #include "io/csv_table.h"
+#include "util/content_hash.h"
 
 namespace gravcal {
 namespace {

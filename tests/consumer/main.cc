@@ -9,9 +9,9 @@
 #include <iostream>
 #include <vector>
 
+#include "gravcal/core/position.h"
 #include "gravcal/methods/twelve_position.h"
 #include "gravcal/residuals/gravity_magnitude_residual.h"
-#include "gravcal/core/position.h"
 
 namespace {
 

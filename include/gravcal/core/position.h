@@ -12,7 +12,6 @@
 #include <string>
 #include <vector>
 
-
 namespace gravcal {
 
 // One static interval: samples [begin, end) of the log, and their statistics.

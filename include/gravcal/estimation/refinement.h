@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
+#include "gravcal/core/position.h"
 #include "gravcal/core/solver_result.h"
 #include "gravcal/estimation/observability.h"
-#include "gravcal/core/position.h"
 
 namespace gravcal {
 

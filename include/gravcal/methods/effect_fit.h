@@ -26,11 +26,11 @@
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
-#include "gravcal/methods/twelve_position.h"
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/position.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
 

@@ -37,11 +37,11 @@
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
-#include "gravcal/methods/twelve_position.h"
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/imu_log.h"
-#include "gravcal/estimation/refinement.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/estimation/refinement.h"
+#include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
 

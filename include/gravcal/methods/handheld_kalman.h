@@ -67,9 +67,9 @@
 #include <string>
 
 #include "gravcal/core/calibration.h"
-#include "gravcal/estimation/error_state_layout.h"
 #include "gravcal/core/gravity.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/estimation/error_state_layout.h"
 
 namespace gravcal {
 

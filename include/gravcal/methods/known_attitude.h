@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/io/attitude_fixture.h"
-#include "gravcal/methods/twelve_position.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/position.h"
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
 

@@ -31,9 +31,9 @@
 
 #include <string>
 
-#include "gravcal/methods/twelve_position.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/estimation/static_alignment.h"
+#include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
 

@@ -12,14 +12,14 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/methods/twelve_position.h"
-#include "gravcal/workflows/discovery.h"
+#include "gravcal/io/log_reader.h"
 #include "gravcal/methods/gyro_calibration.h"
 #include "gravcal/methods/handheld_kalman.h"
-#include "gravcal/simulation/handheld_simulator.h"
-#include "gravcal/io/log_reader.h"
-#include "gravcal/simulation/simulator.h"
 #include "gravcal/methods/ten_position.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/discovery.h"
 
 namespace gravcal {
 

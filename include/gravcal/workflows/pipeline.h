@@ -8,8 +8,8 @@
 #include <string>
 
 #include "gravcal/core/calibration.h"
-#include "gravcal/workflows/config.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/workflows/config.h"
 
 namespace gravcal {
 
