@@ -410,10 +410,19 @@ bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, 
 
   // 2. Each dominating term read at one point, the others subtracted; twice,
   // the second time with the first readings' values and variances.
-  Coefficients value = c;
+  // Only terms that dominate somewhere are subtracted: a term the fit gives
+  // a small share everywhere is not determined by the curve (quantisation
+  // and white noise, both falling, trade against each other), and
+  // subtracting it would bias the reading.
+  Coefficients value{0.0, 0.0, 0.0, 0.0};
+  for (int j = 0; j < kTerms; ++j) {
+    for (size_t k = 0; k < n; ++k) {
+      if (c[j] * Shape(j, tau[k]) >= options.dominance * model[k]) value[j] = c[j];
+    }
+  }
   Coefficients variance{0.0, 0.0, 0.0, 0.0};
   for (int pass = 0; pass < 2; ++pass) {
-    Coefficients next = c;
+    Coefficients next{0.0, 0.0, 0.0, 0.0};
     Coefficients next_variance{0.0, 0.0, 0.0, 0.0};
     for (int j = 0; j < kTerms; ++j) {
       NoiseTerm* term = internal::TermOf(j, &fit->model);
@@ -450,7 +459,6 @@ bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, 
                               " % of the Allan variance, at tau " + internal::Seconds(best_tau)
                         : " is not in the fitted curve (tau " + internal::Seconds(tau.front()) +
                               " to " + internal::Seconds(tau.back()) + ")");
-        next[j] = c[j];
         continue;
       }
       const size_t k = static_cast<size_t>(chosen);
