@@ -1,6 +1,7 @@
 #include "gravcal/estimation/noise_characterisation.h"
 
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <vector>
 
@@ -82,10 +83,11 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
       seconds * options.allan.max_tau_fraction < options.allan.max_tau) {
     std::ostringstream s;
     s.precision(4);
-    s << log.source << ": the longest still interval (t = " << model.still_t_begin << " to "
-      << model.still_t_end << " s) lasts " << seconds << " s, too short for tau up to "
-      << options.allan.max_tau << " s: that needs at least "
-      << options.allan.max_tau / options.allan.max_tau_fraction << " s of rest";
+    s << log.source << ": the longest still interval (t = " << std::fixed << std::setprecision(2)
+      << model.still_t_begin << " to " << model.still_t_end << " s) lasts " << std::defaultfloat
+      << std::setprecision(4) << seconds << " s, too short for tau up to " << options.allan.max_tau
+      << " s: that needs at least " << options.allan.max_tau / options.allan.max_tau_fraction
+      << " s of rest";
     result->message = s.str();
     return false;
   }
@@ -124,8 +126,8 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
   }
   std::ostringstream s;
   s.precision(4);
-  s << "noise from " << seconds << " s of rest (t = " << model.still_t_begin << " to "
-    << model.still_t_end << " s) at " << model.rate_hz << " Hz";
+  s << "noise from " << seconds << " s of rest (t = " << std::fixed << std::setprecision(2)
+    << model.still_t_begin << " to " << model.still_t_end << " s) at " << model.rate_hz << " Hz";
   result->message = s.str();
   return true;
 }

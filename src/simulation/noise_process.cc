@@ -46,7 +46,7 @@ NoiseProcess::NoiseProcess(const NoiseProcessOptions& options, uint64_t seed)
   walk_step_ = options.random_walk * std::sqrt(dt);
   if (options.bias_instability > 0.0) {
     const double step = std::pow(10.0, 0.5);
-    for (double T = options.bias_tau_low / 10.0; T <= 3.0 * options.bias_tau_high * 1.000001;
+    for (double T = options.bias_tau_low / 10.0; T <= 10.0 * options.bias_tau_high * 1.000001;
          T *= step) {
       if (T >= dt) times_.push_back(T);
     }

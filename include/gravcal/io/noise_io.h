@@ -28,6 +28,7 @@
 #ifndef GRAVCAL_IO_NOISE_IO_H_
 #define GRAVCAL_IO_NOISE_IO_H_
 
+#include <array>
 #include <string>
 
 #include "gravcal/core/noise_model.h"

@@ -14,7 +14,7 @@
 //   a bump peaking at 0.381 s^2 near tau = 1.89 T. Equal variances at
 //   correlation times spaced evenly in log T sum to a 1/f spectrum over their
 //   span, i.e. a flat Allan variance: here two per decade from tau_low / 10
-//   to 3 tau_high (none below dt), s^2 chosen so that the sum equals the
+//   to 10 tau_high (none below dt), s^2 chosen so that the sum equals the
 //   flicker floor (2 ln 2 / pi) B^2 at the geometric middle of the range.
 //   Within [tau_low, tau_high] the sum stays within about 10 % of the floor
 //   (5 % in deviation; ModelAllanVariance gives it exactly), below tau_low it
