@@ -60,4 +60,11 @@
 #include "gravcal/workflows/discovery_report.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/pipeline.h"
+
+// noise characterisation (issue 14): core, estimation, io, simulation
+#include "gravcal/core/noise_model.h"
+#include "gravcal/estimation/allan_deviation.h"
+#include "gravcal/estimation/noise_characterisation.h"
+#include "gravcal/io/noise_io.h"
+#include "gravcal/simulation/noise_process.h"
 #endif  // GRAVCAL_GRAVCAL_H_

@@ -1,0 +1,135 @@
+#include "gravcal/estimation/noise_characterisation.h"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <vector>
+
+namespace gravcal {
+namespace internal {
+namespace {
+
+// Allan curve and fit of one axis of `samples` (already SI) over the still
+// interval.
+bool CharacteriseAxis(const std::vector<double>& samples, const ImuNoiseModel& where,
+                      const NoiseOptions& options, const std::string& name, AllanDeviation* curve,
+                      AxisNoiseModel* axis, std::string* error) {
+  AllanDeviation raw;
+  if (!ComputeAllanDeviation(samples, 0, samples.size(), where.rate_hz, options.allan, &raw)) {
+    *error = name + ": " + raw.message;
+    return false;
+  }
+  NoiseFit fit;
+  if (!FitNoiseTerms(raw, options.fit, &fit)) {
+    *error = name + ": " + fit.message;
+    return false;
+  }
+  *curve = fit.curve;
+  *axis = fit.model;
+  return true;
+}
+
+}  // namespace
+}  // namespace internal
+
+bool NoiseOptions::IsValid(std::string* error) const {
+  if (!(accel_scale > 0.0) || !std::isfinite(accel_scale) || !(gyro_scale > 0.0) ||
+      !std::isfinite(gyro_scale)) {
+    *error = "noise accel_scale and gyro_scale must be finite and > 0";
+    return false;
+  }
+  return (!find_still || detector.IsValid(error)) && allan.IsValid(error) && fit.IsValid(error);
+}
+
+bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise* result) {
+  *result = ImuNoise();
+  std::string error;
+  if (!options.IsValid(&error) || !log.Validate(&error)) {
+    result->message = error;
+    return false;
+  }
+  ImuNoiseModel& model = result->model;
+  size_t begin = 0, end = log.size();
+  if (options.find_still) {
+    StaticDetection detection;
+    if (!DetectStaticIntervals(log, options.detector, &detection)) {
+      result->message = log.source + ": " + detection.message;
+      return false;
+    }
+    if (detection.intervals.empty()) {
+      result->message = log.source +
+                        ": no still interval: the static detector found none (the noise model "
+                        "needs the sensor at rest)";
+      return false;
+    }
+    const StaticInterval* longest = &detection.intervals.front();
+    for (const StaticInterval& s : detection.intervals) {
+      if (s.count() > longest->count()) longest = &s;
+    }
+    begin = longest->begin;
+    end = longest->end;
+  }
+  model.still_begin = begin;
+  model.still_end = end;
+  model.still_t_begin = log.t[begin];
+  model.still_t_end = log.t[end - 1];
+  if (!CheckUniformSampling(log.t, begin, end, options.allan.time_step_tolerance, &model.rate_hz,
+                            &error)) {
+    result->message = log.source + ": " + error;
+    return false;
+  }
+  const double seconds = (end - begin) / model.rate_hz;
+  if (options.allan.max_tau > 0.0 &&
+      seconds * options.allan.max_tau_fraction < options.allan.max_tau) {
+    std::ostringstream s;
+    s.precision(4);
+    s << log.source << ": the longest still interval (t = " << std::fixed << std::setprecision(2)
+      << model.still_t_begin << " to " << model.still_t_end << " s) lasts " << std::defaultfloat
+      << std::setprecision(4) << seconds << " s, too short for tau up to " << options.allan.max_tau
+      << " s: that needs at least " << options.allan.max_tau / options.allan.max_tau_fraction
+      << " s of rest";
+    result->message = s.str();
+    return false;
+  }
+
+  const char* axes = "xyz";
+  std::vector<double> samples(end - begin);
+  for (int a = 0; a < 3; ++a) {
+    for (size_t i = begin; i < end; ++i) samples[i - begin] = options.accel_scale * log.accel[i](a);
+    if (!internal::CharacteriseAxis(samples, model, options, std::string("accel ") + axes[a],
+                                    &result->accel_curves[a], &model.accel[a], &error)) {
+      result->message = log.source + ": " + error;
+      return false;
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (!log.has_gyro()) {
+      NoiseTerm missing;
+      missing.reason = "the log has no gyroscope";
+      model.gyro[a] = {missing, missing, missing, missing};
+      continue;
+    }
+    for (size_t i = begin; i < end; ++i) samples[i - begin] = options.gyro_scale * log.gyro[i](a);
+    if (!internal::CharacteriseAxis(samples, model, options, std::string("gyro ") + axes[a],
+                                    &result->gyro_curves[a], &model.gyro[a], &error)) {
+      result->message = log.source + ": " + error;
+      return false;
+    }
+  }
+  if (log.has_temperature()) {
+    for (size_t i = begin; i < end; ++i) samples[i - begin] = log.temperature[i];
+    if (!ComputeAllanDeviation(samples, 0, samples.size(), model.rate_hz, options.allan,
+                               &result->temperature_curve)) {
+      result->message = log.source + ": temperature: " + result->temperature_curve.message;
+      return false;
+    }
+  }
+  std::ostringstream s;
+  s.precision(4);
+  s << "noise from " << seconds << " s of rest (t = " << std::fixed << std::setprecision(2)
+    << model.still_t_begin << " to " << model.still_t_end << " s) at " << model.rate_hz << " Hz";
+  result->message = s.str();
+  return true;
+}
+
+}  // namespace gravcal

@@ -1,0 +1,258 @@
+#include "gravcal/io/noise_io.h"
+
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "gravcal/io/log_reader.h"
+
+namespace gravcal {
+namespace internal {
+namespace {
+
+using nlohmann::json;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+double NumberOr(const json& j, const char* key) {
+  if (!j.contains(key) || j.at(key).is_null()) return kNaN;
+  return j.at(key).get<double>();
+}
+
+struct TermKey {
+  const char* name;
+  NoiseTerm AxisNoiseModel::*term;
+};
+constexpr TermKey kTermKeys[] = {{"white_noise", &AxisNoiseModel::white_noise},
+                                 {"bias_instability", &AxisNoiseModel::bias_instability},
+                                 {"random_walk", &AxisNoiseModel::random_walk},
+                                 {"quantisation", &AxisNoiseModel::quantisation}};
+constexpr const char* kAxes[] = {"x", "y", "z"};
+
+json TermJson(const NoiseTerm& t) {
+  json j = {{"value", Number(t.value)},
+            {"std", Number(t.std)},
+            {"tau", Number(t.tau)},
+            {"tau_range", json::array({Number(t.tau_min), Number(t.tau_max)})}};
+  if (!t.reason.empty()) j["reason"] = t.reason;
+  return j;
+}
+
+NoiseTerm TermFromJson(const json& j) {
+  NoiseTerm t;
+  t.value = NumberOr(j, "value");
+  t.std = NumberOr(j, "std");
+  t.tau = NumberOr(j, "tau");
+  const json& range = j.at("tau_range");
+  t.tau_min = range.at(0).is_null() ? kNaN : range.at(0).get<double>();
+  t.tau_max = range.at(1).is_null() ? kNaN : range.at(1).get<double>();
+  if (j.contains("reason")) t.reason = j.at("reason").get<std::string>();
+  return t;
+}
+
+json CurveJson(const AllanDeviation& c) {
+  json tau = json::array(), adev = json::array(), lo = json::array(), hi = json::array(),
+       edf = json::array();
+  for (const AllanPoint& p : c.points) {
+    tau.push_back(p.tau);
+    adev.push_back(p.adev);
+    lo.push_back(p.lo);
+    hi.push_back(p.hi);
+    edf.push_back(p.edf);
+  }
+  return {{"tau", tau}, {"adev", adev}, {"lo", lo}, {"hi", hi}, {"edf", edf}};
+}
+
+AllanDeviation CurveFromJson(const json& j, double rate_hz, size_t samples, double confidence) {
+  AllanDeviation c;
+  c.rate_hz = rate_hz;
+  c.samples = samples;
+  c.confidence = confidence;
+  const json& tau = j.at("tau");
+  for (size_t i = 0; i < tau.size(); ++i) {
+    AllanPoint p;
+    p.tau = tau.at(i).get<double>();
+    p.m = static_cast<size_t>(std::llround(p.tau * rate_hz));
+    p.adev = j.at("adev").at(i).get<double>();
+    p.lo = j.at("lo").at(i).get<double>();
+    p.hi = j.at("hi").at(i).get<double>();
+    if (j.contains("edf")) p.edf = j.at("edf").at(i).get<double>();
+    c.points.push_back(p);
+  }
+  c.message = "read from noise.json";
+  return c;
+}
+
+json SensorJson(const std::array<AxisNoiseModel, 3>& axes,
+                const std::array<AllanDeviation, 3>& curves) {
+  json sensor;
+  for (int a = 0; a < 3; ++a) {
+    json axis;
+    for (const TermKey& k : kTermKeys) axis[k.name] = TermJson(axes[a].*(k.term));
+    axis["allan"] = CurveJson(curves[a]);
+    sensor[kAxes[a]] = axis;
+  }
+  return sensor;
+}
+
+void SensorFromJson(const json& sensor, double rate_hz, size_t samples, double confidence,
+                    std::array<AxisNoiseModel, 3>* axes, std::array<AllanDeviation, 3>* curves) {
+  for (int a = 0; a < 3; ++a) {
+    const json& axis = sensor.at(kAxes[a]);
+    for (const TermKey& k : kTermKeys) {
+      if (axis.contains(k.name)) (*axes)[a].*(k.term) = TermFromJson(axis.at(k.name));
+    }
+    if (axis.contains("allan")) {
+      (*curves)[a] = CurveFromJson(axis.at("allan"), rate_hz, samples, confidence);
+    }
+  }
+}
+
+std::string Format(double v) {
+  std::ostringstream s;
+  s.precision(9);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+}  // namespace internal
+
+double AxisMaximum(const std::array<AxisNoiseModel, 3>& axes, NoiseTerm AxisNoiseModel::*term) {
+  double largest = internal::kNaN;
+  for (const AxisNoiseModel& axis : axes) {
+    const double v = (axis.*term).value;
+    if (std::isfinite(v) && !(v <= largest)) largest = v;
+  }
+  return largest;
+}
+
+std::string NoiseToJson(const ImuNoise& noise) {
+  using internal::json;
+  const ImuNoiseModel& m = noise.model;
+  json out;
+  out["rate_hz"] = m.rate_hz;
+  out["still"] = {{"begin", m.still_begin},
+                  {"end", m.still_end},
+                  {"t_begin", m.still_t_begin},
+                  {"t_end", m.still_t_end}};
+  out["confidence"] = noise.accel_curves[0].confidence;
+  out["accel"] = internal::SensorJson(m.accel, noise.accel_curves);
+  if (!noise.gyro_curves[0].points.empty()) {
+    out["gyro"] = internal::SensorJson(m.gyro, noise.gyro_curves);
+  }
+  if (!noise.temperature_curve.points.empty()) {
+    out["temperature"] = {{"allan", internal::CurveJson(noise.temperature_curve)}};
+  }
+  return out.dump(2) + "\n";
+}
+
+bool NoiseFromJson(const std::string& text, const std::string& name, ImuNoise* noise,
+                   std::string* error) {
+  using internal::json;
+  ImuNoise parsed;
+  try {
+    const json in = json::parse(text);
+    ImuNoiseModel& m = parsed.model;
+    m.rate_hz = in.at("rate_hz").get<double>();
+    const json& still = in.at("still");
+    m.still_begin = still.at("begin").get<size_t>();
+    m.still_end = still.at("end").get<size_t>();
+    m.still_t_begin = still.at("t_begin").get<double>();
+    m.still_t_end = still.at("t_end").get<double>();
+    const double confidence = in.value("confidence", 0.683);
+    const size_t samples = m.still_end - m.still_begin;
+    internal::SensorFromJson(in.at("accel"), m.rate_hz, samples, confidence, &m.accel,
+                             &parsed.accel_curves);
+    if (in.contains("gyro")) {
+      internal::SensorFromJson(in.at("gyro"), m.rate_hz, samples, confidence, &m.gyro,
+                               &parsed.gyro_curves);
+    } else {
+      NoiseTerm missing;
+      missing.reason = "the log has no gyroscope";
+      for (AxisNoiseModel& axis : m.gyro) axis = {missing, missing, missing, missing};
+    }
+    if (in.contains("temperature")) {
+      parsed.temperature_curve =
+          internal::CurveFromJson(in.at("temperature").at("allan"), m.rate_hz, samples, confidence);
+    }
+  } catch (const std::exception& e) {
+    *error = name + ": not a noise.json: " + e.what();
+    return false;
+  }
+  parsed.message = "read from " + name;
+  *noise = std::move(parsed);
+  return true;
+}
+
+bool WriteNoiseJson(const ImuNoise& noise, const std::string& path, std::string* error) {
+  return WriteFileAtomically(path, NoiseToJson(noise), error);
+}
+
+bool ReadNoiseJson(const std::string& path, ImuNoise* noise, std::string* error) {
+  std::string text;
+  return ReadFileBytes(path, &text, error) && NoiseFromJson(text, path, noise, error);
+}
+
+bool NoiseToKalibrYaml(const ImuNoiseModel& model, std::string* yaml, std::string* error) {
+  const double values[4] = {AxisMaximum(model.accel, &AxisNoiseModel::white_noise),
+                            AxisMaximum(model.accel, &AxisNoiseModel::random_walk),
+                            AxisMaximum(model.gyro, &AxisNoiseModel::white_noise),
+                            AxisMaximum(model.gyro, &AxisNoiseModel::random_walk)};
+  const char* keys[4] = {"accelerometer_noise_density", "accelerometer_random_walk",
+                         "gyroscope_noise_density", "gyroscope_random_walk"};
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(values[i])) {
+      *error = std::string("Kalibr needs ") + keys[i] +
+               ", which no axis of the log shows (record a longer still log)";
+      return false;
+    }
+  }
+  std::ostringstream s;
+  s << "# Kalibr imu.yaml from gravcal's Allan deviation fit: continuous-time densities\n"
+    << "# (Kalibr wiki, \"IMU Noise Model\"), the largest of the three axes.\n"
+    << "accelerometer_noise_density: " << internal::Format(values[0]) << "  # m/s^2/sqrt(Hz)\n"
+    << "accelerometer_random_walk: " << internal::Format(values[1]) << "  # m/s^3/sqrt(Hz)\n"
+    << "gyroscope_noise_density: " << internal::Format(values[2]) << "  # rad/s/sqrt(Hz)\n"
+    << "gyroscope_random_walk: " << internal::Format(values[3]) << "  # rad/s^2/sqrt(Hz)\n"
+    << "update_rate: " << internal::Format(model.rate_hz) << "  # Hz\n";
+  *yaml = s.str();
+  return true;
+}
+
+bool WriteKalibrImuYaml(const ImuNoiseModel& model, const std::string& path, std::string* error) {
+  std::string yaml;
+  return NoiseToKalibrYaml(model, &yaml, error) && WriteFileAtomically(path, yaml, error);
+}
+
+std::string NoiseToHandheldYaml(const ImuNoiseModel& model) {
+  struct Key {
+    const char* name;
+    const std::array<AxisNoiseModel, 3>* axes;
+    NoiseTerm AxisNoiseModel::*term;
+    const char* unit;
+  };
+  const Key keys[] = {
+      {"hk_accel_noise_density", &model.accel, &AxisNoiseModel::white_noise, "m/s^2/sqrt(Hz)"},
+      {"hk_gyro_noise_density", &model.gyro, &AxisNoiseModel::white_noise, "rad/s/sqrt(Hz)"},
+      {"hk_accel_bias_walk", &model.accel, &AxisNoiseModel::random_walk, "m/s^2/sqrt(s)"},
+      {"hk_gyro_bias_walk", &model.gyro, &AxisNoiseModel::random_walk, "rad/s/sqrt(s)"}};
+  std::ostringstream s;
+  s << "# Handheld Kalman filter noise from gravcal's Allan deviation fit (largest axis).\n";
+  for (const Key& k : keys) {
+    const double v = AxisMaximum(*k.axes, k.term);
+    if (std::isfinite(v)) {
+      s << k.name << ": " << internal::Format(v) << "  # " << k.unit << "\n";
+    } else {
+      const std::string& reason = ((*k.axes)[0].*(k.term)).reason;
+      s << "# " << k.name << " left at its default: " << (reason.empty() ? "not shown" : reason)
+        << "\n";
+    }
+  }
+  return s.str();
+}
+
+}  // namespace gravcal

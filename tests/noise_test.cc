@@ -1,0 +1,488 @@
+// Noise characterisation: the Allan deviation, its confidence intervals, the
+// fit of white noise (N), bias instability (B) and rate random walk (K) on
+// simulated still logs of known noise, bad input, the files, and the real
+// recordings' white-noise densities against their sensors' datasheet class.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <future>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gravcal/core/noise_model.h"
+#include "gravcal/estimation/allan_deviation.h"
+#include "gravcal/estimation/noise_characterisation.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/io/noise_io.h"
+#include "gravcal/simulation/noise_process.h"
+#include "sigma_check.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+constexpr double kRate = 100.0;
+
+// White noise N, bias instability B over [0.1, 300] s and random walk K on
+// one axis, scaled by `unit`: white noise meets the flicker floor at tau1 =
+// 0.3 s and the floor meets the random walk at tau2 = 3 s, so that each term
+// dominates a stretch of the curve of a 2-hour log.
+NoiseProcessOptions ThreeTerms(double unit) {
+  NoiseProcessOptions o;
+  o.rate_hz = kRate;
+  o.white_noise = unit;
+  const double floor = unit * unit / 0.3;  // (2 ln 2 / pi) B^2
+  o.bias_instability = std::sqrt(floor / kFlickerAllanFactor);
+  o.bias_tau_low = 0.1;
+  o.bias_tau_high = 300.0;
+  o.random_walk = std::sqrt(3.0 * floor / 3.0);
+  return o;
+}
+
+std::vector<double> Series(const NoiseProcessOptions& o, uint64_t seed, double seconds) {
+  NoiseProcess p(o, seed);
+  return p.Generate(static_cast<size_t>(seconds * o.rate_hz));
+}
+
+// A still IMU log: accelerometer (m/s^2, gravity on z) with accel noise,
+// gyroscope in counts of gyro_scale rad/s each.
+ImuLog StillLog(const NoiseProcessOptions& accel, const NoiseProcessOptions& gyro,
+                double gyro_scale, uint64_t seed, double seconds) {
+  ImuLog log;
+  log.source = "still.csv";
+  const size_t n = static_cast<size_t>(seconds * kRate);
+  log.t.resize(n);
+  log.accel.assign(n, Eigen::Vector3d(0.0, 0.0, 9.80665));
+  log.gyro.assign(n, Eigen::Vector3d::Zero());
+  for (size_t i = 0; i < n; ++i) log.t[i] = i / kRate;
+  for (int a = 0; a < 3; ++a) {
+    NoiseProcess pa(accel, seed * 16 + a);
+    NoiseProcess pg(gyro, seed * 16 + 8 + a);
+    for (size_t i = 0; i < n; ++i) {
+      log.accel[i](a) += pa.Next();
+      log.gyro[i](a) = pg.Next() / gyro_scale;
+    }
+  }
+  return log;
+}
+
+TEST(NoiseProcess, BiasInstabilityIsFlatOverItsRange) {
+  NoiseProcessOptions o;
+  o.bias_instability = 2e-3;
+  o.bias_tau_low = 0.1;
+  o.bias_tau_high = 300.0;
+  const NoiseProcess p(o, 1);
+  const double floor = kFlickerAllanFactor * o.bias_instability * o.bias_instability;
+  for (double tau = 0.1; tau <= 300.0; tau *= 1.2) {
+    EXPECT_NEAR(p.ModelAllanVariance(tau) / floor, 1.0, 0.10) << tau;
+  }
+  // Outside the range it falls off: not flicker noise forever.
+  EXPECT_LT(p.ModelAllanVariance(0.01) / floor, 0.5);
+  EXPECT_LT(p.ModelAllanVariance(30000.0) / floor, 0.5);
+}
+
+TEST(NoiseProcess, DeterministicFromSeed) {
+  const NoiseProcessOptions o = ThreeTerms(1e-3);
+  EXPECT_EQ(Series(o, 7, 10.0), Series(o, 7, 10.0));
+  EXPECT_NE(Series(o, 7, 10.0), Series(o, 8, 10.0));
+}
+
+// The running-sum formula equals the definition: half the mean squared
+// difference of adjacent overlapping m-sample averages.
+TEST(AllanDeviation, MatchesDefinition) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::vector<double> x(1000);
+  double walk = 0.0;
+  for (double& v : x) v = 5.0 + n01(rng) + (walk += 0.1 * n01(rng));
+  AllanOptions options;
+  options.points_per_octave = 3;
+  AllanDeviation curve;
+  ASSERT_TRUE(ComputeAllanDeviation(x, 0, x.size(), 50.0, options, &curve)) << curve.message;
+  ASSERT_GT(curve.points.size(), 15u);
+  for (const AllanPoint& p : curve.points) {
+    const size_t m = p.m;
+    double sum = 0.0;
+    size_t count = 0;
+    for (size_t j = 0; j + 2 * m <= x.size(); ++j) {
+      double a = 0.0, b = 0.0;
+      for (size_t i = 0; i < m; ++i) {
+        a += x[j + i];
+        b += x[j + m + i];
+      }
+      sum += (b / m - a / m) * (b / m - a / m);
+      ++count;
+    }
+    EXPECT_NEAR(p.adev, std::sqrt(sum / (2.0 * count)), 1e-9 * p.adev) << m;
+    EXPECT_DOUBLE_EQ(p.tau, m / 50.0);
+  }
+}
+
+// Pure white noise: the curve is N / sqrt(tau), and the 68.3 % intervals
+// cover it at about that rate (over 20 seeds and every tau; the points of
+// one curve are correlated, hence the band).
+TEST(AllanDeviation, WhiteNoiseWithinConfidenceIntervals) {
+  NoiseProcessOptions o;
+  o.rate_hz = kRate;
+  o.white_noise = 0.02;
+  int covered = 0, total = 0;
+  for (uint64_t seed = 0; seed < 20; ++seed) {
+    AllanDeviation curve;
+    const std::vector<double> x = Series(o, seed, 1000.0);
+    ASSERT_TRUE(ComputeAllanDeviation(x, 0, x.size(), kRate, AllanOptions(), &curve));
+    for (const AllanPoint& p : curve.points) {
+      const double truth = o.white_noise / std::sqrt(p.tau);
+      covered += p.lo <= truth && truth <= p.hi;
+      ++total;
+      // Far outside the interval is a broken estimator or a broken edf.
+      EXPECT_LT(std::abs(p.adev / truth - 1.0), 5.0 * (p.hi - p.lo) / (2.0 * p.adev)) << p.tau;
+    }
+  }
+  const double coverage = static_cast<double>(covered) / total;
+  EXPECT_GT(coverage, 0.55) << covered << " of " << total;
+  EXPECT_LT(coverage, 0.80) << covered << " of " << total;
+}
+
+TEST(AllanDeviation, EquivalentDofOfWhiteNoiseIsAboutThreeHalvesOfAverages) {
+  // Large n: edf -> 3 n / (2 m) for white noise, n / m for random walk.
+  EXPECT_NEAR(AllanEquivalentDof(AllanNoiseType::kWhiteNoise, 1000000, 100), 15000.0, 50.0);
+  EXPECT_NEAR(AllanEquivalentDof(AllanNoiseType::kRandomWalk, 1000000, 100), 10000.0, 50.0);
+  EXPECT_GE(AllanEquivalentDof(AllanNoiseType::kRandomWalk, 100, 49), 1.0);
+}
+
+// White noise and random walk only (the model's own shapes): N and K within
+// 10 % on each of 24 series, and their reported standard deviations match
+// the spread (two-sided band). With the bias-instability construction added
+// the readings are still accurate (next test) but carry that construction's
+// few-percent departure from pure flicker noise, which a statistical sigma
+// of 0.2 % (for N) does not and should not cover.
+TEST(NoiseFit, WhiteNoiseAndRandomWalkWithHonestSigmas) {
+  NoiseProcessOptions o;
+  o.rate_hz = kRate;
+  o.white_noise = 1e-3;
+  o.random_walk = std::sqrt(3.0) * 1e-3;  // meets white noise at tau = 1 s
+  testing_util::SigmaCheck check;
+  for (uint64_t seed = 0; seed < 24; ++seed) {
+    const std::vector<double> x = Series(o, 100 + seed, 3600.0);
+    AllanDeviation curve;
+    ASSERT_TRUE(ComputeAllanDeviation(x, 0, x.size(), kRate, AllanOptions(), &curve));
+    NoiseFit fit;
+    ASSERT_TRUE(FitNoiseTerms(curve, NoiseFitOptions(), &fit)) << fit.message;
+    const AxisNoiseModel& m = fit.model;
+    ASSERT_TRUE(m.white_noise.visible()) << m.white_noise.reason;
+    ASSERT_TRUE(m.random_walk.visible()) << m.random_walk.reason;
+    EXPECT_NEAR(m.white_noise.value / o.white_noise, 1.0, 0.10) << seed;
+    EXPECT_NEAR(m.random_walk.value / o.random_walk, 1.0, 0.10) << seed;
+    EXPECT_FALSE(m.bias_instability.visible()) << seed;
+    EXPECT_FALSE(m.bias_instability.reason.empty());
+    EXPECT_LE(m.white_noise.tau_min, m.white_noise.tau);
+    EXPECT_GE(m.white_noise.tau_max, m.white_noise.tau);
+    check.Add("white_noise", m.white_noise.value - o.white_noise, m.white_noise.std);
+    check.Add("random_walk", m.random_walk.value - o.random_walk, m.random_walk.std);
+  }
+  check.ExpectHonest("allan fit");
+  std::cout << check.Table();
+}
+
+// The whole IMU: two 2-hour still logs, accelerometer in m/s^2 and gyroscope
+// in counts, each axis with all three terms: N and K within 10 %, B within
+// 25 % on all twelve axes (predicted sd: N 0.2 %, K 3 %, B 1.5 %).
+TEST(CharacteriseNoise, RecoversThreeTermsOnStillLogs) {
+  const NoiseProcessOptions accel = ThreeTerms(2e-3);
+  const NoiseProcessOptions gyro = ThreeTerms(1e-4);
+  const double gyro_scale = 1e-4;  // rad/s per count
+  // The two seeds on two threads.
+  std::vector<std::future<std::pair<bool, ImuNoise>>> runs;
+  for (uint64_t seed = 0; seed < 2; ++seed) {
+    runs.push_back(std::async(std::launch::async, [&, seed] {
+      const ImuLog log = StillLog(accel, gyro, gyro_scale, seed, 7200.0);
+      NoiseOptions options;
+      options.gyro_scale = gyro_scale;
+      ImuNoise noise;
+      const bool ok = CharacteriseNoise(log, options, &noise);
+      return std::make_pair(ok, noise);
+    }));
+  }
+  for (auto& run : runs) {
+    const auto [ok, noise] = run.get();
+    ASSERT_TRUE(ok) << noise.message;
+    EXPECT_NEAR(noise.model.rate_hz, kRate, 1e-6);
+    // The detector keeps all of a still log but its settle margins.
+    EXPECT_GT(noise.model.still_t_end - noise.model.still_t_begin, 7190.0);
+    for (int sensor = 0; sensor < 2; ++sensor) {
+      const NoiseProcessOptions& truth = sensor == 0 ? accel : gyro;
+      for (int a = 0; a < 3; ++a) {
+        const AxisNoiseModel& m = sensor == 0 ? noise.model.accel[a] : noise.model.gyro[a];
+        const std::string where = (sensor == 0 ? "accel " : "gyro ") + std::to_string(a);
+        EXPECT_NEAR(m.white_noise.value / truth.white_noise, 1.0, 0.10) << where;
+        EXPECT_NEAR(m.random_walk.value / truth.random_walk, 1.0, 0.10) << where;
+        EXPECT_NEAR(m.bias_instability.value / truth.bias_instability, 1.0, 0.25) << where;
+        // The flat part is read between the two slopes.
+        EXPECT_GT(m.bias_instability.tau, 0.3) << where;
+        EXPECT_LT(m.bias_instability.tau, 3.0) << where;
+        EXPECT_FALSE(m.quantisation.visible()) << where;
+        // The variance of a 10 s mean is the model's Allan variance there
+        // (white alone would say N^2 / 10, far too small).
+        EXPECT_GT(StillMeanVariance(m, 10.0),
+                  5.0 * m.white_noise.value * m.white_noise.value / 10.0);
+      }
+    }
+    EXPECT_TRUE(noise.temperature_curve.points.empty());
+    EXPECT_FALSE(noise.accel_curves[0].points.empty());
+  }
+}
+
+TEST(StillMeanVariance, TermByTerm) {
+  AxisNoiseModel m;
+  m.white_noise.value = 0.01;
+  EXPECT_DOUBLE_EQ(StillMeanVariance(m, 4.0), 1e-4 / 4.0);
+  m.random_walk.value = 0.002;
+  EXPECT_DOUBLE_EQ(StillMeanVariance(m, 4.0), 1e-4 / 4.0 + 4e-6 * 4.0 / 3.0);
+  m.bias_instability.value = 0.003;
+  EXPECT_NEAR(StillMeanVariance(m, 4.0), 1e-4 / 4.0 + 4e-6 * 4.0 / 3.0 + 0.4412722 * 9e-6, 1e-12);
+  EXPECT_TRUE(std::isnan(StillMeanVariance(AxisNoiseModel(), 4.0)));
+}
+
+// Bad input: a one-line message naming the problem.
+
+TEST(CharacteriseNoise, RefusesTooShortForTauAsked) {
+  const ImuLog log = StillLog(ThreeTerms(2e-3), ThreeTerms(1e-4), 1.0, 1, 120.0);
+  NoiseOptions options;
+  options.allan.max_tau = 100.0;
+  ImuNoise noise;
+  EXPECT_FALSE(CharacteriseNoise(log, options, &noise));
+  EXPECT_NE(noise.message.find("too short for tau up to 100 s"), std::string::npos)
+      << noise.message;
+  EXPECT_EQ(noise.message.find('\n'), std::string::npos);
+}
+
+TEST(CharacteriseNoise, RefusesNonUniformTime) {
+  ImuLog log = StillLog(ThreeTerms(2e-3), ThreeTerms(1e-4), 1.0, 1, 120.0);
+  for (size_t i = 5000; i < log.size(); ++i) log.t[i] += 0.5;  // a gap
+  NoiseOptions options;
+  options.find_still = false;
+  ImuNoise noise;
+  EXPECT_FALSE(CharacteriseNoise(log, options, &noise));
+  EXPECT_NE(noise.message.find("time step at sample 5000"), std::string::npos) << noise.message;
+  // The series-level entry refuses it too.
+  std::vector<double> x(log.size(), 0.0);
+  AllanDeviation curve;
+  EXPECT_FALSE(ComputeAllanDeviation(log.t, x, AllanOptions(), &curve));
+  EXPECT_NE(curve.message.find("uniform sampling"), std::string::npos) << curve.message;
+}
+
+TEST(CharacteriseNoise, RefusesMovingLog) {
+  ImuLog log;
+  log.source = "moving.csv";
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n01(0.0, 0.01);
+  for (int i = 0; i < 6000; ++i) {
+    const double t = i / kRate;
+    log.t.push_back(t);
+    // Turning all the time about x, at a varying rate.
+    const double angle = 0.8 * t + 0.5 * std::sin(0.3 * t);
+    log.accel.push_back(9.81 * Eigen::Vector3d(n01(rng), std::sin(angle), std::cos(angle)));
+    log.gyro.push_back(
+        Eigen::Vector3d(0.8 + 0.15 * std::cos(0.3 * t) + n01(rng), n01(rng), n01(rng)));
+  }
+  ImuNoise noise;
+  EXPECT_FALSE(CharacteriseNoise(log, NoiseOptions(), &noise));
+  EXPECT_NE(noise.message.find("moving.csv: no still interval"), std::string::npos)
+      << noise.message;
+}
+
+TEST(CharacteriseNoise, RejectsInvalidOptions) {
+  NoiseOptions options;
+  std::string error;
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+  options.gyro_scale = 0.0;
+  EXPECT_FALSE(options.IsValid(&error));
+  options = NoiseOptions();
+  options.allan.points_per_octave = 0;
+  EXPECT_FALSE(options.IsValid(&error));
+  options = NoiseOptions();
+  options.fit.dominance = 1.5;
+  EXPECT_FALSE(options.IsValid(&error));
+}
+
+// Files: noise.json round trip, Kalibr and handheld YAML.
+
+ImuNoise SmallResult() {
+  NoiseProcessOptions accel = ThreeTerms(2e-3);
+  NoiseProcessOptions gyro = ThreeTerms(1e-4);
+  ImuLog log = StillLog(accel, gyro, 1.0, 3, 600.0);
+  log.temperature.assign(log.size(), 25.0);
+  for (size_t i = 0; i < log.size(); ++i) log.temperature[i] += 0.01 * std::sin(0.01 * i);
+  NoiseOptions options;
+  options.find_still = false;
+  ImuNoise noise;
+  EXPECT_TRUE(CharacteriseNoise(log, options, &noise)) << noise.message;
+  return noise;
+}
+
+void ExpectSameTerm(const NoiseTerm& a, const NoiseTerm& b) {
+  auto same = [](double x, double y) { return (std::isnan(x) && std::isnan(y)) || x == y; };
+  EXPECT_TRUE(same(a.value, b.value)) << a.value << " " << b.value;
+  EXPECT_TRUE(same(a.std, b.std));
+  EXPECT_TRUE(same(a.tau, b.tau));
+  EXPECT_TRUE(same(a.tau_min, b.tau_min));
+  EXPECT_TRUE(same(a.tau_max, b.tau_max));
+  EXPECT_EQ(a.reason, b.reason);
+}
+
+TEST(NoiseIo, JsonRoundTrip) {
+  const ImuNoise noise = SmallResult();
+  const std::string text = NoiseToJson(noise);
+  ImuNoise back;
+  std::string error;
+  ASSERT_TRUE(NoiseFromJson(text, "noise.json", &back, &error)) << error;
+  EXPECT_EQ(back.model.rate_hz, noise.model.rate_hz);
+  EXPECT_EQ(back.model.still_end, noise.model.still_end);
+  for (int a = 0; a < 3; ++a) {
+    for (auto term : {&AxisNoiseModel::white_noise, &AxisNoiseModel::bias_instability,
+                      &AxisNoiseModel::random_walk, &AxisNoiseModel::quantisation}) {
+      ExpectSameTerm(noise.model.accel[a].*term, back.model.accel[a].*term);
+      ExpectSameTerm(noise.model.gyro[a].*term, back.model.gyro[a].*term);
+    }
+    ASSERT_EQ(back.gyro_curves[a].points.size(), noise.gyro_curves[a].points.size());
+    for (size_t i = 0; i < back.gyro_curves[a].points.size(); ++i) {
+      EXPECT_EQ(back.gyro_curves[a].points[i].adev, noise.gyro_curves[a].points[i].adev);
+      EXPECT_EQ(back.gyro_curves[a].points[i].m, noise.gyro_curves[a].points[i].m);
+    }
+  }
+  EXPECT_EQ(back.temperature_curve.points.size(), noise.temperature_curve.points.size());
+  EXPECT_EQ(NoiseToJson(back), text);
+  // Terms the 10-minute log cannot show are null with a reason.
+  EXPECT_NE(text.find("\"value\": null"), std::string::npos);
+  EXPECT_FALSE(NoiseFromJson("{\"rate_hz\": 1}", "bad.json", &back, &error));
+  EXPECT_NE(error.find("bad.json: not a noise.json"), std::string::npos) << error;
+}
+
+TEST(NoiseIo, KalibrYamlTakesAxisMaxima) {
+  ImuNoiseModel model;
+  model.rate_hz = 200.0;
+  for (int a = 0; a < 3; ++a) {
+    model.accel[a].white_noise.value = 1e-3 * (a + 1);
+    model.accel[a].random_walk.value = 1e-4 * (3 - a);
+    model.gyro[a].white_noise.value = 1e-5 * (a + 1);
+    model.gyro[a].random_walk.value = 1e-6;
+  }
+  std::string yaml, error;
+  ASSERT_TRUE(NoiseToKalibrYaml(model, &yaml, &error)) << error;
+  EXPECT_NE(yaml.find("accelerometer_noise_density: 0.003"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("accelerometer_random_walk: 0.0003"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("gyroscope_noise_density: 3e-05"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("gyroscope_random_walk: 1e-06"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("update_rate: 200"), std::string::npos) << yaml;
+  const std::string handheld = NoiseToHandheldYaml(model);
+  EXPECT_NE(handheld.find("hk_accel_noise_density: 0.003"), std::string::npos) << handheld;
+  EXPECT_NE(handheld.find("hk_gyro_bias_walk: 1e-06"), std::string::npos) << handheld;
+  for (auto& axis : model.gyro) {
+    axis.random_walk = NoiseTerm();
+    axis.random_walk.reason = "too short";
+  }
+  EXPECT_FALSE(NoiseToKalibrYaml(model, &yaml, &error));
+  EXPECT_NE(error.find("gyroscope_random_walk"), std::string::npos) << error;
+  EXPECT_NE(NoiseToHandheldYaml(model).find("# hk_gyro_bias_walk left at its default: too short"),
+            std::string::npos);
+}
+
+// Real recordings: the white-noise density of each axis over the longest
+// still part, against the datasheet class of the sensor.
+
+struct RealNoiseCase {
+  const char* file;
+  double accel_scale;      // m/s^2 per unit
+  double gyro_scale;       // rad/s per unit
+  double accel_datasheet;  // m/s^2/sqrt(Hz)
+  double gyro_datasheet;   // rad/s/sqrt(Hz)
+};
+
+ImuLog ReadRealLog(const std::string& file) {
+  LogReaderOptions options;
+  if (file.find("ferraris") != std::string::npos) {
+    options.rename = {{"t", "n_samples"}, {"ax", "acc_x"}, {"ay", "acc_y"}, {"az", "acc_z"},
+                      {"gx", "gyr_x"},    {"gy", "gyr_y"}, {"gz", "gyr_z"}};
+    options.time_scale = 1.0 / 102.4;
+  } else if (file.find("mpu6050") != std::string::npos) {
+    options.skip_lines = 4;
+    options.sample_rate = 100.0;
+  } else {
+    options.format = LogFormat::kWhitespace;
+    options.columns = {"t",  "ax", "ay", "az", "gx", "gy", "gz",
+                       "mx", "my", "mz", "qx", "qy", "qz", "qw"};
+  }
+  ImuLog log;
+  std::string error;
+  EXPECT_TRUE(ReadImuLog(testing_util::RealDataDir() + "/" + file, options, &log, &error)) << error;
+  return log;
+}
+
+// The factor: datasheet densities are typical values (parts scatter by tens
+// of percent), the MPU-6050's is specified with its 10 Hz low-pass filter
+// while the logger's setting is unknown (a wider filter passes more noise),
+// and the still parts are hand-held rests of 9-37 s, so the density is read
+// at short tau (4 samples) where a little tremor already adds. A density
+// off by more than 3 is a wrong scale or a wrong formula (deg for rad is
+// 57, a per-sample sigma for a density is 10).
+constexpr double kDatasheetFactor = 3.0;
+
+TEST(CharacteriseNoiseRealData, WhiteNoiseMatchesDatasheetClass) {
+  if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "no real data";
+  const double ug = 1e-6 * 9.80665;
+  const double dps = M_PI / 180.0;
+  const RealNoiseCase cases[] = {
+      {"ferraris_nilspod/session.csv", 1.0, dps, 180.0 * ug, 0.007 * dps},
+      {"mpu6050_ten_pose/session.csv", 9.80665 / 16384.0, dps / 131.0, 400.0 * ug, 0.005 * dps},
+  };
+  for (const RealNoiseCase& c : cases) {
+    const ImuLog log = ReadRealLog(c.file);
+    NoiseOptions options;
+    options.accel_scale = c.accel_scale;
+    options.gyro_scale = c.gyro_scale;
+    ImuNoise noise;
+    ASSERT_TRUE(CharacteriseNoise(log, options, &noise)) << noise.message;
+    std::cout << c.file << ": " << noise.message << "\n";
+    for (int sensor = 0; sensor < 2; ++sensor) {
+      for (int a = 0; a < 3; ++a) {
+        const AxisNoiseModel& m = sensor == 0 ? noise.model.accel[a] : noise.model.gyro[a];
+        const double datasheet = sensor == 0 ? c.accel_datasheet : c.gyro_datasheet;
+        EXPECT_GT(m.white_noise.value / datasheet, 1.0 / kDatasheetFactor) << c.file << a;
+        EXPECT_LT(m.white_noise.value / datasheet, kDatasheetFactor) << c.file << a;
+        std::cout << "  " << (sensor == 0 ? "accel " : "gyro ") << "xyz"[a]
+                  << " N = " << m.white_noise.value << " +- " << m.white_noise.std << " (tau "
+                  << m.white_noise.tau << " s, ratio to datasheet "
+                  << m.white_noise.value / datasheet << ") B = " << m.bias_instability.value
+                  << " K = " << m.random_walk.value << "\n";
+      }
+    }
+  }
+}
+
+// The AHRS's time stamps jitter by up to 50 % of the step (the samples do
+// not: neighbouring steps add up to two): refused by default, naming where,
+// and characterised with a tolerance that accepts the jitter. No datasheet
+// is known for it: its numbers are printed only.
+TEST(CharacteriseNoiseRealData, AhrsJitteryTimeStamps) {
+  if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "no real data";
+  const ImuLog log = ReadRealLog("ahrs_static_poses/imu_good1.txt");
+  NoiseOptions options;
+  ImuNoise noise;
+  EXPECT_FALSE(CharacteriseNoise(log, options, &noise));
+  EXPECT_NE(noise.message.find("time step at sample"), std::string::npos) << noise.message;
+  options.allan.time_step_tolerance = 0.6;
+  ASSERT_TRUE(CharacteriseNoise(log, options, &noise)) << noise.message;
+  std::cout << noise.message << "\n";
+  for (int a = 0; a < 3; ++a) {
+    std::cout << "  accel "
+              << "xyz"[a] << " N = " << noise.model.accel[a].white_noise.value
+              << " gyro N = " << noise.model.gyro[a].white_noise.value << "\n";
+    EXPECT_TRUE(noise.model.accel[a].white_noise.visible());
+    EXPECT_TRUE(noise.model.gyro[a].white_noise.visible());
+  }
+}
+
+}  // namespace
+}  // namespace gravcal
