@@ -6,11 +6,11 @@
 // a SigmaCheck, whose ExpectHonest is the two-sided check of
 // tests/sigma_check.h (|mean z| and rms z inside the 99.9 % band for N).
 //
-// The number of seeds comes from the environment, so the same code is the
-// ordinary ctest entry (modest N) and the large-seed one (N >= 400, ctest
-// label large_seed):
-//   GRAVCAL_PROPERTY_SEEDS       seeds per case (default kDefaultSeeds)
-//   GRAVCAL_PROPERTY_FIRST_SEED  first seed (default 1)
+// The seeds come from the environment, so the same code is the ordinary
+// ctest entry (modest N) and the large-seed one (N >= 400, ctest label
+// large_seed):
+//   GRAVCAL_PROPERTY_SEEDS       "N" (seeds 1..N) or "F:N" (seeds F..F+N-1);
+//                                default kDefaultSeeds from seed 1
 //   GRAVCAL_PROPERTY_THREADS     worker threads (default: the cores, at most 2)
 #ifndef GRAVCAL_TESTS_PROPERTY_METHOD_CASE_H_
 #define GRAVCAL_TESTS_PROPERTY_METHOD_CASE_H_
@@ -83,8 +83,21 @@ inline int EnvInt(const char* name, int fallback) {
   return value != nullptr && *value != '\0' ? std::atoi(value) : fallback;
 }
 
-inline int PropertySeeds() { return EnvInt("GRAVCAL_PROPERTY_SEEDS", kDefaultSeeds); }
-inline int PropertyFirstSeed() { return EnvInt("GRAVCAL_PROPERTY_FIRST_SEED", 1); }
+// The first seed and the number of seeds of GRAVCAL_PROPERTY_SEEDS.
+inline void PropertySeeds(int* first, int* count) {
+  *first = 1;
+  *count = kDefaultSeeds;
+  const char* value = std::getenv("GRAVCAL_PROPERTY_SEEDS");
+  if (value == nullptr || *value == '\0') return;
+  const std::string text = value;
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos) {
+    *count = std::atoi(text.c_str());
+  } else {
+    *first = std::atoi(text.substr(0, colon).c_str());
+    *count = std::atoi(text.substr(colon + 1).c_str());
+  }
+}
 inline int PropertyThreads() {
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   return std::max(1, EnvInt("GRAVCAL_PROPERTY_THREADS", std::min(cores, 2)));

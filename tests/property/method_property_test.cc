@@ -7,7 +7,7 @@
 //
 // ctest runs this twice: MethodProperty.* with kDefaultSeeds seeds per case,
 // and large_seed.MethodProperty.* (label large_seed) with
-// GRAVCAL_PROPERTY_SEEDS=400 from other seeds; both print the per-parameter
+// GRAVCAL_PROPERTY_SEEDS=1001:400 (400 other seeds); both print the per-parameter
 // table (n, mean z, rms z, band).
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -315,8 +315,8 @@ TEST_P(MethodProperty, ErrorOverSigmaIsStandardNormal) {
   const std::vector<MethodCase> cases = AllCases();
   ASSERT_LT(GetParam(), static_cast<int>(cases.size()));
   const MethodCase& method = cases[GetParam()];
-  const int seeds = PropertySeeds();
-  const int first = PropertyFirstSeed();
+  int first = 1, seeds = 0;
+  PropertySeeds(&first, &seeds);
   const int threads = PropertyThreads();
   ASSERT_GE(seeds, 2);
   const auto start = std::chrono::steady_clock::now();
