@@ -22,13 +22,14 @@
 #include <thread>
 #include <vector>
 
-#include "gravcal/workflows/batch_manifest.h"
+#include "cli_runner.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/batch_manifest.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
-#include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/pipeline.h"
-#include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -66,33 +67,6 @@ struct Process {
   int exit_code = -1;
   std::string err;
 };
-
-// Starts the CLI with `args`, stderr into `err_path`; returns the child's pid.
-pid_t Spawn(const std::vector<std::string>& args, const std::string& err_path) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int err = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int null = open("/dev/null", O_RDWR);
-    dup2(null, 0);
-    dup2(null, 1);
-    dup2(err, 2);
-    std::vector<char*> argv;
-    std::string program = GRAVCAL_CLI_PATH;
-    argv.push_back(program.data());
-    std::vector<std::string> copy = args;
-    for (std::string& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(program.c_str(), argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-int WaitFor(pid_t pid) {
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 struct FileId {
   ino_t inode = 0;
@@ -143,9 +117,8 @@ class BatchTest : public ::testing::Test {
   static constexpr double kPlantedBias = 1500.0;
 
   static void SetUpTestSuite() {
-    char pattern[] = "/tmp/gravcal_batch_XXXXXX";
-    ASSERT_NE(mkdtemp(pattern), nullptr);
-    dir_ = new std::string(pattern);
+    scratch_ = new testing_util::ScratchDir();
+    dir_ = new std::string(scratch_->path());
     config_path_ = new std::string(testing_util::SourceDir() + "/configs/twelve_position.yaml");
     std::string error;
     ASSERT_TRUE(LoadConfigFile(*config_path_, &base_, &error)) << error;
@@ -181,17 +154,14 @@ class BatchTest : public ::testing::Test {
   }
 
   static void TearDownTestSuite() {
-    std::system(("rm -rf '" + *dir_ + "'").c_str());
+    delete scratch_;
     delete dir_;
     delete config_path_;
   }
 
   static Process Run(const std::vector<std::string>& args) {
-    const std::string err = *dir_ + "/stderr.txt";
-    Process p;
-    p.exit_code = WaitFor(Spawn(args, err));
-    p.err = Slurp(err);
-    return p;
+    const testing_util::CliResult r = testing_util::RunCli(args, *scratch_);
+    return {r.exit_code, r.err};
   }
 
   static Process RunBatch(const std::string& out, std::vector<std::string> extra = {}) {
@@ -209,11 +179,13 @@ class BatchTest : public ::testing::Test {
     return units;
   }
 
+  static testing_util::ScratchDir* scratch_;
   static std::string* dir_;
   static std::string* config_path_;
   static Config base_;
 };
 
+testing_util::ScratchDir* BatchTest::scratch_ = nullptr;
 std::string* BatchTest::dir_ = nullptr;
 std::string* BatchTest::config_path_ = nullptr;
 Config BatchTest::base_;
@@ -438,7 +410,7 @@ TEST_F(BatchTest, KilledRunResumesWithoutRecomputing) {
                                     out,        "--threads",   "1"};
   };
   const std::string out = *dir_ + "/killed";
-  const pid_t pid = Spawn(args(out), *dir_ + "/killed.txt");
+  const pid_t pid = testing_util::SpawnCli(args(out), "/dev/null", *dir_ + "/killed.txt");
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (JsonFiles(out + "/batch_state").size() < 20 &&
          std::chrono::steady_clock::now() < deadline) {

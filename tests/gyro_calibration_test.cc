@@ -14,16 +14,17 @@
 #include <iostream>
 #include <random>
 
-#include "gravcal/methods/twelve_position.h"
-#include "gravcal/io/calibration_io.h"
-#include "gravcal/workflows/config.h"
-#include "gravcal/residuals/gyro_rotation_residual.h"
-#include "gravcal/methods/handheld_kalman.h"
-#include "gravcal/simulation/handheld_simulator.h"
-#include "gravcal/workflows/pipeline.h"
-#include "gravcal/methods/rate_table.h"
-#include "gravcal/simulation/simulator.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/methods/handheld_kalman.h"
+#include "gravcal/methods/rate_table.h"
+#include "gravcal/methods/twelve_position.h"
+#include "gravcal/residuals/gyro_rotation_residual.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/pipeline.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace {
@@ -128,7 +129,7 @@ double WorstIntegrationError(double sample_rate) {
     IntegrateGyroRotation<double>(d, bias, matrix, nullptr, dq);
     const Eigen::Quaterniond estimate(dq[0], dq[1], dq[2], dq[3]);
     const Eigen::Quaterniond truth = s.poses[k].attitude.conjugate() * s.poses[k + 1].attitude;
-    worst = std::max(worst, Eigen::AngleAxisd(estimate.conjugate() * truth).angle());
+    worst = std::max(worst, testing_util::QuaternionAngle(estimate, truth));
   }
   return worst;
 }

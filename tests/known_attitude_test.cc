@@ -11,9 +11,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "cli_runner.h"
 #include "gravcal/io/attitude_fixture.h"
-#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 #include "test_util.h"
 
@@ -41,17 +42,8 @@ std::string WithField(const std::string& text, int line, int field, const std::s
 
 class KnownAttitudeTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    char pattern[] = "/tmp/gravcal_known_XXXXXX";
-    ASSERT_NE(mkdtemp(pattern), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { std::system(("rm -rf '" + dir_ + "'").c_str()); }
-
   std::string Write(const std::string& name, const std::string& text) const {
-    const std::string path = dir_ + "/" + name;
-    std::ofstream(path) << text;
-    return path;
+    return scratch_.Write(name, text);
   }
 
   static SimulatorOptions TenPositions() {
@@ -70,7 +62,8 @@ class KnownAttitudeTest : public ::testing::Test {
     return options;
   }
 
-  std::string dir_;
+  testing_util::ScratchDir scratch_;
+  const std::string dir_ = scratch_.path();
 };
 
 TEST_F(KnownAttitudeTest, AllTwelveParametersWithinTheirUncertainty) {
@@ -185,17 +178,11 @@ TEST_F(KnownAttitudeTest, RejectsBadAttitudeFiles) {
 // The command line: simulate writes a usable attitudes.csv; a bad one gives
 // one line naming file:line, exit code 1 and no output file.
 TEST_F(KnownAttitudeTest, CommandLineEndToEnd) {
-  const std::string cli = GRAVCAL_CLI_PATH;
   const std::string config = testing_util::SourceDir() + "/configs/known_attitude.yaml";
   auto run = [&](const std::string& args, std::string* err) {
-    const std::string err_path = dir_ + "/stderr.txt";
-    const int status =
-        std::system((cli + " " + args + " >/dev/null 2>" + err_path + " </dev/null").c_str());
-    std::ifstream in(err_path);
-    std::stringstream s;
-    s << in.rdbuf();
-    *err = s.str();
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const testing_util::CliResult r = testing_util::RunCli(args, scratch_);
+    *err = r.err;
+    return r.exit_code;
   };
   std::string err;
   ASSERT_EQ(

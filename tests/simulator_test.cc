@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "test_util.h"
+
 namespace gravcal {
 namespace {
 
@@ -18,10 +20,6 @@ Eigen::Vector3d Axis(int nominal_up) {
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
   v(nominal_up / 2) = nominal_up % 2 == 0 ? 1.0 : -1.0;
   return v;
-}
-
-double AngleBetween(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
-  return Eigen::AngleAxisd(a.conjugate() * b).angle();
 }
 
 double AngleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -73,7 +71,7 @@ TEST(Simulator, DifferentSeedsDiffer) {
   ASSERT_EQ(a.log.size(), b.log.size());
   EXPECT_NE(a.accel_truth.bias, b.accel_truth.bias);
   EXPECT_NE(a.gyro_truth.matrix, b.gyro_truth.matrix);
-  EXPECT_GT(AngleBetween(a.poses[0].attitude, b.poses[0].attitude), 1e-3);
+  EXPECT_GT(testing_util::QuaternionAngle(a.poses[0].attitude, b.poses[0].attitude), 1e-3);
   size_t differing = 0;
   for (size_t i = 0; i < a.log.size(); ++i) differing += a.log.accel[i] != b.log.accel[i];
   EXPECT_GT(differing, a.log.size() / 2);
@@ -216,7 +214,7 @@ TEST(Simulator, GyroIntegrationReproducesThePoses) {
     double worst_force = 0.0;
     for (size_t i = 0; i < session.log.size(); ++i) {
       if (next < session.poses.size() && i == session.poses[next].begin) {
-        worst = std::max(worst, AngleBetween(q, session.poses[next].attitude));
+        worst = std::max(worst, testing_util::QuaternionAngle(q, session.poses[next].attitude));
         ++next;
       }
       // The specific force follows the attitude at every sample.

@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
-#include "gravcal/workflows/config.h"
 #include "gravcal/core/imu_log.h"
-#include "gravcal/io/log_reader.h"
 #include "gravcal/core/position.h"
 #include "gravcal/estimation/refinement.h"
+#include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/config.h"
 
 namespace gravcal {
 namespace testing_util {
@@ -106,6 +106,11 @@ inline bool LoadRealSession(const std::string& config_name, const std::string& f
                             ImuLog* log, std::string* error) {
   return LoadConfigFile(SourceDir() + "/configs/" + config_name, config, error) &&
          ReadImuLog(RealDataDir() + "/" + file, config->input, log, error);
+}
+
+// The angle (rad, in [0, pi]) of the rotation between two attitudes.
+inline double QuaternionAngle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+  return a.angularDistance(b);
 }
 
 // Issue 6: 24 random poses held 10 s during a warm-up from 20 to 35 degC
