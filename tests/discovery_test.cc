@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <functional>
 
-#include "gravcal/workflows/config.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/config.h"
 #include "test_util.h"
 
 namespace gravcal {

@@ -16,6 +16,7 @@
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
+#include "sigma_check.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -69,7 +70,7 @@ class KnownAttitudeTest : public ::testing::Test {
 TEST_F(KnownAttitudeTest, AllTwelveParametersWithinTheirUncertainty) {
   const SimulatorOptions sim = TenPositions();
   const int seeds = 40;
-  Eigen::Matrix<double, 12, 1> sum = Eigen::Matrix<double, 12, 1>::Zero();
+  testing_util::SigmaCheck check;
   for (int seed = 1; seed <= seeds; ++seed) {
     SimulatedSession s;
     std::string error;
@@ -83,22 +84,11 @@ TEST_F(KnownAttitudeTest, AllTwelveParametersWithinTheirUncertainty) {
     ASSERT_EQ(c.positions.size(), 10u);
     const Eigen::Matrix3d m = c.accel.model.matrix();
     const Eigen::Matrix3d truth = s.accel_truth.matrix();
-    for (int i = 0; i < 3; ++i) {
-      const double e = (c.accel.model.bias(i) - s.accel_truth.bias(i)) / c.accel.bias_std(i);
-      sum(i) += e * e;
-    }
-    for (int i = 0; i < 9; ++i) {
-      const double e = (m(i / 3, i % 3) - truth(i / 3, i % 3)) / c.accel.matrix_std(i / 3, i % 3);
-      sum(3 + i) += e * e;
-    }
+    testing_util::AddEach(&check, "bias", c.accel.model.bias - s.accel_truth.bias,
+                          c.accel.bias_std);
+    testing_util::AddEach(&check, "matrix", m - truth, c.accel.matrix_std);
   }
-  const Eigen::Matrix<double, 12, 1> rms = (sum / seeds).cwiseSqrt();
-  const double overall = std::sqrt(sum.sum() / (12.0 * seeds));
-  EXPECT_GT(overall, 0.8) << rms.transpose();
-  EXPECT_LT(overall, 1.25) << rms.transpose();
-  // Each parameter on its own (40 seeds: the RMS itself scatters by ~11 %).
-  EXPECT_LT(rms.maxCoeff(), 1.5) << rms.transpose();
-  EXPECT_GT(rms.minCoeff(), 0.6) << rms.transpose();
+  check.ExpectHonest("known_attitude");
 }
 
 TEST_F(KnownAttitudeTest, WorseAttitudesGiveLargerHonestSigmas) {

@@ -9,10 +9,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "gravcal/workflows/config.h"
 #include "gravcal/io/log_reader.h"
-#include "gravcal/workflows/pipeline.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/pipeline.h"
 #include "test_util.h"
 
 namespace gravcal {
