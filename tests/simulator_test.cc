@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -432,22 +431,6 @@ TEST(Simulator, TruthJsonHoldsTheTruth) {
     EXPECT_TRUE(j["options"].contains(field)) << field;
   }
   EXPECT_EQ(j["options"]["scheme"], "ten");
-}
-
-TEST(Simulator, TwelvePosesAt100HzAreFast) {
-  const SimulatorOptions options;
-  SimulatedSession session;
-  std::string error;
-  double best = 1e9;
-  for (int run = 0; run < 5; ++run) {
-    const auto start = std::chrono::steady_clock::now();
-    ASSERT_TRUE(Simulate(options, run, &session, &error)) << error;
-    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
-    best = std::min(best, took.count());
-  }
-  RecordProperty("best_seconds", Scientific(best));
-  // Well under 10 ms in a release build; generous for sanitizer builds.
-  EXPECT_LT(best, 0.1);
 }
 
 }  // namespace
