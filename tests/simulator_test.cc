@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "sigma_check.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -285,16 +287,28 @@ TEST(Simulator, TemperatureFollowsTheWarmUpCurve) {
   EXPECT_NEAR(session.log.temperature.back(), 40.0 - 20.0 * std::exp(-t / 60.0), 1e-9);
 }
 
+// Without noise, two samples of one still pose differ only by the bias
+// walks: per axis N(0, q^2 T) over T seconds. Over 40 seeds the differences
+// must match q sqrt(T) (SigmaCheck's band), accelerometer and gyroscope: a
+// walk scaled by dt instead of sqrt(dt), or a missing one, fails.
 TEST(Simulator, BiasRandomWalkMovesTheBias) {
   SimulatorOptions options = Exact();
   options.accel_bias_random_walk = 0.01;
-  const SimulatedSession session = MustSimulate(options, 21);
-  // Samples of one still period differ only by the walk.
-  const SimulatedPose& pose = session.poses.back();
-  const double walked = (session.log.accel[pose.end - 1] - session.log.accel[pose.begin]).norm();
-  EXPECT_GT(walked, 0.0);
-  // Over hold_seconds the walk spreads by about 0.01 * sqrt(10) per axis.
-  EXPECT_LT(walked, 0.2);
+  options.gyro_bias_random_walk = 1e-3;
+  testing_util::SigmaCheck check;
+  for (uint64_t seed = 1; seed <= 40; ++seed) {
+    const SimulatedSession session = MustSimulate(options, seed);
+    const SimulatedPose& pose = session.poses.back();
+    const double t = session.log.t[pose.end - 1] - session.log.t[pose.begin];
+    const Eigen::Vector3d accel = session.log.accel[pose.end - 1] - session.log.accel[pose.begin];
+    const Eigen::Vector3d gyro = session.log.gyro[pose.end - 1] - session.log.gyro[pose.begin];
+    testing_util::AddEach(&check, "accel walk", accel,
+                          Eigen::Vector3d::Constant(options.accel_bias_random_walk * std::sqrt(t)));
+    testing_util::AddEach(&check, "gyro walk", gyro,
+                          Eigen::Vector3d::Constant(options.gyro_bias_random_walk * std::sqrt(t)));
+  }
+  std::printf("%s", check.Table().c_str());
+  check.ExpectHonest("bias random walk");
 }
 
 TEST(Simulator, RejectsInvalidOptions) {
