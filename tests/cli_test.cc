@@ -1,8 +1,6 @@
 // The command-line tool end to end: bad input gets one line naming the file,
 // line or key, a non-zero exit and no output file.
 #include <gtest/gtest.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -11,53 +9,22 @@
 #include <sstream>
 #include <string>
 
+#include "cli_runner.h"
 #include "test_util.h"
 
 namespace gravcal {
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string err;
-  std::string out;
-};
+using RunResult = testing_util::CliResult;
+using testing_util::Slurp;
 
 class CliTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    char pattern[] = "/tmp/gravcal_cli_XXXXXX";
-    ASSERT_NE(mkdtemp(pattern), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { std::system(("rm -rf '" + dir_ + "'").c_str()); }
-
-  RunResult Run(const std::string& args) const {
-    const std::string out = dir_ + "/stdout.txt";
-    const std::string err = dir_ + "/stderr.txt";
-    const std::string command =
-        std::string(GRAVCAL_CLI_PATH) + " " + args + " >" + out + " 2>" + err + " </dev/null";
-    const int status = std::system(command.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = Slurp(out);
-    r.err = Slurp(err);
-    return r;
-  }
-  static std::string Slurp(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
+  RunResult Run(const std::string& args) const { return testing_util::RunCli(args, scratch_); }
   std::string Write(const std::string& name, const std::string& text) const {
-    const std::string path = dir_ + "/" + name;
-    std::ofstream(path) << text;
-    return path;
+    return scratch_.Write(name, text);
   }
-  bool Exists(const std::string& path) const {
-    struct stat st;
-    return stat(path.c_str(), &st) == 0;
-  }
+  static bool Exists(const std::string& path) { return testing_util::FileExists(path); }
   std::string Config() const { return testing_util::SourceDir() + "/configs/twelve_position.yaml"; }
   // A simulated twelve-position session in raw counts.
   std::string Simulated(int seed = 7) {
@@ -82,7 +49,8 @@ class CliTest : public ::testing::Test {
     return last;
   }
 
-  std::string dir_;
+  testing_util::ScratchDir scratch_;
+  const std::string dir_ = scratch_.path();
 };
 
 TEST_F(CliTest, DemoPrintsEstimateNextToTruth) {

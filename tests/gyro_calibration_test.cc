@@ -24,6 +24,8 @@
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
+#include "sigma_check.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace {
@@ -92,16 +94,6 @@ struct RatioRms {
   Eigen::MatrixXd Mean() const { return signed_sum / count; }
 };
 
-// The band of the issue: reported sigmas match the spread over the seeds.
-void ExpectInBand(const Eigen::MatrixXd& rms, const std::string& what) {
-  for (int r = 0; r < rms.rows(); ++r) {
-    for (int c = 0; c < rms.cols(); ++c) {
-      EXPECT_GT(rms(r, c), 0.7) << what << "(" << r << ", " << c << ")\n" << rms;
-      EXPECT_LT(rms(r, c), 1.4) << what << "(" << r << ", " << c << ")\n" << rms;
-    }
-  }
-}
-
 // Largest attitude error of the integrated truth rate over the rotations of
 // a noise-free hand-profile session.
 double WorstIntegrationError(double sample_rate) {
@@ -128,7 +120,7 @@ double WorstIntegrationError(double sample_rate) {
     IntegrateGyroRotation<double>(d, bias, matrix, nullptr, dq);
     const Eigen::Quaterniond estimate(dq[0], dq[1], dq[2], dq[3]);
     const Eigen::Quaterniond truth = s.poses[k].attitude.conjugate() * s.poses[k + 1].attitude;
-    worst = std::max(worst, Eigen::AngleAxisd(estimate.conjugate() * truth).angle());
+    worst = std::max(worst, testing_util::QuaternionAngle(estimate, truth));
   }
   return worst;
 }
@@ -149,15 +141,17 @@ TEST(GyroCalibration, FullModelSigmaMatchesSpreadAndResidualsAtNoiseLevel) {
   const SimulatorOptions sim = HandSession();
   GyroCalibrationOptions options;
   options.parameterization = GyroParameterization::kFull;
-  RatioRms matrix, bias;
+  testing_util::SigmaCheck check;
   double chi2 = 0.0, dof = 0.0, residual2 = 0.0, sigma2 = 0.0;
   for (int seed = 1; seed <= 40; ++seed) {
     const GyroRun run = CalibrateSimulated(sim, seed, options);
     if (!run.ok) continue;
     EXPECT_TRUE(run.gyro.undetermined.empty()) << "seed " << seed;
     EXPECT_EQ(run.gyro.rotations.size(), run.session.poses.size() - 1);
-    matrix.Add(run.gyro.model.matrix - MatrixInAccelFrame(run.session), run.gyro.matrix_std);
-    bias.Add(run.gyro.model.bias - run.session.gyro_truth.bias, run.gyro.bias_std);
+    testing_util::AddEach(&check, "M_g", run.gyro.model.matrix - MatrixInAccelFrame(run.session),
+                          run.gyro.matrix_std);
+    testing_util::AddEach(&check, "b_g", run.gyro.model.bias - run.session.gyro_truth.bias,
+                          run.gyro.bias_std);
     chi2 += run.gyro.chi2;
     dof += run.gyro.dof;
     for (const GyroRotationReport& r : run.gyro.rotations) {
@@ -165,8 +159,7 @@ TEST(GyroCalibration, FullModelSigmaMatchesSpreadAndResidualsAtNoiseLevel) {
       sigma2 += r.sigma_deg * r.sigma_deg;
     }
   }
-  ExpectInBand(matrix.Rms(), "M_g error / sigma RMS");
-  ExpectInBand(bias.Rms(), "b_g error / sigma RMS");
+  check.ExpectHonest("full gyroscope model");
   // The residuals are what the noise explains: chi2 / dof near 1 (about 1800
   // dof, so +-0.1 is more than 3 standard deviations).
   EXPECT_NEAR(chi2 / dof, 1.0, 0.1);
@@ -187,15 +180,16 @@ TEST(GyroCalibration, GSensitivitySigmaMatchesSpread) {
   GyroCalibrationOptions options;
   options.parameterization = GyroParameterization::kFull;
   options.g_sensitivity = true;
-  RatioRms matrix, g;
+  testing_util::SigmaCheck check;
   for (int seed = 1; seed <= 60; ++seed) {
     const GyroRun run = CalibrateSimulated(sim, seed, options);
     if (!run.ok) continue;
-    matrix.Add(run.gyro.model.matrix - MatrixInAccelFrame(run.session), run.gyro.matrix_std);
-    g.Add(run.gyro.g_sensitivity - GInAccelFrame(run.session), run.gyro.g_sensitivity_std);
+    testing_util::AddEach(&check, "M_g", run.gyro.model.matrix - MatrixInAccelFrame(run.session),
+                          run.gyro.matrix_std);
+    testing_util::AddEach(&check, "G", run.gyro.g_sensitivity - GInAccelFrame(run.session),
+                          run.gyro.g_sensitivity_std);
   }
-  ExpectInBand(matrix.Rms(), "M_g error / sigma RMS");
-  ExpectInBand(g.Rms(), "G error / sigma RMS");
+  check.ExpectHonest("gyroscope with g-sensitivity");
 }
 
 TEST(GyroCalibration, UnmodelledGSensitivityIsFlagged) {
@@ -217,18 +211,19 @@ TEST(GyroCalibration, JointFitSigmaMatchesSpread) {
   GyroCalibrationOptions options;
   options.parameterization = GyroParameterization::kFull;
   options.joint = true;
-  RatioRms matrix, accel_bias;
+  testing_util::SigmaCheck check;
   for (int seed = 1; seed <= 30; ++seed) {
     const GyroRun run = CalibrateSimulated(sim, seed, options);
     if (!run.ok) continue;
     ASSERT_TRUE(run.gyro.accel_refined);
     ASSERT_TRUE(run.gyro.accel.covariance_available);
-    matrix.Add(run.gyro.model.matrix - MatrixInAccelFrame(run.session), run.gyro.matrix_std);
-    accel_bias.Add(run.gyro.accel.model.bias - run.session.accel_truth.bias,
-                   run.gyro.accel.covariance.diagonal().head<3>().cwiseSqrt());
+    testing_util::AddEach(&check, "M_g", run.gyro.model.matrix - MatrixInAccelFrame(run.session),
+                          run.gyro.matrix_std);
+    testing_util::AddEach(&check, "accel_bias",
+                          run.gyro.accel.model.bias - run.session.accel_truth.bias,
+                          run.gyro.accel.covariance.diagonal().head<3>().cwiseSqrt());
   }
-  ExpectInBand(matrix.Rms(), "M_g error / sigma RMS (joint)");
-  ExpectInBand(accel_bias.Rms(), "accelerometer bias error / sigma RMS (joint)");
+  check.ExpectHonest("joint gyroscope and accelerometer fit");
 }
 
 TEST(GyroCalibration, ScaleAndBiasModels) {

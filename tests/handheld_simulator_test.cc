@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "gravcal/workflows/config.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace {
@@ -16,10 +17,6 @@ SimulatorOptions NoiseFree() {
   sensor.accel_noise = 0.0;
   sensor.gyro_noise = 0.0;
   return sensor;
-}
-
-double Angle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
-  return Eigen::AngleAxisd(a.conjugate() * b).angle();
 }
 
 TEST(HandheldSimulator, DeterministicPerSeed) {
@@ -41,7 +38,7 @@ TEST(HandheldSimulator, TurntableReturnsToZero) {
   std::string error;
   ASSERT_TRUE(SimulateMotion(NoiseFree(), motion, 2, &s, &error)) << error;
   // Whole turns and the tilt back: the end attitude is the start one, level.
-  EXPECT_LT(Angle(s.attitude.front(), s.attitude.back()), 1e-6);
+  EXPECT_LT(testing_util::QuaternionAngle(s.attitude.front(), s.attitude.back()), 1e-6);
   const Eigen::Vector3d up = s.attitude.front().conjugate() * Eigen::Vector3d::UnitZ();
   EXPECT_NEAR(up.z(), 1.0, 1e-12);
   // No sway on a table.

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <map>
 
+#include "cli_runner.h"
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/methods/known_attitude.h"
@@ -87,7 +88,8 @@ TEST(MethodComparison, ReproducesTheReadmeTable) {
   twelve_affine.calibration.refinement.parameterization = AccelParameterization::kAffine;
   const Config known = LoadConfig("known_attitude.yaml");
   const SimulatorOptions& sim = ten.simulation;
-  const std::string fixture = ::testing::TempDir() + "gravcal_comparison_attitudes.csv";
+  const testing_util::ScratchDir scratch;
+  const std::string fixture = scratch / "attitudes.csv";
 
   std::map<std::string, Row> rows;
   const std::vector<std::string> order = {

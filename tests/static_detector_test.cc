@@ -423,10 +423,12 @@ TEST(StaticDetector, NominalAxes) {
 
 // --- Real recordings (skipped when ../shared/data/real is missing) ---------
 
-ImuLog ReadReal(const std::string& file, const LogReaderOptions& options) {
+// A real recording read with its shipped config's input settings.
+ImuLog ReadReal(const std::string& config_name, const std::string& file) {
+  Config config;
   ImuLog log;
   std::string error;
-  EXPECT_TRUE(ReadImuLog(testing_util::RealDataDir() + "/" + file, options, &log, &error)) << error;
+  EXPECT_TRUE(testing_util::LoadRealSession(config_name, file, &config, &log, &error)) << error;
   return log;
 }
 
@@ -440,11 +442,7 @@ bool Overlaps(const StaticInterval& s, size_t begin, size_t end) {
 // after each of the three rotations. 13 intervals, 6 orientations.
 TEST(StaticDetectorRealData, FerrarisNilsPod) {
   if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "no real data";
-  LogReaderOptions options;
-  options.rename = {{"t", "n_samples"}, {"ax", "acc_x"}, {"ay", "acc_y"}, {"az", "acc_z"},
-                    {"gx", "gyr_x"},    {"gy", "gyr_y"}, {"gz", "gyr_z"}};
-  options.time_scale = 1.0 / 102.4;
-  const ImuLog log = ReadReal("ferraris_nilspod/session.csv", options);
+  const ImuLog log = ReadReal("ferraris_nilspod.yaml", "ferraris_nilspod/session.csv");
   ASSERT_EQ(log.size(), 10376u);
   StaticDetection d;
   ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
@@ -486,10 +484,7 @@ TEST(StaticDetectorRealData, FerrarisNilsPod) {
 // period.
 TEST(StaticDetectorRealData, Mpu6050TenPose) {
   if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "no real data";
-  LogReaderOptions options;
-  options.skip_lines = 4;
-  options.sample_rate = 100.0;
-  const ImuLog log = ReadReal("mpu6050_ten_pose/session.csv", options);
+  const ImuLog log = ReadReal("mpu6050_ten_pose.yaml", "mpu6050_ten_pose/session.csv");
   ASSERT_EQ(log.size(), 10245u);
   StaticDetection d;
   ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
@@ -515,11 +510,7 @@ TEST(StaticDetectorRealData, Mpu6050TenPose) {
 // apart in time: two intervals.
 TEST(StaticDetectorRealData, AhrsStaticPoses) {
   if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "no real data";
-  LogReaderOptions options;
-  options.format = LogFormat::kWhitespace;
-  options.columns = {"t",  "ax", "ay", "az", "gx", "gy", "gz",
-                     "mx", "my", "mz", "qx", "qy", "qz", "qw"};
-  const ImuLog log = ReadReal("ahrs_static_poses/imu_good1.txt", options);
+  const ImuLog log = ReadReal("ahrs_static_poses.yaml", "ahrs_static_poses/imu_good1.txt");
   ASSERT_GT(log.size(), 6500u);
   StaticDetection d;
   ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;

@@ -5,16 +5,13 @@
 #include <cmath>
 
 #include "gravcal/simulation/handheld_simulator.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace {
 
 using Eigen::Quaterniond;
 using Eigen::Vector3d;
-
-double AngleBetween(const Quaterniond& a, const Quaterniond& b) {
-  return Eigen::AngleAxisd(a.conjugate() * b).angle();
-}
 
 TEST(Strapdown, StillUnitStaysStill) {
   StrapdownOptions options;
@@ -28,7 +25,7 @@ TEST(Strapdown, StillUnitStaysStill) {
     nav.Step(0.005, f, Vector3d::Zero(), f, Vector3d::Zero(), nullptr);
   EXPECT_LT(nav.state().position.norm(), 1e-6);
   EXPECT_LT(nav.state().velocity.norm(), 1e-7);
-  EXPECT_LT(AngleBetween(nav.state().attitude, start.attitude), 1e-12);
+  EXPECT_LT(testing_util::QuaternionAngle(nav.state().attitude, start.attitude), 1e-12);
 }
 
 TEST(Strapdown, StillUnitStaysStillWithEarthRate) {
@@ -45,11 +42,12 @@ TEST(Strapdown, StillUnitStaysStillWithEarthRate) {
   const Vector3d w = start.attitude.conjugate() * EarthRateEnu(options.latitude_deg);
   for (int i = 0; i < 36000; ++i) nav.Step(0.01, f, w, f, w, nullptr);
   EXPECT_LT(nav.state().position.norm(), 1e-6);
-  EXPECT_LT(AngleBetween(nav.state().attitude, start.attitude), 1e-10);
+  EXPECT_LT(testing_util::QuaternionAngle(nav.state().attitude, start.attitude), 1e-10);
   // Without the Earth rate in the mechanisation the same data turns it.
   Strapdown plain(StrapdownOptions(), start);
   for (int i = 0; i < 36000; ++i) plain.Step(0.01, f, w, f, w, nullptr);
-  EXPECT_NEAR(AngleBetween(plain.state().attitude, start.attitude), kEarthRate * 360.0, 1e-6);
+  EXPECT_NEAR(testing_util::QuaternionAngle(plain.state().attitude, start.attitude),
+              kEarthRate * 360.0, 1e-6);
 }
 
 TEST(Strapdown, ConstantRateIntegratesToKnownAttitude) {
@@ -58,7 +56,7 @@ TEST(Strapdown, ConstantRateIntegratesToKnownAttitude) {
   const Vector3d w = 1.3 * axis;
   for (int i = 0; i < 200; ++i) nav.Step(0.01, Vector3d::Zero(), w, Vector3d::Zero(), w, nullptr);
   const Quaterniond expected(Eigen::AngleAxisd(2.6, axis));
-  EXPECT_LT(AngleBetween(nav.state().attitude, expected), 1e-12);
+  EXPECT_LT(testing_util::QuaternionAngle(nav.state().attitude, expected), 1e-12);
 }
 
 TEST(Strapdown, VaryingRateIntegratesToKnownAttitude) {
@@ -74,7 +72,7 @@ TEST(Strapdown, VaryingRateIntegratesToKnownAttitude) {
              a * std::sin(t0 + dt) * axis, nullptr);
   }
   const Quaterniond expected(Eigen::AngleAxisd(a * (1.0 - std::cos(3.0)), axis));
-  EXPECT_LT(AngleBetween(nav.state().attitude, expected), 1e-4);
+  EXPECT_LT(testing_util::QuaternionAngle(nav.state().attitude, expected), 1e-4);
 }
 
 TEST(Strapdown, LevelAttitudeRecoversRollAndPitch) {
@@ -83,9 +81,9 @@ TEST(Strapdown, LevelAttitudeRecoversRollAndPitch) {
       const Quaterniond c = Quaterniond(Eigen::AngleAxisd(pitch, Vector3d::UnitY())) *
                             Quaterniond(Eigen::AngleAxisd(roll, Vector3d::UnitX()));
       const Vector3d f = c.conjugate() * Vector3d(0, 0, 9.8);
-      EXPECT_LT(AngleBetween(LevelAttitude(f), c), 1e-12) << roll << " " << pitch;
+      EXPECT_LT(testing_util::QuaternionAngle(LevelAttitude(f), c), 1e-12) << roll << " " << pitch;
       // Any scale of f gives the same attitude.
-      EXPECT_LT(AngleBetween(LevelAttitude(0.1 * f), c), 1e-12);
+      EXPECT_LT(testing_util::QuaternionAngle(LevelAttitude(0.1 * f), c), 1e-12);
     }
   }
 }
@@ -114,7 +112,7 @@ void MechanisationError(const MotionOptions& motion, double sample_rate, double*
     nav.Step(log.t[i] - log.t[i - 1], s.sensor.accel_truth.Apply(log.accel[i - 1]),
              s.sensor.gyro_truth.Apply(log.gyro[i - 1]), s.sensor.accel_truth.Apply(log.accel[i]),
              s.sensor.gyro_truth.Apply(log.gyro[i]), nullptr);
-    *angle = std::max(*angle, AngleBetween(nav.state().attitude, s.attitude[i]));
+    *angle = std::max(*angle, testing_util::QuaternionAngle(nav.state().attitude, s.attitude[i]));
     *position = std::max(*position, (nav.state().position - s.position[i]).norm());
   }
 }

@@ -108,6 +108,25 @@ inline bool LoadRealSession(const std::string& config_name, const std::string& f
          ReadImuLog(RealDataDir() + "/" + file, config->input, log, error);
 }
 
+// The angle (rad, in [0, pi]) of the rotation between two attitudes.
+inline double QuaternionAngle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+  return a.angularDistance(b);
+}
+
+// Adds every entry of `error` / `sigma` to an error/sigma accumulator
+// (SigmaCheck) as "<name>(r,c)", or "<name>(i)" for a vector.
+template <class Check>
+void AddEach(Check* check, const std::string& name, const Eigen::MatrixXd& error,
+             const Eigen::MatrixXd& sigma) {
+  for (int r = 0; r < error.rows(); ++r) {
+    for (int c = 0; c < error.cols(); ++c) {
+      const std::string index =
+          error.cols() == 1 ? std::to_string(r) : std::to_string(r) + "," + std::to_string(c);
+      check->Add(name + "(" + index + ")", error(r, c), sigma(r, c));
+    }
+  }
+}
+
 // Issue 6: 24 random poses held 10 s during a warm-up from 20 to 35 degC
 // (time constant 120 s), so temperature and time both vary and are not
 // proportional: the session in which hidden effects are looked for.
