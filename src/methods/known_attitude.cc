@@ -311,7 +311,7 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
 
   AccelModel nominal;
   nominal.upper = s0 * Eigen::Matrix3d::Identity();
-  ReportPositions(positions, nominal, c.accel.model, g, {}, &c);
+  internal::ReportPositions(positions, nominal, c.accel.model, g, {}, &c);
   c.residual_coarse = c.residual_nominal;
   for (int k = 0; k < n; ++k) {
     PositionReport& r = c.positions[k];
@@ -350,7 +350,7 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path
   }
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
-  if (!DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
+  if (!internal::DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
   std::vector<FixtureAttitude> rows;
   std::vector<int> row_of_position;
   std::string error;

@@ -7,24 +7,28 @@
 #include "util/statistics.h"
 
 namespace gravcal {
+namespace internal {
+
+bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector,
+                        std::vector<StaticInterval>* intervals, std::string* message) {
+  if (!log.Validate(message)) return false;
+  StaticDetection detection;
+  if (!DetectStaticIntervals(log, detector, &detection)) {
+    *message = log.source + ": " + detection.message;
+    return false;
+  }
+  *intervals = detection.intervals;
+  return true;
+}
 
 bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
                            Calibration* calibration, std::vector<StaticInterval>* intervals,
                            std::vector<Position>* positions) {
   Calibration& c = *calibration;
-  std::string error;
-  if (!options.IsValid(&error) || !log.Validate(&error)) {
-    c.message = error;
-    return false;
-  }
+  if (!options.IsValid(&c.message)) return false;
   if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
-  StaticDetection detection;
-  if (!DetectStaticIntervals(log, options.detector, &detection)) {
-    c.message = log.source + ": " + detection.message;
-    return false;
-  }
-  *intervals = detection.intervals;
-  *positions = PositionsFromIntervals(detection.intervals);
+  if (!DetectLogIntervals(log, options.detector, intervals, &c.message)) return false;
+  *positions = PositionsFromIntervals(*intervals);
   return true;
 }
 
@@ -68,4 +72,5 @@ void ReportPositions(const std::vector<Position>& positions, const AccelModel& n
   }
 }
 
+}  // namespace internal
 }  // namespace gravcal

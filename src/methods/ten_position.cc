@@ -26,7 +26,7 @@ bool AlignPositions(const ImuLog& log, const std::vector<StaticInterval>& interv
   alignments->assign(intervals.size(), StaticAlignmentResult());
   std::vector<Eigen::Vector3d> force, rate;
   for (size_t k = 0; k < intervals.size(); ++k) {
-    const double dt = IntervalSamples(log, intervals[k], 1.0, gyro_scale, &force, &rate);
+    const double dt = internal::IntervalSamples(log, intervals[k], 1.0, gyro_scale, &force, &rate);
     for (Eigen::Vector3d& f : force) f = transform(f);
     if (!AlignStatic(force, rate, dt, options, &(*alignments)[k])) {
       std::ostringstream s;
@@ -67,7 +67,7 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
   }
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
-  if (!DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
+  if (!internal::DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
   const std::string where = log.source.empty() ? "" : log.source + ": ";
   const int n = static_cast<int>(positions.size());
   if (n < kMinPositions) {
@@ -212,7 +212,7 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
 
   AccelModel nominal;
   nominal.upper = nominal_scale * Eigen::Matrix3d::Identity();
-  ReportPositions(positions, nominal, c.accel.model, c.gravity, c.refinement.sigmas, &c);
+  internal::ReportPositions(positions, nominal, c.accel.model, c.gravity, c.refinement.sigmas, &c);
   c.residual_coarse = c.residual_nominal;
   for (int k = 0; k < n; ++k) {
     PositionReport& r = c.positions[k];

@@ -6,10 +6,12 @@
 #include <cmath>
 #include <sstream>
 
-#include "estimation/accel_uncertainty.h"
 #include "core/calibration_gravity.h"
+#include "estimation/accel_uncertainty.h"
 #include "gravcal/estimation/housing_rotation.h"
+#include "methods/static_positions.h"
 #include "util/statistics.h"
+#include "util/units.h"
 
 namespace gravcal {
 
@@ -134,8 +136,8 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
       s.precision(3);
       s << "affine: bias, scale and non-orthogonality come from the gravity magnitude; the "
            "rotation of the sensor axes in the housing comes from the nominal axes of "
-        << housing.positions_used
-        << " axis-aligned positions (placement error seen: " << housing.tilt_rms * 180.0 / M_PI
+        << housing.positions_used << " axis-aligned positions (placement error seen: "
+        << housing.tilt_rms * internal::kRadToDeg
         << " deg rms), so its accuracy is that of the placement";
       c.warnings.push_back(s.str());
     } else {
@@ -195,23 +197,13 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
                             Calibration* calibration, std::vector<StaticInterval>* intervals) {
   CHECK(calibration != nullptr);
   *calibration = Calibration();
-  std::string error;
-  if (!options.IsValid(&error)) {
-    calibration->message = error;
+  std::vector<StaticInterval> detected;
+  if (!options.IsValid(&calibration->message) ||
+      !internal::DetectLogIntervals(log, options.detector, &detected, &calibration->message)) {
     return false;
   }
-  if (!log.Validate(&error)) {
-    calibration->message = error;
-    return false;
-  }
-  StaticDetection detection;
-  if (!DetectStaticIntervals(log, options.detector, &detection)) {
-    calibration->message = log.source + ": " + detection.message;
-    return false;
-  }
-  const std::vector<Position> positions = PositionsFromIntervals(detection.intervals);
-  if (intervals != nullptr) *intervals = detection.intervals;
-  const bool ok = CalibrateFromPositions(positions, options, calibration);
+  if (intervals != nullptr) *intervals = detected;
+  const bool ok = CalibrateFromPositions(PositionsFromIntervals(detected), options, calibration);
   if (!ok && !log.source.empty()) calibration->message = log.source + ": " + calibration->message;
   return ok;
 }
