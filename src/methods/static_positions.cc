@@ -46,6 +46,19 @@ double IntervalSamples(const ImuLog& log, const StaticInterval& interval, double
                : 0.0;
 }
 
+PositionReport MakePositionReport(const Position& position, double before, double after,
+                                  double sigma) {
+  PositionReport r;
+  r.position = position;
+  const double n = static_cast<double>(std::max<size_t>(position.sample_count, 1));
+  r.raw_std = (position.raw_mean_cov.diagonal() * n).cwiseSqrt();
+  r.nominal_up = position.nominal_up;
+  r.residual_before = before;
+  r.residual_after = after;
+  r.sigma = sigma;
+  return r;
+}
+
 void ReportPositions(const std::vector<Position>& positions, const AccelModel& nominal,
                      const AccelModel& final_model, double gravity,
                      const std::vector<double>& sigmas, Calibration* calibration) {
@@ -60,15 +73,8 @@ void ReportPositions(const std::vector<Position>& positions, const AccelModel& n
   c.residual_refined = {Rms(after), MaxAbs(after)};
   c.positions.clear();
   for (size_t k = 0; k < positions.size(); ++k) {
-    PositionReport r;
-    r.position = positions[k];
-    const double n = static_cast<double>(std::max<size_t>(positions[k].sample_count, 1));
-    r.raw_std = (positions[k].raw_mean_cov.diagonal() * n).cwiseSqrt();
-    r.nominal_up = positions[k].nominal_up;
-    r.residual_before = before[k];
-    r.residual_after = after[k];
-    r.sigma = k < sigmas.size() ? sigmas[k] : NAN;
-    c.positions.push_back(r);
+    c.positions.push_back(
+        MakePositionReport(positions[k], before[k], after[k], k < sigmas.size() ? sigmas[k] : NAN));
   }
 }
 

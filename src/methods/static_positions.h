@@ -36,6 +36,11 @@ double IntervalSamples(const ImuLog& log, const StaticInterval& interval, double
                        double gyro_scale, std::vector<Eigen::Vector3d>* force,
                        std::vector<Eigen::Vector3d>* rate);
 
+// The report of one position: its noise per sample, nominal axis,
+// residuals |a| - g before and after, and sigma.
+PositionReport MakePositionReport(const Position& position, double before, double after,
+                                  double sigma);
+
 // One PositionReport per position, with residuals |a| - g before (nominal)
 // and after (final) and the given sigmas.
 void ReportPositions(const std::vector<Position>& positions, const AccelModel& nominal,

@@ -9,11 +9,11 @@
 
 #include "gravcal/estimation/refinement.h"
 #include "methods/static_positions.h"
+#include "util/units.h"
 
 namespace gravcal {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Fewest positions: step 4 has six unknowns (bias and three scales).
 constexpr int kMinPositions = 6;
 
@@ -216,10 +216,10 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
   c.residual_coarse = c.residual_nominal;
   for (int k = 0; k < n; ++k) {
     PositionReport& r = c.positions[k];
-    r.roll_deg = second[k].roll * kRadToDeg;
-    r.pitch_deg = second[k].pitch * kRadToDeg;
-    r.roll_std_deg = second[k].roll_std * kRadToDeg;
-    r.pitch_std_deg = second[k].pitch_std * kRadToDeg;
+    r.roll_deg = second[k].roll * internal::kRadToDeg;
+    r.pitch_deg = second[k].pitch * internal::kRadToDeg;
+    r.roll_std_deg = second[k].roll_std * internal::kRadToDeg;
+    r.pitch_std_deg = second[k].pitch_std * internal::kRadToDeg;
   }
   c.success = true;
   std::ostringstream s;
