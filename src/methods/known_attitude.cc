@@ -13,13 +13,14 @@
 #include <sstream>
 
 #include "estimation/robust_loss.h"
+#include "gravcal/core/gravity.h"
 #include "methods/static_positions.h"
 #include "util/statistics.h"
+#include "util/units.h"
 
 namespace gravcal {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Twelve unknowns, three equations per position.
 constexpr int kMinPositions = 4;
 
@@ -103,22 +104,17 @@ std::vector<std::string> ParameterNames() {
   return names;
 }
 
-}  // namespace
-
-bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
-                                 const std::vector<KnownAttitude>& attitudes,
-                                 const CalibrationOptions& options, Calibration* calibration) {
-  CHECK(calibration != nullptr);
-  Calibration& c = *calibration;
-  c.method = "known_attitude";
+// Checks the options, the gravity (resolved unless the caller did), and one
+// finite attitude with positive standard deviations per position. False
+// with c->message.
+bool CheckInputs(const std::vector<Position>& positions,
+                 const std::vector<KnownAttitude>& attitudes, const CalibrationOptions& options,
+                 Calibration* c) {
+  if (!options.IsValid(&c->message)) return false;
   std::string error;
-  if (!options.IsValid(&error)) {
-    c.message = error;
-    return false;
-  }
-  if (c.gravity_source.empty() &&
-      !ResolveGravity(options.gravity, &c.gravity, &c.gravity_source, &error)) {
-    c.message = error;
+  if (c->gravity_source.empty() &&
+      !ResolveGravity(options.gravity, &c->gravity, &c->gravity_source, &error)) {
+    c->message = error;
     return false;
   }
   const int n = static_cast<int>(positions.size());
@@ -126,32 +122,45 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
     std::ostringstream s;
     s << "found " << n << " static positions; the known-attitude method needs at least "
       << kMinPositions << " (twelve unknowns)";
-    c.message = s.str();
+    c->message = s.str();
     return false;
   }
   if (attitudes.size() != positions.size()) {
-    c.message = "known_attitude: one attitude per position is needed";
+    c->message = "known_attitude: one attitude per position is needed";
     return false;
   }
   for (int k = 0; k < n; ++k) {
     const KnownAttitude& a = attitudes[k];
     if (!std::isfinite(a.roll) || !std::isfinite(a.pitch) || !(a.roll_std > 0.0) ||
         !(a.pitch_std > 0.0) || !std::isfinite(a.roll_std) || !std::isfinite(a.pitch_std)) {
-      c.message = "known_attitude: attitude " + std::to_string(k) +
-                  " is not finite or has no positive standard deviation";
+      c->message = "known_attitude: attitude " + std::to_string(k) +
+                   " is not finite or has no positive standard deviation";
       return false;
     }
   }
-  const double g = c.gravity;
+  return true;
+}
 
-  // Normalised raw units (v_n = s0 v, s0 = g / mean |v|) keep the problem
-  // well conditioned whatever the raw units are.
-  double mean_norm = 0.0;
-  for (const Position& p : positions) mean_norm += p.raw_mean.norm();
-  const double s0 = g * n / mean_norm;
+// The estimation state: parameters in normalised raw units (v_n = s0 v,
+// s0 = g / mean |v|, which keeps the problem well conditioned whatever the
+// raw units are), the attitudes, and the whitening of every position.
+struct AttitudeFit {
+  double s0 = 1.0;
+  double gravity = 0.0;
+  double bias[3] = {0.0, 0.0, 0.0};
+  double matrix[9] = {};
+  std::vector<std::array<double, 2>> attitude;
+  std::vector<Eigen::Matrix3d> whitening;
+};
 
-  // Initial value, linear: g u_k = M v_k + c_off for the fixed attitudes,
-  // normal equations over [v_k; 1], then b = -M^-1 c_off.
+// Initial value, linear: g u_k = M v_k + c_off for the fixed attitudes,
+// normal equations over [v_k; 1], then b = -M^-1 c_off; and the whitening
+// of every position at it. False with *error.
+bool InitialFit(const std::vector<Position>& positions, const std::vector<KnownAttitude>& attitudes,
+                AttitudeFit* fit, std::string* error) {
+  const int n = static_cast<int>(positions.size());
+  const double g = fit->gravity;
+  const double s0 = fit->s0;
   Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
   Eigen::Matrix<double, 4, 3> right = Eigen::Matrix<double, 4, 3>::Zero();
   for (int k = 0; k < n; ++k) {
@@ -166,56 +175,146 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
   const Eigen::Matrix<double, 4, 3> x = ldlt.solve(right);
   const Eigen::Matrix3d m0 = x.topRows<3>().transpose();
   if (ldlt.info() != Eigen::Success || !x.allFinite() || std::fabs(m0.determinant()) < 1e-12) {
-    c.message =
+    *error =
         "known_attitude: the positions do not determine the twelve parameters (the gravity "
         "directions must not all lie in one plane)";
     return false;
   }
   const Eigen::Vector3d b0 = -m0.inverse() * x.row(3).transpose();
-
-  double bias[3] = {b0(0), b0(1), b0(2)};
-  double matrix[9];
+  for (int i = 0; i < 3; ++i) fit->bias[i] = b0(i);
   for (int r = 0; r < 3; ++r) {
-    for (int col = 0; col < 3; ++col) matrix[3 * r + col] = m0(r, col);
+    for (int col = 0; col < 3; ++col) fit->matrix[3 * r + col] = m0(r, col);
   }
-  std::vector<std::array<double, 2>> attitude(n);
-  std::vector<Eigen::Matrix3d> whitening(n);
+  fit->attitude.resize(n);
+  fit->whitening.resize(n);
   for (int k = 0; k < n; ++k) {
-    attitude[k] = {attitudes[k].roll, attitudes[k].pitch};
+    fit->attitude[k] = {attitudes[k].roll, attitudes[k].pitch};
     const Eigen::Matrix3d cov = m0 * (s0 * s0 * positions[k].raw_mean_cov) * m0.transpose();
     const Eigen::LLT<Eigen::Matrix3d> llt(cov);
     if (llt.info() != Eigen::Success) {
-      c.message = "known_attitude: static position " + std::to_string(k) +
-                  " has no usable noise estimate (its covariance is not positive definite)";
+      *error = "known_attitude: static position " + std::to_string(k) +
+               " has no usable noise estimate (its covariance is not positive definite)";
       return false;
     }
-    whitening[k] = llt.matrixL().solve(Eigen::Matrix3d::Identity());
+    fit->whitening[k] = llt.matrixL().solve(Eigen::Matrix3d::Identity());
   }
+  return true;
+}
+
+// Whitened sum of squares (no loss) at the current parameters.
+double Chi2(const std::vector<Position>& positions, const std::vector<KnownAttitude>& attitudes,
+            AttitudeFit* fit) {
+  double sum = 0.0;
+  for (size_t k = 0; k < positions.size(); ++k) {
+    double r[3], p[2];
+    const GravityVectorResidual sensor(fit->s0 * positions[k].raw_mean, fit->whitening[k],
+                                       fit->gravity);
+    const AttitudePriorResidual prior(attitudes[k]);
+    sensor(fit->bias, fit->matrix, fit->attitude[k].data(), r);
+    prior(fit->attitude[k].data(), p);
+    sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + p[0] * p[0] + p[1] * p[1];
+  }
+  return sum;
+}
+
+// The covariance of (b, M) in raw units (scale_back per parameter) into
+// c->refinement and c->accel, and each attitude's standard deviations.
+void ComputeCovariance(ceres::Problem* problem, const double scale_back[12], AttitudeFit* fit,
+                       std::vector<Eigen::Vector2d>* attitude_std, Calibration* c) {
+  RefinementResult& f = c->refinement;
+  double* bias = fit->bias;
+  double* matrix = fit->matrix;
+  std::vector<std::array<double, 2>>& attitude = fit->attitude;
+  const int n = static_cast<int>(attitude.size());
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.num_threads = 1;
+  ceres::Covariance covariance(covariance_options);
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {bias, bias}, {bias, matrix}, {matrix, matrix}};
+  for (int k = 0; k < n; ++k) blocks.push_back({attitude[k].data(), attitude[k].data()});
+  if (covariance.Compute(blocks, problem)) {
+    double cbb[9], cbm[27], cmm[81];
+    covariance.GetCovarianceBlock(bias, bias, cbb);
+    covariance.GetCovarianceBlock(bias, matrix, cbm);
+    covariance.GetCovarianceBlock(matrix, matrix, cmm);
+    Eigen::MatrixXd cov(12, 12);
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) cov(i, j) = cbb[3 * i + j];
+      for (int j = 0; j < 9; ++j) cov(i, 3 + j) = cov(3 + j, i) = cbm[9 * i + j];
+    }
+    for (int i = 0; i < 9; ++i) {
+      for (int j = 0; j < 9; ++j) cov(3 + i, 3 + j) = cmm[9 * i + j];
+    }
+    for (int i = 0; i < 12; ++i) {
+      for (int j = 0; j < 12; ++j) cov(i, j) *= scale_back[i] * scale_back[j];
+    }
+    f.covariance = cov;
+    f.covariance_available = true;
+    c->accel.covariance = cov;
+    c->accel.covariance_names = f.parameter_names;
+    for (int i = 0; i < 3; ++i) c->accel.bias_std(i) = std::sqrt(cov(i, i));
+    for (int i = 0; i < 9; ++i) c->accel.matrix_std(i / 3, i % 3) = std::sqrt(cov(3 + i, 3 + i));
+    for (int k = 0; k < n; ++k) {
+      double ca[4];
+      covariance.GetCovarianceBlock(attitude[k].data(), attitude[k].data(), ca);
+      (*attitude_std)[k] = Eigen::Vector2d(std::sqrt(ca[0]), std::sqrt(ca[3]));
+    }
+  } else {
+    c->warnings.push_back(
+        "known_attitude: the covariance could not be computed (rank deficient); no standard "
+        "deviations are reported");
+  }
+}
+
+// Warnings on the fit's degrees of freedom and chi-square.
+void WarnFit(const RefinementResult& f, Calibration* c) {
+  if (f.dof <= 0) {
+    c->warnings.push_back(
+        "known_attitude: as many equations as unknowns; the fit cannot show whether the attitudes "
+        "or the noise estimate are right: record more positions");
+  } else if (ChiSquareUpperTail(f.chi2, f.dof) < 1e-3) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "known_attitude: residuals are " << std::sqrt(f.chi2 / f.dof)
+      << " times what the sensor noise and the stated attitude uncertainties allow (chi2 = "
+      << f.chi2 << " on " << f.dof
+      << " dof): an attitude is wrong or too confident, or a position was disturbed; the "
+         "standard deviations are too small by about that factor";
+    c->warnings.push_back(s.str());
+  }
+}
+
+}  // namespace
+
+bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
+                                 const std::vector<KnownAttitude>& attitudes,
+                                 const CalibrationOptions& options, Calibration* calibration) {
+  CHECK(calibration != nullptr);
+  Calibration& c = *calibration;
+  c.method = "known_attitude";
+  if (!CheckInputs(positions, attitudes, options, &c)) return false;
+  const int n = static_cast<int>(positions.size());
+  const double g = c.gravity;
+  AttitudeFit fit;
+  fit.gravity = g;
+  double mean_norm = 0.0;
+  for (const Position& p : positions) mean_norm += p.raw_mean.norm();
+  fit.s0 = g * n / mean_norm;
+  const double s0 = fit.s0;
+  if (!InitialFit(positions, attitudes, &fit, &c.message)) return false;
 
   ceres::Problem problem;
   const RefinementOptions& ro = options.refinement;
   for (int k = 0; k < n; ++k) {
     problem.AddResidualBlock(
-        GravityVectorResidual::Create(s0 * positions[k].raw_mean, whitening[k], g),
-        MakeLoss(ro.loss, ro.loss_scale), bias, matrix, attitude[k].data());
+        GravityVectorResidual::Create(s0 * positions[k].raw_mean, fit.whitening[k], g),
+        MakeLoss(ro.loss, ro.loss_scale), fit.bias, fit.matrix, fit.attitude[k].data());
     problem.AddResidualBlock(AttitudePriorResidual::Create(attitudes[k]), nullptr,
-                             attitude[k].data());
+                             fit.attitude[k].data());
   }
-  // Whitened sum of squares (no loss) at the current parameters.
-  auto chi2 = [&]() {
-    double sum = 0.0;
-    for (int k = 0; k < n; ++k) {
-      double r[3], p[2];
-      const GravityVectorResidual sensor(s0 * positions[k].raw_mean, whitening[k], g);
-      const AttitudePriorResidual prior(attitudes[k]);
-      sensor(bias, matrix, attitude[k].data(), r);
-      prior(attitude[k].data(), p);
-      sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + p[0] * p[0] + p[1] * p[1];
-    }
-    return sum;
-  };
   RefinementResult& f = c.refinement;
-  f.initial_cost = 0.5 * chi2();
+  f.initial_cost = 0.5 * Chi2(positions, attitudes, &fit);
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;
   solver_options.max_num_iterations = ro.max_iterations;
@@ -231,7 +330,7 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
   f.iterations = static_cast<int>(summary.iterations.size()) - 1;
   f.termination = ceres::TerminationTypeToString(summary.termination_type);
   f.converged = summary.termination_type == ceres::CONVERGENCE;
-  f.chi2 = chi2();
+  f.chi2 = Chi2(positions, attitudes, &fit);
   f.final_cost = 0.5 * f.chi2;
   f.num_residuals = 5 * n;
   f.num_parameters = 12;
@@ -242,8 +341,8 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
   const double scale_back[12] = {1 / s0, 1 / s0, 1 / s0, s0, s0, s0, s0, s0, s0, s0, s0, s0};
   Eigen::Vector3d b;
   Eigen::Matrix3d m;
-  for (int i = 0; i < 3; ++i) b(i) = bias[i] * scale_back[i];
-  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = matrix[i] * s0;
+  for (int i = 0; i < 3; ++i) b(i) = fit.bias[i] * scale_back[i];
+  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = fit.matrix[i] * s0;
   if (!summary.IsSolutionUsable() || !b.allFinite() || !m.allFinite() ||
       !AccelModel::FromMatrix(b, m, AccelParameterization::kAffine, &c.accel.model)) {
     c.not_converged = true;
@@ -253,72 +352,19 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
   f.model = c.accel.model;
 
   std::vector<Eigen::Vector2d> attitude_std(n, Eigen::Vector2d::Constant(NAN));
-  if (ro.compute_covariance) {
-    ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::DENSE_SVD;
-    covariance_options.num_threads = 1;
-    ceres::Covariance covariance(covariance_options);
-    std::vector<std::pair<const double*, const double*>> blocks = {
-        {bias, bias}, {bias, matrix}, {matrix, matrix}};
-    for (int k = 0; k < n; ++k) blocks.push_back({attitude[k].data(), attitude[k].data()});
-    if (covariance.Compute(blocks, &problem)) {
-      double cbb[9], cbm[27], cmm[81];
-      covariance.GetCovarianceBlock(bias, bias, cbb);
-      covariance.GetCovarianceBlock(bias, matrix, cbm);
-      covariance.GetCovarianceBlock(matrix, matrix, cmm);
-      Eigen::MatrixXd cov(12, 12);
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) cov(i, j) = cbb[3 * i + j];
-        for (int j = 0; j < 9; ++j) cov(i, 3 + j) = cov(3 + j, i) = cbm[9 * i + j];
-      }
-      for (int i = 0; i < 9; ++i) {
-        for (int j = 0; j < 9; ++j) cov(3 + i, 3 + j) = cmm[9 * i + j];
-      }
-      for (int i = 0; i < 12; ++i) {
-        for (int j = 0; j < 12; ++j) cov(i, j) *= scale_back[i] * scale_back[j];
-      }
-      f.covariance = cov;
-      f.covariance_available = true;
-      c.accel.covariance = cov;
-      c.accel.covariance_names = f.parameter_names;
-      for (int i = 0; i < 3; ++i) c.accel.bias_std(i) = std::sqrt(cov(i, i));
-      for (int i = 0; i < 9; ++i) c.accel.matrix_std(i / 3, i % 3) = std::sqrt(cov(3 + i, 3 + i));
-      for (int k = 0; k < n; ++k) {
-        double ca[4];
-        covariance.GetCovarianceBlock(attitude[k].data(), attitude[k].data(), ca);
-        attitude_std[k] = Eigen::Vector2d(std::sqrt(ca[0]), std::sqrt(ca[3]));
-      }
-    } else {
-      c.warnings.push_back(
-          "known_attitude: the covariance could not be computed (rank deficient); no standard "
-          "deviations are reported");
-    }
-  }
-  if (f.dof <= 0) {
-    c.warnings.push_back(
-        "known_attitude: as many equations as unknowns; the fit cannot show whether the attitudes "
-        "or the noise estimate are right: record more positions");
-  } else if (ChiSquareUpperTail(f.chi2, f.dof) < 1e-3) {
-    std::ostringstream s;
-    s.precision(3);
-    s << "known_attitude: residuals are " << std::sqrt(f.chi2 / f.dof)
-      << " times what the sensor noise and the stated attitude uncertainties allow (chi2 = "
-      << f.chi2 << " on " << f.dof
-      << " dof): an attitude is wrong or too confident, or a position was disturbed; the "
-         "standard deviations are too small by about that factor";
-    c.warnings.push_back(s.str());
-  }
+  if (ro.compute_covariance) ComputeCovariance(&problem, scale_back, &fit, &attitude_std, &c);
+  WarnFit(f, &c);
 
   AccelModel nominal;
   nominal.upper = s0 * Eigen::Matrix3d::Identity();
-  ReportPositions(positions, nominal, c.accel.model, g, {}, &c);
+  internal::ReportPositions(positions, nominal, c.accel.model, g, {}, &c);
   c.residual_coarse = c.residual_nominal;
   for (int k = 0; k < n; ++k) {
     PositionReport& r = c.positions[k];
-    r.roll_deg = attitude[k][0] * kRadToDeg;
-    r.pitch_deg = attitude[k][1] * kRadToDeg;
-    r.roll_std_deg = attitude_std[k](0) * kRadToDeg;
-    r.pitch_std_deg = attitude_std[k](1) * kRadToDeg;
+    r.roll_deg = fit.attitude[k][0] * internal::kRadToDeg;
+    r.pitch_deg = fit.attitude[k][1] * internal::kRadToDeg;
+    r.roll_std_deg = attitude_std[k](0) * internal::kRadToDeg;
+    r.pitch_std_deg = attitude_std[k](1) * internal::kRadToDeg;
   }
   std::ostringstream s;
   s << (f.converged ? "converged" : "did not converge") << " after " << f.iterations
@@ -350,7 +396,7 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path
   }
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
-  if (!DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
+  if (!internal::DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
   std::vector<FixtureAttitude> rows;
   std::vector<int> row_of_position;
   std::string error;
@@ -359,12 +405,12 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path
     c.message = error;
     return false;
   }
-  constexpr double kDegToRad = M_PI / 180.0;
   std::vector<KnownAttitude> attitudes;
   for (int row : row_of_position) {
     const FixtureAttitude& r = rows[row];
-    attitudes.push_back({r.roll_deg * kDegToRad, r.pitch_deg * kDegToRad,
-                         r.roll_std_deg * kDegToRad, r.pitch_std_deg * kDegToRad});
+    attitudes.push_back({r.roll_deg * internal::kDegToRad, r.pitch_deg * internal::kDegToRad,
+                         r.roll_std_deg * internal::kDegToRad,
+                         r.pitch_std_deg * internal::kDegToRad});
   }
   const bool ok = CalibrateFromKnownAttitudes(positions, attitudes, options, &c);
   if (!ok && !log.source.empty()) c.message = log.source + ": " + c.message;

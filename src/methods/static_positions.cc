@@ -7,24 +7,28 @@
 #include "util/statistics.h"
 
 namespace gravcal {
+namespace internal {
+
+bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector,
+                        std::vector<StaticInterval>* intervals, std::string* message) {
+  if (!log.Validate(message)) return false;
+  StaticDetection detection;
+  if (!DetectStaticIntervals(log, detector, &detection)) {
+    *message = log.source + ": " + detection.message;
+    return false;
+  }
+  *intervals = detection.intervals;
+  return true;
+}
 
 bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
                            Calibration* calibration, std::vector<StaticInterval>* intervals,
                            std::vector<Position>* positions) {
   Calibration& c = *calibration;
-  std::string error;
-  if (!options.IsValid(&error) || !log.Validate(&error)) {
-    c.message = error;
-    return false;
-  }
+  if (!options.IsValid(&c.message)) return false;
   if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
-  StaticDetection detection;
-  if (!DetectStaticIntervals(log, options.detector, &detection)) {
-    c.message = log.source + ": " + detection.message;
-    return false;
-  }
-  *intervals = detection.intervals;
-  *positions = PositionsFromIntervals(detection.intervals);
+  if (!DetectLogIntervals(log, options.detector, intervals, &c.message)) return false;
+  *positions = PositionsFromIntervals(*intervals);
   return true;
 }
 
@@ -42,6 +46,19 @@ double IntervalSamples(const ImuLog& log, const StaticInterval& interval, double
                : 0.0;
 }
 
+PositionReport MakePositionReport(const Position& position, double before, double after,
+                                  double sigma) {
+  PositionReport r;
+  r.position = position;
+  const double n = static_cast<double>(std::max<size_t>(position.sample_count, 1));
+  r.raw_std = (position.raw_mean_cov.diagonal() * n).cwiseSqrt();
+  r.nominal_up = position.nominal_up;
+  r.residual_before = before;
+  r.residual_after = after;
+  r.sigma = sigma;
+  return r;
+}
+
 void ReportPositions(const std::vector<Position>& positions, const AccelModel& nominal,
                      const AccelModel& final_model, double gravity,
                      const std::vector<double>& sigmas, Calibration* calibration) {
@@ -56,16 +73,10 @@ void ReportPositions(const std::vector<Position>& positions, const AccelModel& n
   c.residual_refined = {Rms(after), MaxAbs(after)};
   c.positions.clear();
   for (size_t k = 0; k < positions.size(); ++k) {
-    PositionReport r;
-    r.position = positions[k];
-    const double n = static_cast<double>(std::max<size_t>(positions[k].sample_count, 1));
-    r.raw_std = (positions[k].raw_mean_cov.diagonal() * n).cwiseSqrt();
-    r.nominal_up = positions[k].nominal_up;
-    r.residual_before = before[k];
-    r.residual_after = after[k];
-    r.sigma = k < sigmas.size() ? sigmas[k] : NAN;
-    c.positions.push_back(r);
+    c.positions.push_back(
+        MakePositionReport(positions[k], before[k], after[k], k < sigmas.size() ? sigmas[k] : NAN));
   }
 }
 
+}  // namespace internal
 }  // namespace gravcal

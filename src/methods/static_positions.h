@@ -1,10 +1,13 @@
-// Private: the start shared by the attitude-based methods (ten_position,
-// known_attitude): options and log checked, local gravity resolved, static
-// intervals detected.
+// Private: the front end shared by the methods and workflows that start
+// from a raw log (twelve_position, ten_position, known_attitude, discovery):
+// log checked and static intervals detected; for the attitude-based methods
+// also options checked, local gravity resolved and positions formed; and
+// the position reports.
 #ifndef GRAVCAL_SRC_METHODS_STATIC_POSITIONS_H_
 #define GRAVCAL_SRC_METHODS_STATIC_POSITIONS_H_
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "gravcal/core/imu_log.h"
@@ -13,10 +16,16 @@
 #include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
+namespace internal {
 
-// Fills calibration->gravity, gravity_source (and the standard-gravity
-// warning). Returns false with calibration->message (naming log.source) on
-// invalid options or log, or a detector failure.
+// Checks the log and detects its static intervals. Returns false with
+// *message on an invalid log or a detector failure (naming log.source).
+bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector,
+                        std::vector<StaticInterval>* intervals, std::string* message);
+
+// Checks the options, then as DetectLogIntervals; also fills calibration->gravity, gravity_source
+// (and the standard-gravity warning). Returns false with calibration->message (naming log.source)
+// on invalid options or log, or a detector failure.
 bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
                            Calibration* calibration, std::vector<StaticInterval>* intervals,
                            std::vector<Position>* positions);
@@ -27,12 +36,18 @@ double IntervalSamples(const ImuLog& log, const StaticInterval& interval, double
                        double gyro_scale, std::vector<Eigen::Vector3d>* force,
                        std::vector<Eigen::Vector3d>* rate);
 
+// The report of one position: its noise per sample, nominal axis,
+// residuals |a| - g before and after, and sigma.
+PositionReport MakePositionReport(const Position& position, double before, double after,
+                                  double sigma);
+
 // One PositionReport per position, with residuals |a| - g before (nominal)
 // and after (final) and the given sigmas.
 void ReportPositions(const std::vector<Position>& positions, const AccelModel& nominal,
                      const AccelModel& final_model, double gravity,
                      const std::vector<double>& sigmas, Calibration* calibration);
 
+}  // namespace internal
 }  // namespace gravcal
 
 #endif  // GRAVCAL_SRC_METHODS_STATIC_POSITIONS_H_

@@ -9,11 +9,11 @@
 
 #include "gravcal/estimation/refinement.h"
 #include "methods/static_positions.h"
+#include "util/units.h"
 
 namespace gravcal {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Fewest positions: step 4 has six unknowns (bias and three scales).
 constexpr int kMinPositions = 6;
 
@@ -26,7 +26,7 @@ bool AlignPositions(const ImuLog& log, const std::vector<StaticInterval>& interv
   alignments->assign(intervals.size(), StaticAlignmentResult());
   std::vector<Eigen::Vector3d> force, rate;
   for (size_t k = 0; k < intervals.size(); ++k) {
-    const double dt = IntervalSamples(log, intervals[k], 1.0, gyro_scale, &force, &rate);
+    const double dt = internal::IntervalSamples(log, intervals[k], 1.0, gyro_scale, &force, &rate);
     for (Eigen::Vector3d& f : force) f = transform(f);
     if (!AlignStatic(force, rate, dt, options, &(*alignments)[k])) {
       std::ostringstream s;
@@ -67,7 +67,7 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
   }
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
-  if (!DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
+  if (!internal::DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
   const std::string where = log.source.empty() ? "" : log.source + ": ";
   const int n = static_cast<int>(positions.size());
   if (n < kMinPositions) {
@@ -212,14 +212,14 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
 
   AccelModel nominal;
   nominal.upper = nominal_scale * Eigen::Matrix3d::Identity();
-  ReportPositions(positions, nominal, c.accel.model, c.gravity, c.refinement.sigmas, &c);
+  internal::ReportPositions(positions, nominal, c.accel.model, c.gravity, c.refinement.sigmas, &c);
   c.residual_coarse = c.residual_nominal;
   for (int k = 0; k < n; ++k) {
     PositionReport& r = c.positions[k];
-    r.roll_deg = second[k].roll * kRadToDeg;
-    r.pitch_deg = second[k].pitch * kRadToDeg;
-    r.roll_std_deg = second[k].roll_std * kRadToDeg;
-    r.pitch_std_deg = second[k].pitch_std * kRadToDeg;
+    r.roll_deg = second[k].roll * internal::kRadToDeg;
+    r.pitch_deg = second[k].pitch * internal::kRadToDeg;
+    r.roll_std_deg = second[k].roll_std * internal::kRadToDeg;
+    r.pitch_std_deg = second[k].pitch_std * internal::kRadToDeg;
   }
   c.success = true;
   std::ostringstream s;

@@ -9,7 +9,9 @@
 #include "core/calibration_gravity.h"
 #include "estimation/accel_uncertainty.h"
 #include "gravcal/estimation/housing_rotation.h"
+#include "methods/static_positions.h"
 #include "util/statistics.h"
+#include "util/units.h"
 
 namespace gravcal {
 
@@ -56,6 +58,64 @@ namespace {
 
 ResidualSummary Summarise(const std::vector<double>& r) { return {Rms(r), MaxAbs(r)}; }
 
+// The refinement with the configured solver (Ceres or the Newton baseline).
+bool RefineWithSolver(const std::vector<Position>& placed, const CalibrationOptions& options,
+                      Calibration* calibration) {
+  Calibration& c = *calibration;
+  const AccelParameterization p = options.refinement.parameterization;
+  bool ok;
+  if (options.solver == RefinementSolver::kCeres) {
+    ok = Refine(placed, c.coarse.model, c.gravity, options.refinement, &c.refinement);
+    c.solver_name = "ceres_levenberg_marquardt";
+  } else {
+    NewtonOptions newton;
+    newton.parameterization = p;
+    newton.residual = options.newton_residual;
+    newton.max_iterations = options.refinement.max_iterations;
+    newton.compute_covariance = options.refinement.compute_covariance;
+    ok = NewtonRefine(placed, c.coarse.model, c.gravity, newton, &c.refinement);
+    c.solver_name = std::string("newton_") + ToString(options.newton_residual);
+  }
+  return ok;
+}
+
+// affine: the rotation of the sensor axes in the housing from the nominal
+// axes of the axis-aligned positions, and the accelerometer's uncertainty
+// with it (or without a housing rotation).
+void AddHousingRotation(const std::vector<Position>& placed, AccelParameterization p,
+                        Calibration* calibration) {
+  Calibration& c = *calibration;
+  std::string error;
+  HousingRotation housing;
+  bool have_housing = false;
+  if (p == AccelParameterization::kAffine) {
+    if (EstimateHousingRotation(placed, c.coarse.nominal_up, c.accel.model, &housing, &error)) {
+      c.accel.model.rotation = housing.rotation;
+      c.accel.tilt_rms = housing.tilt_rms;
+      have_housing = true;
+      std::ostringstream s;
+      s.precision(3);
+      s << "affine: bias, scale and non-orthogonality come from the gravity magnitude; the "
+           "rotation of the sensor axes in the housing comes from the nominal axes of "
+        << housing.positions_used << " axis-aligned positions (placement error seen: "
+        << housing.tilt_rms * internal::kRadToDeg
+        << " deg rms), so its accuracy is that of the placement";
+      c.warnings.push_back(s.str());
+    } else {
+      c.warnings.push_back(
+          "affine: the rotation of the sensor axes in the housing is not "
+          "determined (" +
+          error +
+          "); it is left at identity with no standard "
+          "deviation");
+    }
+  }
+  if (c.refinement.covariance_available) {
+    PropagateUncertainty(c.refinement, have_housing ? &housing : nullptr, &c.accel);
+    if (p == AccelParameterization::kAffine && !have_housing) c.accel.matrix_std.setConstant(NAN);
+  }
+}
+
 }  // namespace
 
 bool CalibrateFromPositions(const std::vector<Position>& positions,
@@ -96,19 +156,7 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
   }
   for (size_t k = 0; k < placed.size(); ++k) placed[k].nominal_up = c.coarse.nominal_up[k];
 
-  bool ok;
-  if (options.solver == RefinementSolver::kCeres) {
-    ok = Refine(placed, c.coarse.model, c.gravity, options.refinement, &c.refinement);
-    c.solver_name = "ceres_levenberg_marquardt";
-  } else {
-    NewtonOptions newton;
-    newton.parameterization = p;
-    newton.residual = options.newton_residual;
-    newton.max_iterations = options.refinement.max_iterations;
-    newton.compute_covariance = options.refinement.compute_covariance;
-    ok = NewtonRefine(placed, c.coarse.model, c.gravity, newton, &c.refinement);
-    c.solver_name = std::string("newton_") + ToString(options.newton_residual);
-  }
+  const bool ok = RefineWithSolver(placed, options, &c);
   if (!ok) {
     c.message = c.refinement.message;
     return false;
@@ -123,46 +171,13 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
   c.residual_coarse = Summarise(MagnitudeResiduals(placed, c.coarse.model, c.gravity));
   c.residual_refined = Summarise(MagnitudeResiduals(placed, c.accel.model, c.gravity));
 
-  HousingRotation housing;
-  bool have_housing = false;
-  if (p == AccelParameterization::kAffine) {
-    if (EstimateHousingRotation(placed, c.coarse.nominal_up, c.accel.model, &housing, &error)) {
-      c.accel.model.rotation = housing.rotation;
-      c.accel.tilt_rms = housing.tilt_rms;
-      have_housing = true;
-      std::ostringstream s;
-      s.precision(3);
-      s << "affine: bias, scale and non-orthogonality come from the gravity magnitude; the "
-           "rotation of the sensor axes in the housing comes from the nominal axes of "
-        << housing.positions_used
-        << " axis-aligned positions (placement error seen: " << housing.tilt_rms * 180.0 / M_PI
-        << " deg rms), so its accuracy is that of the placement";
-      c.warnings.push_back(s.str());
-    } else {
-      c.warnings.push_back(
-          "affine: the rotation of the sensor axes in the housing is not "
-          "determined (" +
-          error +
-          "); it is left at identity with no standard "
-          "deviation");
-    }
-  }
-  if (c.refinement.covariance_available) {
-    PropagateUncertainty(c.refinement, have_housing ? &housing : nullptr, &c.accel);
-    if (p == AccelParameterization::kAffine && !have_housing) c.accel.matrix_std.setConstant(NAN);
-  }
+  AddHousingRotation(placed, p, &c);
 
   const std::vector<double>& sigmas = c.refinement.sigmas;
   for (size_t k = 0; k < placed.size(); ++k) {
-    PositionReport r;
-    r.position = placed[k];
-    const double n = static_cast<double>(std::max<size_t>(placed[k].sample_count, 1));
-    r.raw_std = (placed[k].raw_mean_cov.diagonal() * n).cwiseSqrt();
-    r.nominal_up = placed[k].nominal_up;
-    r.residual_before = c.refinement.residuals_before[k];
-    r.residual_after = c.refinement.residuals_after.empty() ? NAN : c.refinement.residuals_after[k];
-    r.sigma = sigmas[k];
-    c.positions.push_back(r);
+    c.positions.push_back(internal::MakePositionReport(
+        placed[k], c.refinement.residuals_before[k],
+        c.refinement.residuals_after.empty() ? NAN : c.refinement.residuals_after[k], sigmas[k]));
   }
 
   const std::vector<std::string>& undetermined = c.refinement.observability.undetermined;
@@ -195,23 +210,13 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
                             Calibration* calibration, std::vector<StaticInterval>* intervals) {
   CHECK(calibration != nullptr);
   *calibration = Calibration();
-  std::string error;
-  if (!options.IsValid(&error)) {
-    calibration->message = error;
+  std::vector<StaticInterval> detected;
+  if (!options.IsValid(&calibration->message) ||
+      !internal::DetectLogIntervals(log, options.detector, &detected, &calibration->message)) {
     return false;
   }
-  if (!log.Validate(&error)) {
-    calibration->message = error;
-    return false;
-  }
-  StaticDetection detection;
-  if (!DetectStaticIntervals(log, options.detector, &detection)) {
-    calibration->message = log.source + ": " + detection.message;
-    return false;
-  }
-  const std::vector<Position> positions = PositionsFromIntervals(detection.intervals);
-  if (intervals != nullptr) *intervals = detection.intervals;
-  const bool ok = CalibrateFromPositions(positions, options, calibration);
+  if (intervals != nullptr) *intervals = detected;
+  const bool ok = CalibrateFromPositions(PositionsFromIntervals(detected), options, calibration);
   if (!ok && !log.source.empty()) calibration->message = log.source + ": " + calibration->message;
   return ok;
 }

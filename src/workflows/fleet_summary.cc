@@ -10,6 +10,7 @@
 
 #include "io/csv_table.h"
 #include "util/content_hash.h"
+#include "util/statistics.h"
 
 namespace gravcal {
 namespace {
@@ -70,12 +71,6 @@ std::string Short(double v) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%.6g", v);
   return buffer;
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 double ValueOf(const SummaryRow& row, const std::string& column) {

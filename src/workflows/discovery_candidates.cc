@@ -1,0 +1,292 @@
+#include "workflows/discovery_candidates.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "util/statistics.h"
+#include "workflows/discovery_cross_validation.h"
+
+namespace gravcal {
+namespace internal {
+namespace {
+
+// Why an effect cannot be tried in this session, or "".
+std::string NotApplicable(const DiscoveryContext& ctx, const std::vector<Effect>& current, Effect e,
+                          const DiscoveryOptions& options, int sensor_residuals,
+                          int sensor_parameters) {
+  const EffectInfo& info = Info(e);
+  if (Contains(current, e)) return "already in the model";
+  if (e == Effect::kAccelMisalignment && ctx.parameterization != AccelParameterization::kScale) {
+    return "already in the baseline (parameterization " +
+           std::string(ToString(ctx.parameterization)) + ")";
+  }
+  if (info.sensor == EffectSensor::kGyroscope && !ctx.has_gyro) {
+    return "the log has no gyroscope";
+  }
+  if (info.regressor == EffectRegressor::kTemperature) {
+    if (!ctx.has_temperature) return "the log has no temperature";
+    if (ctx.temperature_range < options.min_temperature_range) {
+      return "the positions span only " + FormatNumber("%.2f", ctx.temperature_range) +
+             " degC (needs " + FormatNumber("%.2f", options.min_temperature_range) +
+             "): record while the temperature changes";
+    }
+  }
+  const int per_position = info.sensor == EffectSensor::kGyroscope ? 3 : 1;
+  const int dof = sensor_residuals - sensor_parameters - info.num_parameters;
+  if (dof < options.min_dof || dof - per_position < 1) {
+    std::ostringstream s;
+    s << "too few positions: " << sensor_residuals / per_position << " positions give "
+      << sensor_residuals << " residuals for " << sensor_parameters << " + " << info.num_parameters
+      << " parameters (needs " << options.min_dof
+      << " left over, and one in every leave-one-out fold); record more poses"
+      << (IsAccel(e) && ctx.parameterization != AccelParameterization::kScale
+              ? " or use parameterization: scale"
+              : "");
+    return s.str();
+  }
+  return "";
+}
+
+// Warns once per effect that it cannot be tested in this session.
+void WarnUntestable(Effect e, const std::string& why, std::vector<std::string>* warned,
+                    std::vector<std::string>* warnings) {
+  if (std::find(warned->begin(), warned->end(), Info(e).name) != warned->end()) return;
+  warned->push_back(Info(e).name);
+  warnings->push_back(why);
+}
+
+// The names of e's parameters that the extended fit does not determine.
+std::string UndeterminedOf(Effect e, const SensorFitSummary& ext) {
+  std::string undetermined;
+  for (const std::string& name : Info(e).parameter_names) {
+    if (std::find(ext.undetermined.begin(), ext.undetermined.end(), name) !=
+        ext.undetermined.end()) {
+      undetermined += (undetermined.empty() ? "" : ", ") + name;
+    }
+  }
+  return undetermined;
+}
+
+// Tries e on top of `current`: fills *c (tried, or the reason not) and *fit.
+void TryCandidate(const DiscoveryContext& ctx, const ModelAssessment& current, Effect e,
+                  const DiscoveryOptions& options, std::vector<std::string>* warned,
+                  std::vector<std::string>* warnings, CandidateScore* c, EffectFitResult* fit) {
+  c->effect = e;
+  const bool accel = IsAccel(e);
+  const SensorFitSummary& now = accel ? current.fit.accel_fit : current.fit.gyro_fit;
+  c->reason =
+      NotApplicable(ctx, current.effects, e, options, now.num_residuals, now.num_parameters);
+  if (!c->reason.empty()) {
+    // Warn once per effect; "already in the model / baseline" is no news.
+    if (c->reason.rfind("already", 0) != 0) {
+      WarnUntestable(e,
+                     std::string(Info(e).name) + " cannot be tested in this session: " + c->reason,
+                     warned, warnings);
+    }
+    return;
+  }
+  std::vector<Effect> extended = current.effects;
+  extended.push_back(e);
+  EffectFitResult extended_fit;
+  if (!FitDiscoveryModel(ctx, *ctx.observations, extended, current.fit, accel, !accel, true,
+                         &extended_fit)) {
+    c->reason = "the extended fit failed: " + extended_fit.message;
+    return;
+  }
+  const SensorFitSummary& ext = accel ? extended_fit.accel_fit : extended_fit.gyro_fit;
+  const std::string undetermined = UndeterminedOf(e, ext);
+  if (!undetermined.empty()) {
+    c->reason = "cannot be identified in this session (" + undetermined +
+                " not determined by the positions)";
+    WarnUntestable(e, std::string(Info(e).name) + ": " + c->reason, warned, warnings);
+    return;
+  }
+  c->tried = true;
+  c->dof = Info(e).num_parameters;
+  c->delta_chi2 = now.chi2 - ext.chi2;
+  c->gap = InSampleGap(extended_fit, ctx.has_gyro);
+  // The other sensor's part was not refitted: its gap is the current one.
+  if (accel) {
+    c->gap.gyro = current.gap.gyro;
+    c->gap.gyro_sigma = current.gap.gyro_sigma;
+  } else {
+    c->gap.accel = current.gap.accel;
+    c->gap.accel_sigma = current.gap.accel_sigma;
+  }
+  c->cv_gap = current.cv_gap;
+  if (!CrossValidate(ctx, extended, extended_fit, Info(e).sensor, &c->cv_gap, nullptr, nullptr)) {
+    c->reason = "cross-validation failed (a fold could not be fitted)";
+    c->tried = false;
+  }
+  *fit = extended_fit;
+}
+
+// When no candidate is significant on its own but some pass the likelihood
+// ratio and BIC and fail only the cross-validation, two effects may be
+// masking each other: each alone leaves the other's large residual, which
+// dominates the left-out predictions. Tries those candidates in pairs of
+// the same sensor: a pair counts when together they lower the
+// cross-validated gap and each adds significantly (chi2 test at `alpha`)
+// on top of the other. The member of the best such pair (lowest
+// cross-validated gap) with the lower delta BIC alone is named; the index
+// of its score, or -1.
+int PairLookAhead(const DiscoveryContext& ctx, const ModelAssessment& current, double alpha,
+                  const DiscoveryOptions& options, std::vector<CandidateScore>* scores) {
+  std::vector<int> masked;
+  for (size_t i = 0; i < scores->size(); ++i) {
+    const CandidateScore& c = (*scores)[i];
+    if (c.tried && c.p_value < alpha && c.delta_bic < -options.min_bic_gain) {
+      masked.push_back(static_cast<int>(i));
+    }
+  }
+  int best = -1;
+  double best_cv = INFINITY;
+  std::string partner;
+  for (size_t a = 0; a < masked.size(); ++a) {
+    for (size_t b = a + 1; b < masked.size(); ++b) {
+      CandidateScore& ca = (*scores)[masked[a]];
+      CandidateScore& cb = (*scores)[masked[b]];
+      const bool accel = IsAccel(ca.effect);
+      if (IsAccel(cb.effect) != accel) continue;
+      std::vector<Effect> pair = current.effects;
+      pair.push_back(ca.effect);
+      pair.push_back(cb.effect);
+      EffectFitResult fit;
+      if (!FitDiscoveryModel(ctx, *ctx.observations, pair, current.fit, accel, !accel, true, &fit))
+        continue;
+      const SensorFitSummary& now = accel ? current.fit.accel_fit : current.fit.gyro_fit;
+      const double chi2 = accel ? fit.accel_fit.chi2 : fit.gyro_fit.chi2;
+      // chi2 with only A = chi2_now - delta_chi2_A; B adds that minus chi2.
+      const double adds_b = now.chi2 - ca.delta_chi2 - chi2;
+      const double adds_a = now.chi2 - cb.delta_chi2 - chi2;
+      if (!(ChiSquareUpperTail(adds_b, cb.dof) < alpha) ||
+          !(ChiSquareUpperTail(adds_a, ca.dof) < alpha)) {
+        continue;
+      }
+      Gap cv = current.cv_gap;
+      if (!CrossValidate(ctx, pair, fit, Info(ca.effect).sensor, &cv, nullptr, nullptr)) continue;
+      const double before = accel ? current.cv_gap.accel_sigma : current.cv_gap.gyro_sigma;
+      const double after = accel ? cv.accel_sigma : cv.gyro_sigma;
+      if (!(after < before) || !(after < best_cv)) continue;
+      best_cv = after;
+      const bool a_first = ca.delta_bic <= cb.delta_bic;
+      best = a_first ? masked[a] : masked[b];
+      partner = ToString(a_first ? cb.effect : ca.effect);
+    }
+  }
+  if (best >= 0) {
+    CandidateScore& c = (*scores)[best];
+    c.significant = true;
+    std::ostringstream why;
+    why.precision(3);
+    why << "significant together with " << partner << " (cross-validated gap " << best_cv
+        << " sigma with both); alone: " << c.reason;
+    c.reason = why.str();
+  }
+  return best;
+}
+
+}  // namespace
+
+void TryCandidates(const DiscoveryContext& ctx, const ModelAssessment& current,
+                   const std::vector<Effect>& candidates, const DiscoveryOptions& options,
+                   std::vector<std::string>* warned, std::vector<std::string>* warnings,
+                   std::vector<CandidateScore>* scores, std::vector<EffectFitResult>* fits) {
+  for (Effect e : candidates) {
+    CandidateScore c;
+    EffectFitResult fit;
+    TryCandidate(ctx, current, e, options, warned, warnings, &c, &fit);
+    scores->push_back(c);
+    fits->push_back(fit);
+  }
+}
+
+// The noise scale: when the current model extended by all candidates of a
+// sensor at once fits that sensor's data to its own noise (chi2 test, p >=
+// 0.01), the per-position sigmas are right and each candidate is tested
+// against them (chi-square); otherwise the data show noise (or an effect)
+// beyond the catalogue, and each candidate's statistic is divided by the
+// dispersion phi = chi2 / dof its extended model leaves, and referred to
+// F(p, dof). (Dividing by each candidate's own phi alone would count the
+// other missing effects as noise: two effects hidden together could then
+// both go unnamed.)
+void ScoreCandidates(const DiscoveryContext& ctx, const ModelAssessment& current,
+                     const std::vector<EffectFitResult>& fits, double log_n,
+                     std::vector<CandidateScore>* scores) {
+  for (EffectSensor sensor : {EffectSensor::kAccelerometer, EffectSensor::kGyroscope}) {
+    const bool accel = sensor == EffectSensor::kAccelerometer;
+    std::vector<Effect> all = current.effects;
+    int count = 0;
+    int last = -1;
+    for (size_t i = 0; i < scores->size(); ++i) {
+      if ((*scores)[i].tried && IsAccel((*scores)[i].effect) == accel) {
+        all.push_back((*scores)[i].effect);
+        ++count;
+        last = static_cast<int>(i);
+      }
+    }
+    if (count == 0) continue;
+    bool noise_fits = false;
+    EffectFitResult joint;
+    const EffectFitResult* richest = &fits[last];
+    if (count == 1 ||
+        FitDiscoveryModel(ctx, *ctx.observations, all, current.fit, accel, !accel, true, &joint)) {
+      if (count > 1) richest = &joint;
+      const SensorFitSummary& f = accel ? richest->accel_fit : richest->gyro_fit;
+      const int dof = f.num_residuals - f.rank;
+      noise_fits = dof >= 1 && ChiSquareUpperTail(f.chi2, dof) >= 0.01;
+    }
+    for (size_t i = 0; i < scores->size(); ++i) {
+      CandidateScore& c = (*scores)[i];
+      if (!c.tried || IsAccel(c.effect) != accel) continue;
+      const SensorFitSummary& ext = accel ? fits[i].accel_fit : fits[i].gyro_fit;
+      const int dof1 = ext.dof();
+      c.dispersion = noise_fits || dof1 <= 0 ? 1.0 : std::max(1.0, ext.chi2 / dof1);
+      if (!(c.delta_chi2 > 0.0)) {
+        c.p_value = 1.0;
+      } else if (c.dispersion > 1.0) {
+        c.p_value = FUpperTail(c.delta_chi2 / c.dof / c.dispersion, c.dof, dof1);
+      } else {
+        c.p_value = ChiSquareUpperTail(c.delta_chi2, c.dof);
+      }
+      c.delta_bic = -c.delta_chi2 / c.dispersion + c.dof * log_n;
+    }
+  }
+}
+
+int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,
+                    const DiscoveryOptions& options, std::vector<CandidateScore>* scores_out) {
+  std::vector<CandidateScore>& scores = *scores_out;
+  int tried = 0;
+  for (const CandidateScore& c : scores) tried += c.tried ? 1 : 0;
+  const double alpha = options.significance / std::max(1, tried);
+  int best = -1;
+  for (size_t i = 0; i < scores.size(); ++i) {
+    CandidateScore& c = scores[i];
+    if (!c.tried) continue;
+    const bool accel = IsAccel(c.effect);
+    const double before = accel ? current.cv_gap.accel_sigma : current.cv_gap.gyro_sigma;
+    const double after = accel ? c.cv_gap.accel_sigma : c.cv_gap.gyro_sigma;
+    std::ostringstream why;
+    why.precision(3);
+    if (!(c.p_value < alpha)) why << "p = " << c.p_value << " not below " << alpha << "; ";
+    if (!(c.delta_bic < -options.min_bic_gain)) {
+      why << "delta BIC = " << c.delta_bic << " not below " << -options.min_bic_gain << "; ";
+    }
+    if (!(after < before)) {
+      why << "cross-validated gap " << after << " sigma not below " << before << "; ";
+    }
+    c.reason = why.str();
+    if (!c.reason.empty()) c.reason.resize(c.reason.size() - 2);
+    c.significant = c.reason.empty();
+    if (c.significant && (best < 0 || c.delta_bic < scores[best].delta_bic)) {
+      best = static_cast<int>(i);
+    }
+  }
+  if (best < 0) best = PairLookAhead(ctx, current, alpha, options, &scores);
+  return best;
+}
+
+}  // namespace internal
+}  // namespace gravcal
