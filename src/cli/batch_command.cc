@@ -25,11 +25,11 @@
 #include <system_error>
 
 #include "cli/commands.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/batch_manifest.h"
-#include "gravcal/io/calibration_io.h"
 #include "gravcal/workflows/fleet_summary.h"
-#include "gravcal/io/log_reader.h"
 
 namespace gravcal {
 namespace cli {

@@ -3,9 +3,9 @@
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/discovery.h"
 #include "gravcal/workflows/discovery_report.h"
-#include "gravcal/io/log_reader.h"
 
 namespace gravcal {
 namespace cli {

@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/io/attitude_fixture.h"
-#include "gravcal/methods/twelve_position.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/position.h"
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
 
@@ -57,6 +57,12 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
 // CalibrateFromKnownAttitudes. Messages name the log or the file and line.
 bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path,
                             const CalibrationOptions& options, Calibration* calibration);
+
+// Same with the file's rows already read (ReadFixtureAttitudes);
+// `attitudes_name` names the file in messages.
+bool CalibrateKnownAttitude(const ImuLog& log, const std::vector<FixtureAttitude>& rows,
+                            const std::string& attitudes_name, const CalibrationOptions& options,
+                            Calibration* calibration);
 
 }  // namespace gravcal
 

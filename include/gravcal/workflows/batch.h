@@ -24,8 +24,8 @@
 #include <vector>
 
 #include "gravcal/core/calibration.h"
-#include "gravcal/workflows/config.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/workflows/config.h"
 
 namespace gravcal {
 

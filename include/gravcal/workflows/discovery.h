@@ -40,10 +40,10 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/methods/twelve_position.h"
-#include "gravcal/methods/effect_fit.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/model_effects.h"
+#include "gravcal/methods/effect_fit.h"
+#include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
 
