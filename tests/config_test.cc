@@ -2,7 +2,6 @@
 // validate; every kind of bad input must fail with a message naming the file
 // and line or the key, and leave the config untouched.
 #include "gravcal/workflows/config.h"
-#include "gravcal/workflows/method_registry.h"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "gravcal/workflows/method_registry.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -162,9 +162,10 @@ TEST(Config, DefaultsCommandKeysAndUsedKeysAreNotErrors) {
     std::string error;
     EXPECT_TRUE(config.IsValid(&error)) << m.name << ": " << error;
     // Simulator and discovery keys belong to commands, not to methods.
-    ASSERT_TRUE(LoadConfigText("sim_hold: 5\nhh_rate: 30\ndiscovery_max_steps: 2\n"
-                               "output_covariance: false\nformat: csv\n",
-                               "c.yaml", &config, &error))
+    ASSERT_TRUE(
+        LoadConfigText("sim_hold: 5\nhh_rate: 30\ndiscovery_max_steps: 2\n"
+                       "output_covariance: false\nformat: csv\n",
+                       "c.yaml", &config, &error))
         << error;
     EXPECT_TRUE(config.IsValid(&error)) << m.name << ": " << error;
   }

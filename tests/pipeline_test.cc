@@ -107,8 +107,7 @@ TEST(Pipeline, RateTableFromSegmentsFileEqualsCalibrateRateTable) {
   ASSERT_EQ(s.segments.size(), 6u);
   const std::string text = RateTableSegmentsToCsv(s.segments, s.sensor.log);
   std::vector<RateTableSegment> parsed;
-  ASSERT_TRUE(ParseRateTableSegments(text, "segments.csv", s.sensor.log, &parsed, &error))
-      << error;
+  ASSERT_TRUE(ParseRateTableSegments(text, "segments.csv", s.sensor.log, &parsed, &error)) << error;
   ASSERT_EQ(parsed.size(), s.segments.size());
   for (size_t k = 0; k < parsed.size(); ++k) {
     EXPECT_EQ(parsed[k].begin, s.segments[k].begin) << k;
@@ -160,13 +159,13 @@ TEST(Pipeline, BadSegmentsFileNamesFileAndLine) {
       "t_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n0,0.5,10,0,0\n0.6,x,0,0,0\n", "s.csv", log,
       &segments, &error));
   EXPECT_EQ(error.rfind("s.csv:3:", 0), 0u) << error;
-  EXPECT_FALSE(ParseRateTableSegments(
-      "t_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n5,6,10,0,0\n", "s.csv", log, &segments,
-      &error));
+  EXPECT_FALSE(
+      ParseRateTableSegments("t_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n5,6,10,0,0\n",
+                             "s.csv", log, &segments, &error));
   EXPECT_NE(error.find("fewer than 2 samples"), std::string::npos) << error;
   ASSERT_TRUE(ParseRateTableSegments(
-      "# comment\nt_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n0.1,0.5,10,0,0\n", "s.csv",
-      log, &segments, &error))
+      "# comment\nt_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n0.1,0.5,10,0,0\n", "s.csv", log,
+      &segments, &error))
       << error;
   ASSERT_EQ(segments.size(), 1u);
   EXPECT_EQ(segments[0].begin, 10u);

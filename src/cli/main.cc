@@ -15,6 +15,7 @@
 #include "cli/commands.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/method_registry.h"
 
 DEFINE_string(input, "", "raw log to read");
 DEFINE_string(output, "", "file to write (calibration JSON or corrected CSV)");
@@ -32,9 +33,12 @@ DEFINE_double(outlier_sigmas, gravcal::FleetOptions().outlier_sigmas,
               "batch: outlier threshold, robust standard deviations from the fleet median");
 DEFINE_int32(outlier_min_units, gravcal::FleetOptions().min_units,
              "batch: fewest calibrated units for the outlier check");
-DEFINE_string(attitudes, "", "known_attitude: CSV of each static position's roll and pitch");
+DEFINE_string(attitudes, "",
+              "CSV of each static position's roll and pitch (methods that need the fixture's "
+              "attitudes)");
 DEFINE_string(segments, "",
-              "rate_table: CSV of the constant-rate segments (t_begin, t_end, rates)");
+              "CSV of the constant-rate segments, t_begin, t_end, rates (methods that need a rate "
+              "table)");
 DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
 DEFINE_string(report, "", "HTML report to write (discover)");
 
@@ -94,6 +98,31 @@ const std::vector<CommandInfo>& Commands() {
   return commands;
 }
 
+// Who reads the keys of `section` (help's section headers): "every method",
+// "not a method key", or the methods, with the keys when a method reads only
+// some of them.
+std::string SectionReaders(const std::string& section) {
+  std::vector<const gravcal::ConfigKey*> keys;
+  for (const gravcal::ConfigKey& k : gravcal::ConfigKeys()) {
+    if (k.section == section) keys.push_back(&k);
+  }
+  if (keys.empty()) return "";
+  if (keys[0]->use == gravcal::ConfigSectionUse::kAllMethods) return "every method";
+  if (keys[0]->use == gravcal::ConfigSectionUse::kCommand) return "commands, not methods";
+  std::string text;
+  for (const gravcal::CalibrationMethod& m : gravcal::CalibrationMethods()) {
+    std::string read;
+    size_t count = 0;
+    for (const gravcal::ConfigKey* k : keys) {
+      if (!gravcal::MethodReadsKey(m, *k)) continue;
+      read += (count++ ? ", " : "") + k->name;
+    }
+    if (count == 0) continue;
+    text += (text.empty() ? "" : "; ") + m.name + (count < keys.size() ? " (" + read + ")" : "");
+  }
+  return text;
+}
+
 void PrintHelp(const std::string& command) {
   gravcal::Config defaults;
   if (command.empty()) {
@@ -120,7 +149,7 @@ void PrintHelp(const std::string& command) {
     for (const gravcal::ConfigKey& k : gravcal::ConfigKeys()) {
       if (k.section != section) {
         section = k.section;
-        std::printf("  %s:\n", section.c_str());
+        std::printf("  %s (read by %s):\n", section.c_str(), SectionReaders(section).c_str());
       }
       std::printf("    --%-26s %s [%s]\n", k.name.c_str(), k.help.c_str(),
                   gravcal::ConfigValueText(defaults, k.name).c_str());

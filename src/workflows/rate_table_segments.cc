@@ -99,7 +99,8 @@ std::string RateTableSegmentsToCsv(const std::vector<RateTableSegment>& segments
   std::string text = "t_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n";
   for (const RateTableSegment& s : segments) {
     if (s.end <= s.begin || s.end > log.size()) continue;
-    const Eigen::Vector3d dps = s.rate * internal::kRadToDeg;
+    // + 0.0 writes a zero rate as 0, not -0.
+    const Eigen::Vector3d dps = (s.rate * internal::kRadToDeg).array() + 0.0;
     text += Number(log.t[s.begin]) + "," + Number(log.t[s.end - 1]) + "," + Number(dps.x()) + "," +
             Number(dps.y()) + "," + Number(dps.z()) + "\n";
   }
