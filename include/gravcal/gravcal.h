@@ -59,5 +59,7 @@
 #include "gravcal/workflows/discovery.h"
 #include "gravcal/workflows/discovery_report.h"
 #include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/pipeline.h"
+#include "gravcal/workflows/rate_table_segments.h"
 #endif  // GRAVCAL_GRAVCAL_H_
