@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "gravcal/workflows/method_registry.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -99,6 +100,122 @@ TEST(Config, InvalidValuesAreCaughtByValidation) {
   config.method = "thirteen_position";
   EXPECT_FALSE(config.IsValid(&error));
   EXPECT_NE(error.find("method"), std::string::npos) << error;
+}
+
+TEST(Config, UnknownMethodListsEveryRegistryMethod) {
+  Config config;
+  std::string error;
+  ASSERT_TRUE(SetConfigValue("method", "nine_position", &config, &error)) << error;
+  EXPECT_FALSE(config.IsValid(&error));
+  EXPECT_NE(error.find("unknown method 'nine_position'"), std::string::npos) << error;
+  for (const CalibrationMethod& m : CalibrationMethods()) {
+    EXPECT_NE(error.find(m.name), std::string::npos) << error;
+  }
+}
+
+TEST(Config, KeyTheMethodDoesNotUseIsAnErrorNamingKeyAndMethod) {
+  struct Case {
+    const char* yaml;
+    const char* message;
+  };
+  for (const Case& k : {
+           Case{"method: known_attitude\neffects: [accel_temperature_bias]\n",
+                "key 'effects' is not used by method 'known_attitude'"},
+           Case{"method: known_attitude\nparameterization: affine\n",
+                "key 'parameterization' is not used by method 'known_attitude'"},
+           Case{"method: known_attitude\nsolver: newton\n",
+                "key 'solver' is not used by method 'known_attitude'"},
+           Case{"method: ten_position\ngyro_model: full\n",
+                "key 'gyro_model' is not used by method 'ten_position'"},
+           Case{"method: ten_position\neffects: []\n",
+                "key 'effects' is not used by method 'ten_position'"},
+           Case{"method: handheld_kalman\nwindow: 2\n",
+                "key 'window' is not used by method 'handheld_kalman'"},
+           Case{"method: twelve_position\nhk_passes: 3\n",
+                "key 'hk_passes' is not used by method 'twelve_position'"},
+           Case{"method: twelve_position\ngyro_nominal_scale: 1\n",
+                "key 'gyro_nominal_scale' is not used by method 'twelve_position'"},
+           Case{"method: rate_table\ngravity: 9.81\n",
+                "key 'gravity' is not used by method 'rate_table'"},
+       }) {
+    Config config;
+    std::string error;
+    ASSERT_TRUE(LoadConfigText(k.yaml, "c.yaml", &config, &error)) << error;
+    EXPECT_FALSE(config.IsValid(&error)) << k.yaml;
+    EXPECT_EQ(error.rfind(k.message, 0), 0u) << error;
+  }
+  // A key given on the command line counts the same as one in the file.
+  Config config;
+  std::string error;
+  ASSERT_TRUE(SetConfigValue("method", "known_attitude", &config, &error)) << error;
+  ASSERT_TRUE(config.IsValid(&error)) << error;
+  ASSERT_TRUE(SetConfigValue("gyro_joint", "true", &config, &error)) << error;
+  EXPECT_FALSE(config.IsValid(&error));
+  EXPECT_NE(error.find("'gyro_joint'"), std::string::npos) << error;
+}
+
+TEST(Config, DefaultsCommandKeysAndUsedKeysAreNotErrors) {
+  for (const CalibrationMethod& m : CalibrationMethods()) {
+    // Defaults of keys the method ignores never count: only keys set do.
+    Config config;
+    config.method = m.name;
+    std::string error;
+    EXPECT_TRUE(config.IsValid(&error)) << m.name << ": " << error;
+    // Simulator and discovery keys belong to commands, not to methods.
+    ASSERT_TRUE(
+        LoadConfigText("sim_hold: 5\nhh_rate: 30\ndiscovery_max_steps: 2\n"
+                       "output_covariance: false\nformat: csv\n",
+                       "c.yaml", &config, &error))
+        << error;
+    EXPECT_TRUE(config.IsValid(&error)) << m.name << ": " << error;
+  }
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigText("method: known_attitude\nloss: huber\nwindow: 2\ngravity: 9.8\n",
+                             "c.yaml", &config, &error))
+      << error;
+  EXPECT_TRUE(config.IsValid(&error)) << error;
+}
+
+TEST(Config, EveryRegistryMethodIsReachableByMethodKey) {
+  ASSERT_GE(CalibrationMethods().size(), 5u);
+  const std::string help = FindConfigKey("method")->help;
+  for (const CalibrationMethod& m : CalibrationMethods()) {
+    Config config;
+    std::string error;
+    ASSERT_TRUE(LoadConfigText("method: " + m.name + "\n", "c.yaml", &config, &error)) << error;
+    EXPECT_EQ(config.method, m.name);
+    EXPECT_EQ(FindCalibrationMethod(config.method), &m);
+    EXPECT_TRUE(config.IsValid(&error)) << m.name << ": " << error;
+    EXPECT_NE(help.find(m.name + " ("), std::string::npos) << help;
+    ASSERT_TRUE(m.run) << m.name;
+  }
+}
+
+TEST(Config, RegistrySectionsAndKeysExist) {
+  for (const CalibrationMethod& m : CalibrationMethods()) {
+    for (const std::string& section : m.sections) {
+      int keys = 0;
+      for (const ConfigKey& k : ConfigKeys()) {
+        if (k.section != section) continue;
+        EXPECT_EQ(k.use, ConfigSectionUse::kSomeMethods) << m.name << " lists " << section;
+        ++keys;
+      }
+      EXPECT_GT(keys, 0) << m.name << " lists an unknown section " << section;
+    }
+    for (const std::string& key : m.keys) {
+      const ConfigKey* k = FindConfigKey(key);
+      ASSERT_NE(k, nullptr) << m.name << " lists an unknown key " << key;
+      EXPECT_EQ(k->use, ConfigSectionUse::kSomeMethods) << key;
+    }
+  }
+  // Every method-specific key is read by some method (no dead keys).
+  for (const ConfigKey& k : ConfigKeys()) {
+    if (k.use != ConfigSectionUse::kSomeMethods) continue;
+    bool read = false;
+    for (const CalibrationMethod& m : CalibrationMethods()) read |= MethodReadsKey(m, k);
+    EXPECT_TRUE(read) << k.name;
+  }
 }
 
 }  // namespace

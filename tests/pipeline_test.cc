@@ -4,8 +4,16 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/methods/rate_table.h"
+#include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/method_registry.h"
+#include "gravcal/workflows/rate_table_segments.h"
 
 namespace gravcal {
 namespace {
@@ -40,6 +48,128 @@ TEST(Pipeline, InvalidConfigFailsWithTheKey) {
   EXPECT_FALSE(RunCalibration(config, input, &c));
   EXPECT_NE(c.message.find("method"), std::string::npos) << c.message;
   EXPECT_FALSE(c.success);
+}
+
+TEST(Pipeline, UnknownMethodFailsNamingIt) {
+  Config config;
+  config.method = "thirteen_position";
+  PipelineInput input;
+  Calibration c;
+  EXPECT_FALSE(RunCalibration(config, input, &c));
+  EXPECT_NE(c.message.find("unknown method 'thirteen_position'"), std::string::npos) << c.message;
+}
+
+TEST(Pipeline, KeyTheMethodDoesNotUseFailsBeforeRunning) {
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigText("method: known_attitude\neffects: [accel_temperature_bias]\n",
+                             "c.yaml", &config, &error))
+      << error;
+  PipelineInput input;
+  input.attitudes_path = "attitudes.csv";
+  Calibration c;
+  EXPECT_FALSE(RunCalibration(config, input, &c));
+  EXPECT_EQ(c.message.rfind("key 'effects' is not used by method 'known_attitude'", 0), 0u)
+      << c.message;
+}
+
+// Every registry method is dispatched to: on an empty log each fails, but
+// with its own name in the result (and the side input it needs asked for).
+TEST(Pipeline, EveryRegistryMethodIsDispatched) {
+  for (const CalibrationMethod& m : CalibrationMethods()) {
+    Config config;
+    config.method = m.name;
+    PipelineInput input;
+    Calibration c;
+    EXPECT_FALSE(RunCalibration(config, input, &c)) << m.name;
+    EXPECT_EQ(c.method, m.name);
+    EXPECT_FALSE(c.message.empty()) << m.name;
+    if (m.side_input == MethodSideInput::kAttitudes) {
+      EXPECT_NE(c.message.find("--attitudes"), std::string::npos) << c.message;
+    }
+    if (m.side_input == MethodSideInput::kSegments) {
+      EXPECT_NE(c.message.find("--segments"), std::string::npos) << c.message;
+    }
+  }
+}
+
+// method: rate_table through the segments file gives what CalibrateRateTable
+// gives on the simulator's own segments.
+TEST(Pipeline, RateTableFromSegmentsFileEqualsCalibrateRateTable) {
+  SimulatorOptions sensor;
+  MotionOptions motion;
+  motion.profile = MotionProfile::kRateTable;
+  motion.rate_dps = 60.0;
+  motion.seconds_per_axis = 10.0;
+  MotionSession s;
+  std::string error;
+  ASSERT_TRUE(SimulateMotion(sensor, motion, 4, &s, &error)) << error;
+  ASSERT_EQ(s.segments.size(), 6u);
+  const std::string text = RateTableSegmentsToCsv(s.segments, s.sensor.log);
+  std::vector<RateTableSegment> parsed;
+  ASSERT_TRUE(ParseRateTableSegments(text, "segments.csv", s.sensor.log, &parsed, &error)) << error;
+  ASSERT_EQ(parsed.size(), s.segments.size());
+  for (size_t k = 0; k < parsed.size(); ++k) {
+    EXPECT_EQ(parsed[k].begin, s.segments[k].begin) << k;
+    EXPECT_EQ(parsed[k].end, s.segments[k].end) << k;
+    EXPECT_LT((parsed[k].rate - s.segments[k].rate).norm(), 1e-12) << k;
+  }
+  const std::string path = ::testing::TempDir() + "/pipeline_segments.csv";
+  std::ofstream(path) << text;
+
+  Config config;
+  ASSERT_TRUE(SetConfigValue("method", "rate_table", &config, &error)) << error;
+  PipelineInput input;
+  input.log = s.sensor.log;
+  input.segments_path = path;
+  Calibration c;
+  ASSERT_TRUE(RunCalibration(config, input, &c)) << c.message;
+  std::remove(path.c_str());
+  EXPECT_EQ(c.method, "rate_table");
+  ASSERT_TRUE(c.gyro.estimated);
+  ASSERT_FALSE(c.warnings.empty());
+  RateTableResult direct;
+  ASSERT_TRUE(CalibrateRateTable(s.sensor.log, s.segments, &direct)) << direct.message;
+  EXPECT_LT((c.gyro.model.bias - direct.gyro.model.bias).norm(),
+            1e-9 * direct.gyro.model.bias.norm() + 1e-12);
+  EXPECT_LT((c.gyro.model.matrix - direct.gyro.model.matrix).norm(),
+            1e-9 * direct.gyro.model.matrix.norm());
+  // And it is a calibration: the truth within four standard deviations.
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(std::fabs(c.gyro.model.matrix(i, i) - s.sensor.gyro_truth.matrix(i, i)),
+              4.0 * c.gyro.matrix_std(i, i))
+        << i;
+  }
+}
+
+TEST(Pipeline, BadSegmentsFileNamesFileAndLine) {
+  ImuLog log;
+  log.source = "log.csv";
+  for (int i = 0; i < 100; ++i) {
+    log.t.push_back(0.01 * i);
+    log.accel.push_back(Eigen::Vector3d::UnitZ());
+    log.gyro.push_back(Eigen::Vector3d::Zero());
+  }
+  std::vector<RateTableSegment> segments;
+  std::string error;
+  EXPECT_FALSE(ParseRateTableSegments("t_begin,t_end,rate_x_dps,rate_y_dps\n0,1,2,3\n", "s.csv",
+                                      log, &segments, &error));
+  EXPECT_NE(error.find("rate_z_dps"), std::string::npos) << error;
+  EXPECT_FALSE(ParseRateTableSegments(
+      "t_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n0,0.5,10,0,0\n0.6,x,0,0,0\n", "s.csv", log,
+      &segments, &error));
+  EXPECT_EQ(error.rfind("s.csv:3:", 0), 0u) << error;
+  EXPECT_FALSE(
+      ParseRateTableSegments("t_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n5,6,10,0,0\n",
+                             "s.csv", log, &segments, &error));
+  EXPECT_NE(error.find("fewer than 2 samples"), std::string::npos) << error;
+  ASSERT_TRUE(ParseRateTableSegments(
+      "# comment\nt_begin,t_end,rate_x_dps,rate_y_dps,rate_z_dps\n0.1,0.5,10,0,0\n", "s.csv", log,
+      &segments, &error))
+      << error;
+  ASSERT_EQ(segments.size(), 1u);
+  EXPECT_EQ(segments[0].begin, 10u);
+  EXPECT_EQ(segments[0].end, 51u);
 }
 
 }  // namespace

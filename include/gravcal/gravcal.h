@@ -11,6 +11,7 @@
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/model_effects.h"
+#include "gravcal/core/noise_model.h"
 #include "gravcal/core/position.h"
 #include "gravcal/core/rate_table_segment.h"
 #include "gravcal/core/solver_result.h"
@@ -24,10 +25,12 @@
 #include "gravcal/residuals/gyro_static_residual.h"
 
 // estimation
+#include "gravcal/estimation/allan_deviation.h"
 #include "gravcal/estimation/coarse_fit.h"
 #include "gravcal/estimation/error_state_layout.h"
 #include "gravcal/estimation/housing_rotation.h"
 #include "gravcal/estimation/newton_solver.h"
+#include "gravcal/estimation/noise_characterisation.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/estimation/static_alignment.h"
@@ -37,9 +40,11 @@
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/io/noise_io.h"
 
 // simulation
 #include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/noise_process.h"
 #include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 
@@ -59,12 +64,7 @@
 #include "gravcal/workflows/discovery.h"
 #include "gravcal/workflows/discovery_report.h"
 #include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/pipeline.h"
-
-// noise characterisation (issue 14): core, estimation, io, simulation
-#include "gravcal/core/noise_model.h"
-#include "gravcal/estimation/allan_deviation.h"
-#include "gravcal/estimation/noise_characterisation.h"
-#include "gravcal/io/noise_io.h"
-#include "gravcal/simulation/noise_process.h"
+#include "gravcal/workflows/rate_table_segments.h"
 #endif  // GRAVCAL_GRAVCAL_H_

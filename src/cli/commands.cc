@@ -13,6 +13,7 @@
 #include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/pipeline.h"
+#include "gravcal/workflows/rate_table_segments.h"
 
 namespace gravcal {
 namespace cli {
@@ -108,6 +109,7 @@ int RunCalibrate(const CommandArgs& args) {
   PipelineInput input;
   input.source = args.input;
   input.attitudes_path = args.attitudes;
+  input.segments_path = args.segments;
   if (!ReadImuLog(args.input, args.config.input, &input.log, &error)) return Fail(error);
   Calibration c;
   const bool ok = RunCalibration(args.config, input, &c);
@@ -147,6 +149,8 @@ int RunSimulate(const CommandArgs& args) {
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
   SimulatedSession session;
+  // The rate table's constant-rate segments (motion profile rate_table).
+  std::vector<RateTableSegment> segments;
   if (!args.config.sim_motion.empty()) {
     MotionOptions motion = args.config.motion;
     FromString(args.config.sim_motion, &motion.profile);
@@ -154,6 +158,7 @@ int RunSimulate(const CommandArgs& args) {
     if (!SimulateMotion(args.config.simulation, motion, args.seed, &moving, &error)) {
       return Fail(error);
     }
+    segments = moving.segments;
     session = std::move(moving.sensor);
   } else if (!Simulate(args.config.simulation, args.seed, &session, &error)) {
     return Fail(error);
@@ -179,8 +184,15 @@ int RunSimulate(const CommandArgs& args) {
     std::remove(truth.c_str());
     return Fail(error);
   }
-  std::fprintf(stderr, "gravcal: wrote %s (%zu samples), %s and %s\n", raw.c_str(),
-               session.log.size(), truth.c_str(), attitudes.c_str());
+  const std::string segments_path = args.output_dir + "/segments.csv";
+  if (!segments.empty() &&
+      !WriteFileAtomically(segments_path, RateTableSegmentsToCsv(segments, session.log), &error)) {
+    for (const std::string& f : {raw, truth, attitudes}) std::remove(f.c_str());
+    return Fail(error);
+  }
+  std::fprintf(stderr, "gravcal: wrote %s (%zu samples), %s and %s%s%s\n", raw.c_str(),
+               session.log.size(), truth.c_str(), attitudes.c_str(),
+               segments.empty() ? "" : " and ", segments.empty() ? "" : segments_path.c_str());
   return 0;
 }
 

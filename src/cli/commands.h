@@ -18,8 +18,10 @@ struct CommandArgs {
   std::string output_dir;
   std::string calibration;
   std::string config_path;
-  // known_attitude: the attitudes CSV.
+  // Side inputs of the methods that need them (method_registry.h): the
+  // attitudes CSV, the rate table's segments CSV.
   std::string attitudes;
+  std::string segments;
   // calibrate: the time history CSV of recursive methods (--history).
   std::string history;
   // discover: the HTML report to write (optional).

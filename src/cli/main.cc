@@ -15,6 +15,7 @@
 #include "cli/commands.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/method_registry.h"
 
 DEFINE_string(input, "", "raw log to read");
 DEFINE_string(output, "", "file to write (calibration JSON or corrected CSV)");
@@ -32,7 +33,12 @@ DEFINE_double(outlier_sigmas, gravcal::FleetOptions().outlier_sigmas,
               "batch: outlier threshold, robust standard deviations from the fleet median");
 DEFINE_int32(outlier_min_units, gravcal::FleetOptions().min_units,
              "batch: fewest calibrated units for the outlier check");
-DEFINE_string(attitudes, "", "known_attitude: CSV of each static position's roll and pitch");
+DEFINE_string(attitudes, "",
+              "CSV of each static position's roll and pitch (methods that need the fixture's "
+              "attitudes)");
+DEFINE_string(segments, "",
+              "CSV of the constant-rate segments, t_begin, t_end, rates (methods that need a rate "
+              "table)");
 DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
 DEFINE_string(report, "", "HTML report to write (discover)");
 
@@ -42,38 +48,79 @@ struct CommandInfo {
   const char* name;
   const char* summary;
   std::vector<const char*> flags;
+  // nullptr for help, which main handles before parsing flags.
+  int (*run)(const gravcal::cli::CommandArgs&);
+  // Takes arguments that are not flags (merge-summaries: the shard folders).
+  bool positional = false;
 };
 
 const std::vector<CommandInfo>& Commands() {
   static const std::vector<CommandInfo> commands = {
       {"demo",
        "simulate a twelve-position session in raw counts, calibrate it, print estimate vs truth",
-       {"config", "seed"}},
+       {"config", "seed"},
+       gravcal::cli::RunDemo},
       {"calibrate",
-       "calibrate the accelerometer from a multi-position log (or, with method "
-       "handheld_kalman, both sensors from a handheld log)",
-       {"input", "config", "output", "attitudes", "history"}},
+       "calibrate the sensors from a log with the config's method (the config key 'method' "
+       "lists them)",
+       {"input", "config", "output", "attitudes", "segments", "history"},
+       gravcal::cli::RunCalibrate},
       {"apply",
        "apply a calibration to a raw log, writing SI units",
-       {"calibration", "input", "output"}},
+       {"calibration", "input", "output"},
+       gravcal::cli::RunApply},
       {"simulate",
-       "simulate a session: raw.csv, truth.json and the fixture's attitudes.csv",
-       {"config", "seed", "output_dir"}},
+       "simulate a session: raw.csv, truth.json, the fixture's attitudes.csv (and, for "
+       "sim_motion rate_table, segments.csv)",
+       {"config", "seed", "output_dir"},
+       gravcal::cli::RunSimulate},
       {"batch",
        "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
        "statistics)",
        {"manifest", "input_dir", "pattern", "config", "output_dir", "threads", "shard",
-        "outlier_sigmas", "outlier_min_units"}},
+        "outlier_sigmas", "outlier_min_units"},
+       gravcal::cli::RunBatch},
       {"merge-summaries",
        "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
        "shard1/ shard2/ ...",
-       {"output_dir", "outlier_sigmas", "outlier_min_units"}},
+       {"output_dir", "outlier_sigmas", "outlier_min_units"},
+       gravcal::cli::RunMergeSummaries,
+       true},
       {"discover",
        "find the effects the model misses: discovery.json and an HTML report",
-       {"input", "config", "output", "report"}},
-      {"help", "list commands, or the flags and config keys of one: gravcal help <command>", {}},
+       {"input", "config", "output", "report"},
+       gravcal::cli::RunDiscover},
+      {"help",
+       "list commands, or the flags and config keys of one: gravcal help <command>",
+       {},
+       nullptr},
   };
   return commands;
+}
+
+// Who reads the keys of `section` (help's section headers): "every method",
+// "not a method key", or the methods, with the keys when a method reads only
+// some of them.
+std::string SectionReaders(const std::string& section) {
+  std::vector<const gravcal::ConfigKey*> keys;
+  for (const gravcal::ConfigKey& k : gravcal::ConfigKeys()) {
+    if (k.section == section) keys.push_back(&k);
+  }
+  if (keys.empty()) return "";
+  if (keys[0]->use == gravcal::ConfigSectionUse::kAllMethods) return "every method";
+  if (keys[0]->use == gravcal::ConfigSectionUse::kCommand) return "commands, not methods";
+  std::string text;
+  for (const gravcal::CalibrationMethod& m : gravcal::CalibrationMethods()) {
+    std::string read;
+    size_t count = 0;
+    for (const gravcal::ConfigKey* k : keys) {
+      if (!gravcal::MethodReadsKey(m, *k)) continue;
+      read += (count++ ? ", " : "") + k->name;
+    }
+    if (count == 0) continue;
+    text += (text.empty() ? "" : "; ") + m.name + (count < keys.size() ? " (" + read + ")" : "");
+  }
+  return text;
 }
 
 void PrintHelp(const std::string& command) {
@@ -102,7 +149,7 @@ void PrintHelp(const std::string& command) {
     for (const gravcal::ConfigKey& k : gravcal::ConfigKeys()) {
       if (k.section != section) {
         section = k.section;
-        std::printf("  %s:\n", section.c_str());
+        std::printf("  %s (read by %s):\n", section.c_str(), SectionReaders(section).c_str());
       }
       std::printf("    --%-26s %s [%s]\n", k.name.c_str(), k.help.c_str(),
                   gravcal::ConfigValueText(defaults, k.name).c_str());
@@ -128,9 +175,11 @@ int main(int argc, char** argv) {
     PrintHelp(argc > 2 ? argv[2] : "");
     return 0;
   }
-  bool known = false;
-  for (const CommandInfo& c : Commands()) known |= command == c.name;
-  if (!known) return Fail("unknown command '" + command + "' (gravcal help lists them)");
+  const CommandInfo* info = nullptr;
+  for (const CommandInfo& c : Commands()) {
+    if (command == c.name) info = &c;
+  }
+  if (info == nullptr) return Fail("unknown command '" + command + "' (gravcal help lists them)");
 
   // Split argv: config keys become overrides, the rest goes to gflags.
   std::vector<std::pair<std::string, std::string>> overrides;
@@ -145,7 +194,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (arg.rfind("--", 0) != 0) {
-      if (command != "merge-summaries") return Fail("unexpected argument '" + arg + "'");
+      if (!info->positional) return Fail("unexpected argument '" + arg + "'");
       positional.push_back(arg);
       continue;
     }
@@ -214,14 +263,9 @@ int main(int argc, char** argv) {
   args.outlier_min_units = FLAGS_outlier_min_units;
   args.positional = positional;
   args.attitudes = FLAGS_attitudes;
+  args.segments = FLAGS_segments;
   args.history = FLAGS_history;
   args.report = FLAGS_report;
 
-  if (command == "demo") return gravcal::cli::RunDemo(args);
-  if (command == "calibrate") return gravcal::cli::RunCalibrate(args);
-  if (command == "apply") return gravcal::cli::RunApply(args);
-  if (command == "batch") return gravcal::cli::RunBatch(args);
-  if (command == "merge-summaries") return gravcal::cli::RunMergeSummaries(args);
-  if (command == "discover") return gravcal::cli::RunDiscover(args);
-  return gravcal::cli::RunSimulate(args);
+  return info->run(args);
 }

@@ -388,20 +388,29 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path
                             const CalibrationOptions& options, Calibration* calibration) {
   CHECK(calibration != nullptr);
   *calibration = Calibration();
-  Calibration& c = *calibration;
-  c.method = "known_attitude";
+  calibration->method = "known_attitude";
   if (attitudes_path.empty()) {
-    c.message = "known_attitude needs the attitudes file (--attitudes fixture.csv)";
+    calibration->message = "known_attitude needs the attitudes file (--attitudes fixture.csv)";
     return false;
   }
+  std::vector<FixtureAttitude> rows;
+  if (!ReadFixtureAttitudes(attitudes_path, &rows, &calibration->message)) return false;
+  return CalibrateKnownAttitude(log, rows, attitudes_path, options, calibration);
+}
+
+bool CalibrateKnownAttitude(const ImuLog& log, const std::vector<FixtureAttitude>& rows,
+                            const std::string& attitudes_name, const CalibrationOptions& options,
+                            Calibration* calibration) {
+  CHECK(calibration != nullptr);
+  *calibration = Calibration();
+  Calibration& c = *calibration;
+  c.method = "known_attitude";
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
   if (!internal::DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
-  std::vector<FixtureAttitude> rows;
   std::vector<int> row_of_position;
   std::string error;
-  if (!ReadFixtureAttitudes(attitudes_path, &rows, &error) ||
-      !MatchFixtureAttitudes(rows, intervals, attitudes_path, &row_of_position, &error)) {
+  if (!MatchFixtureAttitudes(rows, intervals, attitudes_name, &row_of_position, &error)) {
     c.message = error;
     return false;
   }

@@ -1,12 +1,36 @@
 #include "gravcal/workflows/pipeline.h"
 
-#include "gravcal/methods/effect_fit.h"
-#include "gravcal/methods/gyro_calibration.h"
-#include "gravcal/methods/handheld_kalman.h"
-#include "gravcal/methods/known_attitude.h"
-#include "gravcal/methods/ten_position.h"
+#include "gravcal/workflows/method_registry.h"
+#include "gravcal/workflows/rate_table_segments.h"
 
 namespace gravcal {
+namespace {
+
+// Reads the side input `method` needs into `data`.
+bool ReadSideInput(const CalibrationMethod& method, const PipelineInput& input, MethodData* data,
+                   std::string* error) {
+  switch (method.side_input) {
+    case MethodSideInput::kNone:
+      return true;
+    case MethodSideInput::kAttitudes:
+      data->side_input_name = input.attitudes_path;
+      if (input.attitudes_path.empty()) {
+        *error = method.name + " needs the attitudes file (--attitudes fixture.csv)";
+        return false;
+      }
+      return ReadFixtureAttitudes(input.attitudes_path, &data->attitudes, error);
+    case MethodSideInput::kSegments:
+      data->side_input_name = input.segments_path;
+      if (input.segments_path.empty()) {
+        *error = method.name + " needs the segments file (--segments segments.csv)";
+        return false;
+      }
+      return ReadRateTableSegments(input.segments_path, input.log, &data->segments, error);
+  }
+  return true;
+}
+
+}  // namespace
 
 bool RunCalibration(const Config& config, const PipelineInput& input, Calibration* calibration) {
   *calibration = Calibration();
@@ -15,40 +39,17 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
     calibration->message = error;
     return false;
   }
-  // One branch per method; each fills the same Calibration.
-  if (config.method == "twelve_position") {
-    // accel_misalignment on a scale baseline is the scale_misalignment model.
-    CalibrationOptions options = config.calibration;
-    if (Contains(config.effects, Effect::kAccelMisalignment) &&
-        options.refinement.parameterization == AccelParameterization::kScale) {
-      options.refinement.parameterization = AccelParameterization::kScaleMisalignment;
-    }
-    // Detected once; the effect and gyroscope steps reuse the intervals.
-    std::vector<StaticInterval> intervals;
-    bool ok = CalibrateAccelerometer(input.log, options, calibration, &intervals);
-    if (ok && !config.effects.empty()) {
-      ok = FitCalibrationEffects(input.log, intervals, options, config.effects, calibration);
-    }
-    calibration->method = config.method;
-    if (!ok || config.gyro.parameterization == GyroParameterization::kNone) return ok;
-    return AddGyroscopeCalibration(input.log, intervals, config.gyro, calibration);
+  const CalibrationMethod& method = *FindCalibrationMethod(config.method);
+  MethodData data;
+  data.log = &input.log;
+  if (!ReadSideInput(method, input, &data, &error)) {
+    calibration->method = method.name;
+    calibration->message = error;
+    return false;
   }
-  if (config.method == "ten_position") {
-    return CalibrateTenPosition(input.log, config.calibration, config.ten_position, calibration);
-  }
-  if (config.method == "known_attitude") {
-    return CalibrateKnownAttitude(input.log, input.attitudes_path, config.calibration, calibration);
-  }
-  if (config.method == "handheld_kalman") {
-    HandheldKalmanOptions options = config.handheld;
-    options.gravity = config.calibration.gravity;
-    options.accel_nominal_scale = config.calibration.nominal_scale;
-    const bool ok = CalibrateHandheld(input.log, options, calibration);
-    calibration->method = config.method;
-    return ok;
-  }
-  calibration->message = "key 'method': unknown method '" + config.method + "'";
-  return false;
+  const bool ok = method.run(config, data, calibration);
+  calibration->method = method.name;
+  return ok;
 }
 
 }  // namespace gravcal

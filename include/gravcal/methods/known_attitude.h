@@ -58,6 +58,12 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
 bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path,
                             const CalibrationOptions& options, Calibration* calibration);
 
+// Same with the file's rows already read (ReadFixtureAttitudes);
+// `attitudes_name` names the file in messages.
+bool CalibrateKnownAttitude(const ImuLog& log, const std::vector<FixtureAttitude>& rows,
+                            const std::string& attitudes_name, const CalibrationOptions& options,
+                            Calibration* calibration);
+
 }  // namespace gravcal
 
 #endif  // GRAVCAL_METHODS_KNOWN_ATTITUDE_H_

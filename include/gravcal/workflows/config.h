@@ -3,9 +3,12 @@
 //
 // Keys are flat, one name per setting, so the same name works in the YAML
 // file and as a command-line flag (`gravity: 9.81744` or `--gravity
-// 9.81744`). Simulator keys start with `sim_`. A key that does not exist is
-// an error naming it (and the line in a file); so is a value of the wrong
-// type or out of range. `gravcal help` lists every key with its default.
+// 9.81744`). Keys come in sections, each owned by the options it fills
+// (src/workflows/config/*_keys.cc); simulator keys start with `sim_`. A key
+// that does not exist is an error naming it (and the line in a file); so is
+// a value of the wrong type or out of range, and so is a key the user set
+// that the chosen method does not use (method_registry.h). `gravcal help`
+// lists every key with its default.
 #ifndef GRAVCAL_WORKFLOWS_CONFIG_H_
 #define GRAVCAL_WORKFLOWS_CONFIG_H_
 
@@ -24,10 +27,7 @@
 namespace gravcal {
 
 struct Config {
-  // Calibration method: "twelve_position" is the multi-position magnitude
-  // calibration (any number of positions), "ten_position" the patent's
-  // self-aligned method (ten_position.h), "known_attitude" the calibration
-  // from a fixture's attitudes (known_attitude.h).
+  // Calibration method, a name in the method registry (method_registry.h).
   std::string method = "twelve_position";
   LogReaderOptions input;
   CalibrationOptions calibration;
@@ -49,19 +49,40 @@ struct Config {
   // already in the baseline of `discover`), and the discovery workflow.
   std::vector<Effect> effects;
   DiscoveryOptions discovery;
+  // The keys set through LoadConfigText/LoadConfigFile/SetConfigValue, in
+  // the order set (a key set twice appears once). Only these are checked
+  // against the method: defaults never make a config invalid.
+  std::vector<std::string> keys_set;
 
+  // Checks the method (a registry name), that every key in keys_set is used
+  // by it (or by every method, or is a command key such as sim_*), and the
+  // values of the options the method reads.
   bool IsValid(std::string* error) const;
+};
+
+// Who reads a section's keys.
+enum class ConfigSectionUse {
+  // Every calibration method (general, input).
+  kAllMethods,
+  // The methods whose registry entry lists the section or the key.
+  kSomeMethods,
+  // A command, never a method: simulate and demo (sim_*, hh_*), discover
+  // (discovery_*). Never an error under any method.
+  kCommand,
 };
 
 struct ConfigKey {
   std::string name;
   std::string section;
   std::string help;
+  ConfigSectionUse use = ConfigSectionUse::kSomeMethods;
 };
 
 // Every key, in the order `gravcal help` lists them.
 const std::vector<ConfigKey>& ConfigKeys();
 bool IsConfigKey(const std::string& name);
+// The key's entry, or nullptr when there is no such key.
+const ConfigKey* FindConfigKey(const std::string& name);
 
 // Current value of a key as YAML text (for help and reports).
 std::string ConfigValueText(const Config& config, const std::string& key);

@@ -19,12 +19,16 @@ struct PipelineInput {
   ImuLog log;
   // Name used in messages (the input path, or a unit id).
   std::string source = "input";
-  // Method-specific side inputs (paths); empty when not used.
-  // known_attitude: the per-position attitude CSV (--attitudes).
+  // Side input files (method_registry.h, MethodSideInput), read here for
+  // the methods that need them; empty when not used.
+  // kAttitudes: the per-position attitude CSV (--attitudes).
   std::string attitudes_path;
+  // kSegments: the rate table's constant-rate segments (--segments).
+  std::string segments_path;
 };
 
-// Runs config.method on the input. Returns false with a one-line
+// Runs config.method (its registry entry) on the input, after reading the
+// side input the method needs. Returns false with a one-line
 // calibration->message on bad input, a method that cannot determine what it
 // must, or no convergence (calibration->not_converged). Never prints, never
 // exits.

@@ -1,0 +1,94 @@
+// The machinery behind config.h: one ConfigKeyHandler per key, binding its
+// name and help to a field of Config (how to set it from a YAML node, how to
+// print it), and a ConfigSection per group of keys. Each section lives in
+// its own file under src/workflows/config/ beside the options it fills;
+// config.cc only strings the sections together.
+#ifndef GRAVCAL_SRC_WORKFLOWS_CONFIG_CONFIG_KEY_H_
+#define GRAVCAL_SRC_WORKFLOWS_CONFIG_CONFIG_KEY_H_
+
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "gravcal/workflows/config.h"
+
+namespace gravcal {
+namespace internal {
+
+// One key: how to set it from a YAML node and how to print it as YAML.
+struct ConfigKeyHandler {
+  std::string name;
+  std::string help;
+  std::function<bool(const YAML::Node&, Config*, std::string*)> set;
+  std::function<std::string(const Config&)> get;
+};
+
+struct ConfigSection {
+  std::string name;
+  ConfigSectionUse use = ConfigSectionUse::kSomeMethods;
+  std::vector<ConfigKeyHandler> keys;
+};
+
+// The sections, in the order `gravcal help` lists them (config.cc).
+const std::vector<ConfigSection>& ConfigSections();
+
+// One function per section file.
+ConfigSection GeneralSection();
+ConfigSection InputSection();
+ConfigSection GravitySection();
+ConfigSection DetectorSection();
+ConfigSection ModelSection();
+ConfigSection SolverSection();
+ConfigSection GyroSection();
+ConfigSection AlignmentSection();
+ConfigSection HandheldKalmanSection();
+ConfigSection EffectsSection();
+ConfigSection DiscoverySection();
+ConfigSection SimulatorSection();
+ConfigSection MotionSimulatorSection();
+
+// Value readers: false with `error` saying what the value must be.
+bool ReadDouble(const YAML::Node& n, double* v, std::string* error);  // null = NaN
+bool ReadInt(const YAML::Node& n, int* v, std::string* error);
+bool ReadBool(const YAML::Node& n, bool* v, std::string* error);
+bool ReadString(const YAML::Node& n, std::string* v, std::string* error);
+bool ReadStringList(const YAML::Node& n, std::vector<std::string>* v, std::string* error);
+template <typename Enum>
+bool ReadEnum(const YAML::Node& n, Enum* v, const char* choices, std::string* error) {
+  std::string s;
+  if (!ReadString(n, &s, error) || !FromString(s, v)) {
+    *error = std::string("must be one of ") + choices;
+    return false;
+  }
+  return true;
+}
+
+// Value printers (YAML text).
+std::string DoubleText(double v);  // NaN = "null"
+std::string ListText(const std::vector<std::string>& v);
+
+}  // namespace internal
+}  // namespace gravcal
+
+// Binders from a key name to a (nested) field of Config, e.g.
+// GRAVCAL_DOUBLE("window", calibration.detector.window_seconds, "help").
+#define GRAVCAL_KEY(name, help, read, print)                                         \
+  ::gravcal::internal::ConfigKeyHandler {                                            \
+    name, help, [](const YAML::Node& n, Config* c, std::string* e) { return read; }, \
+        [](const Config& c) { return print; }                                        \
+  }
+#define GRAVCAL_DOUBLE(name, field, help) \
+  GRAVCAL_KEY(name, help, ReadDouble(n, &c->field, e), DoubleText(c.field))
+#define GRAVCAL_INT(name, field, help) \
+  GRAVCAL_KEY(name, help, ReadInt(n, &c->field, e), std::to_string(c.field))
+#define GRAVCAL_BOOL(name, field, help) \
+  GRAVCAL_KEY(name, help, ReadBool(n, &c->field, e), std::string(c.field ? "true" : "false"))
+#define GRAVCAL_STRING(name, field, help)              \
+  GRAVCAL_KEY(name, help, ReadString(n, &c->field, e), \
+              c.field.empty() ? std::string("\"\"") : c.field)
+#define GRAVCAL_ENUM(name, field, choices, help) \
+  GRAVCAL_KEY(name, help, ReadEnum(n, &c->field, choices, e), std::string(ToString(c.field)))
+
+#endif  // GRAVCAL_SRC_WORKFLOWS_CONFIG_CONFIG_KEY_H_

@@ -1,0 +1,52 @@
+// Config section "effects": effects beyond the textbook model fitted by the
+// calibration (and the baseline of `discover`), and section "discovery":
+// the discovery workflow of `gravcal discover` (DiscoveryOptions).
+#include "workflows/config/config_key.h"
+
+namespace gravcal {
+namespace internal {
+
+namespace {
+
+bool ReadEffects(const YAML::Node& n, std::vector<Effect>* effects, std::string* e) {
+  std::vector<std::string> names;
+  return ReadStringList(n, &names, e) && ParseEffects(names, effects, e);
+}
+
+}  // namespace
+
+ConfigSection EffectsSection() {
+  return {"effects",
+          ConfigSectionUse::kSomeMethods,
+          {
+              GRAVCAL_KEY("effects",
+                          "effects added to the model by name (README: effect catalogue), e.g. "
+                          "[accel_temperature_bias]",
+                          ReadEffects(n, &c->effects, e), ListText(EffectNames(c.effects))),
+          }};
+}
+
+ConfigSection DiscoverySection() {
+  return {
+      "discovery",
+      ConfigSectionUse::kCommand,
+      {
+          GRAVCAL_KEY("discovery_candidates", "effects discover tries; empty = the whole catalogue",
+                      ReadEffects(n, &c->discovery.candidates, e),
+                      ListText(EffectNames(c.discovery.candidates))),
+          GRAVCAL_DOUBLE("discovery_significance", discovery.significance,
+                         "family-wise significance level of one discovery step"),
+          GRAVCAL_DOUBLE("discovery_min_bic_gain", discovery.min_bic_gain,
+                         "BIC decrease a candidate must bring (10 = very strong evidence)"),
+          GRAVCAL_DOUBLE("discovery_ambiguity_bic", discovery.ambiguity_bic,
+                         "candidates within this delta BIC of the best are reported as ambiguous"),
+          GRAVCAL_INT("discovery_max_steps", discovery.max_steps, "most effects discover adds"),
+          GRAVCAL_INT("discovery_min_dof", discovery.min_dof,
+                      "residual dof an extended model must keep"),
+          GRAVCAL_DOUBLE("discovery_min_temperature_range", discovery.min_temperature_range,
+                         "degC the positions must span for temperature effects to be tried"),
+      }};
+}
+
+}  // namespace internal
+}  // namespace gravcal

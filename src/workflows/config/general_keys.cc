@@ -1,0 +1,80 @@
+// Config section "general": the method and what every method writes, and
+// section "input": how the log is read (LogReaderOptions). Every method
+// uses both.
+#include <map>
+
+#include "gravcal/workflows/method_registry.h"
+#include "workflows/config/config_key.h"
+
+namespace gravcal {
+namespace internal {
+
+ConfigSection GeneralSection() {
+  return {"general",
+          ConfigSectionUse::kAllMethods,
+          {
+              GRAVCAL_STRING("method", method, "calibration method: " + CalibrationMethodsHelp()),
+              GRAVCAL_BOOL("output_covariance", output_covariance,
+                           "write accel.covariance into the calibration JSON"),
+          }};
+}
+
+namespace {
+
+bool ReadRename(const YAML::Node& n, Config* c, std::string* e) {
+  if (n.IsNull()) {
+    c->input.rename.clear();
+    return true;
+  }
+  if (!n.IsMap()) {
+    *e = "must be a map, e.g. {ax: acc_x}";
+    return false;
+  }
+  std::map<std::string, std::string> out;
+  for (const auto& kv : n) {
+    if (!kv.first.IsScalar() || !kv.second.IsScalar()) {
+      *e = "must map names to names";
+      return false;
+    }
+    out[kv.first.Scalar()] = kv.second.Scalar();
+  }
+  c->input.rename = out;
+  return true;
+}
+
+std::string RenameText(const Config& c) {
+  std::string s = "{";
+  for (const auto& kv : c.input.rename) {
+    s += (s.size() > 1 ? ", " : "") + kv.first + ": " + kv.second;
+  }
+  return s + "}";
+}
+
+}  // namespace
+
+ConfigSection InputSection() {
+  return {
+      "input",
+      ConfigSectionUse::kAllMethods,
+      {
+          GRAVCAL_ENUM("format", input.format, "csv, whitespace",
+                       "log format: csv (header row) or whitespace (no header; give columns)"),
+          GRAVCAL_KEY("columns",
+                      "column names in file order (t, ax, ay, az, gx, gy, gz, temp; others "
+                      "ignored)",
+                      ReadStringList(n, &c->input.columns, e), ListText(c.input.columns)),
+          GRAVCAL_KEY("rename",
+                      "contract name -> column name in the file, e.g. {ax: acc_x, t: n_samples}",
+                      ReadRename(n, c, e), RenameText(c)),
+          GRAVCAL_INT("skip_lines", input.skip_lines, "metadata lines before the header"),
+          GRAVCAL_DOUBLE("sample_rate", input.sample_rate,
+                         "Hz; gives t = index / sample_rate when the log has no time column"),
+          GRAVCAL_DOUBLE("time_scale", input.time_scale,
+                         "multiplies the time column (1e-9 for nanoseconds)"),
+          GRAVCAL_STRING("gyro_path", input.gyro_path,
+                         "second whitespace file with t gx gy gz sharing the timestamps"),
+      }};
+}
+
+}  // namespace internal
+}  // namespace gravcal

@@ -1,0 +1,32 @@
+// Config section "gyro": the gyroscope from the rotations between the
+// static poses (GyroCalibrationOptions, gyro_calibration.h).
+#include "workflows/config/config_key.h"
+
+namespace gravcal {
+namespace internal {
+
+ConfigSection GyroSection() {
+  return {"gyro",
+          ConfigSectionUse::kSomeMethods,
+          {
+              GRAVCAL_ENUM("gyro_model", gyro.parameterization, "none, bias, scale, full",
+                           "gyroscope from the rotations between poses: none, bias (+ common "
+                           "scale), scale (diagonal) or full (scale and misalignment)"),
+              GRAVCAL_BOOL("gyro_g_sensitivity", gyro.g_sensitivity,
+                           "also estimate the gyroscope g-sensitivity G (rad/s per m/s^2)"),
+              GRAVCAL_BOOL("gyro_joint", gyro.joint,
+                           "refine the accelerometer's bias and U together with the gyroscope"),
+              GRAVCAL_ENUM("gyro_loss", gyro.loss, "none, huber, cauchy, soft_l1, arctan, tukey",
+                           "robust loss on the gyroscope residuals"),
+              GRAVCAL_DOUBLE("gyro_loss_scale", gyro.loss_scale,
+                             "gyroscope robust loss scale, in standard deviations"),
+              GRAVCAL_DOUBLE("gyro_edge", gyro.edge_seconds,
+                             "seconds at each end of a static interval integrated with the "
+                             "rotations"),
+              GRAVCAL_DOUBLE("gyro_max_rotation", gyro.max_rotation_seconds,
+                             "longest gap between poses used as a rotation, s"),
+          }};
+}
+
+}  // namespace internal
+}  // namespace gravcal
