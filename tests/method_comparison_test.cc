@@ -1,9 +1,9 @@
-// The README's method comparison (section "Ten-position calibration"): the
+// The method comparison of docs/methods/ten_position.md: the
 // same simulated ten-position sessions calibrated by the self-aligned patent
 // method, the twelve-position magnitude refinement and the known-attitude
 // method, errors against the simulator's truth and the Cramer-Rao bound of
 // the magnitude model. The test prints the table and checks that it
-// reproduces the README's numbers (fixed seeds 1..20).
+// reproduces the table's numbers (fixed seeds 1..20).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -163,7 +163,7 @@ TEST(MethodComparison, ReproducesTheReadmeTable) {
     std::printf("| %s | %.3g | %.3g | %.3g | %.3g |\n", name.c_str(), v(0), v(1), v(2), v(3));
   }
 
-  // The README's table (rms over seeds 1..20); regenerate it from the output
+  // The table of docs/methods/ten_position.md (rms over seeds 1..20); regenerate it from the output
   // above when the simulator or a method changes on purpose.
   const std::map<std::string, Eigen::Vector4d> readme = {
       {order[0], {14.7, 813, 8.31, 18.7}},    {order[1], {0.411, 46.3, 0.2, 18.7}},
