@@ -50,7 +50,13 @@ bool EstimateHousingRotation(const std::vector<Position>& positions,
   const double tilt_var = sum_sq / dof;
   result->rotation = r;
   result->tilt_rms = std::sqrt(tilt_var);
-  result->angle_covariance = tilt_var * info.inverse();
+  // tilt_var is itself estimated from dof residuals, so (theta_hat - theta)
+  // over the plug-in sigma follows Student's t with dof degrees of freedom,
+  // whose variance is dof / (dof - 2): with six faces (dof 9) the plug-in
+  // sigma is 13 % too small (measured: rms error/sigma 1.08-1.16 over 400
+  // seeds). The factor makes the reported sigma cover the spread.
+  const double t_factor = static_cast<double>(dof) / (dof - 2);
+  result->angle_covariance = t_factor * tilt_var * info.inverse();
   result->positions_used = count;
   return true;
 }

@@ -16,9 +16,8 @@ namespace internal {
 // is the disagreement of the current model. False with result->message when
 // the refit fails.
 bool TakeStep(const DiscoveryContext& ctx, const DiscoveryOptions& options,
-              const std::vector<CandidateScore>& scores, int best,
-              const EffectFitResult& best_fit, const Disagreement& where,
-              ModelAssessment* current, DiscoveryResult* result);
+              const std::vector<CandidateScore>& scores, int best, const EffectFitResult& best_fit,
+              const Disagreement& where, ModelAssessment* current, DiscoveryResult* result);
 
 }  // namespace internal
 }  // namespace gravcal

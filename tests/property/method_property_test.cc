@@ -143,14 +143,9 @@ std::vector<MethodCase> AllCases() {
     MethodCase m =
         PipelineCase("twelve_position/affine",
                      ShippedConfig("twelve_position.yaml", {{"parameterization", "affine"}}));
-    // Known failure, measured 2026-11-23 (seeds 1001-1400): the housing
-    // rotation's rms error/sigma is 1.075, 1.161, 1.118 (band [0.885,
-    // 1.118]). Its sigma is estimated from the tilt residuals of the six
-    // axis-aligned poses with 2 * 6 - 3 = 9 degrees of freedom
-    // (housing_rotation.cc), so error/sigma is Student-t with 9 dof, rms
-    // sqrt(9 / 7) = 1.134, not N(0, 1). To be fixed in the method (state a
-    // t-based sigma or use the known placement noise), not here.
-    m.known_failures = {"accel.rot_x", "accel.rot_y", "accel.rot_z"};
+    // The housing rotation's sigma carries the Student-t factor nu/(nu-2)
+    // (housing_rotation.h); before it, rms error/sigma was 1.075, 1.161,
+    // 1.118 over seeds 1001-1400 (sigma estimated from 9 dof).
     cases.push_back(m);
   }
 

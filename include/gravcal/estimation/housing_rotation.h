@@ -9,8 +9,11 @@
 // with some tilt error, which the residual angles e_k = u_k x ... show; with
 // sigma_t^2 their variance per axis,
 //
-//   Cov(theta) = sigma_t^2 (sum_k (I - n_k n_k^T))^-1,
+//   Cov(theta) = nu / (nu - 2) sigma_t^2 (sum_k (I - n_k n_k^T))^-1,
 //
+// with nu = 2 K - 3 the degrees of freedom of sigma_t^2 (K axis-aligned
+// positions): the factor is the variance of Student's t, because sigma_t is
+// estimated from the same residuals.
 // theta the small rotation vector of R (R_true = exp([theta]x) R). A rotation
 // about a single axis seen is not determined: at least two different axes
 // must have been up.
