@@ -126,7 +126,9 @@ TEST(TenPosition, RealMpu6050TenPoses) {
   config.ten_position.gyro_nominal_scale = M_PI / 180.0 / 131.0;
   // The twelve-position config's nominal_scale: ten_position does not read it
   // (it scales by the data), so it would be an unused-key error.
-  config.keys_set.erase(std::find(config.keys_set.begin(), config.keys_set.end(), "nominal_scale"));
+  config.keys_set.erase(
+      std::remove(config.keys_set.begin(), config.keys_set.end(), "nominal_scale"),
+      config.keys_set.end());
   Calibration ten;
   ASSERT_TRUE(RunCalibration(config, input, &ten)) << ten.message;
   ASSERT_EQ(ten.positions.size(), 10u);
