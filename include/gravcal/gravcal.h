@@ -14,6 +14,7 @@
 #include "gravcal/core/position.h"
 #include "gravcal/core/rate_table_segment.h"
 #include "gravcal/core/solver_result.h"
+#include "gravcal/core/types.h"
 
 // detection
 #include "gravcal/detection/static_detector.h"
@@ -30,6 +31,7 @@
 #include "gravcal/estimation/newton_solver.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/refinement.h"
+#include "gravcal/estimation/solver_tolerances.h"
 #include "gravcal/estimation/static_alignment.h"
 #include "gravcal/estimation/strapdown.h"
 

@@ -16,16 +16,6 @@ bool CoarseFitOptions::IsValid(std::string* error) const {
   return true;
 }
 
-const char* ToString(CoarseMethod method) {
-  switch (method) {
-    case CoarseMethod::kSixPosition:
-      return "six_position_least_squares";
-    case CoarseMethod::kEllipsoid:
-      return "ellipsoid_fit";
-  }
-  return "unknown";
-}
-
 void AssignNominalAxes(const std::vector<Position>& positions, const AccelModel* model,
                        double tolerance_deg, std::vector<int>* nominal_up) {
   const size_t n = positions.size();

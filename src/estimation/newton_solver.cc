@@ -11,27 +11,6 @@
 
 namespace gravcal {
 
-const char* ToString(NewtonResidual residual) {
-  switch (residual) {
-    case NewtonResidual::kSquaredMagnitude:
-      return "squared_magnitude";
-    case NewtonResidual::kMagnitude:
-      return "magnitude";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, NewtonResidual* residual) {
-  if (name == "squared_magnitude") {
-    *residual = NewtonResidual::kSquaredMagnitude;
-  } else if (name == "magnitude") {
-    *residual = NewtonResidual::kMagnitude;
-  } else {
-    return false;
-  }
-  return true;
-}
-
 bool NewtonOptions::IsValid(std::string* error) const {
   if (max_iterations < 1) {
     *error = "max_iterations: must be at least 1";

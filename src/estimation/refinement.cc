@@ -10,43 +10,14 @@
 #include <memory>
 #include <sstream>
 
-#include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "estimation/magnitude_fit.h"
 #include "estimation/normalization.h"
 #include "estimation/robust_loss.h"
+#include "estimation/solver_settings.h"
+#include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "util/statistics.h"
 
 namespace gravcal {
-
-const char* ToString(LossType loss) {
-  switch (loss) {
-    case LossType::kNone:
-      return "none";
-    case LossType::kHuber:
-      return "huber";
-    case LossType::kCauchy:
-      return "cauchy";
-    case LossType::kSoftL1:
-      return "soft_l1";
-    case LossType::kArctan:
-      return "arctan";
-    case LossType::kTukey:
-      return "tukey";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, LossType* loss) {
-  static const LossType kAll[] = {LossType::kNone,   LossType::kHuber,  LossType::kCauchy,
-                                  LossType::kSoftL1, LossType::kArctan, LossType::kTukey};
-  for (LossType l : kAll) {
-    if (name == ToString(l)) {
-      *loss = l;
-      return true;
-    }
-  }
-  return false;
-}
 
 bool RefinementOptions::IsValid(std::string* error) const {
   if (!(loss_scale > 0.0 && std::isfinite(loss_scale))) {
@@ -57,15 +28,7 @@ bool RefinementOptions::IsValid(std::string* error) const {
     *error = "max_bias_std, max_matrix_std: must be positive";
     return false;
   }
-  if (max_iterations < 1) {
-    *error = "max_iterations: must be at least 1";
-    return false;
-  }
-  if (!(function_tolerance > 0.0) || !(gradient_tolerance > 0.0) || !(parameter_tolerance > 0.0)) {
-    *error = "function_tolerance, gradient_tolerance, parameter_tolerance: must be positive";
-    return false;
-  }
-  return true;
+  return solver.IsValid(error);
 }
 
 std::vector<double> MagnitudeSigmas(const std::vector<Position>& positions,
@@ -203,19 +166,12 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
     problem.SetManifold(upper, new ceres::SubsetManifold(kUpperSize, held_upper));
   }
 
-  ceres::Solver::Options solver_options;
   // For speed: with 9 parameters and the normalised (well-conditioned)
   // problem, J^T J + D and a Cholesky factor are about 4 times cheaper per
   // step than Householder QR; the optimum is the same to within the solver's
   // tolerances (benchmarks/RESULTS.md).
-  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = options.gradient_tolerance;
-  solver_options.parameter_tolerance = options.parameter_tolerance;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.minimizer_progress_to_stdout = false;
-  solver_options.num_threads = 1;
+  const ceres::Solver::Options solver_options =
+      internal::SolverOptions(options.solver, ceres::DENSE_NORMAL_CHOLESKY);
   ceres::Solver::Summary summary;
   const auto start = std::chrono::steady_clock::now();
   result->iterations = 0;

@@ -126,31 +126,6 @@ double TurnAngle(double rate_rad, double seconds, double unit) {
 
 }  // namespace
 
-const char* ToString(MotionProfile profile) {
-  switch (profile) {
-    case MotionProfile::kHandheld:
-      return "handheld";
-    case MotionProfile::kTurntable:
-      return "turntable";
-    case MotionProfile::kVertical:
-      return "vertical";
-    case MotionProfile::kRateTable:
-      return "rate_table";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, MotionProfile* profile) {
-  for (MotionProfile p : {MotionProfile::kHandheld, MotionProfile::kTurntable,
-                          MotionProfile::kVertical, MotionProfile::kRateTable}) {
-    if (name == ToString(p)) {
-      *profile = p;
-      return true;
-    }
-  }
-  return false;
-}
-
 bool MotionOptions::IsValid(std::string* error) const {
   auto check = [&](const char* key, double v, bool ok) {
     if (ok && std::isfinite(v)) return true;

@@ -286,7 +286,7 @@ const std::vector<KeyHandler>& Handlers() {
                      "robust loss scale, in standard deviations"),
       GRAVCAL_BOOL("covariance", "solver", calibration.refinement.compute_covariance,
                    "compute the covariance (standard deviations)"),
-      GRAVCAL_INT("max_iterations", "solver", calibration.refinement.max_iterations,
+      GRAVCAL_INT("max_iterations", "solver", calibration.refinement.solver.max_iterations,
                   "solver iteration limit"),
       // Simulator.
       GRAVCAL_STRING("sim_scheme", "simulator", simulation.scheme, "six, twelve, ten or random:N"),
