@@ -7,6 +7,7 @@
 
 #include "gravcal/io/log_reader.h"
 #include "io/json_helpers.h"
+#include "util/units.h"
 
 namespace gravcal {
 namespace {
@@ -33,7 +34,7 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
                            {"matrix", JsonMatrix(c.accel.covariance)}};
   }
   if (c.accel.model.parameterization == AccelParameterization::kAffine) {
-    accel["placement_error_deg"] = JsonNumber(c.accel.tilt_rms * 180.0 / M_PI);
+    accel["placement_error_deg"] = JsonNumber(c.accel.tilt_rms * internal::kRadToDeg);
   }
   json out;
   out["method"] = c.method;
