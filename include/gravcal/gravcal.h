@@ -15,6 +15,7 @@
 #include "gravcal/core/position.h"
 #include "gravcal/core/rate_table_segment.h"
 #include "gravcal/core/solver_result.h"
+#include "gravcal/core/types.h"
 
 // detection
 #include "gravcal/detection/static_detector.h"
@@ -33,6 +34,7 @@
 #include "gravcal/estimation/noise_characterisation.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/refinement.h"
+#include "gravcal/estimation/solver_tolerances.h"
 #include "gravcal/estimation/static_alignment.h"
 #include "gravcal/estimation/strapdown.h"
 

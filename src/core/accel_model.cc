@@ -7,31 +7,6 @@
 
 namespace gravcal {
 
-const char* ToString(AccelParameterization p) {
-  switch (p) {
-    case AccelParameterization::kScale:
-      return "scale";
-    case AccelParameterization::kScaleMisalignment:
-      return "scale_misalignment";
-    case AccelParameterization::kAffine:
-      return "affine";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, AccelParameterization* p) {
-  if (name == "scale") {
-    *p = AccelParameterization::kScale;
-  } else if (name == "scale_misalignment") {
-    *p = AccelParameterization::kScaleMisalignment;
-  } else if (name == "affine") {
-    *p = AccelParameterization::kAffine;
-  } else {
-    return false;
-  }
-  return true;
-}
-
 int NumParameters(AccelParameterization p) {
   switch (p) {
     case AccelParameterization::kScale:

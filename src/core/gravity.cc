@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "util/units.h"
+
 namespace gravcal {
 namespace {
 
@@ -16,7 +18,7 @@ constexpr double kGravityRatio = 0.00344978650684;  // omega^2 a^2 b / GM
 }  // namespace
 
 double NormalGravity(double latitude_deg, double height_m) {
-  const double s = std::sin(latitude_deg * M_PI / 180.0);
+  const double s = std::sin(latitude_deg * internal::kDegToRad);
   const double s2 = s * s;
   const double g0 =
       kEquatorialGravity * (1.0 + kSomiglianaK * s2) / std::sqrt(1.0 - kFirstEccentricitySq * s2);

@@ -5,73 +5,70 @@
 namespace gravcal {
 
 const std::vector<EffectInfo>& EffectCatalogue() {
-  static const std::vector<EffectInfo> catalogue = {
-      {Effect::kAccelMisalignment,
-       "accel_misalignment",
-       "non-orthogonality of the accelerometer axes (cross-axis terms u_xy, u_xz, u_yz of U), "
-       "missing from a scale-only baseline",
-       EffectSensor::kAccelerometer,
-       EffectRegressor::kOrientation,
-       3,
-       {"u_xy", "u_xz", "u_yz"},
-       "m/s^2 per raw unit"},
-      {Effect::kAccelQuadratic,
-       "accel_quadratic_nonlinearity",
-       "second-order scale factor per axis: the reading is a + k2 a^2",
-       EffectSensor::kAccelerometer,
-       EffectRegressor::kOrientation,
-       3,
-       {"k2_x", "k2_y", "k2_z"},
-       "1/(m/s^2)"},
-      {Effect::kAccelTemperatureBias,
-       "accel_temperature_bias",
-       "accelerometer bias linear in temperature (m/s^2 per degree C)",
-       EffectSensor::kAccelerometer,
-       EffectRegressor::kTemperature,
-       3,
-       {"beta_x", "beta_y", "beta_z"},
-       "m/s^2/degC"},
-      {Effect::kAccelTemperatureScale,
-       "accel_temperature_scale",
-       "accelerometer scale factor linear in temperature (fraction per degree C)",
-       EffectSensor::kAccelerometer,
-       EffectRegressor::kTemperature,
-       3,
-       {"c_x", "c_y", "c_z"},
-       "1/degC"},
-      {Effect::kAccelBiasDrift,
-       "accel_bias_drift",
-       "accelerometer bias linear in time (m/s^2 per second)",
-       EffectSensor::kAccelerometer,
-       EffectRegressor::kTime,
-       3,
-       {"delta_x", "delta_y", "delta_z"},
-       "m/s^2/s"},
-      {Effect::kGyroGSensitivity,
-       "gyro_g_sensitivity",
-       "gyroscope bias proportional to specific force (3x3 G, raw gyro units per m/s^2)",
-       EffectSensor::kGyroscope,
-       EffectRegressor::kOrientation,
-       9,
-       {"g_xx", "g_xy", "g_xz", "g_yx", "g_yy", "g_yz", "g_zx", "g_zy", "g_zz"},
-       "raw gyro units/(m/s^2)"},
-      {Effect::kGyroTemperatureBias,
-       "gyro_temperature_bias",
-       "gyroscope bias linear in temperature (raw gyro units per degree C)",
-       EffectSensor::kGyroscope,
-       EffectRegressor::kTemperature,
-       3,
-       {"gamma_x", "gamma_y", "gamma_z"},
-       "raw gyro units/degC"},
-      {Effect::kGyroBiasDrift,
-       "gyro_bias_drift",
-       "gyroscope bias linear in time (raw gyro units per second)",
-       EffectSensor::kGyroscope,
-       EffectRegressor::kTime,
-       3,
-       {"eta_x", "eta_y", "eta_z"},
-       "raw gyro units/s"},
-  };
+  static const std::vector<EffectInfo> catalogue = [] {
+    std::vector<EffectInfo> entries = {
+        {Effect::kAccelMisalignment,
+         "non-orthogonality of the accelerometer axes (cross-axis terms u_xy, u_xz, u_yz of U), "
+         "missing from a scale-only baseline",
+         EffectSensor::kAccelerometer,
+         EffectRegressor::kOrientation,
+         3,
+         {"u_xy", "u_xz", "u_yz"},
+         "m/s^2 per raw unit"},
+        {Effect::kAccelQuadratic,
+         "second-order scale factor per axis: the reading is a + k2 a^2",
+         EffectSensor::kAccelerometer,
+         EffectRegressor::kOrientation,
+         3,
+         {"k2_x", "k2_y", "k2_z"},
+         "1/(m/s^2)"},
+        {Effect::kAccelTemperatureBias,
+         "accelerometer bias linear in temperature (m/s^2 per degree C)",
+         EffectSensor::kAccelerometer,
+         EffectRegressor::kTemperature,
+         3,
+         {"beta_x", "beta_y", "beta_z"},
+         "m/s^2/degC"},
+        {Effect::kAccelTemperatureScale,
+         "accelerometer scale factor linear in temperature (fraction per degree C)",
+         EffectSensor::kAccelerometer,
+         EffectRegressor::kTemperature,
+         3,
+         {"c_x", "c_y", "c_z"},
+         "1/degC"},
+        {Effect::kAccelBiasDrift,
+         "accelerometer bias linear in time (m/s^2 per second)",
+         EffectSensor::kAccelerometer,
+         EffectRegressor::kTime,
+         3,
+         {"delta_x", "delta_y", "delta_z"},
+         "m/s^2/s"},
+        {Effect::kGyroGSensitivity,
+         "gyroscope bias proportional to specific force (3x3 G, raw gyro units per m/s^2)",
+         EffectSensor::kGyroscope,
+         EffectRegressor::kOrientation,
+         9,
+         {"g_xx", "g_xy", "g_xz", "g_yx", "g_yy", "g_yz", "g_zx", "g_zy", "g_zz"},
+         "raw gyro units/(m/s^2)"},
+        {Effect::kGyroTemperatureBias,
+         "gyroscope bias linear in temperature (raw gyro units per degree C)",
+         EffectSensor::kGyroscope,
+         EffectRegressor::kTemperature,
+         3,
+         {"gamma_x", "gamma_y", "gamma_z"},
+         "raw gyro units/degC"},
+        {Effect::kGyroBiasDrift,
+         "gyroscope bias linear in time (raw gyro units per second)",
+         EffectSensor::kGyroscope,
+         EffectRegressor::kTime,
+         3,
+         {"eta_x", "eta_y", "eta_z"},
+         "raw gyro units/s"},
+    };
+    // The names come from the one table in types.cc.
+    for (EffectInfo& info : entries) info.name = ToString(info.effect);
+    return entries;
+  }();
   return catalogue;
 }
 
@@ -80,18 +77,6 @@ const EffectInfo& Info(Effect effect) {
     if (info.effect == effect) return info;
   }
   return EffectCatalogue().front();
-}
-
-const char* ToString(Effect effect) { return Info(effect).name; }
-
-bool FromString(const std::string& name, Effect* effect) {
-  for (const EffectInfo& info : EffectCatalogue()) {
-    if (name == info.name) {
-      *effect = info.effect;
-      return true;
-    }
-  }
-  return false;
 }
 
 bool ParseEffects(const std::vector<std::string>& names, std::vector<Effect>* effects,

@@ -8,6 +8,8 @@
 #include <memory>
 #include <sstream>
 
+#include "util/units.h"
+
 namespace gravcal {
 namespace {
 
@@ -139,7 +141,7 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double na = a.norm();
   const double nb = b.norm();
   if (na <= 0.0 || nb <= 0.0) return 180.0;
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * internal::kRadToDeg;
 }
 
 bool Fail(StaticDetection* detection, const std::string& message) {

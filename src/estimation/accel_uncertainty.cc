@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "util/so3.h"
+
 namespace gravcal {
 
 void PropagateUncertainty(const RefinementResult& refinement, const HousingRotation* housing,
@@ -36,10 +38,7 @@ void PropagateUncertainty(const RefinementResult& refinement, const HousingRotat
   if (housing != nullptr) {
     const Eigen::Matrix3d m = model.matrix();
     for (int a = 0; a < 3; ++a) {
-      Eigen::Matrix3d skew = Eigen::Matrix3d::Zero();
-      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(a);
-      skew << 0, -axis(2), axis(1), axis(2), 0, -axis(0), -axis(1), axis(0), 0;
-      const Eigen::Matrix3d dm = skew * m;
+      const Eigen::Matrix3d dm = internal::Skew(Eigen::Vector3d::Unit(a)) * m;
       for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 3; ++c) j(3 + 3 * r + c, nm + a) = dm(r, c);
       }

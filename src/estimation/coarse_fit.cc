@@ -6,6 +6,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "util/units.h"
+
 namespace gravcal {
 
 bool CoarseFitOptions::IsValid(std::string* error) const {
@@ -14,16 +16,6 @@ bool CoarseFitOptions::IsValid(std::string* error) const {
     return false;
   }
   return true;
-}
-
-const char* ToString(CoarseMethod method) {
-  switch (method) {
-    case CoarseMethod::kSixPosition:
-      return "six_position_least_squares";
-    case CoarseMethod::kEllipsoid:
-      return "ellipsoid_fit";
-  }
-  return "unknown";
 }
 
 void AssignNominalAxes(const std::vector<Position>& positions, const AccelModel* model,
@@ -43,7 +35,7 @@ void AssignNominalAxes(const std::vector<Position>& positions, const AccelModel*
   for (int i = 0; i < 3; ++i) {
     if (!(half(i) > 1e-3 * largest)) half(i) = largest;
   }
-  const double cos_tol = std::cos(tolerance_deg * M_PI / 180.0);
+  const double cos_tol = std::cos(tolerance_deg * internal::kDegToRad);
   for (size_t k = 0; k < n; ++k) {
     if (positions[k].nominal_up >= 0) {
       (*nominal_up)[k] = positions[k].nominal_up;

@@ -17,12 +17,14 @@ double WhitenedSumOfSquares(const std::vector<double>& residuals,
 
 bool StartMagnitudeFit(const std::vector<Position>& positions, const AccelModel& initial,
                        double gravity, AccelParameterization p, const std::string& fit,
-                       AccelModel* model, RefinementResult* result) {
+                       MagnitudeFitStart* start, RefinementResult* result) {
+  *result = RefinementResult();
   if (!(gravity > 0.0)) {
     result->message = "gravity must be positive";
     return false;
   }
-  const int num_parameters = 3 + static_cast<int>(FreeUpperIndices(p).size());
+  const std::vector<int> free = FreeUpperIndices(p);
+  const int num_parameters = 3 + static_cast<int>(free.size());
   const int n = static_cast<int>(positions.size());
   if (n < num_parameters) {
     std::ostringstream s;
@@ -31,6 +33,7 @@ bool StartMagnitudeFit(const std::vector<Position>& positions, const AccelModel&
     result->message = s.str();
     return false;
   }
+  AccelModel* model = &start->model;
   *model = initial;
   model->parameterization = p;
   if (p == AccelParameterization::kScale) {
@@ -51,6 +54,12 @@ bool StartMagnitudeFit(const std::vector<Position>& positions, const AccelModel&
   result->num_residuals = n;
   result->num_parameters = num_parameters;
   result->parameter_names = MagnitudeParameterNames(p);
+  start->free = free;
+  start->num_parameters = num_parameters;
+  start->num_positions = n;
+  start->norm = Normalization::For(*model);
+  start->normalized = start->norm.Apply(positions);
+  start->normalized_model = start->norm.Apply(*model);
   return true;
 }
 

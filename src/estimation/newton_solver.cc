@@ -11,27 +11,6 @@
 
 namespace gravcal {
 
-const char* ToString(NewtonResidual residual) {
-  switch (residual) {
-    case NewtonResidual::kSquaredMagnitude:
-      return "squared_magnitude";
-    case NewtonResidual::kMagnitude:
-      return "magnitude";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, NewtonResidual* residual) {
-  if (name == "squared_magnitude") {
-    *residual = NewtonResidual::kSquaredMagnitude;
-  } else if (name == "magnitude") {
-    *residual = NewtonResidual::kMagnitude;
-  } else {
-    return false;
-  }
-  return true;
-}
-
 bool NewtonOptions::IsValid(std::string* error) const {
   if (max_iterations < 1) {
     *error = "max_iterations: must be at least 1";
@@ -80,25 +59,18 @@ void Linearise(const std::vector<Position>& positions, const AccelModel& model, 
 
 bool NewtonRefine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
                   const NewtonOptions& options, RefinementResult* result) {
-  *result = RefinementResult();
-  std::string error;
-  if (!options.IsValid(&error)) {
-    result->message = error;
+  MagnitudeFitStart fit;
+  if (!StartMagnitudeFit(positions, initial, gravity, options, "Newton refinement", &fit, result)) {
     return false;
   }
-  const AccelParameterization p = options.parameterization;
-  const std::vector<int> free = FreeUpperIndices(p);
-  const int num_parameters = 3 + static_cast<int>(free.size());
-  const int n = static_cast<int>(positions.size());
-  AccelModel model;
-  if (!StartMagnitudeFit(positions, initial, gravity, p, "Newton refinement", &model, result)) {
-    return false;
-  }
-
+  const std::vector<int>& free = fit.free;
+  const int num_parameters = fit.num_parameters;
+  const int n = fit.num_positions;
   // Iterate in well-conditioned units (normalization.h).
-  const Normalization norm = Normalization::For(model);
-  const std::vector<Position> normalized = norm.Apply(positions);
-  model = norm.Apply(model);
+  const Normalization& norm = fit.norm;
+  const std::vector<Position>& normalized = fit.normalized;
+  AccelModel model = fit.normalized_model;
+  std::string error;
   const auto start = std::chrono::steady_clock::now();
   Eigen::VectorXd f;
   Eigen::MatrixXd j;

@@ -13,40 +13,11 @@
 #include "estimation/magnitude_fit.h"
 #include "estimation/normalization.h"
 #include "estimation/robust_loss.h"
+#include "estimation/solver_settings.h"
 #include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "util/statistics.h"
 
 namespace gravcal {
-
-const char* ToString(LossType loss) {
-  switch (loss) {
-    case LossType::kNone:
-      return "none";
-    case LossType::kHuber:
-      return "huber";
-    case LossType::kCauchy:
-      return "cauchy";
-    case LossType::kSoftL1:
-      return "soft_l1";
-    case LossType::kArctan:
-      return "arctan";
-    case LossType::kTukey:
-      return "tukey";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, LossType* loss) {
-  static const LossType kAll[] = {LossType::kNone,   LossType::kHuber,  LossType::kCauchy,
-                                  LossType::kSoftL1, LossType::kArctan, LossType::kTukey};
-  for (LossType l : kAll) {
-    if (name == ToString(l)) {
-      *loss = l;
-      return true;
-    }
-  }
-  return false;
-}
 
 bool RefinementOptions::IsValid(std::string* error) const {
   if (!(loss_scale > 0.0 && std::isfinite(loss_scale))) {
@@ -57,15 +28,7 @@ bool RefinementOptions::IsValid(std::string* error) const {
     *error = "max_bias_std, max_matrix_std: must be positive";
     return false;
   }
-  if (max_iterations < 1) {
-    *error = "max_iterations: must be at least 1";
-    return false;
-  }
-  if (!(function_tolerance > 0.0) || !(gradient_tolerance > 0.0) || !(parameter_tolerance > 0.0)) {
-    *error = "function_tolerance, gradient_tolerance, parameter_tolerance: must be positive";
-    return false;
-  }
-  return true;
+  return solver.IsValid(error);
 }
 
 std::vector<double> MagnitudeSigmas(const std::vector<Position>& positions,
@@ -118,65 +81,63 @@ std::vector<double> MagnitudeResiduals(const std::vector<Position>& positions,
   return r;
 }
 
-bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
-            const RefinementOptions& options, RefinementResult* result) {
-  CHECK(result != nullptr);
-  *result = RefinementResult();
-  std::string error;
-  if (!options.IsValid(&error)) {
-    result->message = error;
-    return false;
-  }
-  const AccelParameterization p = options.parameterization;
-  const std::vector<int> free = FreeUpperIndices(p);
-  const int num_parameters = 3 + static_cast<int>(free.size());
-  const int n = static_cast<int>(positions.size());
-  AccelModel model;
-  if (!StartMagnitudeFit(positions, initial, gravity, p, "refinement", &model, result)) {
-    return false;
-  }
+namespace {
 
-  // Solve in well-conditioned units (normalization.h); |a| is unchanged.
-  const Normalization norm = Normalization::For(model);
-  const std::vector<Position> normalized = norm.Apply(positions);
-  const AccelModel model_n = norm.Apply(model);
-  double bias[3] = {model_n.bias(0), model_n.bias(1), model_n.bias(2)};
-  double upper[kUpperSize];
-  model_n.GetUpper(upper);
-
-  // Graduated loss scales: from one that holds every initial residual (the
-  // first stage is then close to least squares) down to the requested one.
+// Graduated loss scales, widest last: from one that holds every initial
+// whitened residual (the first stage is then close to least squares) down to
+// the requested one. Just loss_scale without a loss.
+std::vector<double> LossScales(const RefinementOptions& options, const RefinementResult& result) {
   std::vector<double> scales = {options.loss_scale};
   if (options.loss != LossType::kNone) {
+    const int n = static_cast<int>(result.residuals_before.size());
     std::vector<double> whitened(n);
     for (int k = 0; k < n; ++k)
-      whitened[k] = std::fabs(result->residuals_before[k] / result->sigmas[k]);
+      whitened[k] = std::fabs(result.residuals_before[k] / result.sigmas[k]);
     const double start_scale = *std::max_element(whitened.begin(), whitened.end());
     while (scales.back() * 2.0 < start_scale) scales.push_back(scales.back() * 2.0);
   }
-  ceres::Problem::Options problem_options;
-  problem_options.enable_fast_removal = false;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  // For speed: the blocks below are built correctly by construction, so
-  // Ceres's checks of them are pure overhead (results are bit-identical).
-  problem_options.disable_all_safety_checks = true;
-  ceres::Problem problem(problem_options);
+  return scales;
+}
+
+// The Ceres problem of the magnitude fit in normalised units, with its
+// parameter blocks and loss.
+struct MagnitudeProblem {
+  explicit MagnitudeProblem(const ceres::Problem::Options& options) : problem(options) {}
+  ceres::Problem problem;
+  double bias[3];
+  double upper[kUpperSize];
   std::unique_ptr<ceres::LossFunctionWrapper> loss;
+  // Columns (bias_x ... u_zz of the free parameters) held at their value.
+  std::vector<bool> held_column;
+};
+
+// One autodiff residual block per position (the public functor), so the
+// robust loss acts per position; the blocks start at the normalised initial
+// model and the loss at the widest scale.
+void AddMagnitudeBlocks(const MagnitudeFitStart& fit, double gravity,
+                        const RefinementOptions& options, const std::vector<double>& scales,
+                        const std::vector<double>& sigmas, MagnitudeProblem* m) {
+  for (int i = 0; i < 3; ++i) m->bias[i] = fit.normalized_model.bias(i);
+  fit.normalized_model.GetUpper(m->upper);
   if (options.loss != LossType::kNone) {
-    loss = std::make_unique<ceres::LossFunctionWrapper>(MakeLoss(options.loss, scales.back()),
-                                                        ceres::TAKE_OWNERSHIP);
+    m->loss = std::make_unique<ceres::LossFunctionWrapper>(MakeLoss(options.loss, scales.back()),
+                                                           ceres::TAKE_OWNERSHIP);
   }
-  // One autodiff residual block per position (the public functor), so the
-  // robust loss acts per position.
-  for (int k = 0; k < n; ++k) {
-    problem.AddResidualBlock(
-        GravityMagnitudeResidual::Create(normalized[k].raw_mean, gravity, result->sigmas[k]),
-        loss.get(), bias, upper);
+  for (int k = 0; k < fit.num_positions; ++k) {
+    m->problem.AddResidualBlock(
+        GravityMagnitudeResidual::Create(fit.normalized[k].raw_mean, gravity, sigmas[k]),
+        m->loss.get(), m->bias, m->upper);
   }
-  // Held entries: the scale model's off-diagonal, and held_parameters.
+}
+
+// Holds the scale model's off-diagonal and options.held_parameters constant.
+// False with result->message on a name that is not a parameter.
+bool HoldParameters(const MagnitudeFitStart& fit, const RefinementOptions& options,
+                    MagnitudeProblem* m, RefinementResult* result) {
+  const AccelParameterization p = options.parameterization;
   std::vector<int> held_bias, held_upper;
   if (p == AccelParameterization::kScale) held_upper = {1, 2, 4};
-  std::vector<bool> held_column(num_parameters, false);
+  m->held_column.assign(fit.num_parameters, false);
   for (const std::string& name : options.held_parameters) {
     const auto it = std::find(result->parameter_names.begin(), result->parameter_names.end(), name);
     if (it == result->parameter_names.end()) {
@@ -185,84 +146,69 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
       return false;
     }
     const int column = static_cast<int>(it - result->parameter_names.begin());
-    held_column[column] = true;
+    m->held_column[column] = true;
     if (column < 3) {
       held_bias.push_back(column);
     } else {
-      held_upper.push_back(free[column - 3]);
+      held_upper.push_back(fit.free[column - 3]);
     }
   }
   if (held_bias.size() == 3) {
-    problem.SetParameterBlockConstant(bias);
+    m->problem.SetParameterBlockConstant(m->bias);
   } else if (!held_bias.empty()) {
-    problem.SetManifold(bias, new ceres::SubsetManifold(3, held_bias));
+    m->problem.SetManifold(m->bias, new ceres::SubsetManifold(3, held_bias));
   }
   if (held_upper.size() == kUpperSize) {
-    problem.SetParameterBlockConstant(upper);
+    m->problem.SetParameterBlockConstant(m->upper);
   } else if (!held_upper.empty()) {
-    problem.SetManifold(upper, new ceres::SubsetManifold(kUpperSize, held_upper));
+    m->problem.SetManifold(m->upper, new ceres::SubsetManifold(kUpperSize, held_upper));
   }
+  return true;
+}
 
-  ceres::Solver::Options solver_options;
+// Solves once per loss scale, narrowest last; fills iterations, solve time
+// and termination.
+void SolveGraduated(const RefinementOptions& options, const std::vector<double>& scales,
+                    MagnitudeProblem* m, ceres::Solver::Summary* summary,
+                    RefinementResult* result) {
   // For speed: with 9 parameters and the normalised (well-conditioned)
   // problem, J^T J + D and a Cholesky factor are about 4 times cheaper per
   // step than Householder QR; the optimum is the same to within the solver's
   // tolerances (benchmarks/RESULTS.md).
-  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = options.gradient_tolerance;
-  solver_options.parameter_tolerance = options.parameter_tolerance;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.minimizer_progress_to_stdout = false;
-  solver_options.num_threads = 1;
-  ceres::Solver::Summary summary;
+  const ceres::Solver::Options solver_options =
+      internal::SolverOptions(options.solver, ceres::DENSE_NORMAL_CHOLESKY);
   const auto start = std::chrono::steady_clock::now();
   result->iterations = 0;
   for (auto it = scales.rbegin(); it != scales.rend(); ++it) {
-    if (loss) loss->Reset(MakeLoss(options.loss, *it), ceres::TAKE_OWNERSHIP);
-    ceres::Solve(solver_options, &problem, &summary);
-    result->iterations += static_cast<int>(summary.iterations.size()) - 1;
-    if (!summary.IsSolutionUsable()) break;
+    if (m->loss) m->loss->Reset(MakeLoss(options.loss, *it), ceres::TAKE_OWNERSHIP);
+    ceres::Solve(solver_options, &m->problem, summary);
+    result->iterations += static_cast<int>(summary->iterations.size()) - 1;
+    if (!summary->IsSolutionUsable()) break;
   }
   result->solve_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  result->termination = ceres::TerminationTypeToString(summary.termination_type);
+  result->termination = ceres::TerminationTypeToString(summary->termination_type);
+}
 
-  AccelModel refined_n = model_n;
-  refined_n.bias = Eigen::Vector3d(bias[0], bias[1], bias[2]);
-  refined_n.SetUpper(upper);
-  const AccelModel refined = norm.Undo(refined_n);
-  const bool usable = summary.IsSolutionUsable() && refined.bias.allFinite() &&
-                      refined.upper.allFinite() && refined.upper.diagonal().minCoeff() > 0.0;
-  result->converged = usable && summary.termination_type == ceres::CONVERGENCE;
-  if (!usable) {
-    result->model = model;
-    result->message = "refinement failed: " + summary.message + "; the coarse result is kept";
-    return true;
-  }
-  result->model = refined;
-  result->residuals_after = MagnitudeResiduals(positions, refined, gravity);
-  result->chi2 = WhitenedSumOfSquares(result->residuals_after, result->sigmas);
-  result->final_cost = 0.5 * result->chi2;
-  result->dof = n - num_parameters +
-                static_cast<int>(std::count(held_column.begin(), held_column.end(), true));
-
-  // Observability from the analytic whitened Jacobian at the optimum.
-  // Held columns are not estimated and take no part in the rank.
-  const Eigen::MatrixXd jacobian = MagnitudeJacobian(normalized, refined_n, result->sigmas);
+// Rank and null directions from the analytic whitened Jacobian at the
+// optimum (normalised units). Held columns are not estimated and take no part
+// in the rank; they are reported as undetermined. Returns the number of
+// estimated parameters.
+int AnalyzeActiveObservability(const MagnitudeFitStart& fit, const AccelModel& refined_n,
+                               const std::vector<bool>& held_column, RefinementResult* result) {
+  const Eigen::MatrixXd jacobian = MagnitudeJacobian(fit.normalized, refined_n, result->sigmas);
   std::vector<int> active;
   std::vector<std::string> active_names;
-  for (int i = 0; i < num_parameters; ++i) {
+  for (int i = 0; i < fit.num_parameters; ++i) {
     if (held_column[i]) continue;
     active.push_back(i);
     active_names.push_back(result->parameter_names[i]);
   }
-  Eigen::MatrixXd active_jacobian(n, active.size());
+  Eigen::MatrixXd active_jacobian(fit.num_positions, active.size());
   for (size_t i = 0; i < active.size(); ++i) active_jacobian.col(i) = jacobian.col(active[i]);
   result->observability = AnalyzeObservability(active_jacobian, active_names);
   const int num_active = static_cast<int>(active.size());
-  for (int i = 0; i < num_parameters; ++i) {
+  for (int i = 0; i < fit.num_parameters; ++i) {
     if (held_column[i]) result->observability.undetermined.push_back(result->parameter_names[i]);
   }
   if (!result->observability.full_rank()) {
@@ -273,99 +219,169 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
     s << "; add positions with other axes up";
     result->warnings.push_back(s.str());
   }
+  return num_active;
+}
 
-  if (options.compute_covariance) {
-    ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::DENSE_SVD;
-    covariance_options.null_space_rank = num_active - result->observability.rank;
-    covariance_options.num_threads = 1;
-    ceres::Covariance covariance(covariance_options);
-    std::vector<std::pair<const double*, const double*>> blocks = {
-        {bias, bias}, {bias, upper}, {upper, upper}};
-    if (covariance.Compute(blocks, &problem)) {
-      double cbb[9], cbu[18], cuu[36];
-      covariance.GetCovarianceBlock(bias, bias, cbb);
-      covariance.GetCovarianceBlock(bias, upper, cbu);
-      covariance.GetCovarianceBlock(upper, upper, cuu);
-      Eigen::MatrixXd cov(num_parameters, num_parameters);
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) cov(i, j) = cbb[3 * i + j];
-        for (size_t j = 0; j < free.size(); ++j) {
-          cov(i, 3 + j) = cov(3 + j, i) = cbu[kUpperSize * i + free[j]];
-        }
-      }
-      for (size_t i = 0; i < free.size(); ++i) {
-        for (size_t j = 0; j < free.size(); ++j) {
-          cov(3 + i, 3 + j) = cuu[kUpperSize * free[i] + free[j]];
-        }
-      }
-      result->covariance = norm.Undo(cov);
-      result->covariance_available = true;
-      // In normalised units the bias is in m/s^2 and U is relative to the
-      // mean scale, so the limits apply directly.
-      std::vector<std::string> weak;
-      for (int i = 0; i < num_parameters; ++i) {
-        if (held_column[i]) continue;
-        const double limit = i < 3 ? options.max_bias_std : options.max_matrix_std;
-        if (std::sqrt(std::max(cov(i, i), 0.0)) > limit) weak.push_back(result->parameter_names[i]);
-      }
-      std::string listed;
-      for (const std::string& name : weak) {
-        listed += (listed.empty() ? "" : ", ") + name;
-        auto& undetermined = result->observability.undetermined;
-        if (std::find(undetermined.begin(), undetermined.end(), name) == undetermined.end()) {
-          undetermined.push_back(name);
-        }
-      }
-      // Only when something is left to fit.
-      if (!weak.empty() && !result->converged && static_cast<int>(weak.size()) < num_active) {
-        // The flat directions stalled the solver: hold them at their initial
-        // (coarse) value and fit the rest again. (When the solve converged,
-        // the free fit is kept: holding would make the other parameters'
-        // standard deviations conditional on the held value.)
-        RefinementOptions again = options;
-        again.held_parameters.insert(again.held_parameters.end(), weak.begin(), weak.end());
-        const double first_seconds = result->solve_seconds;
-        const int first_iterations = result->iterations;
-        if (!Refine(positions, initial, gravity, again, result)) return false;
-        result->solve_seconds += first_seconds;
-        result->iterations += first_iterations;
-        result->warnings.push_back("the positions do not determine " + listed +
-                                   " (standard deviation beyond max_bias_std / max_matrix_std); "
-                                   "they are held at the coarse fit's value and reported without "
-                                   "a number: add positions with other axes up or down");
-        return true;
-      }
-      if (!weak.empty()) {
-        result->warnings.push_back("the positions do not determine " + listed +
-                                   " (standard deviation beyond max_bias_std / max_matrix_std); "
-                                   "they are reported without a number: add positions with other "
-                                   "axes up or down");
-      }
-    } else {
-      result->warnings.push_back(
-          "the covariance could not be computed (the problem is rank deficient); no standard "
-          "deviations are reported");
+// The covariance of (b, free entries of U) in normalised units from Ceres;
+// false when Ceres cannot compute it.
+bool NormalizedCovariance(const MagnitudeFitStart& fit, int null_space_rank, MagnitudeProblem* m,
+                          Eigen::MatrixXd* cov) {
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.null_space_rank = null_space_rank;
+  covariance_options.num_threads = 1;
+  ceres::Covariance covariance(covariance_options);
+  const double* bias = m->bias;
+  const double* upper = m->upper;
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {bias, bias}, {bias, upper}, {upper, upper}};
+  if (!covariance.Compute(blocks, &m->problem)) return false;
+  double cbb[9], cbu[18], cuu[36];
+  covariance.GetCovarianceBlock(bias, bias, cbb);
+  covariance.GetCovarianceBlock(bias, upper, cbu);
+  covariance.GetCovarianceBlock(upper, upper, cuu);
+  const std::vector<int>& free = fit.free;
+  cov->resize(fit.num_parameters, fit.num_parameters);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) (*cov)(i, j) = cbb[3 * i + j];
+    for (size_t j = 0; j < free.size(); ++j) {
+      (*cov)(i, 3 + j) = (*cov)(3 + j, i) = cbu[kUpperSize * i + free[j]];
     }
   }
+  for (size_t i = 0; i < free.size(); ++i) {
+    for (size_t j = 0; j < free.size(); ++j) {
+      (*cov)(3 + i, 3 + j) = cuu[kUpperSize * free[i] + free[j]];
+    }
+  }
+  return true;
+}
 
+// Names of the estimated parameters whose standard deviation (normalised
+// units: bias in m/s^2, U relative to the mean scale, so the limits apply
+// directly) exceeds max_bias_std / max_matrix_std; they are added to the
+// undetermined list.
+std::vector<std::string> WeakParameters(const RefinementOptions& options,
+                                        const Eigen::MatrixXd& cov,
+                                        const std::vector<bool>& held_column,
+                                        RefinementResult* result) {
+  std::vector<std::string> weak;
+  for (int i = 0; i < static_cast<int>(held_column.size()); ++i) {
+    if (held_column[i]) continue;
+    const double limit = i < 3 ? options.max_bias_std : options.max_matrix_std;
+    if (std::sqrt(std::max(cov(i, i), 0.0)) > limit) weak.push_back(result->parameter_names[i]);
+  }
+  for (const std::string& name : weak) {
+    auto& undetermined = result->observability.undetermined;
+    if (std::find(undetermined.begin(), undetermined.end(), name) == undetermined.end()) {
+      undetermined.push_back(name);
+    }
+  }
+  return weak;
+}
+
+// The chi-square verdict: an exact fit, or residuals beyond the noise level.
+void WarnOnChiSquare(RefinementResult* result) {
   if (result->dof <= 0) {
     result->warnings.push_back(
         "as many positions as parameters: the fit is exact and cannot show whether the model or "
         "the noise estimate is right; record more positions");
-  } else {
-    const double p_value = ChiSquareUpperTail(result->chi2, result->dof);
-    if (p_value < 1e-3) {
-      std::ostringstream s;
-      s.precision(3);
-      s << "residuals are " << std::sqrt(result->chi2 / result->dof)
-        << " times the noise level (chi2 = " << result->chi2 << " on " << result->dof
-        << " dof, p = " << p_value
-        << "): the model misses an effect, a position was disturbed, or the noise is correlated; "
-           "the standard deviations are too small by about that factor";
-      result->warnings.push_back(s.str());
+    return;
+  }
+  const double p_value = ChiSquareUpperTail(result->chi2, result->dof);
+  if (p_value < 1e-3) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "residuals are " << std::sqrt(result->chi2 / result->dof)
+      << " times the noise level (chi2 = " << result->chi2 << " on " << result->dof
+      << " dof, p = " << p_value
+      << "): the model misses an effect, a position was disturbed, or the noise is correlated; "
+         "the standard deviations are too small by about that factor";
+    result->warnings.push_back(s.str());
+  }
+}
+
+}  // namespace
+
+bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
+            const RefinementOptions& options, RefinementResult* result) {
+  CHECK(result != nullptr);
+  // Solve in well-conditioned units (normalization.h); |a| is unchanged.
+  MagnitudeFitStart fit;
+  if (!StartMagnitudeFit(positions, initial, gravity, options, "refinement", &fit, result)) {
+    return false;
+  }
+  const std::vector<double> scales = LossScales(options, *result);
+  ceres::Problem::Options problem_options;
+  problem_options.enable_fast_removal = false;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  // For speed: the blocks below are built correctly by construction, so
+  // Ceres's checks of them are pure overhead (results are bit-identical).
+  problem_options.disable_all_safety_checks = true;
+  MagnitudeProblem m(problem_options);
+  AddMagnitudeBlocks(fit, gravity, options, scales, result->sigmas, &m);
+  if (!HoldParameters(fit, options, &m, result)) return false;
+  ceres::Solver::Summary summary;
+  SolveGraduated(options, scales, &m, &summary, result);
+
+  AccelModel refined_n = fit.normalized_model;
+  refined_n.bias = Eigen::Vector3d(m.bias[0], m.bias[1], m.bias[2]);
+  refined_n.SetUpper(m.upper);
+  const AccelModel refined = fit.norm.Undo(refined_n);
+  const bool usable = summary.IsSolutionUsable() && refined.bias.allFinite() &&
+                      refined.upper.allFinite() && refined.upper.diagonal().minCoeff() > 0.0;
+  result->converged = usable && summary.termination_type == ceres::CONVERGENCE;
+  if (!usable) {
+    result->model = fit.model;
+    result->message = "refinement failed: " + summary.message + "; the coarse result is kept";
+    return true;
+  }
+  result->model = refined;
+  result->residuals_after = MagnitudeResiduals(positions, refined, gravity);
+  result->chi2 = WhitenedSumOfSquares(result->residuals_after, result->sigmas);
+  result->final_cost = 0.5 * result->chi2;
+  result->dof = fit.num_positions - fit.num_parameters +
+                static_cast<int>(std::count(m.held_column.begin(), m.held_column.end(), true));
+  const int num_active = AnalyzeActiveObservability(fit, refined_n, m.held_column, result);
+
+  Eigen::MatrixXd cov;
+  if (options.compute_covariance &&
+      !NormalizedCovariance(fit, num_active - result->observability.rank, &m, &cov)) {
+    result->warnings.push_back(
+        "the covariance could not be computed (the problem is rank deficient); no standard "
+        "deviations are reported");
+  } else if (options.compute_covariance) {
+    result->covariance = fit.norm.Undo(cov);
+    result->covariance_available = true;
+    const std::vector<std::string> weak = WeakParameters(options, cov, m.held_column, result);
+    std::string listed;
+    for (const std::string& name : weak) listed += (listed.empty() ? "" : ", ") + name;
+    // Only when something is left to fit.
+    if (!weak.empty() && !result->converged && static_cast<int>(weak.size()) < num_active) {
+      // The flat directions stalled the solver: hold them at their initial
+      // (coarse) value and fit the rest again. (When the solve converged,
+      // the free fit is kept: holding would make the other parameters'
+      // standard deviations conditional on the held value.)
+      RefinementOptions again = options;
+      again.held_parameters.insert(again.held_parameters.end(), weak.begin(), weak.end());
+      const double first_seconds = result->solve_seconds;
+      const int first_iterations = result->iterations;
+      if (!Refine(positions, initial, gravity, again, result)) return false;
+      result->solve_seconds += first_seconds;
+      result->iterations += first_iterations;
+      result->warnings.push_back("the positions do not determine " + listed +
+                                 " (standard deviation beyond max_bias_std / max_matrix_std); "
+                                 "they are held at the coarse fit's value and reported without "
+                                 "a number: add positions with other axes up or down");
+      return true;
+    }
+    if (!weak.empty()) {
+      result->warnings.push_back("the positions do not determine " + listed +
+                                 " (standard deviation beyond max_bias_std / max_matrix_std); "
+                                 "they are reported without a number: add positions with other "
+                                 "axes up or down");
     }
   }
+  WarnOnChiSquare(result);
 
   std::ostringstream s;
   s << (result->converged ? "converged" : "did not converge") << " after " << result->iterations

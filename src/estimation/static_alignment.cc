@@ -8,22 +8,21 @@
 #include <cmath>
 #include <sstream>
 
+#include "util/so3.h"
+#include "util/units.h"
+
 namespace gravcal {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+using internal::kDegToRad;
+using internal::Skew;
+
 // A mean specific force further than this from g (relative) is not a unit
 // at rest, or the data is not in m/s^2.
 constexpr double kMaxGravityMismatch = 0.2;
 // Prior of the heading error when heading is not observed: it couples to
 // nothing then, so any value works; 1 rad keeps the numbers tame.
 constexpr double kUnobservedHeadingVariance = 1.0;
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d s;
-  s << 0.0, -v(2), v(1), v(2), 0.0, -v(0), -v(1), v(0), 0.0;
-  return s;
-}
 
 Eigen::Matrix3d Exp(const Eigen::Vector3d& v) {
   const double angle = v.norm();
@@ -206,7 +205,7 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
   r.coarse_roll = std::atan2(f0(1), f0(2));
   r.coarse_pitch = std::atan2(-f0(0), std::hypot(f0(1), f0(2)));
   const bool have_latitude = std::isfinite(options.latitude_deg);
-  const double latitude = have_latitude ? options.latitude_deg * kDeg : 0.0;
+  const double latitude = have_latitude ? options.latitude_deg * kDegToRad : 0.0;
   const double earth_horizontal = kEarthRate * std::fabs(std::cos(latitude));
   const double gyro_bias_var = options.gyro_bias_std * options.gyro_bias_std;
   const double gyro_noise_var = r.gyro_noise * r.gyro_noise;
@@ -214,7 +213,7 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
   if (gyro && have_latitude && earth_horizontal > 0.0) {
     r.gyrocompass_heading_std =
         std::sqrt(gyro_bias_var + gyro_noise_var / static_cast<double>(n - n0)) / earth_horizontal;
-    r.heading_observed = r.gyrocompass_heading_std < options.max_heading_std_deg * kDeg;
+    r.heading_observed = r.gyrocompass_heading_std < options.max_heading_std_deg * kDegToRad;
   }
   const Eigen::Matrix3d c = CoarseAttitude(f0, w0, r.heading_observed);
   r.coarse_heading = RollPitchHeadingOf(c)(2);
@@ -379,7 +378,7 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
     } else if (!have_latitude) {
       s << "no latitude given for gyrocompassing";
     } else {
-      s << "gyrocompassing would give " << r.gyrocompass_heading_std / kDeg
+      s << "gyrocompassing would give " << r.gyrocompass_heading_std / kDegToRad
         << " deg, above align_max_heading_std " << options.max_heading_std_deg
         << " deg (gyroscope bias and noise against Earth rate)";
     }
@@ -392,8 +391,9 @@ bool AlignStatic(const std::vector<Eigen::Vector3d>& specific_force,
   r.success = true;
   std::ostringstream s;
   s.precision(4);
-  s << "aligned on " << n << " samples: roll " << r.roll / kDeg << " +- " << r.roll_std / kDeg
-    << " deg, pitch " << r.pitch / kDeg << " +- " << r.pitch_std / kDeg << " deg";
+  s << "aligned on " << n << " samples: roll " << r.roll / kDegToRad << " +- "
+    << r.roll_std / kDegToRad << " deg, pitch " << r.pitch / kDegToRad << " +- "
+    << r.pitch_std / kDegToRad << " deg";
   r.message = s.str();
   return true;
 }

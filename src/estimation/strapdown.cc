@@ -1,5 +1,7 @@
 #include "gravcal/estimation/strapdown.h"
 
+#include "util/units.h"
+
 namespace gravcal {
 
 bool StrapdownOptions::IsValid(std::string* error) const {
@@ -30,7 +32,7 @@ Eigen::Quaterniond RotationVectorToQuaternion(const Eigen::Vector3d& v) {
 }
 
 Eigen::Vector3d EarthRateEnu(double latitude_deg) {
-  const double lat = latitude_deg * M_PI / 180.0;
+  const double lat = latitude_deg * internal::kDegToRad;
   return kEarthRate * Eigen::Vector3d(0.0, std::cos(lat), std::sin(lat));
 }
 

@@ -8,11 +8,12 @@
 #include <sstream>
 
 #include "gravcal/estimation/static_alignment.h"
+#include "util/units.h"
 
 namespace gravcal {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
+using internal::kRadToDeg;
 // Smallest standard deviation written for a simulated fixture, degrees.
 
 std::string Trim(const std::string& s) {

@@ -6,79 +6,69 @@
 #include <sstream>
 
 #include "gravcal/io/log_reader.h"
+#include "io/json_helpers.h"
+#include "util/units.h"
 
 namespace gravcal {
 namespace {
 
+using internal::JsonArray;
+using internal::JsonMatrix;
+using internal::JsonNumber;
+using internal::JsonVector;
 using nlohmann::json;
-
-json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-json Vector(const Eigen::Vector3d& v) {
-  return json::array({Number(v(0)), Number(v(1)), Number(v(2))});
-}
-
-json Matrix(const Eigen::MatrixXd& m) {
-  json rows = json::array();
-  for (int r = 0; r < m.rows(); ++r) {
-    json row = json::array();
-    for (int c = 0; c < m.cols(); ++c) row.push_back(Number(m(r, c)));
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 }  // namespace
 
 std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
   json accel;
   accel["model"] = ToString(c.accel.model.parameterization);
-  accel["bias"] = Vector(c.accel.model.bias);
-  accel["matrix"] = Matrix(c.accel.model.matrix());
-  accel["upper"] = Matrix(c.accel.model.upper);
-  accel["rotation"] = Matrix(c.accel.model.rotation);
-  accel["std"] = {{"bias", Vector(c.accel.bias_std)}, {"matrix", Matrix(c.accel.matrix_std)}};
+  accel["bias"] = JsonVector(c.accel.model.bias);
+  accel["matrix"] = JsonMatrix(c.accel.model.matrix());
+  accel["upper"] = JsonMatrix(c.accel.model.upper);
+  accel["rotation"] = JsonMatrix(c.accel.model.rotation);
+  accel["std"] = {{"bias", JsonVector(c.accel.bias_std)},
+                  {"matrix", JsonMatrix(c.accel.matrix_std)}};
   if (include_covariance && c.accel.covariance.size() > 0) {
     accel["covariance"] = {{"parameters", c.accel.covariance_names},
-                           {"matrix", Matrix(c.accel.covariance)}};
+                           {"matrix", JsonMatrix(c.accel.covariance)}};
   }
   if (c.accel.model.parameterization == AccelParameterization::kAffine) {
-    accel["placement_error_deg"] = Number(c.accel.tilt_rms * 180.0 / M_PI);
+    accel["placement_error_deg"] = JsonNumber(c.accel.tilt_rms * internal::kRadToDeg);
   }
   json out;
   out["method"] = c.method;
   out["accel"] = accel;
   if (c.gyro.estimated) {
     json gyro;
-    gyro["bias"] = Vector(c.gyro.model.bias);
-    gyro["matrix"] = Matrix(c.gyro.model.matrix);
-    gyro["std"] = {{"bias", Vector(c.gyro.bias_std)}, {"matrix", Matrix(c.gyro.matrix_std)}};
+    gyro["bias"] = JsonVector(c.gyro.model.bias);
+    gyro["matrix"] = JsonMatrix(c.gyro.model.matrix);
+    gyro["std"] = {{"bias", JsonVector(c.gyro.bias_std)},
+                   {"matrix", JsonMatrix(c.gyro.matrix_std)}};
     if (include_covariance && c.gyro.covariance.size() > 0) {
       gyro["covariance"] = {{"parameters", c.gyro.covariance_names},
-                            {"matrix", Matrix(c.gyro.covariance)}};
+                            {"matrix", JsonMatrix(c.gyro.covariance)}};
     }
     json extra = json::object();
     for (size_t i = 0; i < c.gyro.extra_names.size(); ++i) {
-      extra[c.gyro.extra_names[i]] = {{"value", Number(c.gyro.extra_values[i])},
-                                      {"std", Number(c.gyro.extra_std[i])}};
+      extra[c.gyro.extra_names[i]] = {{"value", JsonNumber(c.gyro.extra_values[i])},
+                                      {"std", JsonNumber(c.gyro.extra_std[i])}};
     }
     if (!extra.empty()) gyro["extra"] = extra;
     if (!c.gyro.rotation_residual_deg.empty()) {
-      json r = json::array();
-      for (double v : c.gyro.rotation_residual_deg) r.push_back(Number(v));
-      gyro["rotation_residual_deg"] = r;
+      gyro["rotation_residual_deg"] = JsonArray(c.gyro.rotation_residual_deg);
     }
     out["gyro"] = gyro;
   }
   // Issue 6: effects beyond the textbook model, by catalogue name.
   if (!c.effects.estimates.empty()) {
-    json effects = {{"reference_temperature", Number(c.effects.reference_temperature)},
-                    {"reference_time", Number(c.effects.reference_time)}};
+    json effects = {{"reference_temperature", JsonNumber(c.effects.reference_temperature)},
+                    {"reference_time", JsonNumber(c.effects.reference_time)}};
     for (const EffectEstimate& e : c.effects.estimates) {
       json values = json::array(), stds = json::array();
       for (size_t i = 0; i < e.values.size(); ++i) {
-        values.push_back(Number(e.values[i]));
-        stds.push_back(Number(i < e.std.size() ? e.std[i] : NAN));
+        values.push_back(JsonNumber(e.values[i]));
+        stds.push_back(JsonNumber(i < e.std.size() ? e.std[i] : NAN));
       }
       effects[ToString(e.effect)] = {
           {"parameters", e.names}, {"value", values}, {"std", stds}, {"unit", e.unit}};
@@ -87,7 +77,7 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
   }
   out["gravity"] = {{"value", c.gravity}, {"source", c.gravity_source}};
   auto summary = [](const ResidualSummary& s) {
-    return json{{"rms", Number(s.rms)}, {"max", Number(s.max)}};
+    return json{{"rms", JsonNumber(s.rms)}, {"max", JsonNumber(s.max)}};
   };
   out["residual"] = {{"unit", "m/s^2"},
                      {"quantity", "|a| - g over static positions"},
@@ -99,18 +89,18 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
     json p = {{"t_begin", r.position.t_begin},
               {"t_end", r.position.t_end},
               {"samples", r.position.sample_count},
-              {"raw_mean", Vector(r.position.raw_mean)},
-              {"raw_std", Vector(r.raw_std)},
+              {"raw_mean", JsonVector(r.position.raw_mean)},
+              {"raw_std", JsonVector(r.raw_std)},
               {"nominal_up", NominalAxisName(r.nominal_up)},
-              {"residual_before", Number(r.residual_before)},
-              {"residual_after", Number(r.residual_after)},
-              {"sigma", Number(r.sigma)}};
+              {"residual_before", JsonNumber(r.residual_before)},
+              {"residual_after", JsonNumber(r.residual_after)},
+              {"sigma", JsonNumber(r.sigma)}};
     // Only the methods that use an attitude per position have one.
     if (std::isfinite(r.roll_deg) && std::isfinite(r.pitch_deg)) {
       p["attitude_deg"] = {{"roll", r.roll_deg},
                            {"pitch", r.pitch_deg},
-                           {"roll_std", Number(r.roll_std_deg)},
-                           {"pitch_std", Number(r.pitch_std_deg)}};
+                           {"roll_std", JsonNumber(r.roll_std_deg)},
+                           {"pitch_std", JsonNumber(r.pitch_std_deg)}};
     }
     positions.push_back(p);
   }
@@ -131,12 +121,12 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
   if (!c.convergence.entries.empty()) {
     json entries = json::object();
     for (const ConvergenceEntry& e : c.convergence.entries) {
-      entries[e.name] = {{"value", Number(e.value)},
+      entries[e.name] = {{"value", JsonNumber(e.value)},
                          {"unit", e.unit},
-                         {"sigma_initial", Number(e.sigma_initial)},
-                         {"sigma_final", Number(e.sigma_final)},
+                         {"sigma_initial", JsonNumber(e.sigma_initial)},
+                         {"sigma_final", JsonNumber(e.sigma_final)},
                          {"converged", e.converged},
-                         {"time_s", Number(e.time)}};
+                         {"time_s", JsonNumber(e.time)}};
     }
     out["convergence"] = {{"criterion", c.convergence.criterion}, {"parameters", entries}};
   }

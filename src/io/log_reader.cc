@@ -543,28 +543,6 @@ bool CheckWritable(const ImuLog& log, std::string* why) {
 
 }  // namespace
 
-const char* ToString(LogFormat format) {
-  switch (format) {
-    case LogFormat::kCsv:
-      return "csv";
-    case LogFormat::kWhitespace:
-      return "whitespace";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, LogFormat* format) {
-  if (format == nullptr) return false;
-  if (name == "csv") {
-    *format = LogFormat::kCsv;
-  } else if (name == "whitespace") {
-    *format = LogFormat::kWhitespace;
-  } else {
-    return false;
-  }
-  return true;
-}
-
 bool LogReaderOptions::IsValid(std::string* error) const {
   if (format != LogFormat::kCsv && format != LogFormat::kWhitespace) {
     return SetError(error, "format is not csv or whitespace");

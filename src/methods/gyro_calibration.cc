@@ -20,33 +20,6 @@
 
 namespace gravcal {
 
-const char* ToString(GyroParameterization p) {
-  switch (p) {
-    case GyroParameterization::kNone:
-      return "none";
-    case GyroParameterization::kBias:
-      return "bias";
-    case GyroParameterization::kScale:
-      return "scale";
-    case GyroParameterization::kFull:
-      return "full";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, GyroParameterization* p) {
-  static const GyroParameterization kAll[] = {
-      GyroParameterization::kNone, GyroParameterization::kBias, GyroParameterization::kScale,
-      GyroParameterization::kFull};
-  for (GyroParameterization q : kAll) {
-    if (name == ToString(q)) {
-      *p = q;
-      return true;
-    }
-  }
-  return false;
-}
-
 bool GyroCalibrationOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& what) {
     if (error) *error = what;

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "estimation/robust_loss.h"
+#include "estimation/solver_settings.h"
 #include "gravcal/core/gravity.h"
 #include "methods/static_positions.h"
 #include "util/statistics.h"
@@ -315,14 +316,7 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
   }
   RefinementResult& f = c.refinement;
   f.initial_cost = 0.5 * Chi2(positions, attitudes, &fit);
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = ro.max_iterations;
-  solver_options.function_tolerance = ro.function_tolerance;
-  solver_options.gradient_tolerance = ro.gradient_tolerance;
-  solver_options.parameter_tolerance = ro.parameter_tolerance;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.num_threads = 1;
+  const ceres::Solver::Options solver_options = internal::SolverOptions(ro.solver, ceres::DENSE_QR);
   ceres::Solver::Summary summary;
   const auto start = std::chrono::steady_clock::now();
   ceres::Solve(solver_options, &problem, &summary);

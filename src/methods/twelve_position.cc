@@ -15,27 +15,6 @@
 
 namespace gravcal {
 
-const char* ToString(RefinementSolver solver) {
-  switch (solver) {
-    case RefinementSolver::kCeres:
-      return "ceres";
-    case RefinementSolver::kNewton:
-      return "newton";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, RefinementSolver* solver) {
-  if (name == "ceres") {
-    *solver = RefinementSolver::kCeres;
-  } else if (name == "newton") {
-    *solver = RefinementSolver::kNewton;
-  } else {
-    return false;
-  }
-  return true;
-}
-
 bool CalibrationOptions::IsValid(std::string* error) const {
   if (!detector.IsValid(error) || !gravity.IsValid(error) || !coarse.IsValid(error) ||
       !refinement.IsValid(error)) {
@@ -71,7 +50,7 @@ bool RefineWithSolver(const std::vector<Position>& placed, const CalibrationOpti
     NewtonOptions newton;
     newton.parameterization = p;
     newton.residual = options.newton_residual;
-    newton.max_iterations = options.refinement.max_iterations;
+    newton.max_iterations = options.refinement.solver.max_iterations;
     newton.compute_covariance = options.refinement.compute_covariance;
     ok = NewtonRefine(placed, c.coarse.model, c.gravity, newton, &c.refinement);
     c.solver_name = std::string("newton_") + ToString(options.newton_residual);

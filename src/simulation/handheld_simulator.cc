@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "gravcal/estimation/strapdown.h"
+#include "util/units.h"
 
 namespace gravcal {
 namespace {
@@ -13,7 +14,7 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Quat = Eigen::Quaterniond;
 
-constexpr double kDeg = M_PI / 180.0;
+using internal::kDegToRad;
 // Truth attitude integration steps per sample.
 constexpr int kSubsteps = 4;
 // Ramp at each end of a turn, s (rate rises as sin^2).
@@ -126,31 +127,6 @@ double TurnAngle(double rate_rad, double seconds, double unit) {
 
 }  // namespace
 
-const char* ToString(MotionProfile profile) {
-  switch (profile) {
-    case MotionProfile::kHandheld:
-      return "handheld";
-    case MotionProfile::kTurntable:
-      return "turntable";
-    case MotionProfile::kVertical:
-      return "vertical";
-    case MotionProfile::kRateTable:
-      return "rate_table";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, MotionProfile* profile) {
-  for (MotionProfile p : {MotionProfile::kHandheld, MotionProfile::kTurntable,
-                          MotionProfile::kVertical, MotionProfile::kRateTable}) {
-    if (name == ToString(p)) {
-      *profile = p;
-      return true;
-    }
-  }
-  return false;
-}
-
 bool MotionOptions::IsValid(std::string* error) const {
   auto check = [&](const char* key, double v, bool ok) {
     if (ok && std::isfinite(v)) return true;
@@ -186,7 +162,7 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
   s.gravity = sensor.gravity;
   // Truth sensors, as in simulator.cc: scale in SI per raw unit.
   const double accel_scale = sensor.raw_counts ? kStandardGravity / sensor.accel_counts_per_g : 1.0;
-  const double gyro_scale = sensor.raw_counts ? kDeg / sensor.gyro_counts_per_dps : 1.0;
+  const double gyro_scale = sensor.raw_counts ? kDegToRad / sensor.gyro_counts_per_dps : 1.0;
   s.accel_units_per_si = 1.0 / accel_scale;
   s.gyro_units_per_si = 1.0 / gyro_scale;
   s.accel_truth =
@@ -200,14 +176,14 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
   // Phases.
   const MotionProfile profile = motion.profile;
   const bool hand = profile == MotionProfile::kHandheld || profile == MotionProfile::kVertical;
-  const double rate = motion.rate_dps * kDeg;
+  const double rate = motion.rate_dps * kDegToRad;
   const double turn_seconds = motion.seconds_per_axis;
   Trajectory traj;
   double t = motion.initial_still_seconds;
   Quat start = Quat::Identity();
   if (profile != MotionProfile::kRateTable) {
     const double heading = 2.0 * M_PI * u01(rng);
-    const double tilt = profile == MotionProfile::kTurntable ? 0.0 : 2.0 * kDeg;
+    const double tilt = profile == MotionProfile::kTurntable ? 0.0 : 2.0 * kDegToRad;
     start = RotationVectorToQuaternion(Vec3(0, 0, heading)) *
             RotationVectorToQuaternion(Vec3(tilt * n01(rng), tilt * n01(rng), 0.0));
   }
@@ -276,7 +252,7 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
   t += motion.final_still_seconds;
   const double total_seconds = t;
   if (hand) {
-    const double wobble_rad = motion.axis_wobble_deg * kDeg;
+    const double wobble_rad = motion.axis_wobble_deg * kDegToRad;
     traj.wobble_ = RandomSines(wobble_rad, 0.2, 1.0, &rng);
     traj.angular_tremor_ = RandomSines(motion.angular_tremor, 8.0, 12.0, &rng);
     traj.sway_ = RandomSines(motion.sway, 0.05, motion.sway_hz, &rng);

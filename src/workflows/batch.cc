@@ -114,28 +114,6 @@ std::string ConfigText(const Config& config) {
   return text;
 }
 
-const char* ToString(BatchStatus status) {
-  switch (status) {
-    case BatchStatus::kOk:
-      return "ok";
-    case BatchStatus::kFailed:
-      return "failed";
-    case BatchStatus::kNotConverged:
-      return "not_converged";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, BatchStatus* status) {
-  for (BatchStatus s : {BatchStatus::kOk, BatchStatus::kFailed, BatchStatus::kNotConverged}) {
-    if (name == ToString(s)) {
-      *status = s;
-      return true;
-    }
-  }
-  return false;
-}
-
 bool BatchOptions::IsValid(std::string* error) const {
   if (threads < 0) {
     *error = "threads: must be >= 0 (0 = one per core), is " + std::to_string(threads);

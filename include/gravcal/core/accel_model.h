@@ -21,22 +21,10 @@
 #include <random>
 #include <string>
 
+#include "gravcal/core/types.h"
+
 namespace gravcal {
 
-// Which parameters of the model are free.
-enum class AccelParameterization {
-  // b and diag(U): 6 parameters, R = I, U diagonal.
-  kScale,
-  // b and U: 9 parameters, R = I. Gauge-free: the sensor x axis defines the
-  // body x axis and the sensor xy plane the body xy plane.
-  kScaleMisalignment,
-  // b, U and R: 12 parameters. R comes from the nominal axes of the poses.
-  kAffine,
-};
-
-const char* ToString(AccelParameterization p);
-// Accepts "scale", "scale_misalignment", "affine".
-bool FromString(const std::string& name, AccelParameterization* p);
 // 6, 9 or 12.
 int NumParameters(AccelParameterization p);
 

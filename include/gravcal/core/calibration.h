@@ -26,6 +26,9 @@ struct ResidualSummary {
   double max = 0.0;
 };
 
+// The rms and the largest absolute value of `residuals` (0 for none).
+ResidualSummary SummarizeResiduals(const std::vector<double>& residuals);
+
 struct AccelCalibration {
   AccelModel model;
   // Standard deviations of b and of M = R U, element by element; NaN where

@@ -39,28 +39,12 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/core/types.h"
+
 namespace gravcal {
-
-enum class Effect {
-  kAccelMisalignment,
-  kAccelQuadratic,
-  kAccelTemperatureBias,
-  kAccelTemperatureScale,
-  kAccelBiasDrift,
-  kGyroGSensitivity,
-  kGyroTemperatureBias,
-  kGyroBiasDrift,
-};
-
-enum class EffectSensor { kAccelerometer, kGyroscope };
-
-// What an effect's residual varies with: the regressor plotted in reports.
-enum class EffectRegressor { kOrientation, kTemperature, kTime };
 
 struct EffectInfo {
   Effect effect;
-  // Name in configs and discovery.json, e.g. "accel_temperature_bias".
-  const char* name;
   // Physical meaning, one sentence.
   const char* description;
   EffectSensor sensor;
@@ -69,14 +53,14 @@ struct EffectInfo {
   // Names of the parameters (num_parameters of them) and their unit.
   std::vector<std::string> parameter_names;
   const char* unit;
+  // Name in configs and discovery.json, e.g. "accel_temperature_bias":
+  // ToString(effect).
+  const char* name = nullptr;
 };
 
 // Every effect, in catalogue order.
 const std::vector<EffectInfo>& EffectCatalogue();
 const EffectInfo& Info(Effect effect);
-const char* ToString(Effect effect);
-// Accepts the catalogue names.
-bool FromString(const std::string& name, Effect* effect);
 // Parses names into effects; on an unknown name returns false with a message
 // listing the catalogue. Duplicates are dropped.
 bool ParseEffects(const std::vector<std::string>& names, std::vector<Effect>* effects,

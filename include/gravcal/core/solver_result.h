@@ -10,13 +10,9 @@
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
+#include "gravcal/core/types.h"
 
 namespace gravcal {
-
-enum class LossType { kNone, kHuber, kCauchy, kSoftL1, kArctan, kTukey };
-const char* ToString(LossType loss);
-// Accepts "none", "huber", "cauchy", "soft_l1", "arctan", "tukey".
-bool FromString(const std::string& name, LossType* loss);
 
 struct ObservabilityReport {
   int rank = 0;
@@ -31,9 +27,6 @@ struct ObservabilityReport {
   std::vector<std::string> descriptions;
   bool full_rank() const { return rank == columns; }
 };
-
-enum class CoarseMethod { kSixPosition, kEllipsoid };
-const char* ToString(CoarseMethod method);
 
 struct CoarseFitResult {
   AccelModel model;

@@ -21,19 +21,10 @@
 
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/position.h"
+#include "gravcal/core/types.h"
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
-
-enum class NewtonResidual {
-  // The seed's f_k = |a_k|^2 - g^2, weighted by 1 / (2 g sigma_k).
-  kSquaredMagnitude,
-  // (|a_k| - g) / sigma_k, the Ceres refinement's residual.
-  kMagnitude,
-};
-const char* ToString(NewtonResidual residual);
-// Accepts "squared_magnitude", "magnitude".
-bool FromString(const std::string& name, NewtonResidual* residual);
 
 struct NewtonOptions {
   AccelParameterization parameterization = AccelParameterization::kScaleMisalignment;

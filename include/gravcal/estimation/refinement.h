@@ -26,6 +26,7 @@
 #include "gravcal/core/position.h"
 #include "gravcal/core/solver_result.h"
 #include "gravcal/estimation/observability.h"
+#include "gravcal/estimation/solver_tolerances.h"
 
 namespace gravcal {
 
@@ -47,10 +48,9 @@ struct RefinementOptions {
   // here and the fit is repeated, so a flat direction does not stall the
   // solver; they are reported as undetermined.
   std::vector<std::string> held_parameters;
-  int max_iterations = 100;
-  double function_tolerance = 1e-14;
-  double gradient_tolerance = 1e-14;
-  double parameter_tolerance = 1e-12;
+  // Stopping rules of the solve (max_iterations 100, tolerances 1e-14, 1e-14,
+  // 1e-12).
+  SolverTolerances solver;
 
   bool IsValid(std::string* error) const;
 };

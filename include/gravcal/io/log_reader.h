@@ -24,19 +24,9 @@
 #include <vector>
 
 #include "gravcal/core/imu_log.h"
+#include "gravcal/core/types.h"
 
 namespace gravcal {
-
-enum class LogFormat {
-  // Comma separated with a header row.
-  kCsv,
-  // Whitespace separated, no header row; `columns` names the columns.
-  kWhitespace,
-};
-
-const char* ToString(LogFormat format);
-// Accepts "csv", "whitespace".
-bool FromString(const std::string& name, LogFormat* format);
 
 struct LogReaderOptions {
   LogFormat format = LogFormat::kCsv;

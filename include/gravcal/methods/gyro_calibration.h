@@ -39,26 +39,12 @@
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/core/types.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
-
-// Which gyroscope parameters are free.
-enum class GyroParameterization {
-  // No gyroscope calibration.
-  kNone,
-  // b_g and one common scale factor (M_g = s I): 4 parameters.
-  kBias,
-  // b_g and diag(M_g): 6 parameters.
-  kScale,
-  // b_g and the full M_g (scale and misalignment): 12 parameters.
-  kFull,
-};
-const char* ToString(GyroParameterization p);
-// Accepts "none", "bias", "scale", "full".
-bool FromString(const std::string& name, GyroParameterization* p);
 
 struct GyroCalibrationOptions {
   // kNone makes CalibrateGyroscope fail: there is nothing to do.

@@ -19,17 +19,13 @@
 #include "gravcal/core/gravity.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/position.h"
+#include "gravcal/core/types.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/coarse_fit.h"
 #include "gravcal/estimation/newton_solver.h"
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
-
-enum class RefinementSolver { kCeres, kNewton };
-const char* ToString(RefinementSolver solver);
-// Accepts "ceres", "newton".
-bool FromString(const std::string& name, RefinementSolver* solver);
 
 struct CalibrationOptions {
   StaticDetectorOptions detector;

@@ -35,14 +35,10 @@
 #include <vector>
 
 #include "gravcal/core/rate_table_segment.h"
+#include "gravcal/core/types.h"
 #include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
-
-enum class MotionProfile { kHandheld, kTurntable, kVertical, kRateTable };
-const char* ToString(MotionProfile profile);
-// Accepts "handheld", "turntable", "vertical", "rate_table".
-bool FromString(const std::string& name, MotionProfile* profile);
 
 struct MotionOptions {
   MotionProfile profile = MotionProfile::kHandheld;

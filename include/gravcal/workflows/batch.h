@@ -25,6 +25,7 @@
 
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/core/types.h"
 #include "gravcal/workflows/config.h"
 
 namespace gravcal {
@@ -54,18 +55,6 @@ bool EffectiveConfig(const BatchUnit& unit, const Config& base, Config* config, 
 // Every key with its value, one "key: value" line each, in ConfigKeys()
 // order: the configuration part of the content hash.
 std::string ConfigText(const Config& config);
-
-enum class BatchStatus {
-  // Calibrated.
-  kOk,
-  // Bad input, configuration or too little data (`gravcal calibrate` exit 1).
-  kFailed,
-  // The solver ran and did not converge (`gravcal calibrate` exit 2).
-  kNotConverged,
-};
-const char* ToString(BatchStatus status);
-// Accepts "ok", "failed", "not_converged".
-bool FromString(const std::string& name, BatchStatus* status);
 
 // Wall-clock seconds spent on one unit.
 struct BatchTimings {

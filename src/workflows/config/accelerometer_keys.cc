@@ -114,7 +114,7 @@ ConfigSection SolverSection() {
                          "robust loss scale, in standard deviations"),
           GRAVCAL_BOOL("covariance", calibration.refinement.compute_covariance,
                        "compute the covariance (standard deviations)"),
-          GRAVCAL_INT("max_iterations", calibration.refinement.max_iterations,
+          GRAVCAL_INT("max_iterations", calibration.refinement.solver.max_iterations,
                       "solver iteration limit"),
       }};
 }

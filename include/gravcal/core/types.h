@@ -1,0 +1,133 @@
+// gravcal/core/types.h: every enum of the library with its string forms, in
+// one place (as ceres/types.h does). The names are the ones configs, YAML,
+// JSON and command-line flags use; ToString gives "unknown" for a value
+// outside the enum and FromString returns false (leaving *value unchanged) on
+// a name it does not know or a null output.
+#ifndef GRAVCAL_CORE_TYPES_H_
+#define GRAVCAL_CORE_TYPES_H_
+
+#include <string>
+
+namespace gravcal {
+
+// Which accelerometer parameters are free.
+enum class AccelParameterization {
+  // b and diag(U): 6 parameters, R = I, U diagonal.
+  kScale,
+  // b and U: 9 parameters, R = I. Gauge-free: the sensor x axis defines the
+  // body x axis and the sensor xy plane the body xy plane.
+  kScaleMisalignment,
+  // b, U and R: 12 parameters. R comes from the nominal axes of the poses.
+  kAffine,
+};
+// "scale", "scale_misalignment", "affine".
+const char* ToString(AccelParameterization p);
+bool FromString(const std::string& name, AccelParameterization* p);
+
+// Which gyroscope parameters are free.
+enum class GyroParameterization {
+  // No gyroscope calibration.
+  kNone,
+  // b_g and one common scale factor (M_g = s I): 4 parameters.
+  kBias,
+  // b_g and diag(M_g): 6 parameters.
+  kScale,
+  // b_g and the full M_g (scale and misalignment): 12 parameters.
+  kFull,
+};
+// "none", "bias", "scale", "full".
+const char* ToString(GyroParameterization p);
+bool FromString(const std::string& name, GyroParameterization* p);
+
+// The robust loss applied to the whitened residuals.
+enum class LossType { kNone, kHuber, kCauchy, kSoftL1, kArctan, kTukey };
+// "none", "huber", "cauchy", "soft_l1", "arctan", "tukey".
+const char* ToString(LossType loss);
+bool FromString(const std::string& name, LossType* loss);
+
+// How the coarse fit found its model.
+enum class CoarseMethod { kSixPosition, kEllipsoid };
+// "six_position_least_squares", "ellipsoid_fit".
+const char* ToString(CoarseMethod method);
+bool FromString(const std::string& name, CoarseMethod* method);
+
+// Which solver refines the twelve-position fit.
+enum class RefinementSolver { kCeres, kNewton };
+// "ceres", "newton".
+const char* ToString(RefinementSolver solver);
+bool FromString(const std::string& name, RefinementSolver* solver);
+
+// The residual the Newton baseline minimises.
+enum class NewtonResidual {
+  // The seed's f_k = |a_k|^2 - g^2, weighted by 1 / (2 g sigma_k).
+  kSquaredMagnitude,
+  // (|a_k| - g) / sigma_k, the Ceres refinement's residual.
+  kMagnitude,
+};
+// "squared_magnitude", "magnitude".
+const char* ToString(NewtonResidual residual);
+bool FromString(const std::string& name, NewtonResidual* residual);
+
+// Text layout of a log file.
+enum class LogFormat {
+  // Comma separated with a header row.
+  kCsv,
+  // Whitespace separated, no header row; `columns` names the columns.
+  kWhitespace,
+};
+// "csv", "whitespace".
+const char* ToString(LogFormat format);
+bool FromString(const std::string& name, LogFormat* format);
+
+// The motion of a simulated handheld or rate-table recording.
+enum class MotionProfile { kHandheld, kTurntable, kVertical, kRateTable };
+// "handheld", "turntable", "vertical", "rate_table".
+const char* ToString(MotionProfile profile);
+bool FromString(const std::string& name, MotionProfile* profile);
+
+// The outcome of one unit in a batch.
+enum class BatchStatus {
+  // Calibrated.
+  kOk,
+  // Bad input, configuration or too little data (`gravcal calibrate` exit 1).
+  kFailed,
+  // The solver ran and did not converge (`gravcal calibrate` exit 2).
+  kNotConverged,
+};
+// "ok", "failed", "not_converged".
+const char* ToString(BatchStatus status);
+bool FromString(const std::string& name, BatchStatus* status);
+
+// The sensor effects beyond the textbook model (model_effects.h holds their
+// catalogue: meaning, parameters, units).
+enum class Effect {
+  kAccelMisalignment,
+  kAccelQuadratic,
+  kAccelTemperatureBias,
+  kAccelTemperatureScale,
+  kAccelBiasDrift,
+  kGyroGSensitivity,
+  kGyroTemperatureBias,
+  kGyroBiasDrift,
+};
+// "accel_misalignment", "accel_quadratic_nonlinearity",
+// "accel_temperature_bias", "accel_temperature_scale", "accel_bias_drift",
+// "gyro_g_sensitivity", "gyro_temperature_bias", "gyro_bias_drift".
+const char* ToString(Effect effect);
+bool FromString(const std::string& name, Effect* effect);
+
+// The sensor an effect acts on.
+enum class EffectSensor { kAccelerometer, kGyroscope };
+// "accelerometer", "gyroscope".
+const char* ToString(EffectSensor sensor);
+bool FromString(const std::string& name, EffectSensor* sensor);
+
+// What an effect's residual varies with: the regressor plotted in reports.
+enum class EffectRegressor { kOrientation, kTemperature, kTime };
+// "orientation", "temperature", "time".
+const char* ToString(EffectRegressor regressor);
+bool FromString(const std::string& name, EffectRegressor* regressor);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_CORE_TYPES_H_

@@ -1,0 +1,11 @@
+#include "gravcal/core/calibration.h"
+
+#include "util/statistics.h"
+
+namespace gravcal {
+
+ResidualSummary SummarizeResiduals(const std::vector<double>& residuals) {
+  return {Rms(residuals), MaxAbs(residuals)};
+}
+
+}  // namespace gravcal

@@ -1,0 +1,130 @@
+#include "gravcal/core/types.h"
+
+#include <cstddef>
+
+namespace gravcal {
+namespace {
+
+// One row of an enum's table: a value and its string form.
+template <typename E>
+struct EnumName {
+  E value;
+  const char* name;
+};
+
+template <typename E, std::size_t N>
+const char* NameOf(const EnumName<E> (&table)[N], E value) {
+  for (const EnumName<E>& row : table) {
+    if (row.value == value) return row.name;
+  }
+  return "unknown";
+}
+
+template <typename E, std::size_t N>
+bool ValueOf(const EnumName<E> (&table)[N], const std::string& name, E* value) {
+  if (value == nullptr) return false;
+  for (const EnumName<E>& row : table) {
+    if (name == row.name) {
+      *value = row.value;
+      return true;
+    }
+  }
+  return false;
+}
+
+const EnumName<AccelParameterization> kAccelParameterizations[] = {
+    {AccelParameterization::kScale, "scale"},
+    {AccelParameterization::kScaleMisalignment, "scale_misalignment"},
+    {AccelParameterization::kAffine, "affine"},
+};
+
+const EnumName<GyroParameterization> kGyroParameterizations[] = {
+    {GyroParameterization::kNone, "none"},
+    {GyroParameterization::kBias, "bias"},
+    {GyroParameterization::kScale, "scale"},
+    {GyroParameterization::kFull, "full"},
+};
+
+const EnumName<LossType> kLossTypes[] = {
+    {LossType::kNone, "none"},      {LossType::kHuber, "huber"},   {LossType::kCauchy, "cauchy"},
+    {LossType::kSoftL1, "soft_l1"}, {LossType::kArctan, "arctan"}, {LossType::kTukey, "tukey"},
+};
+
+const EnumName<CoarseMethod> kCoarseMethods[] = {
+    {CoarseMethod::kSixPosition, "six_position_least_squares"},
+    {CoarseMethod::kEllipsoid, "ellipsoid_fit"},
+};
+
+const EnumName<RefinementSolver> kRefinementSolvers[] = {
+    {RefinementSolver::kCeres, "ceres"},
+    {RefinementSolver::kNewton, "newton"},
+};
+
+const EnumName<NewtonResidual> kNewtonResiduals[] = {
+    {NewtonResidual::kSquaredMagnitude, "squared_magnitude"},
+    {NewtonResidual::kMagnitude, "magnitude"},
+};
+
+const EnumName<LogFormat> kLogFormats[] = {
+    {LogFormat::kCsv, "csv"},
+    {LogFormat::kWhitespace, "whitespace"},
+};
+
+const EnumName<MotionProfile> kMotionProfiles[] = {
+    {MotionProfile::kHandheld, "handheld"},
+    {MotionProfile::kTurntable, "turntable"},
+    {MotionProfile::kVertical, "vertical"},
+    {MotionProfile::kRateTable, "rate_table"},
+};
+
+const EnumName<BatchStatus> kBatchStatuses[] = {
+    {BatchStatus::kOk, "ok"},
+    {BatchStatus::kFailed, "failed"},
+    {BatchStatus::kNotConverged, "not_converged"},
+};
+
+const EnumName<Effect> kEffects[] = {
+    {Effect::kAccelMisalignment, "accel_misalignment"},
+    {Effect::kAccelQuadratic, "accel_quadratic_nonlinearity"},
+    {Effect::kAccelTemperatureBias, "accel_temperature_bias"},
+    {Effect::kAccelTemperatureScale, "accel_temperature_scale"},
+    {Effect::kAccelBiasDrift, "accel_bias_drift"},
+    {Effect::kGyroGSensitivity, "gyro_g_sensitivity"},
+    {Effect::kGyroTemperatureBias, "gyro_temperature_bias"},
+    {Effect::kGyroBiasDrift, "gyro_bias_drift"},
+};
+
+const EnumName<EffectSensor> kEffectSensors[] = {
+    {EffectSensor::kAccelerometer, "accelerometer"},
+    {EffectSensor::kGyroscope, "gyroscope"},
+};
+
+const EnumName<EffectRegressor> kEffectRegressors[] = {
+    {EffectRegressor::kOrientation, "orientation"},
+    {EffectRegressor::kTemperature, "temperature"},
+    {EffectRegressor::kTime, "time"},
+};
+
+}  // namespace
+
+// Each enum's pair, from its table.
+#define GRAVCAL_ENUM_STRINGS(Type, table)                           \
+  const char* ToString(Type value) { return NameOf(table, value); } \
+  bool FromString(const std::string& name, Type* value) { return ValueOf(table, name, value); }
+
+GRAVCAL_ENUM_STRINGS(AccelParameterization, kAccelParameterizations)
+GRAVCAL_ENUM_STRINGS(GyroParameterization, kGyroParameterizations)
+GRAVCAL_ENUM_STRINGS(LossType, kLossTypes)
+GRAVCAL_ENUM_STRINGS(CoarseMethod, kCoarseMethods)
+GRAVCAL_ENUM_STRINGS(RefinementSolver, kRefinementSolvers)
+GRAVCAL_ENUM_STRINGS(NewtonResidual, kNewtonResiduals)
+GRAVCAL_ENUM_STRINGS(LogFormat, kLogFormats)
+GRAVCAL_ENUM_STRINGS(MotionProfile, kMotionProfiles)
+GRAVCAL_ENUM_STRINGS(BatchStatus, kBatchStatuses)
+GRAVCAL_ENUM_STRINGS(Effect, kEffects)
+GRAVCAL_ENUM_STRINGS(EffectSensor, kEffectSensors)
+GRAVCAL_ENUM_STRINGS(EffectRegressor, kEffectRegressors)
+
+#undef GRAVCAL_ENUM_STRINGS
+
+}  // namespace gravcal

@@ -1,0 +1,36 @@
+#include "estimation/solver_settings.h"
+
+namespace gravcal {
+
+bool SolverTolerances::IsValid(std::string* error) const {
+  if (max_iterations < 1) {
+    if (error) *error = "max_iterations: must be at least 1";
+    return false;
+  }
+  if (!(function_tolerance > 0.0) || !(gradient_tolerance > 0.0) || !(parameter_tolerance > 0.0)) {
+    if (error) {
+      *error = "function_tolerance, gradient_tolerance, parameter_tolerance: must be positive";
+    }
+    return false;
+  }
+  return true;
+}
+
+namespace internal {
+
+ceres::Solver::Options SolverOptions(const SolverTolerances& tolerances,
+                                     ceres::LinearSolverType linear_solver) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = linear_solver;
+  options.max_num_iterations = tolerances.max_iterations;
+  options.function_tolerance = tolerances.function_tolerance;
+  options.gradient_tolerance = tolerances.gradient_tolerance;
+  options.parameter_tolerance = tolerances.parameter_tolerance;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  options.num_threads = 1;
+  return options;
+}
+
+}  // namespace internal
+}  // namespace gravcal
