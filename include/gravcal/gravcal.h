@@ -41,6 +41,7 @@
 // io
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
 

@@ -1,11 +1,6 @@
 #include "gravcal/io/log_reader.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -16,12 +11,15 @@
 #include <set>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <utility>
 #include <vector>
 
+#include "io/file_text.h"
+
 namespace gravcal {
 namespace {
+
+using internal::FileText;
 
 // The contract's column names, in the order of the slots a row fills.
 enum Slot : int { kT = 0, kAx, kAy, kAz, kGx, kGy, kGz, kTemp, kNumSlots };
@@ -42,8 +40,6 @@ bool SetError(std::string* error, std::string message) {
   if (error != nullptr) *error = std::move(message);
   return false;
 }
-
-std::string ErrnoMessage(int errnum) { return std::generic_category().message(errnum); }
 
 // Shortest text that reads back to the same double.
 std::string FormatDouble(double x) {
@@ -128,56 +124,6 @@ bool ParsePlainInteger(const char* p, const char* end, double* x, const char** a
   *after = q;
   return true;
 }
-
-class FileText {
- public:
-  bool Read(const std::string& path, std::string* error) {
-    const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return SetError(error, path + ": cannot open: " + ErrnoMessage(errno));
-    size_t capacity = size_t{1} << 16;
-    struct stat st;
-    if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
-      // One more byte than the size, so that end of file shows without a regrow.
-      capacity = static_cast<size_t>(st.st_size) + 1;
-    }
-    data_.reset(new (std::nothrow) char[capacity]);
-    size_ = 0;
-    if (!data_) {
-      close(fd);
-      return SetError(error, path + ": cannot read: out of memory");
-    }
-    for (;;) {
-      if (size_ == capacity) {
-        const size_t bigger = capacity * 2;
-        std::unique_ptr<char[]> grown(new (std::nothrow) char[bigger]);
-        if (!grown) {
-          close(fd);
-          return SetError(error, path + ": cannot read: out of memory");
-        }
-        std::memcpy(grown.get(), data_.get(), size_);
-        data_ = std::move(grown);
-        capacity = bigger;
-      }
-      const ssize_t n = read(fd, data_.get() + size_, capacity - size_);
-      if (n < 0) {
-        if (errno == EINTR) continue;
-        const int errnum = errno;
-        close(fd);
-        return SetError(error, path + ": cannot read: " + ErrnoMessage(errnum));
-      }
-      if (n == 0) break;
-      size_ += static_cast<size_t>(n);
-    }
-    close(fd);
-    return true;
-  }
-
-  std::string_view view() const { return std::string_view(data_.get(), size_); }
-
- private:
-  std::unique_ptr<char[]> data_;
-  size_t size_ = 0;
-};
 
 // Rows in `text`, estimated from the line length of its first 64 KiB.
 size_t EstimateRows(std::string_view text) {
@@ -649,51 +595,6 @@ bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* err
     }
     contents.resize(static_cast<size_t>(p - contents.data()));
     return WriteFileAtomically(path, contents, error);
-  } catch (const std::exception& e) {
-    return SetError(error, path + ": cannot write: " + e.what());
-  }
-}
-
-bool ReadFileBytes(const std::string& path, std::string* bytes, std::string* error) {
-  try {
-    FileText text;
-    if (!text.Read(path, error)) return false;
-    bytes->assign(text.view());
-    return true;
-  } catch (const std::exception& e) {
-    return SetError(error, path + ": cannot read: " + e.what());
-  }
-}
-
-bool WriteFileAtomically(const std::string& path, const std::string& contents, std::string* error) {
-  if (path.empty()) return SetError(error, "cannot write a file with an empty name");
-  try {
-    const std::string temporary = path + ".tmp." + std::to_string(getpid());
-    const int fd = open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd < 0) {
-      return SetError(error, path + ": cannot create '" + temporary + "': " + ErrnoMessage(errno));
-    }
-    auto fail = [&](const std::string& what, int errnum) {
-      unlink(temporary.c_str());
-      return SetError(error, path + ": " + what + ": " + ErrnoMessage(errnum));
-    };
-    const char* p = contents.data();
-    size_t left = contents.size();
-    while (left > 0) {
-      const ssize_t n = write(fd, p, left);
-      if (n < 0) {
-        if (errno == EINTR) continue;
-        const int errnum = errno;
-        close(fd);
-        return fail("cannot write", errnum);
-      }
-      p += n;
-      left -= static_cast<size_t>(n);
-    }
-    if (close(fd) != 0) return fail("cannot write", errno);
-    if (rename(temporary.c_str(), path.c_str()) != 0)
-      return fail("cannot rename into place", errno);
-    return true;
   } catch (const std::exception& e) {
     return SetError(error, path + ": cannot write: " + e.what());
   }

@@ -25,6 +25,7 @@
 
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/types.h"
+#include "gravcal/io/files.h"
 
 namespace gravcal {
 
@@ -61,14 +62,6 @@ bool ParseImuLog(std::string_view text, const std::string& name, const LogReader
 // Writes the log as contract CSV (t,ax,ay,az[,gx,gy,gz][,temp]) with full
 // precision, atomically (temporary file, then rename).
 bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* error);
-
-// Reads a whole file into `bytes`; errors name the file ("x.csv: cannot
-// open: No such file or directory").
-bool ReadFileBytes(const std::string& path, std::string* bytes, std::string* error);
-
-// Writes `contents` to `path` through a temporary file in the same directory
-// and a rename, so a failure never leaves a partial file.
-bool WriteFileAtomically(const std::string& path, const std::string& contents, std::string* error);
 
 }  // namespace gravcal
 
