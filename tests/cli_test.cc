@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "cli_runner.h"
+#include "sigma_check.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -53,12 +55,40 @@ class CliTest : public ::testing::Test {
   const std::string dir_ = scratch_.path();
 };
 
+// The demo's table: a row per parameter (bias_x..z, u_xx..u_zz) with truth,
+// estimate +- std and err/std. The printed err/std must be (estimate -
+// truth) / std of the printed numbers, and every one of the nine within the
+// bound nine honest N(0, 1) values all stay inside with probability 0.999
+// (about 4.0 sigma); the residual after the calibration below the one before.
 TEST_F(CliTest, DemoPrintsEstimateNextToTruth) {
   const RunResult r = Run("demo --config " + Config());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("truth"), std::string::npos);
-  EXPECT_NE(r.out.find("+-"), std::string::npos);
-  EXPECT_NE(r.out.find("before"), std::string::npos);
+  std::istringstream in(r.out);
+  int rows = 0;
+  double before = NAN, after = NAN;
+  const int kRows = 9;
+  const double bound =
+      testing_util::NormalQuantile(1.0 - 0.5 * (1.0 - testing_util::kSigmaBandProbability) / kRows);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream row(line);
+    std::string name, plus_minus;
+    double truth, estimate, sigma, z;
+    if ((line.rfind("bias_", 0) == 0 || line.rfind("u_", 0) == 0) &&
+        row >> name >> truth >> estimate >> plus_minus >> sigma >> z) {
+      ++rows;
+      EXPECT_EQ(plus_minus, "+-") << line;
+      EXPECT_GT(sigma, 0.0) << line;
+      EXPECT_NEAR(z, (estimate - truth) / sigma, 0.01) << line;
+      EXPECT_LT(std::fabs(z), bound) << line;
+    }
+    const size_t at = line.find("before (nominal scale) rms ");
+    if (at != std::string::npos) {
+      before = std::stod(line.substr(at + 27));
+      after = std::stod(line.substr(line.find("after rms ") + 10));
+    }
+  }
+  EXPECT_EQ(rows, kRows) << r.out;
+  EXPECT_LT(after, before) << r.out;
 }
 
 TEST_F(CliTest, SimulateCalibrateApplyRoundTrip) {

@@ -311,25 +311,48 @@ TEST(HandheldKalman, LeverArmIsEstimatedWhenAsked) {
   with_check.ExpectHonest("filter with hk_lever_arm");
 }
 
+// A session whose gyroscope senses the Earth rate (added to the simulated
+// samples through the truth attitude, 45 deg latitude). With the option on
+// the filter models it: its gyroscope biases are within their sigmas (each of
+// three |error/sigma| under the bound three honest N(0, 1) values all stay
+// inside with probability 0.999). With it off, the biases absorb some
+// average of the body-frame Earth rate, a vector no longer than the Earth
+// rate Omega (the filter's weights are matrices, hence the factor 2 below):
+// the two estimates must differ by more than 0.1 Omega (an option that does
+// nothing gives exactly 0) and less than 2 Omega (a wrong unit or a doubled
+// rate gives more).
 TEST(HandheldKalman, EarthRateOptionRuns) {
-  // The simulator has no Earth rate; modelling 7.3e-5 rad/s that is not in
-  // the data moves the gyroscope biases by about that (1-2 sigma here).
   const SimulatorOptions sensor = FilterSensor();
+  const double latitude = 45.0;
   MotionSession s;
   std::string error;
   ASSERT_TRUE(SimulateMotion(sensor, MotionOptions(), 9, &s, &error)) << error;
-  HandheldKalmanOptions options = MatchingOptions(sensor);
-  options.earth_rate = true;
-  options.gravity.latitude = 45.0;
-  Calibration c;
-  ASSERT_TRUE(CalibrateHandheld(s.sensor.log, options, &c)) << c.message;
-  const std::vector<double> truth = TruthVector(s.sensor);
-  for (int j = 0; j < 12; ++j) {
-    const ConvergenceEntry& e = c.convergence.entries[j];
-    EXPECT_LT(std::fabs(e.value - truth[j]),
-              4.0 * e.sigma_final + (j >= 6 && j < 9 ? kEarthRate : 0.0))
-        << e.name;
+  const Eigen::Matrix3d to_raw = s.sensor.gyro_truth.matrix.inverse();
+  for (size_t i = 0; i < s.sensor.log.size(); ++i) {
+    s.sensor.log.gyro[i] += to_raw * (s.attitude[i].conjugate() * EarthRateEnu(latitude));
   }
+  const std::vector<double> truth = TruthVector(s.sensor);
+  const double bound =
+      testing_util::NormalQuantile(1.0 - 0.5 * (1.0 - testing_util::kSigmaBandProbability) / 3);
+  Eigen::Vector3d bias[2];
+  for (bool on : {true, false}) {
+    HandheldKalmanOptions options = MatchingOptions(sensor);
+    options.earth_rate = on;
+    options.gravity.latitude = latitude;
+    Calibration c;
+    ASSERT_TRUE(CalibrateHandheld(s.sensor.log, options, &c)) << c.message;
+    for (int j = 6; j < 9; ++j) {
+      const ConvergenceEntry& e = c.convergence.entries[j];
+      bias[on](j - 6) = e.value;
+      std::printf("earth_rate %d %s error %.3g sigma %.3g\n", on, e.name.c_str(),
+                  e.value - truth[j], e.sigma_final);
+      if (on) EXPECT_LT(std::fabs(e.value - truth[j]), bound * e.sigma_final) << e.name;
+    }
+  }
+  const double shift = (bias[0] - bias[1]).norm();
+  std::printf("bias shift off - on %.3g rad/s, Earth rate %.3g\n", shift, kEarthRate);
+  EXPECT_GT(shift, 0.1 * kEarthRate);
+  EXPECT_LT(shift, 2.0 * kEarthRate);
 }
 
 TEST(HandheldKalman, RejectsBadInput) {

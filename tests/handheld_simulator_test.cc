@@ -25,9 +25,24 @@ TEST(HandheldSimulator, DeterministicPerSeed) {
   ASSERT_TRUE(SimulateMotion(SimulatorOptions(), MotionOptions(), 5, &a, &error)) << error;
   ASSERT_TRUE(SimulateMotion(SimulatorOptions(), MotionOptions(), 5, &b, &error)) << error;
   ASSERT_TRUE(SimulateMotion(SimulatorOptions(), MotionOptions(), 6, &c, &error)) << error;
-  ASSERT_EQ(a.sensor.log.size(), b.sensor.log.size());
-  EXPECT_EQ(a.sensor.log.accel[1000], b.sensor.log.accel[1000]);
-  EXPECT_NE(a.sensor.log.gyro[1000], c.sensor.log.gyro[1000]);
+  // Every sample of every column, and the truth, identical for one seed.
+  const ImuLog& la = a.sensor.log;
+  const ImuLog& lb = b.sensor.log;
+  ASSERT_EQ(la.size(), lb.size());
+  EXPECT_EQ(la.t, lb.t);
+  EXPECT_EQ(la.accel, lb.accel);
+  EXPECT_EQ(la.gyro, lb.gyro);
+  EXPECT_EQ(la.temperature, lb.temperature);
+  EXPECT_EQ(a.position, b.position);
+  EXPECT_EQ(a.velocity, b.velocity);
+  for (size_t i = 0; i < a.attitude.size(); ++i) {
+    ASSERT_EQ(a.attitude[i].coeffs(), b.attitude[i].coeffs()) << "sample " << i;
+  }
+  EXPECT_EQ(a.sensor.gyro_truth.matrix, b.sensor.gyro_truth.matrix);
+  EXPECT_EQ(a.sensor.accel_truth.matrix(), b.sensor.accel_truth.matrix());
+  // Another seed: another session (noise in every column).
+  EXPECT_NE(la.accel, c.sensor.log.accel);
+  EXPECT_NE(la.gyro, c.sensor.log.gyro);
 }
 
 TEST(HandheldSimulator, TurntableReturnsToZero) {

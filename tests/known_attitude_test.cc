@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "cli_runner.h"
@@ -186,8 +187,33 @@ TEST_F(KnownAttitudeTest, CommandLineEndToEnd) {
                 &err),
             0)
       << err;
+  // The twelve parameters against the simulated truth: each within the
+  // bound twelve honest N(0, 1) values all stay inside with probability
+  // 0.999 (about 4.1 sigma).
+  std::ifstream calib_in(calib);
+  std::ifstream truth_in(dir_ + "/sim/truth.json");
+  const nlohmann::json estimate = nlohmann::json::parse(calib_in, nullptr, false);
+  const nlohmann::json truth = nlohmann::json::parse(truth_in, nullptr, false);
+  ASSERT_FALSE(estimate.is_discarded());
+  ASSERT_FALSE(truth.is_discarded());
+  const double bound =
+      testing_util::NormalQuantile(1.0 - 0.5 * (1.0 - testing_util::kSigmaBandProbability) / 12);
+  auto expect_within = [&](const std::string& name, const nlohmann::json& e,
+                           const nlohmann::json& t, const nlohmann::json& sigma) {
+    ASSERT_TRUE(sigma.is_number()) << name;
+    const double z = (e.get<double>() - t.get<double>()) / sigma.get<double>();
+    EXPECT_LT(std::fabs(z), bound) << name << ": error/sigma " << z;
+  };
+  const nlohmann::json& a = estimate["accel"];
+  for (int i = 0; i < 3; ++i) {
+    expect_within("bias " + std::to_string(i), a["bias"][i], truth["accel"]["bias"][i],
+                  a["std"]["bias"][i]);
+    for (int j = 0; j < 3; ++j) {
+      expect_within("matrix " + std::to_string(i) + std::to_string(j), a["matrix"][i][j],
+                    truth["accel"]["matrix"][i][j], a["std"]["matrix"][i][j]);
+    }
+  }
   struct stat st;
-  EXPECT_EQ(stat(calib.c_str(), &st), 0);
 
   std::ifstream in(dir_ + "/sim/attitudes.csv");
   std::stringstream text;

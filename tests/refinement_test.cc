@@ -3,6 +3,8 @@
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "gravcal/core/calibration.h"
 #include "gravcal/estimation/coarse_fit.h"
 #include "gravcal/estimation/newton_solver.h"
@@ -167,9 +169,18 @@ TEST(Refinement, StandardDeviationMatchesSpreadScaleSi) {
   CheckCalibratedUncertainty(AccelParameterization::kScale, 1.0);
 }
 
+// A trial succeeds when all nine parameters are within 3 sigma of the truth.
+// Nine parameters each within 3 sigma fails by chance in about 2.4 % of
+// correct fits; beyond that, a start corrupted by the pushes sometimes leads
+// the graduated robust solve into a wrong basin. Measured on trials
+// 100000-100999 (not the test's): the robust fit succeeds in 952 of 1000,
+// plain least squares in 0 of 1000. The test states p = 0.93 for the robust
+// fit (the one-sided 99.9 % lower confidence bound of 952 / 1000) and at
+// most p = 0.005 for plain least squares (0 of 1000: the 99.5 % upper bound),
+// and takes its thresholds from the binomial tails at those p.
 TEST(Refinement, RobustLossResistsDisturbedPositions) {
   int robust_ok = 0, plain_ok = 0;
-  const int kTrials = 10;
+  const int kTrials = 100;
   for (int trial = 0; trial < kTrials; ++trial) {
     std::mt19937_64 rng(300 + trial);
     const AccelModel truth = Truth(&rng);
@@ -201,12 +212,11 @@ TEST(Refinement, RobustLossResistsDisturbedPositions) {
       (loss == LossType::kNone ? plain_ok : robust_ok) += within;
     }
   }
-  // Nine parameters each within 3 sigma fails by chance in about 2.4 % of
-  // correct fits; beyond that, a start corrupted by the pushes sometimes
-  // leads the graduated robust solve into a wrong basin (measured: 8 of 10
-  // trials here are good). Plain least squares is never within 3 sigma.
-  EXPECT_GE(robust_ok, 8);
-  EXPECT_EQ(plain_ok, 0);
+  std::printf("robust within 3 sigma in %d of %d, plain in %d\n", robust_ok, kTrials, plain_ok);
+  EXPECT_GE(robust_ok, testing_util::RequiredSuccesses(kTrials, 0.93))  // 84
+      << robust_ok << " of " << kTrials;
+  EXPECT_LE(plain_ok, testing_util::AllowedSuccesses(kTrials, 0.005))  // 4
+      << plain_ok << " of " << kTrials;
 }
 
 TEST(Refinement, RankDeficientPositionsWarnInsteadOfCrashing) {

@@ -127,6 +127,45 @@ void AddEach(Check* check, const std::string& name, const Eigen::MatrixXd& error
   }
 }
 
+// --- Counts of successes over independent trials ---------------------------
+//
+// A test that counts how often a method succeeds over n independent trials
+// states the method's success probability p per trial (from the method's
+// design, e.g. its significance level, or from a larger measured run that
+// the test's comment records) and derives its threshold from the binomial
+// distribution, so that an honest method fails the test with probability
+// below kCountFailureProbability (the same 0.001 as SigmaCheck's band).
+constexpr double kCountFailureProbability = 0.001;
+
+// P(X = k) for X ~ Binomial(n, p).
+inline double BinomialProbability(int n, double p, int k) {
+  if (k < 0 || k > n) return 0.0;
+  if (p <= 0.0) return k == 0 ? 1.0 : 0.0;
+  if (p >= 1.0) return k == n ? 1.0 : 0.0;
+  return std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) +
+                  k * std::log(p) + (n - k) * std::log1p(-p));
+}
+
+// The successes out of n that a method succeeding with probability p per
+// trial reaches except with probability below `alpha`: the largest k with
+// P(X < k) < alpha.
+inline int RequiredSuccesses(int n, double p, double alpha = kCountFailureProbability) {
+  double below = 0.0;  // P(X < k)
+  int k = 0;
+  while (k < n && below + BinomialProbability(n, p, k) < alpha) {
+    below += BinomialProbability(n, p, k);
+    ++k;
+  }
+  return k;
+}
+
+// The successes out of n that a method succeeding with probability at most p
+// per trial exceeds only with probability below `alpha`: the smallest m with
+// P(X > m) < alpha.
+inline int AllowedSuccesses(int n, double p, double alpha = kCountFailureProbability) {
+  return n - RequiredSuccesses(n, 1.0 - p, alpha);
+}
+
 // Issue 6: 24 random poses held 10 s during a warm-up from 20 to 35 degC
 // (time constant 120 s), so temperature and time both vary and are not
 // proportional: the session in which hidden effects are looked for.
