@@ -86,6 +86,10 @@ std::vector<std::string> CheckLayering(const fs::path& root) {
       int line_number = 0;
       while (std::getline(in, line)) {
         ++line_number;
+        if (wing != "cli" && line.find("gflags/gflags.h") != std::string::npos) {
+          violations.push_back(shown + ":" + std::to_string(line_number) +
+                               ": gflags outside src/cli");
+        }
         std::smatch m;
         if (!std::regex_search(line, m, include_re)) continue;
         const std::string target = m[1];
@@ -138,9 +142,10 @@ TEST(Layering, PlantedViolationsAreNamed) {
   write("src/estimation/e.cc", "#include \"gravcal/estimation/e.h\"\n#include \"methods/x.h\"\n");
   write("src/util/ok.h", "#include <cmath>\n");
   write("src/loose.cc", "int x;\n");
+  write("src/workflows/flags.cc", "#include <gflags/gflags.h>\n");
   const std::vector<std::string> v = CheckLayering(root);
   const std::string all = Join(v);
-  EXPECT_EQ(v.size(), 5u) << all;
+  EXPECT_EQ(v.size(), 6u) << all;
   EXPECT_NE(all.find("include/gravcal/core/a.h:1: wing 'core' includes \"gravcal/methods/b.h\""),
             std::string::npos)
       << all;
@@ -155,6 +160,7 @@ TEST(Layering, PlantedViolationsAreNamed) {
             std::string::npos)
       << all;
   EXPECT_NE(all.find("src/loose.cc: not inside a wing folder"), std::string::npos) << all;
+  EXPECT_NE(all.find("src/workflows/flags.cc:1: gflags outside src/cli"), std::string::npos) << all;
   fs::remove_all(root);
 }
 
