@@ -4,7 +4,7 @@
 // with r_k the GravityMagnitudeResidual of each static position
 // (gravity_magnitude_residual.h) and rho an optional robust loss. The
 // rotation R of the initial model is kept: the magnitude cannot see it
-// (METHODS.md section 1; the 12-parameter system of the seed is singular in
+// (docs/methods.md section 1; the 12-parameter system of the seed is singular in
 // three directions). sigma_k is computed once, at the initial model, from the
 // position's covariance of the mean:
 //

@@ -1,4 +1,4 @@
-// gravcal/io/calibration_io.h: the calibration JSON file (README, "Calibration
+// gravcal/io/calibration_io.h: the calibration JSON file (docs/data_contract.md, "Calibration
 // JSON"): accel.{model, bias, matrix, std.{bias, matrix}, covariance},
 // gravity, residual, positions, solver, warnings. Standard deviations that
 // were not estimated are null. Written atomically.

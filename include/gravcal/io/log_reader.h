@@ -1,6 +1,6 @@
 // gravcal/io/log_reader.h: reads raw IMU logs from text files.
 //
-// The data contract (README, "Raw log CSV"):
+// The data contract (docs/data_contract.md, "Raw log"):
 // - CSV: a header row naming the columns; `t` (seconds, increasing), `ax`,
 //   `ay`, `az` required; `gx`, `gy`, `gz`, `temp` optional; other columns are
 //   ignored. Lines starting with '#' are comments; blank lines are skipped.

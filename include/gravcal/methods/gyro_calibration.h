@@ -1,6 +1,6 @@
 // gravcal/methods/gyro_calibration.h: gyroscope calibration from the rotations
 // between the static poses of a multi-position session, no turntable
-// (Tedaldi et al. 2014; METHODS.md section 4).
+// (Tedaldi et al. 2014; docs/methods.md section 4).
 //
 // The log is cut into rotations, each from the last sample of one static
 // interval to the first sample of the next (after edge_seconds are trimmed

@@ -24,7 +24,7 @@
 // and installation misalignment, six numbers) come out near zero whatever
 // the truth is. They are reported with a null standard deviation and a
 // warning; use known_attitude (all twelve) or twelve_position
-// (non-orthogonality) for them. README "Ten-position calibration" has the
+// (non-orthogonality) for them. docs/methods/ten_position.md has the
 // measured comparison.
 #ifndef GRAVCAL_METHODS_TEN_POSITION_H_
 #define GRAVCAL_METHODS_TEN_POSITION_H_

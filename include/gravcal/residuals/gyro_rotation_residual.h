@@ -1,6 +1,6 @@
 // gravcal/residuals/gyro_rotation_residual.h: the per-rotation Ceres residual of the
 // gyroscope calibration between static poses (Tedaldi et al. 2014,
-// METHODS.md section 4), and the integrator it uses.
+// docs/methods.md section 4), and the integrator it uses.
 //
 // Frames: the body frame is the calibrated accelerometer's (a = M_a (v - b_a),
 // accel_model.h); the gyroscope model maps into it. A rotation k runs from

@@ -1,7 +1,7 @@
 // gravcal/workflows/batch_manifest.h: the units of a batch, from a manifest CSV or from
 // the files in a folder, and the deterministic split into shards.
 //
-// Manifest CSV (README, "Batch calibration"): a header row, one unit per
+// Manifest CSV (docs/data_contract.md, "Batch manifest"): a header row, one unit per
 // row. Required columns `unit` (the id: letters, digits, '.', '_', '-', not
 // starting with '.', not "summary"; unique) and `path` (the raw log). Optional
 // `gyro_path` (second file with the gyroscope, see log_reader.h) and

@@ -19,10 +19,11 @@ ConfigSection EffectsSection() {
   return {"effects",
           ConfigSectionUse::kSomeMethods,
           {
-              GRAVCAL_KEY("effects",
-                          "effects added to the model by name (README: effect catalogue), e.g. "
-                          "[accel_temperature_bias]",
-                          ReadEffects(n, &c->effects, e), ListText(EffectNames(c.effects))),
+              GRAVCAL_KEY(
+                  "effects",
+                  "effects added to the model by name (catalogue: docs/methods.md section 6), e.g. "
+                  "[accel_temperature_bias]",
+                  ReadEffects(n, &c->effects, e), ListText(EffectNames(c.effects))),
           }};
 }
 
