@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "estimation/normalization.h"
+#include "estimation/solver_settings.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/refinement.h"
 #include "residuals/effect_residual.h"
@@ -30,16 +31,7 @@ constexpr int kOffDiagonal[3] = {1, 2, 4};
 bool IsAccelEffect(Effect e) { return Info(e).sensor == EffectSensor::kAccelerometer; }
 
 ceres::Solver::Options SolverOptions(const EffectFitOptions& o) {
-  ceres::Solver::Options s;
-  s.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  s.max_num_iterations = o.max_iterations;
-  s.function_tolerance = o.function_tolerance;
-  s.gradient_tolerance = o.gradient_tolerance;
-  s.parameter_tolerance = o.parameter_tolerance;
-  s.logging_type = ceres::SILENT;
-  s.minimizer_progress_to_stdout = false;
-  s.num_threads = 1;
-  return s;
+  return internal::SolverOptions(o.solver, ceres::DENSE_NORMAL_CHOLESKY);
 }
 
 // (J^T J)^-1 of a whitened Jacobian, with the undetermined parameters (null
@@ -421,12 +413,9 @@ std::vector<StaticObservation> ObservationsFromIntervals(
 }
 
 bool EffectFitOptions::IsValid(std::string* error) const {
-  if (max_iterations < 1) {
-    *error = "effect fit: max_iterations must be at least 1";
-    return false;
-  }
-  if (!(function_tolerance > 0.0) || !(gradient_tolerance > 0.0) || !(parameter_tolerance > 0.0)) {
-    *error = "effect fit: tolerances must be positive";
+  std::string solver_error;
+  if (!solver.IsValid(&solver_error)) {
+    *error = "effect fit: " + solver_error;
     return false;
   }
   return true;

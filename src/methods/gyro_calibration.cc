@@ -10,6 +10,7 @@
 
 #include "estimation/accel_uncertainty.h"
 #include "estimation/normalization.h"
+#include "estimation/solver_settings.h"
 #include "methods/direction_noise.h"
 #include "methods/gyro_covariance.h"
 #include "methods/gyro_observability.h"
@@ -35,10 +36,8 @@ bool GyroCalibrationOptions::IsValid(std::string* error) const {
   if (!(edge_seconds >= 0.0 && std::isfinite(edge_seconds))) {
     return fail("gyro edge_seconds: must be zero or positive");
   }
-  if (max_iterations < 1) return fail("gyro max_iterations: must be at least 1");
-  if (!(function_tolerance > 0.0) || !(gradient_tolerance > 0.0) || !(parameter_tolerance > 0.0)) {
-    return fail("gyro solver tolerances: must be positive");
-  }
+  std::string solver_error;
+  if (!solver.IsValid(&solver_error)) return fail("gyro " + solver_error);
   return true;
 }
 
@@ -150,15 +149,8 @@ bool SolveHoldingUndetermined(const GyroPrepared& prep, const GyroLayout& layout
                               const std::vector<double>& magnitude_sigmas, double gravity,
                               GyroSolve* solve, std::vector<std::string>* undetermined,
                               std::string* error) {
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = options.gradient_tolerance;
-  solver_options.parameter_tolerance = options.parameter_tolerance;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.minimizer_progress_to_stdout = false;
-  solver_options.num_threads = 1;
+  const ceres::Solver::Options solver_options =
+      internal::SolverOptions(options.solver, ceres::DENSE_QR);
   const AccelParameterization ap = accel.parameterization;
   solve->x = x0;
   solve->held.assign(layout.size, false);

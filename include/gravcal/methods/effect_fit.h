@@ -30,6 +30,7 @@
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/position.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/estimation/solver_tolerances.h"
 #include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
@@ -66,10 +67,9 @@ struct EffectFitOptions {
   // refits of a gyroscope effect alone.
   bool fit_accel = true;
   bool compute_covariance = true;
-  int max_iterations = 50;
-  double function_tolerance = 1e-12;
-  double gradient_tolerance = 1e-12;
-  double parameter_tolerance = 1e-10;
+
+  // Stopping rules of the Ceres solve.
+  SolverTolerances solver = {50, 1e-12, 1e-12, 1e-10};
 
   bool IsValid(std::string* error) const;
 };

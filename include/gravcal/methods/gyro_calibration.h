@@ -42,6 +42,7 @@
 #include "gravcal/core/types.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/refinement.h"
+#include "gravcal/estimation/solver_tolerances.h"
 #include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
@@ -71,10 +72,9 @@ struct GyroCalibrationOptions {
   double edge_seconds = 0.5;
   // A gap between two static poses longer than this is not used, s.
   double max_rotation_seconds = 60.0;
-  int max_iterations = 100;
-  double function_tolerance = 1e-12;
-  double gradient_tolerance = 1e-12;
-  double parameter_tolerance = 1e-10;
+
+  // Stopping rules of the Ceres solve.
+  SolverTolerances solver = {100, 1e-12, 1e-12, 1e-10};
 
   bool IsValid(std::string* error) const;
 };
