@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "io/json_helpers.h"
 #include "util/statistics.h"
 
 namespace gravcal {
@@ -13,15 +14,9 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-json Vector(const Eigen::Vector3d& v) { return {Number(v(0)), Number(v(1)), Number(v(2))}; }
-
-json Matrix(const Eigen::Matrix3d& m) {
-  json rows = json::array();
-  for (int r = 0; r < 3; ++r) rows.push_back(Vector(m.row(r).transpose()));
-  return rows;
-}
+json Number(double v) { return internal::JsonNumber<json>(v); }
+json Vector(const Eigen::Vector3d& v) { return internal::JsonVector<json>(v); }
+json Matrix(const Eigen::Matrix3d& m) { return internal::JsonMatrix<json>(m); }
 
 bool IsAccel(Effect e) { return Info(e).sensor == EffectSensor::kAccelerometer; }
 

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "io/csv_table.h"
+#include "io/json_helpers.h"
 #include "util/content_hash.h"
 #include "util/statistics.h"
 
@@ -78,7 +79,7 @@ double ValueOf(const SummaryRow& row, const std::string& column) {
   return it == row.values.end() ? NAN : it->second;
 }
 
-Json JsonNumber(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+Json JsonNumber(double v) { return internal::JsonNumber<Json>(v); }
 
 }  // namespace
 
