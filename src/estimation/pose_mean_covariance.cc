@@ -123,7 +123,9 @@ bool BatchMeansCovariance(const std::vector<Eigen::Vector3d>& x, size_t begin, s
   Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
   for (const Eigen::Vector3d& y : means) s += (y - grand) * (y - grand).transpose();
   s /= static_cast<double>(b - 1);
-  *covariance = s * (static_cast<double>(m) / static_cast<double>(n));
+  const double dof = static_cast<double>(b - 1);
+  const double unbiased_weight = dof / (dof - 2.0);
+  *covariance = s * (unbiased_weight * static_cast<double>(m) / static_cast<double>(n));
   return true;
 }
 

@@ -43,11 +43,6 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
   const CalibrationMethod& method = *FindCalibrationMethod(config.method);
   MethodData data;
   data.log = &input.log;
-  if (!ReadSideInput(method, input, &data, &error)) {
-    calibration->method = method.name;
-    calibration->message = error;
-    return false;
-  }
   ImuNoise noise;
   if (!input.noise_path.empty()) {
     calibration->method = method.name;
@@ -59,6 +54,11 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
     if (!ReadNoiseJson(input.noise_path, &noise, &calibration->message)) return false;
     data.noise = &noise.model;
     data.noise_name = input.noise_path;
+  }
+  if (!ReadSideInput(method, input, &data, &error)) {
+    calibration->method = method.name;
+    calibration->message = error;
+    return false;
   }
   const bool ok = method.run(config, data, calibration);
   calibration->method = method.name;
