@@ -20,6 +20,7 @@
 #include "gravcal/simulation/noise_process.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
+#include "still_log.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -41,8 +42,8 @@ constexpr double kGyroK = 3.5e-4;
 // rad/s per gyroscope count of the logs (gyro_nominal_scale).
 constexpr double kGyroScale = 1e-3;
 
-// A still log of `seconds`: gravity on z plus the noise above; gyroscope in
-// counts of kGyroScale.
+// A still log of `seconds` with the noise above; gyroscope in counts of
+// kGyroScale.
 ImuLog StillLog(double seconds, uint64_t seed) {
   NoiseProcessOptions accel;
   accel.rate_hz = kRate;
@@ -51,21 +52,7 @@ ImuLog StillLog(double seconds, uint64_t seed) {
   NoiseProcessOptions gyro = accel;
   gyro.white_noise = kGyroN;
   gyro.random_walk = kGyroK;
-  ImuLog log;
-  const size_t n = static_cast<size_t>(seconds * kRate);
-  log.t.resize(n);
-  log.accel.assign(n, Eigen::Vector3d(0.0, 0.0, 9.80665));
-  log.gyro.assign(n, Eigen::Vector3d::Zero());
-  for (size_t i = 0; i < n; ++i) log.t[i] = i / kRate;
-  for (int a = 0; a < 3; ++a) {
-    NoiseProcess pa(accel, seed * 16 + a);
-    NoiseProcess pg(gyro, seed * 16 + 8 + a);
-    for (size_t i = 0; i < n; ++i) {
-      log.accel[i](a) += pa.Next();
-      log.gyro[i](a) = pg.Next() / kGyroScale;
-    }
-  }
-  return log;
+  return testing_util::StillLog(accel, gyro, kGyroScale, seed, seconds);
 }
 
 std::string WriteLog(const ImuLog& log, const ScratchDir& dir, const std::string& name) {
