@@ -18,6 +18,7 @@
 #include "gravcal/io/noise_io.h"
 #include "gravcal/simulation/noise_process.h"
 #include "sigma_check.h"
+#include "still_log.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -46,27 +47,7 @@ std::vector<double> Series(const NoiseProcessOptions& o, uint64_t seed, double s
   return p.Generate(static_cast<size_t>(seconds * o.rate_hz));
 }
 
-// A still IMU log: accelerometer (m/s^2, gravity on z) with accel noise,
-// gyroscope in counts of gyro_scale rad/s each.
-ImuLog StillLog(const NoiseProcessOptions& accel, const NoiseProcessOptions& gyro,
-                double gyro_scale, uint64_t seed, double seconds) {
-  ImuLog log;
-  log.source = "still.csv";
-  const size_t n = static_cast<size_t>(seconds * kRate);
-  log.t.resize(n);
-  log.accel.assign(n, Eigen::Vector3d(0.0, 0.0, 9.80665));
-  log.gyro.assign(n, Eigen::Vector3d::Zero());
-  for (size_t i = 0; i < n; ++i) log.t[i] = i / kRate;
-  for (int a = 0; a < 3; ++a) {
-    NoiseProcess pa(accel, seed * 16 + a);
-    NoiseProcess pg(gyro, seed * 16 + 8 + a);
-    for (size_t i = 0; i < n; ++i) {
-      log.accel[i](a) += pa.Next();
-      log.gyro[i](a) = pg.Next() / gyro_scale;
-    }
-  }
-  return log;
-}
+using testing_util::StillLog;
 
 TEST(NoiseProcess, BiasInstabilityIsFlatOverItsRange) {
   NoiseProcessOptions o;

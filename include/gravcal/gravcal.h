@@ -33,6 +33,7 @@
 #include "gravcal/estimation/newton_solver.h"
 #include "gravcal/estimation/noise_characterisation.h"
 #include "gravcal/estimation/observability.h"
+#include "gravcal/estimation/pose_mean_covariance.h"
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/estimation/solver_tolerances.h"
 #include "gravcal/estimation/static_alignment.h"

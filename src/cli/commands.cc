@@ -110,6 +110,7 @@ int RunCalibrate(const CommandArgs& args) {
   input.source = args.input;
   input.attitudes_path = args.attitudes;
   input.segments_path = args.segments;
+  input.noise_path = args.noise;
   if (!ReadImuLog(args.input, args.config.input, &input.log, &error)) return Fail(error);
   Calibration c;
   const bool ok = RunCalibration(args.config, input, &c);

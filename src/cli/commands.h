@@ -26,6 +26,11 @@ struct CommandArgs {
   std::string history;
   // discover: the HTML report to write (optional).
   std::string report;
+  // noise: Kalibr's imu.yaml and the handheld filter's keys (optional).
+  std::string kalibr;
+  std::string handheld;
+  // calibrate: the noise model from gravcal noise (--noise).
+  std::string noise;
   uint64_t seed = 1;
   // batch and merge-summaries.
   std::string manifest;
@@ -50,6 +55,8 @@ int RunBatch(const CommandArgs& args);
 // 0 merged; 1 bad input (nothing written).
 int RunMergeSummaries(const CommandArgs& args);
 int RunDiscover(const CommandArgs& args);
+// noise_command.cc: 0 written; 1 bad input (nothing written).
+int RunNoise(const CommandArgs& args);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

@@ -41,6 +41,11 @@ DEFINE_string(segments, "",
               "table)");
 DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
 DEFINE_string(report, "", "HTML report to write (discover)");
+DEFINE_string(kalibr, "", "noise: also write Kalibr's imu.yaml (continuous-time densities) here");
+DEFINE_string(handheld, "", "noise: also write the handheld filter's hk_* noise keys (YAML) here");
+DEFINE_string(noise, "",
+              "noise.json from 'gravcal noise': the variance of each pose's mean, and the "
+              "handheld filter's noise, from the noise model");
 
 namespace {
 
@@ -63,7 +68,7 @@ const std::vector<CommandInfo>& Commands() {
       {"calibrate",
        "calibrate the sensors from a log with the config's method (the config key 'method' "
        "lists them)",
-       {"input", "config", "output", "attitudes", "segments", "history"},
+       {"input", "config", "output", "attitudes", "segments", "history", "noise"},
        gravcal::cli::RunCalibrate},
       {"apply",
        "apply a calibration to a raw log, writing SI units",
@@ -90,6 +95,11 @@ const std::vector<CommandInfo>& Commands() {
        "find the effects the model misses: discovery.json and an HTML report",
        {"input", "config", "output", "report"},
        gravcal::cli::RunDiscover},
+      {"noise",
+       "the noise model of a still log (Allan deviation: N, B, K per axis): noise.json, and "
+       "Kalibr's imu.yaml",
+       {"input", "config", "output", "kalibr", "handheld"},
+       gravcal::cli::RunNoise},
       {"help",
        "list commands, or the flags and config keys of one: gravcal help <command>",
        {},
@@ -266,6 +276,9 @@ int main(int argc, char** argv) {
   args.segments = FLAGS_segments;
   args.history = FLAGS_history;
   args.report = FLAGS_report;
+  args.kalibr = FLAGS_kalibr;
+  args.handheld = FLAGS_handheld;
+  args.noise = FLAGS_noise;
 
   return info->run(args);
 }

@@ -1,5 +1,6 @@
 #include "gravcal/estimation/noise_characterisation.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -29,6 +30,30 @@ bool CharacteriseAxis(const std::vector<double>& samples, const ImuNoiseModel& w
   return true;
 }
 
+// Whether the log turns (find_still false): the largest angle between the
+// mean accelerometer vector of one tenth of samples [begin, end) and that of
+// all of them, degrees.
+double LargestTilt(const ImuLog& log, size_t begin, size_t end, size_t* where) {
+  const size_t parts = 10;
+  const size_t n = end - begin;
+  Eigen::Vector3d all = Eigen::Vector3d::Zero();
+  for (size_t i = begin; i < end; ++i) all += log.accel[i];
+  double worst = 0.0;
+  for (size_t p = 0; p < parts && n >= parts; ++p) {
+    const size_t b = begin + p * n / parts;
+    const size_t e = begin + (p + 1) * n / parts;
+    Eigen::Vector3d part = Eigen::Vector3d::Zero();
+    for (size_t i = b; i < e; ++i) part += log.accel[i];
+    const double angle =
+        std::atan2(part.cross(all).norm(), part.dot(all)) * 180.0 / 3.14159265358979323846;
+    if (angle > worst) {
+      worst = angle;
+      *where = b;
+    }
+  }
+  return worst;
+}
+
 }  // namespace
 }  // namespace internal
 
@@ -36,6 +61,10 @@ bool NoiseOptions::IsValid(std::string* error) const {
   if (!(accel_scale > 0.0) || !std::isfinite(accel_scale) || !(gyro_scale > 0.0) ||
       !std::isfinite(gyro_scale)) {
     *error = "noise accel_scale and gyro_scale must be finite and > 0";
+    return false;
+  }
+  if (!(max_tilt_deg > 0.0)) {
+    *error = "noise max_tilt_deg must be > 0";
     return false;
   }
   return (!find_still || detector.IsValid(error)) && allan.IsValid(error) && fit.IsValid(error);
@@ -68,6 +97,19 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
     }
     begin = longest->begin;
     end = longest->end;
+  } else {
+    size_t where = 0;
+    const double tilt = internal::LargestTilt(log, begin, end, &where);
+    if (tilt > options.max_tilt_deg) {
+      std::ostringstream s;
+      s.precision(3);
+      s << log.source << ": the log moves: gravity turns by " << tilt
+        << " degrees (near t = " << log.t[where]
+        << " s), and noise_find_still is false (the whole log must be still; "
+        << "set it true to use the longest still interval)";
+      result->message = s.str();
+      return false;
+    }
   }
   model.still_begin = begin;
   model.still_end = end;

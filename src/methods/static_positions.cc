@@ -28,8 +28,14 @@ bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
   if (!options.IsValid(&c.message)) return false;
   if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
   if (!DetectLogIntervals(log, options.detector, intervals, &c.message)) return false;
-  *positions = PositionsFromIntervals(*intervals);
-  return true;
+  return PosesFromIntervals(log, *intervals, options, positions, &c.warnings, &c.message);
+}
+
+bool PosesFromIntervals(const ImuLog& log, const std::vector<StaticInterval>& intervals,
+                        const CalibrationOptions& options, std::vector<Position>* positions,
+                        std::vector<std::string>* notes, std::string* message) {
+  *positions = PositionsFromIntervals(intervals);
+  return SetPoseMeanCovariance(log, intervals, options.pose_noise, positions, notes, message);
 }
 
 double IntervalSamples(const ImuLog& log, const StaticInterval& interval, double scale,

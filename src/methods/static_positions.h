@@ -23,7 +23,15 @@ namespace internal {
 bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector,
                         std::vector<StaticInterval>* intervals, std::string* message);
 
-// Checks the options, then as DetectLogIntervals; also fills calibration->gravity, gravity_source
+// The positions of the intervals with the covariance of each mean chosen by
+// options.pose_noise (pose_mean_covariance.h); *notes gets its fallbacks and
+// warnings. False with *message only on invalid pose-noise options.
+bool PosesFromIntervals(const ImuLog& log, const std::vector<StaticInterval>& intervals,
+                        const CalibrationOptions& options, std::vector<Position>* positions,
+                        std::vector<std::string>* notes, std::string* message);
+
+// Checks the options, then as DetectLogIntervals and PosesFromIntervals (notes into
+// calibration->warnings); also fills calibration->gravity, gravity_source
 // (and the standard-gravity warning). Returns false with calibration->message (naming log.source)
 // on invalid options or log, or a detector failure.
 bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,

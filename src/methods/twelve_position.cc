@@ -17,7 +17,7 @@ namespace gravcal {
 
 bool CalibrationOptions::IsValid(std::string* error) const {
   if (!detector.IsValid(error) || !gravity.IsValid(error) || !coarse.IsValid(error) ||
-      !refinement.IsValid(error)) {
+      !refinement.IsValid(error) || !pose_noise.IsValid(error)) {
     return false;
   }
   if (!(nominal_scale > 0.0 && std::isfinite(nominal_scale))) {
@@ -195,7 +195,14 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
     return false;
   }
   if (intervals != nullptr) *intervals = detected;
-  const bool ok = CalibrateFromPositions(PositionsFromIntervals(detected), options, calibration);
+  std::vector<Position> positions;
+  std::vector<std::string> notes;
+  if (!internal::PosesFromIntervals(log, detected, options, &positions, &notes,
+                                    &calibration->message)) {
+    return false;
+  }
+  const bool ok = CalibrateFromPositions(positions, options, calibration);
+  for (const std::string& n : notes) calibration->warnings.push_back(n);
   if (!ok && !log.source.empty()) calibration->message = log.source + ": " + calibration->message;
   return ok;
 }

@@ -14,10 +14,10 @@ namespace internal {
 
 const std::vector<ConfigSection>& ConfigSections() {
   static const std::vector<ConfigSection> sections = {
-      GeneralSection(),         InputSection(),   GravitySection(),   DetectorSection(),
-      ModelSection(),           SolverSection(),  GyroSection(),      AlignmentSection(),
-      HandheldKalmanSection(),  EffectsSection(), DiscoverySection(), SimulatorSection(),
-      MotionSimulatorSection(),
+      GeneralSection(),   InputSection(),          GravitySection(),         DetectorSection(),
+      PoseNoiseSection(), ModelSection(),          SolverSection(),          GyroSection(),
+      AlignmentSection(), HandheldKalmanSection(), EffectsSection(),         DiscoverySection(),
+      NoiseSection(),     SimulatorSection(),      MotionSimulatorSection(),
   };
   return sections;
 }

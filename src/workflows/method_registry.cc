@@ -1,7 +1,11 @@
 #include "gravcal/workflows/method_registry.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
 
+#include "gravcal/io/noise_io.h"
 #include "gravcal/methods/effect_fit.h"
 #include "gravcal/methods/gyro_calibration.h"
 #include "gravcal/methods/handheld_kalman.h"
@@ -13,11 +17,22 @@
 namespace gravcal {
 namespace {
 
+// The shared calibration options with the noise model, when given, for
+// the covariance of each pose's mean.
+CalibrationOptions StaticOptions(const Config& config, const MethodData& data) {
+  CalibrationOptions options = config.calibration;
+  options.pose_noise.model = data.noise;
+  return options;
+}
+
+constexpr char kPoseNoiseUse[] =
+    "the variance of each pose's mean (Allan variance at the pose's duration)";
+
 // The multi-position magnitude fit, then the effects and the gyroscope
 // between the poses on the same static intervals.
 bool RunTwelvePosition(const Config& config, const MethodData& data, Calibration* calibration) {
   // accel_misalignment on a scale baseline is the scale_misalignment model.
-  CalibrationOptions options = config.calibration;
+  CalibrationOptions options = StaticOptions(config, data);
   if (Contains(config.effects, Effect::kAccelMisalignment) &&
       options.refinement.parameterization == AccelParameterization::kScale) {
     options.refinement.parameterization = AccelParameterization::kScaleMisalignment;
@@ -33,12 +48,13 @@ bool RunTwelvePosition(const Config& config, const MethodData& data, Calibration
 }
 
 bool RunTenPosition(const Config& config, const MethodData& data, Calibration* calibration) {
-  return CalibrateTenPosition(*data.log, config.calibration, config.ten_position, calibration);
+  return CalibrateTenPosition(*data.log, StaticOptions(config, data), config.ten_position,
+                              calibration);
 }
 
 bool RunKnownAttitude(const Config& config, const MethodData& data, Calibration* calibration) {
-  return CalibrateKnownAttitude(*data.log, data.attitudes, data.side_input_name, config.calibration,
-                                calibration);
+  return CalibrateKnownAttitude(*data.log, data.attitudes, data.side_input_name,
+                                StaticOptions(config, data), calibration);
 }
 
 // The handheld filter takes its gravity and accelerometer nominal scale
@@ -50,8 +66,58 @@ HandheldKalmanOptions HandheldOptions(const Config& config) {
   return options;
 }
 
+// The filter's process noise Q from the noise model: each density the user
+// did not set as a key is the largest of the three axes' values (as
+// `gravcal noise --handheld` writes them; conservative: no axis is trusted
+// more than its noise allows). Returns the note saying where Q came from.
+std::string NoiseModelQ(const Config& config, const MethodData& data,
+                        HandheldKalmanOptions* options) {
+  struct Density {
+    const char* key;
+    const std::array<AxisNoiseModel, 3>* axes;
+    NoiseTerm AxisNoiseModel::*term;
+    double* field;
+  };
+  const ImuNoiseModel& m = *data.noise;
+  const Density densities[] = {
+      {"hk_accel_noise_density", &m.accel, &AxisNoiseModel::white_noise,
+       &options->accel_noise_density},
+      {"hk_gyro_noise_density", &m.gyro, &AxisNoiseModel::white_noise,
+       &options->gyro_noise_density},
+      {"hk_accel_bias_walk", &m.accel, &AxisNoiseModel::random_walk, &options->accel_bias_walk},
+      {"hk_gyro_bias_walk", &m.gyro, &AxisNoiseModel::random_walk, &options->gyro_bias_walk},
+  };
+  std::string from_model, from_config, not_shown;
+  for (const Density& d : densities) {
+    const bool set =
+        std::find(config.keys_set.begin(), config.keys_set.end(), d.key) != config.keys_set.end();
+    const double v = AxisMaximum(*d.axes, d.term);
+    if (set) {
+      from_config += (from_config.empty() ? "" : ", ") + std::string(d.key);
+    } else if (std::isfinite(v)) {
+      *d.field = v;
+      std::ostringstream s;
+      s.precision(3);
+      s << d.key << " " << v;
+      from_model += (from_model.empty() ? "" : ", ") + s.str();
+    } else {
+      not_shown += (not_shown.empty() ? "" : ", ") + std::string(d.key);
+    }
+  }
+  std::string note = "handheld filter Q: ";
+  note += from_model.empty() ? "nothing" : from_model + " (largest axis)";
+  note += " from the noise model " + data.noise_name;
+  if (!from_config.empty()) note += "; " + from_config + " as set in the config";
+  if (!not_shown.empty()) note += "; " + not_shown + " at the default (not shown by the model)";
+  return note;
+}
+
 bool RunHandheldKalman(const Config& config, const MethodData& data, Calibration* calibration) {
-  return CalibrateHandheld(*data.log, HandheldOptions(config), calibration);
+  HandheldKalmanOptions options = HandheldOptions(config);
+  const std::string note = data.noise != nullptr ? NoiseModelQ(config, data, &options) : "";
+  const bool ok = CalibrateHandheld(*data.log, options, calibration);
+  if (!note.empty()) calibration->warnings.push_back(note);
+  return ok;
 }
 
 // The gyroscope alone; the accelerometer part of the result stays the
@@ -77,33 +143,37 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
   static const std::vector<CalibrationMethod> methods = {
       {"twelve_position",
        "multi-position magnitude fit",
-       {"gravity", "detector", "model", "solver", "gyro", "effects"},
+       {"gravity", "detector", "pose_noise", "model", "solver", "gyro", "effects"},
        {},
        MethodSideInput::kNone,
        nullptr,
-       RunTwelvePosition},
+       RunTwelvePosition,
+       kPoseNoiseUse},
       {"ten_position",
        "patent, self-aligned",
-       {"gravity", "detector", "alignment"},
+       {"gravity", "detector", "pose_noise", "alignment"},
        {"parameterization", "allow_undetermined", "loss", "loss_scale", "covariance",
         "max_iterations"},
        MethodSideInput::kNone,
        [](const Config& c, std::string* e) { return c.ten_position.IsValid(e); },
-       RunTenPosition},
+       RunTenPosition,
+       kPoseNoiseUse},
       {"known_attitude",
        "fixture attitudes, --attitudes",
-       {"gravity", "detector"},
+       {"gravity", "detector", "pose_noise"},
        {"loss", "loss_scale", "covariance", "max_iterations"},
        MethodSideInput::kAttitudes,
        nullptr,
-       RunKnownAttitude},
+       RunKnownAttitude,
+       kPoseNoiseUse},
       {"handheld_kalman",
        "21-state Kalman filter on a handheld log",
        {"gravity", "handheld_kalman"},
        {"nominal_scale", "gyro_nominal_scale"},
        MethodSideInput::kNone,
        [](const Config& c, std::string* e) { return HandheldOptions(c).IsValid(e); },
-       RunHandheldKalman},
+       RunHandheldKalman,
+       "the filter's process noise Q (hk_*_noise_density, hk_*_bias_walk not set as keys)"},
       {"rate_table",
        "gyroscope from constant-rate segments, --segments",
        {},

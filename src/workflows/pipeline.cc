@@ -1,5 +1,6 @@
 #include "gravcal/workflows/pipeline.h"
 
+#include "gravcal/io/noise_io.h"
 #include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/rate_table_segments.h"
 
@@ -42,6 +43,18 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
   const CalibrationMethod& method = *FindCalibrationMethod(config.method);
   MethodData data;
   data.log = &input.log;
+  ImuNoise noise;
+  if (!input.noise_path.empty()) {
+    calibration->method = method.name;
+    if (method.noise_model.empty()) {
+      calibration->message = "method '" + method.name + "' uses no noise model (remove --noise " +
+                             input.noise_path + ")";
+      return false;
+    }
+    if (!ReadNoiseJson(input.noise_path, &noise, &calibration->message)) return false;
+    data.noise = &noise.model;
+    data.noise_name = input.noise_path;
+  }
   if (!ReadSideInput(method, input, &data, &error)) {
     calibration->method = method.name;
     calibration->message = error;

@@ -29,6 +29,10 @@ struct NoiseOptions {
   // Use the longest still interval the detector finds (true), or the whole
   // log, known to be still (false).
   bool find_still = true;
+  // With find_still false, the log is refused as moving when the direction
+  // of the mean accelerometer vector of one tenth of it differs from that of
+  // the whole by more than this, degrees.
+  double max_tilt_deg = 2.0;
   StaticDetectorOptions detector;
   AllanOptions allan;
   NoiseFitOptions fit;
@@ -51,7 +55,8 @@ struct ImuNoise {
 
 // Returns false with result->message (one line naming the problem) on
 // invalid options, an invalid log, no still interval or one too short for
-// the tau asked, or non-uniform sampling in it.
+// the tau asked, non-uniform sampling in it, or (find_still false) a log
+// that turns.
 bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise* result);
 
 }  // namespace gravcal

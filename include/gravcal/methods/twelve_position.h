@@ -23,6 +23,7 @@
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/coarse_fit.h"
 #include "gravcal/estimation/newton_solver.h"
+#include "gravcal/estimation/pose_mean_covariance.h"
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
@@ -47,6 +48,9 @@ struct CalibrationOptions {
   // message naming it; true = succeed, report it without a standard
   // deviation and say so in the warnings.
   bool allow_undetermined = false;
+  // The covariance of each pose's mean (pose_mean_covariance.h): white
+  // (sample covariance / n), batch means, or a noise model when one is set.
+  PoseNoiseOptions pose_noise;
 
   bool IsValid(std::string* error) const;
 };

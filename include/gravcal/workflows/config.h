@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/estimation/noise_characterisation.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/methods/gyro_calibration.h"
 #include "gravcal/methods/handheld_kalman.h"
@@ -49,6 +50,9 @@ struct Config {
   // already in the baseline of `discover`), and the discovery workflow.
   std::vector<Effect> effects;
   DiscoveryOptions discovery;
+  // Issue 14: `gravcal noise` (its scales and detector come from the keys
+  // nominal_scale, gyro_nominal_scale and the detector section).
+  NoiseOptions noise;
   // The keys set through LoadConfigText/LoadConfigFile/SetConfigValue, in
   // the order set (a key set twice appears once). Only these are checked
   // against the method: defaults never make a config invalid.

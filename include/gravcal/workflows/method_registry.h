@@ -19,6 +19,7 @@
 
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/core/noise_model.h"
 #include "gravcal/core/rate_table_segment.h"
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/workflows/config.h"
@@ -44,6 +45,11 @@ struct MethodData {
   std::vector<RateTableSegment> segments;
   // Name of the side input file, for messages.
   std::string side_input_name;
+  // The noise model (noise.json, --noise) for a method whose entry says it
+  // uses one; nullptr = none given.
+  const ImuNoiseModel* noise = nullptr;
+  // Its file name, for messages.
+  std::string noise_name;
 };
 
 struct CalibrationMethod {
@@ -60,6 +66,9 @@ struct CalibrationMethod {
   // Fills calibration (calibration->method included). Returns false with a
   // one-line message.
   std::function<bool(const Config&, const MethodData&, Calibration*)> run;
+  // What the method does with a noise model (--noise), for help and notes;
+  // empty = it uses none, and giving one is an error.
+  std::string noise_model;
 };
 
 // Every method, in the order help lists them.

@@ -25,6 +25,9 @@ struct PipelineInput {
   std::string attitudes_path;
   // kSegments: the rate table's constant-rate segments (--segments).
   std::string segments_path;
+  // The noise model from `gravcal noise` (noise.json, --noise); empty = none.
+  // Read here for the methods that use one (CalibrationMethod::noise_model).
+  std::string noise_path;
 };
 
 // Runs config.method (its registry entry) on the input, after reading the

@@ -44,6 +44,8 @@ ConfigSection SolverSection();
 ConfigSection GyroSection();
 ConfigSection AlignmentSection();
 ConfigSection HandheldKalmanSection();
+ConfigSection PoseNoiseSection();
+ConfigSection NoiseSection();
 ConfigSection EffectsSection();
 ConfigSection DiscoverySection();
 ConfigSection SimulatorSection();

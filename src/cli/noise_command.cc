@@ -1,0 +1,108 @@
+// gravcal noise: the noise model of a still log (issue 14): noise.json, and
+// optionally Kalibr's imu.yaml and the handheld filter's hk_* keys.
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "gravcal/core/gravity.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/io/noise_io.h"
+
+namespace gravcal {
+namespace cli {
+namespace {
+
+// The options from the config: the noise section, the raw units of
+// nominal_scale and gyro_nominal_scale, and the detector section.
+NoiseOptions NoiseOptionsOf(const Config& config) {
+  NoiseOptions options = config.noise;
+  options.accel_scale = config.calibration.nominal_scale;
+  options.gyro_scale = config.handheld.gyro_nominal_scale;
+  options.detector = config.calibration.detector;
+  return options;
+}
+
+// |mean accelerometer| over the still interval in m/s^2 must be near
+// gravity: otherwise nominal_scale is not m/s^2 per raw unit and every
+// accelerometer number would be in the wrong unit.
+bool CheckAccelUnit(const ImuLog& log, const ImuNoise& noise, double scale, std::string* error) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  const ImuNoiseModel& m = noise.model;
+  for (size_t i = m.still_begin; i < m.still_end; ++i) mean += log.accel[i];
+  const double g = scale * mean.norm() / static_cast<double>(m.still_end - m.still_begin);
+  if (std::abs(g / kStandardGravity - 1.0) <= 0.1) return true;
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "%s: |mean accelerometer| over the still interval is %.4g m/s^2 with "
+                "nominal_scale %.6g, not about 9.8: set nominal_scale to m/s^2 per raw unit",
+                log.source.c_str(), g, scale);
+  *error = text;
+  return false;
+}
+
+std::string TermText(const NoiseTerm& term, const std::string& unit) {
+  if (!term.visible()) return "not shown";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.3g %s", term.value, unit.c_str());
+  return text;
+}
+
+// "gravcal: accel x: N ..., B ..., K ..." on stderr.
+void PrintAxis(const char* sensor, char axis, const AxisNoiseModel& m, const std::string& unit,
+               const std::string& walk_unit) {
+  std::fprintf(stderr, "gravcal: %s %c: N %s, B %s, K %s\n", sensor, axis,
+               TermText(m.white_noise, unit + "/sqrt(Hz)").c_str(),
+               TermText(m.bias_instability, unit).c_str(),
+               TermText(m.random_walk, walk_unit + "/sqrt(Hz)").c_str());
+}
+
+}  // namespace
+
+int RunNoise(const CommandArgs& args) {
+  if (args.input.empty()) return Fail("noise needs --input <still log>");
+  if (args.output.empty()) return Fail("noise needs --output <noise.json>");
+  std::string error;
+  const NoiseOptions options = NoiseOptionsOf(args.config);
+  if (!args.config.input.IsValid(&error)) return Fail("input: " + error);
+  if (!options.IsValid(&error)) return Fail(error);
+  ImuLog log;
+  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  ImuNoise noise;
+  if (!CharacteriseNoise(log, options, &noise)) return Fail(noise.message);
+  if (!CheckAccelUnit(log, noise, options.accel_scale, &error)) return Fail(error);
+  // Every text first, then the files, so that a failure leaves none.
+  std::string kalibr;
+  if (!args.kalibr.empty() && !NoiseToKalibrYaml(noise.model, &kalibr, &error)) {
+    return Fail(args.kalibr + ": " + error);
+  }
+  std::vector<std::string> written;
+  auto write = [&](const std::string& path, const std::string& text) {
+    if (path.empty()) return true;
+    if (!WriteFileAtomically(path, text, &error)) {
+      for (const std::string& w : written) std::remove(w.c_str());
+      return false;
+    }
+    written.push_back(path);
+    return true;
+  };
+  if (!write(args.output, NoiseToJson(noise)) || !write(args.kalibr, kalibr) ||
+      !write(args.handheld, NoiseToHandheldYaml(noise.model))) {
+    return Fail(error);
+  }
+  const char* axes = "xyz";
+  for (int a = 0; a < 3; ++a) {
+    PrintAxis("accel", axes[a], noise.model.accel[a], "m/s^2", "m/s^3");
+  }
+  for (int a = 0; a < 3 && log.has_gyro(); ++a) {
+    PrintAxis("gyro", axes[a], noise.model.gyro[a], "rad/s", "rad/s^2");
+  }
+  std::string files;
+  for (const std::string& w : written) files += (files.empty() ? "" : ", ") + w;
+  std::fprintf(stderr, "gravcal: %s; wrote %s\n", noise.message.c_str(), files.c_str());
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace gravcal

@@ -1,0 +1,185 @@
+#include "gravcal/estimation/pose_mean_covariance.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "gravcal/core/gravity.h"
+
+namespace gravcal {
+namespace internal {
+namespace {
+
+// Safely positive definite and finite.
+bool IsUsable(const Eigen::Matrix3d& m) {
+  if (!m.allFinite()) return false;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d ev = eig.eigenvalues();
+  return ev[2] > 0.0 && ev[0] > 1e-12 * ev[2];
+}
+
+// The pose's duration: n samples at the interval's mean step.
+double PoseSeconds(const StaticInterval& s) {
+  const size_t n = s.count();
+  if (n < 2) return 0.0;
+  return (s.t_end - s.t_begin) * static_cast<double>(n) / static_cast<double>(n - 1);
+}
+
+// The model's covariance of the mean for one pose, raw units; false when an
+// axis is not shown. *ratio gets the largest disagreement factor between the
+// model's white noise per sample and the pose's own sample deviation.
+bool ModelCovariance(const StaticInterval& s, const Position& white, const ImuNoiseModel& model,
+                     double nominal_scale, Eigen::Matrix3d* cov, double* ratio) {
+  const double seconds = PoseSeconds(s);
+  if (!(seconds > 0.0)) return false;
+  const Eigen::Vector3d var = StillMeanVariance(model.accel, seconds);
+  if (!var.allFinite()) return false;
+  const double s2 = nominal_scale * nominal_scale;
+  const double n = static_cast<double>(s.count());
+  *ratio = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    const double rate = n / seconds;
+    const double model_sample = model.accel[a].white_noise.value * std::sqrt(rate);
+    const double own_sample = nominal_scale * std::sqrt(s.accel_cov(a, a));
+    if (own_sample > 0.0 && model_sample > 0.0) {
+      const double r = model_sample / own_sample;
+      *ratio = std::max(*ratio, std::max(r, 1.0 / r));
+    }
+  }
+  // Off-diagonal terms of the white value, rescaled to the model's diagonal.
+  const Eigen::Vector3d white_sd = white.raw_mean_cov.diagonal().cwiseSqrt();
+  const Eigen::Vector3d model_sd = (var / s2).cwiseSqrt();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double rho = i == j ? 1.0
+                                : (white_sd[i] > 0.0 && white_sd[j] > 0.0
+                                       ? white.raw_mean_cov(i, j) / (white_sd[i] * white_sd[j])
+                                       : 0.0);
+      (*cov)(i, j) = rho * model_sd[i] * model_sd[j];
+    }
+  }
+  return true;
+}
+
+// m/s^2 per raw unit: standard gravity over the median |raw mean|; 0 when
+// there is no pose with a nonzero mean.
+double ScaleFromPoses(const std::vector<Position>& positions) {
+  std::vector<double> norms;
+  for (const Position& p : positions) {
+    if (p.raw_mean.norm() > 0.0) norms.push_back(p.raw_mean.norm());
+  }
+  if (norms.empty()) return 0.0;
+  std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
+  return kStandardGravity / norms[norms.size() / 2];
+}
+
+}  // namespace
+}  // namespace internal
+
+const char* ToString(PoseNoise pose_noise) {
+  switch (pose_noise) {
+    case PoseNoise::kWhite:
+      return "white";
+    case PoseNoise::kBatchMeans:
+      return "batch_means";
+  }
+  return "?";
+}
+
+bool FromString(const std::string& name, PoseNoise* pose_noise) {
+  if (name == "white") {
+    *pose_noise = PoseNoise::kWhite;
+  } else if (name == "batch_means") {
+    *pose_noise = PoseNoise::kBatchMeans;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool PoseNoiseOptions::IsValid(std::string* error) const {
+  if (batches < 5) {
+    *error = "pose_noise_batches: must be at least 5";
+    return false;
+  }
+  return true;
+}
+
+bool BatchMeansCovariance(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end,
+                          int batches, Eigen::Matrix3d* covariance) {
+  const size_t n = end - begin;
+  const size_t b = static_cast<size_t>(batches);
+  if (batches < 2 || end > x.size() || begin >= end || n < 2 * b) return false;
+  const size_t m = n / b;
+  std::vector<Eigen::Vector3d> means(b, Eigen::Vector3d::Zero());
+  Eigen::Vector3d grand = Eigen::Vector3d::Zero();
+  for (size_t j = 0; j < b; ++j) {
+    for (size_t i = 0; i < m; ++i) means[j] += x[begin + j * m + i];
+    means[j] /= static_cast<double>(m);
+    grand += means[j];
+  }
+  grand /= static_cast<double>(b);
+  Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& y : means) s += (y - grand) * (y - grand).transpose();
+  s /= static_cast<double>(b - 1);
+  const double dof = static_cast<double>(b - 1);
+  const double unbiased_weight = dof / (dof - 2.0);
+  *covariance = s * (unbiased_weight * static_cast<double>(m) / static_cast<double>(n));
+  return true;
+}
+
+bool SetPoseMeanCovariance(const ImuLog& log, const std::vector<StaticInterval>& intervals,
+                           const PoseNoiseOptions& options, std::vector<Position>* positions,
+                           std::vector<std::string>* notes, std::string* error) {
+  if (!options.IsValid(error)) return false;
+  if (positions->size() != intervals.size()) {
+    *error = "pose covariance: positions and intervals differ in number";
+    return false;
+  }
+  if (options.model == nullptr && options.method == PoseNoise::kWhite) return true;
+  const double nominal_scale = internal::ScaleFromPoses(*positions);
+  int fallbacks = 0;
+  double worst_ratio = 1.0;
+  for (size_t k = 0; k < intervals.size(); ++k) {
+    const StaticInterval& s = intervals[k];
+    Position& p = (*positions)[k];
+    Eigen::Matrix3d cov;
+    bool ok = false;
+    if (options.model != nullptr && nominal_scale > 0.0) {
+      double ratio = 1.0;
+      ok = internal::ModelCovariance(s, p, *options.model, nominal_scale, &cov, &ratio);
+      if (ok) worst_ratio = std::max(worst_ratio, ratio);
+    } else if (options.model == nullptr) {
+      ok = BatchMeansCovariance(log.accel, s.begin, s.end, options.batches, &cov);
+    }
+    if (ok && internal::IsUsable(cov)) {
+      p.raw_mean_cov = cov;
+    } else {
+      ++fallbacks;
+    }
+  }
+  std::ostringstream s;
+  s.precision(3);
+  if (fallbacks > 0) {
+    s << fallbacks << " of " << intervals.size() << " positions keep the white-noise covariance "
+      << "of the mean (sample covariance / n): "
+      << (options.model != nullptr
+              ? "the noise model does not show white noise on every accelerometer axis"
+              : "fewer than 2 x pose_noise_batches samples or constant data");
+    notes->push_back(s.str());
+  }
+  if (worst_ratio > 2.0) {
+    std::ostringstream r;
+    r.precision(3);
+    r << "the noise model's accelerometer white noise per sample differs from the poses' own "
+         "by a factor up to "
+      << worst_ratio
+      << ": check that the noise model is of this sensor and that gravcal noise had the right "
+         "nominal_scale and gyro_nominal_scale";
+    notes->push_back(r.str());
+  }
+  return true;
+}
+
+}  // namespace gravcal
