@@ -57,6 +57,11 @@ bool RefinementOptions::IsValid(std::string* error) const {
     *error = "max_bias_std, max_matrix_std: must be positive";
     return false;
   }
+  if (!(extra_variance >= 0.0) || !(max_pose_disturbance > 0.0) ||
+      !(structure_test_level > 0.0 && structure_test_level < 1.0)) {
+    *error = "extra_variance >= 0, max_pose_disturbance > 0, 0 < structure_test_level < 1";
+    return false;
+  }
   if (max_iterations < 1) {
     *error = "max_iterations: must be at least 1";
     return false;
@@ -135,6 +140,7 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   if (!StartMagnitudeFit(positions, initial, gravity, p, "refinement", &model, result)) {
     return false;
   }
+  for (double& s : result->sigmas) s = std::sqrt(s * s + options.extra_variance);
 
   // Solve in well-conditioned units (normalization.h); |a| is unchanged.
   const Normalization norm = Normalization::For(model);

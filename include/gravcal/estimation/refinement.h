@@ -47,6 +47,15 @@ struct RefinementOptions {
   // here and the fit is repeated, so a flat direction does not stall the
   // solver; they are reported as undetermined.
   std::vector<std::string> held_parameters;
+  // Added to every sigma_k^2 (m/s^2)^2: the per-pose variance the samples
+  // cannot show (methods/pose_variance.h sets it; 0 = white noise only).
+  double extra_variance = 0.0;
+  // Estimate that variance by REML and absorb it (twelve_position, ceres);
+  // warn when its s exceeds max_pose_disturbance (m/s^2), or when a richer
+  // model explains the excess at structure_test_level (then not absorbed).
+  bool estimate_pose_variance = true;
+  double max_pose_disturbance = 0.01;
+  double structure_test_level = 1e-3;
   int max_iterations = 100;
   double function_tolerance = 1e-14;
   double gradient_tolerance = 1e-14;
