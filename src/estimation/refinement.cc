@@ -28,6 +28,11 @@ bool RefinementOptions::IsValid(std::string* error) const {
     *error = "max_bias_std, max_matrix_std: must be positive";
     return false;
   }
+  if (!(extra_variance >= 0.0) || !(max_pose_disturbance > 0.0) ||
+      !(structure_test_level > 0.0 && structure_test_level < 1.0)) {
+    *error = "extra_variance >= 0, max_pose_disturbance > 0, 0 < structure_test_level < 1";
+    return false;
+  }
   return solver.IsValid(error);
 }
 
@@ -310,6 +315,8 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   if (!StartMagnitudeFit(positions, initial, gravity, options, "refinement", &fit, result)) {
     return false;
   }
+  // sigma_k^2 + s^2: the per-pose variance the samples cannot show.
+  for (double& s : result->sigmas) s = std::sqrt(s * s + options.extra_variance);
   const std::vector<double> scales = LossScales(options, *result);
   ceres::Problem::Options problem_options;
   problem_options.enable_fast_removal = false;

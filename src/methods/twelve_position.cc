@@ -9,6 +9,7 @@
 #include "core/calibration_gravity.h"
 #include "estimation/accel_uncertainty.h"
 #include "gravcal/estimation/housing_rotation.h"
+#include "methods/pose_variance.h"
 #include "methods/static_positions.h"
 #include "util/statistics.h"
 #include "util/units.h"
@@ -139,6 +140,10 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
   if (!ok) {
     c.message = c.refinement.message;
     return false;
+  }
+  if (options.solver == RefinementSolver::kCeres) {
+    internal::AccountForPoseVariance(placed, c.coarse.model, c.gravity, options.refinement,
+                                     &c.refinement, &c.accel.pose_variance);
   }
   c.accel.model = c.refinement.model;
   for (const std::string& w : c.refinement.warnings) c.warnings.push_back(w);

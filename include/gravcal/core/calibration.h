@@ -43,6 +43,9 @@ struct AccelCalibration {
   std::vector<std::string> covariance_names;
   // Placement error the axis-aligned positions show, rad (affine only).
   double tilt_rms = 0.0;
+  // The per-pose variance of |a| beyond the white noise, (m/s^2)^2
+  // (twelve_position; methods/pose_variance.h).
+  VarianceComponent pose_variance;
 };
 
 // The gyroscope part of a calibration, filled by the methods that estimate

@@ -6,6 +6,7 @@
 #define GRAVCAL_CORE_SOLVER_RESULT_H_
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,28 @@ struct CoarseFitResult {
   std::vector<int> nominal_up;
   int axis_positions = 0;
   std::string message = "CoarseFit was not called";
+};
+
+// One extra variance s^2 added to every residual's variance, for what the
+// samples of a pose cannot show (placement disturbances, tremor between
+// poses, mount flex, correlated noise), estimated by restricted maximum
+// likelihood from the residuals of a fit (estimation/variance_component.h).
+struct VarianceComponent {
+  bool estimated = false;
+  // s^2 and its standard deviation (from the expected restricted
+  // information), in the residual's unit squared (for the accelerometer
+  // magnitude fit (m/s^2)^2). s^2 = 0 when the residuals show no excess over
+  // their sigmas (then at_boundary).
+  double variance = 0.0;
+  double variance_std = NAN;
+  bool at_boundary = true;
+  // Residual degrees of freedom n - rank(J) the estimate rests on.
+  int dof = 0;
+  // True when s^2 was added to every residual's variance and the fit
+  // repeated, so every standard deviation carries it; false when the excess
+  // was left unexplained (a structured term explains it, or s^2 = 0).
+  bool absorbed = false;
+  std::string message = "EstimateVarianceComponent was not called";
 };
 
 struct RefinementResult {

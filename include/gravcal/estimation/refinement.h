@@ -48,6 +48,17 @@ struct RefinementOptions {
   // here and the fit is repeated, so a flat direction does not stall the
   // solver; they are reported as undetermined.
   std::vector<std::string> held_parameters;
+  // Added to every sigma_k^2 (m/s^2)^2: the per-pose variance the samples
+  // cannot show (methods/pose_variance.h sets it; 0 = white noise only).
+  double extra_variance = 0.0;
+  // Estimate that variance by REML and absorb it (twelve_position, ceres).
+  // Off by default until it is validated on repeated real recordings (see
+  // docs/methods.md): on the real sessions it grows the sigmas 5-8 times;
+  // warn when its s exceeds max_pose_disturbance (m/s^2), or when a richer
+  // model explains the excess at structure_test_level (then not absorbed).
+  bool estimate_pose_variance = false;
+  double max_pose_disturbance = 0.01;
+  double structure_test_level = 1e-3;
   // Stopping rules of the solve (max_iterations 100, tolerances 1e-14, 1e-14,
   // 1e-12).
   SolverTolerances solver;

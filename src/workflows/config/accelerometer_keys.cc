@@ -116,6 +116,13 @@ ConfigSection SolverSection() {
                        "compute the covariance (standard deviations)"),
           GRAVCAL_INT("max_iterations", calibration.refinement.solver.max_iterations,
                       "solver iteration limit"),
+          GRAVCAL_BOOL("pose_variance", calibration.refinement.estimate_pose_variance,
+                       "estimate the per-pose variance the samples cannot show (REML) and add "
+                       "it to every standard deviation"),
+          GRAVCAL_DOUBLE("max_pose_disturbance", calibration.refinement.max_pose_disturbance,
+                         "warn when the per-pose scatter s exceeds this, m/s^2"),
+          GRAVCAL_DOUBLE("structure_test_level", calibration.refinement.structure_test_level,
+                         "significance at which non-orthogonality, not noise, owns the excess"),
       }};
 }
 
