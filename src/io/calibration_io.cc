@@ -37,9 +37,12 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
     // s^2 of |a| between poses beyond the white noise, its standard
     // deviation, s itself, and whether the standard deviations carry it.
     const VarianceComponent& v = c.accel.pose_variance;
-    accel["pose_variance"] = {{"value", Number(v.variance)}, {"std", Number(v.variance_std)},
-                              {"unit", "(m/s^2)^2"},         {"s", Number(std::sqrt(v.variance))},
-                              {"absorbed", v.absorbed},      {"dof", v.dof}};
+    accel["pose_variance"] = {{"value", JsonNumber(v.variance)},
+                              {"std", JsonNumber(v.variance_std)},
+                              {"unit", "(m/s^2)^2"},
+                              {"s", JsonNumber(std::sqrt(v.variance))},
+                              {"absorbed", v.absorbed},
+                              {"dof", v.dof}};
   }
   if (c.accel.model.parameterization == AccelParameterization::kAffine) {
     accel["placement_error_deg"] = JsonNumber(c.accel.tilt_rms * internal::kRadToDeg);
