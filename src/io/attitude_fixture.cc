@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "gravcal/estimation/static_alignment.h"
+#include "io/csv_table.h"
 #include "util/units.h"
 
 namespace gravcal {
@@ -21,15 +22,6 @@ std::string Trim(const std::string& s) {
   if (b == std::string::npos) return "";
   const size_t e = s.find_last_not_of(" \t\r");
   return s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  std::string field;
-  while (std::getline(s, field, ',')) out.push_back(Trim(field));
-  if (!line.empty() && line.back() == ',') out.push_back("");
-  return out;
 }
 
 // A finite number filling the whole field.
@@ -63,7 +55,14 @@ bool ReadFixtureAttitudes(const std::string& path, std::vector<FixtureAttitude>*
     ++line_number;
     const std::string trimmed = Trim(line);
     if (trimmed.empty() || trimmed[0] == '#') continue;
-    const std::vector<std::string> fields = SplitCsv(trimmed);
+    std::vector<std::string> fields;
+    {
+      std::vector<CsvCell> cells;
+      size_t column = 0;
+      std::string what;
+      if (!internal::SplitCsvLine(trimmed, &cells, &column, &what)) return fail(what);
+      for (CsvCell& cell : cells) fields.push_back(std::move(cell.text));
+    }
     if (column.empty()) {
       for (size_t i = 0; i < fields.size(); ++i) {
         if (column.count(fields[i])) return fail("column '" + fields[i] + "' appears twice");

@@ -7,6 +7,58 @@ bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 
 }  // namespace
 
+namespace internal {
+
+bool SplitCsvLine(std::string_view line, std::vector<CsvCell>* cells, size_t* error_column,
+                  std::string* what) {
+  cells->clear();
+  size_t i = 0;
+  for (;;) {
+    while (i < line.size() && IsBlank(line[i])) ++i;
+    CsvCell cell;
+    cell.column = i + 1;
+    if (i < line.size() && line[i] == '"') {
+      ++i;
+      bool closed = false;
+      while (i < line.size()) {
+        if (line[i] == '"') {
+          if (i + 1 < line.size() && line[i + 1] == '"') {
+            cell.text += '"';
+            i += 2;
+            continue;
+          }
+          closed = true;
+          ++i;
+          break;
+        }
+        cell.text += line[i++];
+      }
+      if (!closed) {
+        *error_column = cell.column;
+        *what = "the quoted field is not closed";
+        return false;
+      }
+      while (i < line.size() && IsBlank(line[i])) ++i;
+      if (i < line.size() && line[i] != ',') {
+        *error_column = i + 1;
+        *what = "unexpected text after a quoted field (a quote inside quotes is written \"\")";
+        return false;
+      }
+    } else {
+      const size_t start = i;
+      while (i < line.size() && line[i] != ',') ++i;
+      size_t stop = i;
+      while (stop > start && IsBlank(line[stop - 1])) --stop;
+      cell.text.assign(line.substr(start, stop - start));
+    }
+    cells->push_back(std::move(cell));
+    if (i >= line.size()) return true;
+    ++i;  // the comma
+  }
+}
+
+}  // namespace internal
+
 std::string CsvWhere(const std::string& name, size_t line, size_t column) {
   return name + ":" + std::to_string(line) + ":" + std::to_string(column) + ": ";
 }
@@ -28,47 +80,11 @@ bool ParseCsvRecords(std::string_view text, const std::string& name,
 
     CsvRecord record;
     record.line = line_number;
-    size_t i = 0;
-    for (;;) {
-      while (i < line.size() && IsBlank(line[i])) ++i;
-      CsvCell cell;
-      cell.column = i + 1;
-      if (i < line.size() && line[i] == '"') {
-        ++i;
-        bool closed = false;
-        while (i < line.size()) {
-          if (line[i] == '"') {
-            if (i + 1 < line.size() && line[i + 1] == '"') {
-              cell.text += '"';
-              i += 2;
-              continue;
-            }
-            closed = true;
-            ++i;
-            break;
-          }
-          cell.text += line[i++];
-        }
-        if (!closed) {
-          *error = CsvWhere(name, line_number, cell.column) + "the quoted field is not closed";
-          return false;
-        }
-        while (i < line.size() && IsBlank(line[i])) ++i;
-        if (i < line.size() && line[i] != ',') {
-          *error = CsvWhere(name, line_number, i + 1) +
-                   "unexpected text after a quoted field (a quote inside quotes is written \"\")";
-          return false;
-        }
-      } else {
-        const size_t start = i;
-        while (i < line.size() && line[i] != ',') ++i;
-        size_t stop = i;
-        while (stop > start && IsBlank(line[stop - 1])) --stop;
-        cell.text.assign(line.substr(start, stop - start));
-      }
-      record.cells.push_back(std::move(cell));
-      if (i >= line.size()) break;
-      ++i;  // the comma
+    size_t column = 0;
+    std::string what;
+    if (!internal::SplitCsvLine(line, &record.cells, &column, &what)) {
+      *error = CsvWhere(name, line_number, column) + what;
+      return false;
     }
     records->push_back(std::move(record));
   }

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/csv_table.h"
 #include "io/file_text.h"
 
 namespace gravcal {
@@ -205,17 +206,13 @@ class Parser {
     const char* source = "the columns are";
     if (names.empty()) {  // CSV header row.
       source = "the header has";
-      std::string_view rest(begin, end - begin);
-      for (;;) {
-        const size_t comma = rest.find(',');
-        std::string_view name = TrimBlanks(rest.substr(0, comma));
-        if (name.size() >= 2 && name.front() == '"' && name.back() == '"') {
-          name = TrimBlanks(name.substr(1, name.size() - 2));
-        }
-        names.emplace_back(name);
-        if (comma == std::string_view::npos) break;
-        rest.remove_prefix(comma + 1);
+      std::vector<CsvCell> cells;
+      size_t column = 0;
+      std::string what;
+      if (!internal::SplitCsvLine(std::string_view(begin, end - begin), &cells, &column, &what)) {
+        return SetError(error, Where(name_, line) + what);
       }
+      for (CsvCell& cell : cells) names.push_back(std::move(cell.text));
     }
     const std::string listing = std::string(source) + ": " + JoinNames(names);
     const std::string where = Where(name_, line);
