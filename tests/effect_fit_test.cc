@@ -9,10 +9,10 @@
 #include <map>
 #include <random>
 
+#include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
-#include "residuals/effect_residual.h"
 #include "sigma_check.h"
 #include "test_util.h"
 #include "util/statistics.h"
@@ -89,7 +89,7 @@ TEST(EffectResidual, JacobianMatchesNumericDifferences) {
   const EffectParameters p = RandomParameters(&rng);
   const Eigen::Vector3d raw(310.0, -1200.0, 15800.0);
   std::unique_ptr<ceres::CostFunction> cost(
-      AccelEffectResidual::Create(raw, 6.0, -40.0, 9.81, 0.001));
+      GravityMagnitudeResidual::CreateWithEffects(raw, 6.0, -40.0, 9.81, 0.001));
   double bias[3] = {20.0, -30.0, 45.0};
   double upper[6] = {6.0e-4, 2e-6, -3e-6, 6.1e-4, 1e-6, 5.9e-4};
   double blocks[4][3];

@@ -15,7 +15,8 @@
 #include "estimation/solver_settings.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/refinement.h"
-#include "residuals/effect_residual.h"
+#include "gravcal/residuals/gravity_magnitude_residual.h"
+#include "gravcal/residuals/gyro_static_residual.h"
 #include "util/statistics.h"
 
 namespace gravcal {
@@ -155,7 +156,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   ceres::Problem problem(keep);
   for (size_t k = 0; k < normalized.size(); ++k) {
     const StaticObservation& o = observations[k];
-    owned.emplace_back(AccelEffectResidual::Create(
+    owned.emplace_back(GravityMagnitudeResidual::CreateWithEffects(
         normalized[k].raw_mean, TemperatureOffset(initial_parameters, o.temperature()),
         o.time() - initial_parameters.reference_time, gravity, result->accel_sigmas[k]));
     problem.AddResidualBlock(owned.back().get(), nullptr, parameter_blocks);
@@ -288,10 +289,10 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   std::vector<std::unique_ptr<ceres::CostFunction>> owned;
   for (int k = 0; k < n; ++k) {
     const StaticObservation& o = observations[k];
-    owned.emplace_back(
-        GyroEffectResidual::Create(o.gyro_mean, whitening[k], result->forces[k],
-                                   TemperatureOffset(initial_parameters, o.temperature()),
-                                   o.time() - initial_parameters.reference_time));
+    owned.emplace_back(GyroStaticResidual::CreateWithEffects(
+        o.gyro_mean, whitening[k], result->forces[k],
+        TemperatureOffset(initial_parameters, o.temperature()),
+        o.time() - initial_parameters.reference_time));
     problem.AddResidualBlock(owned.back().get(), nullptr, bias, g, temperature_bias, drift);
   }
   if (!on_g) problem.SetParameterBlockConstant(g);

@@ -3,7 +3,7 @@
 //
 // Accelerometer: minimises sum_k r_k^2 over b, the free entries of U and the
 // parameters of the accelerometer effects switched on, with r_k the
-// AccelEffectResidual of each position:
+// GravityMagnitudeResidual (with effects) of each position:
 //
 //   r_k = ( |h^-1( U (v_k - b), dT_k, dt_k )| - g ) / sigma_k
 //

@@ -2,7 +2,9 @@
 //
 // For a static position with mean raw accelerometer vector v_k,
 //
-//   r_k = ( |U (v_k - b)| - g ) / sigma_k
+//   m   = U (v_k - b)                                 m/s^2, sensor frame
+//   a   = effect correction of m at (dT_k, dt_k)      model_effects.h
+//   r_k = ( |a| - g ) / sigma_k
 //
 // b: bias, raw units (parameter block of 3).
 // U: upper-triangular scale and non-orthogonality, m/s^2 per raw unit
@@ -13,6 +15,13 @@
 // parameter here. For a diagonal model hold u01, u02 and u12 constant with a
 // ceres::SubsetManifold.
 //
+// Without effects (Create: blocks b, U) a = m, the usual calibration
+// residual. With effects (CreateWithEffects: blocks b, U, k2, beta, c,
+// delta, 3 each; dT_k = T_k - T_ref and dt_k = t_k - t_ref) a is m with the
+// accelerometer effect terms removed (CorrectAccelEffects); an effect that is
+// off has its block held constant at zero, which leaves its term the
+// identity.
+//
 // Another estimator can add this residual to its own problem, sharing the
 // bias and upper blocks with its other residuals.
 #ifndef GRAVCAL_RESIDUALS_GRAVITY_MAGNITUDE_RESIDUAL_H_
@@ -22,24 +31,33 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
+#include <cmath>
+
+#include "gravcal/core/model_effects.h"
 
 namespace gravcal {
 
 struct GravityMagnitudeResidual {
-  GravityMagnitudeResidual(const Eigen::Vector3d& raw_mean, double gravity, double sigma)
-      : raw_mean_(raw_mean), gravity_(gravity), sigma_(sigma) {}
+  GravityMagnitudeResidual(const Eigen::Vector3d& raw_mean, double gravity, double sigma,
+                           double temperature_offset = 0.0, double time_offset = 0.0)
+      : raw_mean_(raw_mean),
+        gravity_(gravity),
+        sigma_(sigma),
+        temperature_offset_(temperature_offset),
+        time_offset_(time_offset) {}
 
+  // Without effects.
   template <typename T>
   bool operator()(const T* const bias, const T* const upper, T* residual) const {
-    const T d0 = T(raw_mean_(0)) - bias[0];
-    const T d1 = T(raw_mean_(1)) - bias[1];
-    const T d2 = T(raw_mean_(2)) - bias[2];
-    const T a0 = upper[0] * d0 + upper[1] * d1 + upper[2] * d2;
-    const T a1 = upper[3] * d1 + upper[4] * d2;
-    const T a2 = upper[5] * d2;
-    using std::sqrt;
-    residual[0] = (sqrt(a0 * a0 + a1 * a1 + a2 * a2) - T(gravity_)) / T(sigma_);
-    return true;
+    return Evaluate<T>(bias, upper, nullptr, nullptr, nullptr, nullptr, residual);
+  }
+  // With the accelerometer effects.
+  template <typename T>
+  bool operator()(const T* const bias, const T* const upper, const T* const quadratic,
+                  const T* const temperature_bias, const T* const temperature_scale,
+                  const T* const drift, T* residual) const {
+    return Evaluate<T>(bias, upper, quadratic, temperature_bias, temperature_scale, drift,
+                       residual);
   }
 
   static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean, double gravity,
@@ -48,10 +66,39 @@ struct GravityMagnitudeResidual {
         new GravityMagnitudeResidual(raw_mean, gravity, sigma));
   }
 
+  // temperature_offset = T_k - T_ref (0 when unknown), time_offset = t_k -
+  // t_ref.
+  static ceres::CostFunction* CreateWithEffects(const Eigen::Vector3d& raw_mean,
+                                                double temperature_offset, double time_offset,
+                                                double gravity, double sigma) {
+    return new ceres::AutoDiffCostFunction<GravityMagnitudeResidual, 1, 3, 6, 3, 3, 3, 3>(
+        new GravityMagnitudeResidual(raw_mean, gravity, sigma, temperature_offset, time_offset));
+  }
+
  private:
+  // Null effect blocks skip their terms.
+  template <typename T>
+  bool Evaluate(const T* bias, const T* upper, const T* quadratic, const T* temperature_bias,
+                const T* temperature_scale, const T* drift, T* residual) const {
+    const T d0 = T(raw_mean_(0)) - bias[0];
+    const T d1 = T(raw_mean_(1)) - bias[1];
+    const T d2 = T(raw_mean_(2)) - bias[2];
+    T m[3] = {upper[0] * d0 + upper[1] * d1 + upper[2] * d2, upper[3] * d1 + upper[4] * d2,
+              upper[5] * d2};
+    if (!CorrectAccelEffects(quadratic, temperature_bias, temperature_scale, drift,
+                             temperature_offset_, time_offset_, m)) {
+      return false;
+    }
+    using std::sqrt;
+    residual[0] = (sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) - T(gravity_)) / T(sigma_);
+    return true;
+  }
+
   const Eigen::Vector3d raw_mean_;
   const double gravity_;
   const double sigma_;
+  const double temperature_offset_;
+  const double time_offset_;
 };
 
 }  // namespace gravcal

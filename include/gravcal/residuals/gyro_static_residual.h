@@ -4,14 +4,24 @@
 // At rest the body rate is zero, so for static pose k with mean raw gyroscope
 // vector u_k and mean calibrated specific force f_k (m/s^2, body frame):
 //
-//   r_k = W_k ( M_g (u_k - b_g) - G f_k )                 3 values
+//   o_k = G' f_k + gamma dT_k + eta dt_k                  raw units (effects)
+//   r_k = W_k ( M_g (u_k - b_g - o_k) - G f_k )           3 values
 //
-// W_k (3x3) is the square-root information of M_g (u_k - b_g) from the
-// covariance of the mean u_k, taken at the initial M_g, so r_k is
-// dimensionless with unit variance. Without G every pose measures b_g
+// W_k (3x3) is the square-root information of what it multiplies, from the
+// covariance of the mean u_k (taken at the initial M_g), so r_k is
+// dimensionless with unit variance.
+//
+// Without effects (Create) o_k = 0 and the blocks are b_g (3), M_g (9,
+// row-major) and optionally G (9). Without G every pose measures b_g
 // directly; with G the poses measure b_g + M_g^-1 G f_k, which separates b_g
 // from G when the f_k span three dimensions (four or more poses not in one
-// plane). Parameter blocks: b_g (3), M_g (9, row-major) and optionally G (9).
+// plane).
+//
+// With effects (CreateWithEffects, the effects fit of effect_fit.h, which
+// works in raw units) M_g = I and G = 0 are not blocks; the blocks are b_g
+// (3), G' (9, row-major, raw units per m/s^2), gamma (3) and eta (3), with
+// dT_k = T_k - T_ref and dt_k = t_k - t_ref (GyroEffectOffset in
+// model_effects.h). An effect that is off has its block held at zero.
 #ifndef GRAVCAL_RESIDUALS_GYRO_STATIC_RESIDUAL_H_
 #define GRAVCAL_RESIDUALS_GYRO_STATIC_RESIDUAL_H_
 
@@ -20,21 +30,36 @@
 
 #include <Eigen/Core>
 
+#include "gravcal/core/model_effects.h"
+
 namespace gravcal {
 
 struct GyroStaticResidual {
   GyroStaticResidual(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& force,
-                     const Eigen::Matrix3d& sqrt_information)
-      : raw_mean_(raw_mean), force_(force), sqrt_information_(sqrt_information) {}
+                     const Eigen::Matrix3d& sqrt_information, double temperature_offset = 0.0,
+                     double time_offset = 0.0)
+      : raw_mean_(raw_mean),
+        force_(force),
+        sqrt_information_(sqrt_information),
+        temperature_offset_(temperature_offset),
+        time_offset_(time_offset) {}
 
+  // Without effects: b_g, M_g.
   template <typename T>
   bool operator()(const T* const bias, const T* const matrix, T* residual) const {
-    return Evaluate<T>(bias, matrix, nullptr, residual);
+    return Evaluate<false, T>(bias, matrix, nullptr, nullptr, nullptr, residual);
   }
+  // Without effects: b_g, M_g, G.
   template <typename T>
   bool operator()(const T* const bias, const T* const matrix, const T* const g_sensitivity,
                   T* residual) const {
-    return Evaluate<T>(bias, matrix, g_sensitivity, residual);
+    return Evaluate<false, T>(bias, matrix, g_sensitivity, nullptr, nullptr, residual);
+  }
+  // With effects: b_g, G', gamma, eta.
+  template <typename T>
+  bool operator()(const T* const bias, const T* const g_sensitivity,
+                  const T* const temperature_bias, const T* const drift, T* residual) const {
+    return Evaluate<true, T>(bias, nullptr, g_sensitivity, temperature_bias, drift, residual);
   }
 
   static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& force,
@@ -46,22 +71,48 @@ struct GyroStaticResidual {
     return new ceres::AutoDiffCostFunction<GyroStaticResidual, 3, 3, 9>(functor);
   }
 
+  // temperature_offset = T_k - T_ref (0 when unknown), time_offset = t_k -
+  // t_ref.
+  static ceres::CostFunction* CreateWithEffects(const Eigen::Vector3d& raw_mean,
+                                                const Eigen::Matrix3d& sqrt_information,
+                                                const Eigen::Vector3d& force,
+                                                double temperature_offset, double time_offset) {
+    return new ceres::AutoDiffCostFunction<GyroStaticResidual, 3, 3, 9, 3, 3>(
+        new GyroStaticResidual(raw_mean, force, sqrt_information, temperature_offset, time_offset));
+  }
+
  private:
-  template <typename T>
-  bool Evaluate(const T* bias, const T* matrix, const T* g_sensitivity, T* residual) const {
-    const T d[3] = {T(raw_mean_(0)) - bias[0], T(raw_mean_(1)) - bias[1],
-                    T(raw_mean_(2)) - bias[2]};
-    T w[3];
-    for (int r = 0; r < 3; ++r) {
-      w[r] = matrix[3 * r] * d[0] + matrix[3 * r + 1] * d[1] + matrix[3 * r + 2] * d[2];
-      if (g_sensitivity != nullptr) {
-        w[r] -= g_sensitivity[3 * r] * force_(0) + g_sensitivity[3 * r + 1] * force_(1) +
-                g_sensitivity[3 * r + 2] * force_(2);
+  // kEffects: matrix is unused (M_g = I) and g_sensitivity is G' inside o_k;
+  // otherwise o_k = 0 and g_sensitivity is G (may be null). Each form keeps
+  // its own order of operations.
+  template <bool kEffects, typename T>
+  bool Evaluate(const T* bias, const T* matrix, const T* g_sensitivity, const T* temperature_bias,
+                const T* drift, T* residual) const {
+    if constexpr (kEffects) {
+      T offset[3];
+      GyroEffectOffset(g_sensitivity, temperature_bias, drift, force_.data(), temperature_offset_,
+                       time_offset_, offset);
+      T e[3];
+      for (int i = 0; i < 3; ++i) e[i] = T(raw_mean_(i)) - bias[i] - offset[i];
+      for (int r = 0; r < 3; ++r) {
+        residual[r] = T(sqrt_information_(r, 0)) * e[0] + T(sqrt_information_(r, 1)) * e[1] +
+                      T(sqrt_information_(r, 2)) * e[2];
       }
-    }
-    for (int r = 0; r < 3; ++r) {
-      residual[r] = sqrt_information_(r, 0) * w[0] + sqrt_information_(r, 1) * w[1] +
-                    sqrt_information_(r, 2) * w[2];
+    } else {
+      const T d[3] = {T(raw_mean_(0)) - bias[0], T(raw_mean_(1)) - bias[1],
+                      T(raw_mean_(2)) - bias[2]};
+      T w[3];
+      for (int r = 0; r < 3; ++r) {
+        w[r] = matrix[3 * r] * d[0] + matrix[3 * r + 1] * d[1] + matrix[3 * r + 2] * d[2];
+        if (g_sensitivity != nullptr) {
+          w[r] -= g_sensitivity[3 * r] * force_(0) + g_sensitivity[3 * r + 1] * force_(1) +
+                  g_sensitivity[3 * r + 2] * force_(2);
+        }
+      }
+      for (int r = 0; r < 3; ++r) {
+        residual[r] = sqrt_information_(r, 0) * w[0] + sqrt_information_(r, 1) * w[1] +
+                      sqrt_information_(r, 2) * w[2];
+      }
     }
     return true;
   }
@@ -69,6 +120,8 @@ struct GyroStaticResidual {
   const Eigen::Vector3d raw_mean_;
   const Eigen::Vector3d force_;
   const Eigen::Matrix3d sqrt_information_;
+  const double temperature_offset_;
+  const double time_offset_;
 };
 
 }  // namespace gravcal
