@@ -100,6 +100,99 @@ Eigen::Matrix3d Whitening(const Eigen::Matrix3d& covariance) {
   return l.inverse();
 }
 
+// result->accel_sigmas from the positions' own noise at `start`; false with
+// the message when one is not positive and finite.
+bool SetAccelSigmas(const std::vector<Position>& positions, const AccelModel& start,
+                    EffectFitResult* result) {
+  result->accel_sigmas = MagnitudeSigmas(positions, start);
+  for (size_t k = 0; k < positions.size(); ++k) {
+    const double s = result->accel_sigmas[k];
+    if (!(s > 0.0) || !std::isfinite(s)) {
+      std::ostringstream msg;
+      msg << "position " << k << " has no usable accelerometer noise estimate (sigma = " << s
+          << ")";
+      result->message = msg.str();
+      return false;
+    }
+  }
+  return true;
+}
+
+// The accelerometer effects with a parameter block each, in block order.
+constexpr Effect kAccelBlockEffect[4] = {Effect::kAccelQuadratic, Effect::kAccelTemperatureBias,
+                                         Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift};
+
+// fit->parameter_names (the columns of the dense Jacobian); returns the
+// indices of the free entries of U.
+std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const bool on[4],
+                                        SensorFitSummary* fit) {
+  static const char* kUpperNames[6] = {"u_xx", "u_xy", "u_xz", "u_yy", "u_yz", "u_zz"};
+  fit->parameter_names = {"bias_x", "bias_y", "bias_z"};
+  std::vector<int> upper_free;
+  for (int i = 0; i < 6; ++i) {
+    const bool off = i == 1 || i == 2 || i == 4;
+    if (off && !free_off_diagonal) continue;
+    upper_free.push_back(i);
+    fit->parameter_names.push_back(kUpperNames[i]);
+  }
+  for (int b = 0; b < 4; ++b) {
+    if (!on[b]) continue;
+    for (const std::string& n : Info(kAccelBlockEffect[b]).parameter_names) {
+      fit->parameter_names.push_back(n);
+    }
+  }
+  return upper_free;
+}
+
+// fit->chi2 and, with `covariance`, the dense Jacobian of the free
+// parameters at `params`; false when the model has no value at a position.
+bool EvaluateAccelFit(const std::vector<std::unique_ptr<ceres::CostFunction>>& owned,
+                      const double* const params[6], const std::vector<int>& upper_free,
+                      const bool on[4], bool covariance, Eigen::MatrixXd* jacobian,
+                      SensorFitSummary* fit) {
+  fit->chi2 = 0.0;
+  for (int k = 0; k < static_cast<int>(owned.size()); ++k) {
+    double r = 0.0;
+    double jb[3], ju[6], je[4][3];
+    double* jacobians[6] = {jb, ju, je[0], je[1], je[2], je[3]};
+    if (!owned[k]->Evaluate(params, &r, covariance ? jacobians : nullptr)) return false;
+    fit->chi2 += r * r;
+    if (!covariance) continue;
+    int col = 0;
+    for (int i = 0; i < 3; ++i) (*jacobian)(k, col++) = jb[i];
+    for (int i : upper_free) (*jacobian)(k, col++) = ju[i];
+    for (int b = 0; b < 4; ++b) {
+      if (!on[b]) continue;
+      for (int i = 0; i < 3; ++i) (*jacobian)(k, col++) = je[b][i];
+    }
+  }
+  return true;
+}
+
+// After the accelerometer fit: the covariance (with `covariance`, back in
+// raw units), the bias standard deviations, the residuals and the forces.
+void FinishAccel(const std::vector<StaticObservation>& observations, double gravity, double scale,
+                 const Eigen::MatrixXd& jacobian, const std::vector<int>& upper_free,
+                 bool covariance, EffectFitResult* result) {
+  SensorFitSummary* fit = &result->accel_fit;
+  if (covariance) {
+    CovarianceFromJacobian(jacobian, 1, fit);
+    // Back to raw units: b = c + s b', U = U' / s; the effects are in SI.
+    Eigen::VectorXd d = Eigen::VectorXd::Ones(jacobian.cols());
+    d.head<3>().setConstant(scale);
+    for (size_t i = 0; i < upper_free.size(); ++i) d(3 + i) = 1.0 / scale;
+    fit->covariance = d.asDiagonal() * fit->covariance * d.asDiagonal();
+    for (int i = 0; i < 3; ++i) result->accel_bias_std(i) = StdOf(*fit, fit->parameter_names[i]);
+  }
+
+  result->accel_residuals.resize(observations.size());
+  result->forces.resize(observations.size());
+  for (size_t k = 0; k < observations.size(); ++k) {
+    result->accel_residuals[k] =
+        AccelResidual(*result, observations[k], gravity, &result->forces[k]);
+  }
+}
+
 // The accelerometer part. Works in normalised raw units (normalization.h).
 bool FitAccel(const std::vector<StaticObservation>& observations, const AccelModel& initial,
               const EffectParameters& initial_parameters, double gravity,
@@ -117,17 +210,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
       start.upper(r, c) = 0.0;
     }
   }
-  result->accel_sigmas = MagnitudeSigmas(positions, start);
-  for (size_t k = 0; k < positions.size(); ++k) {
-    const double s = result->accel_sigmas[k];
-    if (!(s > 0.0) || !std::isfinite(s)) {
-      std::ostringstream msg;
-      msg << "position " << k << " has no usable accelerometer noise estimate (sigma = " << s
-          << ")";
-      result->message = msg.str();
-      return false;
-    }
-  }
+  if (!SetAccelSigmas(positions, start, result)) return false;
   const Normalization norm = Normalization::For(start);
   const AccelModel start_n = norm.Apply(start);
   const std::vector<Position> normalized = norm.Apply(positions);
@@ -136,14 +219,12 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   double upper[6];
   start_n.GetUpper(upper);
   double blocks[4][3];
-  const Effect kBlockEffect[4] = {Effect::kAccelQuadratic, Effect::kAccelTemperatureBias,
-                                  Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift};
   const Eigen::Vector3d* kInitial[4] = {
       &initial_parameters.accel_quadratic, &initial_parameters.accel_temperature_bias,
       &initial_parameters.accel_temperature_scale, &initial_parameters.accel_bias_drift};
   bool on[4];
   for (int b = 0; b < 4; ++b) {
-    on[b] = Contains(effects, kBlockEffect[b]);
+    on[b] = Contains(effects, kAccelBlockEffect[b]);
     for (int i = 0; i < 3; ++i) blocks[b][i] = on[b] ? (*kInitial[b])(i) : 0.0;
   }
 
@@ -178,44 +259,15 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
     return false;
   }
 
-  // Parameter names and the columns of the dense Jacobian.
-  static const char* kUpperNames[6] = {"u_xx", "u_xy", "u_xz", "u_yy", "u_yz", "u_zz"};
-  fit.parameter_names = {"bias_x", "bias_y", "bias_z"};
-  std::vector<int> upper_free;
-  for (int i = 0; i < 6; ++i) {
-    const bool off = i == 1 || i == 2 || i == 4;
-    if (off && !free_off_diagonal) continue;
-    upper_free.push_back(i);
-    fit.parameter_names.push_back(kUpperNames[i]);
-  }
-  for (int b = 0; b < 4; ++b) {
-    if (!on[b]) continue;
-    for (const std::string& n : Info(kBlockEffect[b]).parameter_names) {
-      fit.parameter_names.push_back(n);
-    }
-  }
+  const std::vector<int> upper_free = SetAccelParameterNames(free_off_diagonal, on, &fit);
   const int np = static_cast<int>(fit.parameter_names.size());
   const int n = static_cast<int>(normalized.size());
   Eigen::MatrixXd jacobian(n, np);
-  fit.chi2 = 0.0;
-  for (int k = 0; k < n; ++k) {
-    double r = 0.0;
-    double jb[3], ju[6], je[4][3];
-    double* jacobians[6] = {jb, ju, je[0], je[1], je[2], je[3]};
-    const double* params[6] = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
-    if (!owned[k]->Evaluate(params, &r, options.compute_covariance ? jacobians : nullptr)) {
-      result->message = "accelerometer effect fit: the model has no value at a position";
-      return false;
-    }
-    fit.chi2 += r * r;
-    if (!options.compute_covariance) continue;
-    int col = 0;
-    for (int i = 0; i < 3; ++i) jacobian(k, col++) = jb[i];
-    for (int i : upper_free) jacobian(k, col++) = ju[i];
-    for (int b = 0; b < 4; ++b) {
-      if (!on[b]) continue;
-      for (int i = 0; i < 3; ++i) jacobian(k, col++) = je[b][i];
-    }
+  const double* params[6] = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
+  if (!EvaluateAccelFit(owned, params, upper_free, on, options.compute_covariance, &jacobian,
+                        &fit)) {
+    result->message = "accelerometer effect fit: the model has no value at a position";
+    return false;
   }
   fit.num_residuals = n;
   fit.num_parameters = np;
@@ -232,23 +284,55 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   result->parameters.accel_temperature_scale = Eigen::Vector3d(blocks[2]);
   result->parameters.accel_bias_drift = Eigen::Vector3d(blocks[3]);
 
-  if (options.compute_covariance) {
-    CovarianceFromJacobian(jacobian, 1, &fit);
-    // Back to raw units: b = c + s b', U = U' / s; the effects are in SI.
-    Eigen::VectorXd d = Eigen::VectorXd::Ones(np);
-    d.head<3>().setConstant(norm.scale);
-    for (size_t i = 0; i < upper_free.size(); ++i) d(3 + i) = 1.0 / norm.scale;
-    fit.covariance = d.asDiagonal() * fit.covariance * d.asDiagonal();
-    for (int i = 0; i < 3; ++i) result->accel_bias_std(i) = StdOf(fit, fit.parameter_names[i]);
-  }
+  FinishAccel(observations, gravity, norm.scale, jacobian, upper_free, options.compute_covariance,
+              result);
+  return true;
+}
 
-  result->accel_residuals.resize(n);
-  result->forces.resize(n);
-  for (int k = 0; k < n; ++k) {
-    result->accel_residuals[k] =
-        AccelResidual(*result, observations[k], gravity, &result->forces[k]);
+// Per position, L_k^-1 of the covariance of the mean reading; false with
+// the message when one is not finite.
+bool GyroWhitening(const std::vector<StaticObservation>& observations,
+                   std::vector<Eigen::Matrix3d>* whitening, EffectFitResult* result) {
+  whitening->resize(observations.size());
+  for (size_t k = 0; k < observations.size(); ++k) {
+    (*whitening)[k] = Whitening(observations[k].gyro_mean_cov);
+    if (!(*whitening)[k].allFinite()) {
+      std::ostringstream msg;
+      msg << "position " << k << " has no usable gyroscope noise estimate";
+      result->message = msg.str();
+      return false;
+    }
   }
   return true;
+}
+
+// fit->chi2 and, with `covariance`, the dense Jacobian (3 rows per
+// position) of b_g and the blocks that are on (G, gamma, eta).
+void EvaluateGyroFit(const std::vector<std::unique_ptr<ceres::CostFunction>>& owned,
+                     const double* const params[4], const bool on[3], bool covariance,
+                     Eigen::MatrixXd* jacobian, SensorFitSummary* fit) {
+  fit->chi2 = 0.0;
+  for (int k = 0; k < static_cast<int>(owned.size()); ++k) {
+    double r[3];
+    double jb[9], jg[27], jt[9], jd[9];
+    double* jacobians[4] = {jb, jg, jt, jd};
+    owned[k]->Evaluate(params, r, covariance ? jacobians : nullptr);
+    for (int row = 0; row < 3; ++row) {
+      fit->chi2 += r[row] * r[row];
+      if (!covariance) continue;
+      int col = 0;
+      for (int i = 0; i < 3; ++i) (*jacobian)(3 * k + row, col++) = jb[3 * row + i];
+      if (on[0]) {
+        for (int i = 0; i < 9; ++i) (*jacobian)(3 * k + row, col++) = jg[9 * row + i];
+      }
+      if (on[1]) {
+        for (int i = 0; i < 3; ++i) (*jacobian)(3 * k + row, col++) = jt[3 * row + i];
+      }
+      if (on[2]) {
+        for (int i = 0; i < 3; ++i) (*jacobian)(3 * k + row, col++) = jd[3 * row + i];
+      }
+    }
+  }
 }
 
 bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel& initial_gyro,
@@ -256,16 +340,8 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
              EffectFitResult* result) {
   const std::vector<Effect>& effects = options.effects;
   const int n = static_cast<int>(observations.size());
-  std::vector<Eigen::Matrix3d> whitening(n);
-  for (int k = 0; k < n; ++k) {
-    whitening[k] = Whitening(observations[k].gyro_mean_cov);
-    if (!whitening[k].allFinite()) {
-      std::ostringstream msg;
-      msg << "position " << k << " has no usable gyroscope noise estimate";
-      result->message = msg.str();
-      return false;
-    }
-  }
+  std::vector<Eigen::Matrix3d> whitening;
+  if (!GyroWhitening(observations, &whitening, result)) return false;
   double bias[3] = {initial_gyro.bias(0), initial_gyro.bias(1), initial_gyro.bias(2)};
   double g[9];
   for (int r = 0; r < 3; ++r) {
@@ -320,29 +396,8 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   }
   const int np = static_cast<int>(fit.parameter_names.size());
   Eigen::MatrixXd jacobian(3 * n, np);
-  fit.chi2 = 0.0;
-  for (int k = 0; k < n; ++k) {
-    double r[3];
-    double jb[9], jg[27], jt[9], jd[9];
-    double* jacobians[4] = {jb, jg, jt, jd};
-    const double* params[4] = {bias, g, temperature_bias, drift};
-    owned[k]->Evaluate(params, r, options.compute_covariance ? jacobians : nullptr);
-    for (int row = 0; row < 3; ++row) {
-      fit.chi2 += r[row] * r[row];
-      if (!options.compute_covariance) continue;
-      int col = 0;
-      for (int i = 0; i < 3; ++i) jacobian(3 * k + row, col++) = jb[3 * row + i];
-      if (on_g) {
-        for (int i = 0; i < 9; ++i) jacobian(3 * k + row, col++) = jg[9 * row + i];
-      }
-      if (on_t) {
-        for (int i = 0; i < 3; ++i) jacobian(3 * k + row, col++) = jt[3 * row + i];
-      }
-      if (on_d) {
-        for (int i = 0; i < 3; ++i) jacobian(3 * k + row, col++) = jd[3 * row + i];
-      }
-    }
-  }
+  const double* params[4] = {bias, g, temperature_bias, drift};
+  EvaluateGyroFit(owned, params, on, options.compute_covariance, &jacobian, &fit);
   fit.num_residuals = 3 * n;
   fit.num_parameters = np;
   result->gyro.bias = Eigen::Vector3d(bias[0], bias[1], bias[2]);
@@ -517,6 +572,97 @@ Eigen::Vector3d GyroResidual(const EffectFitResult& fit, const StaticObservation
 }  // namespace gravcal
 
 namespace gravcal {
+namespace {
+
+// The references (mean time, mean temperature) and the starting gyroscope
+// bias (mean reading) of the positions; true when all have a temperature.
+// The reference temperature is NaN without one.
+bool StartParameters(const std::vector<StaticObservation>& observations, EffectParameters* start,
+                     GyroModel* gyro) {
+  const int n = static_cast<int>(observations.size());
+  bool has_temperature = n > 0;
+  double temperature_sum = 0.0, time_sum = 0.0;
+  for (const StaticObservation& o : observations) {
+    has_temperature = has_temperature && std::isfinite(o.temperature());
+    temperature_sum += o.temperature();
+    time_sum += o.time();
+    gyro->bias += o.gyro_mean / n;
+  }
+  start->reference_time = n > 0 ? time_sum / n : 0.0;
+  start->reference_temperature = has_temperature ? temperature_sum / n : NAN;
+  return has_temperature;
+}
+
+// The accelerometer and gyroscope models and uncertainties of the fit.
+void CopyEffectFit(const EffectFitResult& fit, Calibration* calibration) {
+  Calibration& c = *calibration;
+  c.accel.model.bias = fit.accel.bias;
+  c.accel.model.upper = fit.accel.upper;
+  c.accel.model.parameterization = fit.accel.parameterization;
+  c.accel.bias_std = fit.accel_bias_std;
+  c.accel.covariance = fit.accel_fit.covariance;
+  c.accel.covariance_names = fit.accel_fit.parameter_names;
+  const bool rotated = !c.accel.model.rotation.isIdentity(0.0);
+  static const char* kUpperNames[3][3] = {
+      {"u_xx", "u_xy", "u_xz"}, {"", "u_yy", "u_yz"}, {"", "", "u_zz"}};
+  for (int r = 0; r < 3; ++r) {
+    for (int col = r; col < 3; ++col) {
+      if (!rotated) c.accel.matrix_std(r, col) = StdOf(fit.accel_fit, kUpperNames[r][col]);
+    }
+  }
+  if (rotated) {
+    c.warnings.push_back(
+        "effects: accel.std.matrix is from the fit without effects (the housing rotation's "
+        "uncertainty is not propagated through the effect fit)");
+  }
+  if (fit.gyro_fit.fitted) {
+    c.gyro.estimated = true;
+    c.gyro.model.bias = fit.gyro.bias;
+    c.gyro.model.matrix.setIdentity();
+    c.gyro.bias_std = fit.gyro_bias_std;
+    c.gyro.matrix_std.setConstant(NAN);
+    c.gyro.covariance = fit.gyro_fit.covariance;
+    c.gyro.covariance_names = fit.gyro_fit.parameter_names;
+    c.warnings.push_back(
+        "gyro: static positions determine the gyroscope bias and the effects only; gyro.matrix "
+        "is the identity (not determined)");
+  }
+}
+
+// The residuals after the fit with effects, and the chi2 warning in place
+// of the base fit's.
+void SetEffectResiduals(const EffectFitResult& fit, Calibration* calibration) {
+  Calibration& c = *calibration;
+  const int n = static_cast<int>(fit.accel_residuals.size());
+  double s = 0.0, m = 0.0;
+  for (double r : fit.accel_residuals) {
+    s += r * r;
+    m = std::max(m, std::fabs(r));
+  }
+  c.residual_refined = {n > 0 ? std::sqrt(s / n) : 0.0, m};
+  if (static_cast<int>(c.positions.size()) == n) {
+    for (int k = 0; k < n; ++k) c.positions[k].residual_after = fit.accel_residuals[k];
+  }
+  // The base fit's verdict on its residuals no longer applies.
+  c.warnings.erase(std::remove_if(c.warnings.begin(), c.warnings.end(),
+                                  [](const std::string& w) {
+                                    return w.find("times the noise level (chi2") !=
+                                           std::string::npos;
+                                  }),
+                   c.warnings.end());
+  if (fit.accel_fit.dof() > 0 &&
+      ChiSquareUpperTail(fit.accel_fit.chi2, fit.accel_fit.dof()) < 1e-3) {
+    std::ostringstream w;
+    w.precision(3);
+    w << "with effects the residuals are still "
+      << std::sqrt(fit.accel_fit.chi2 / fit.accel_fit.dof())
+      << " times the noise level (chi2 = " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof()
+      << " dof): gravcal discover can look for what the model still misses";
+    c.warnings.push_back(w.str());
+  }
+}
+
+}  // namespace
 
 bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>& intervals,
                            const CalibrationOptions& options, const std::vector<Effect>& effects,
@@ -529,19 +675,9 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   };
   const std::vector<StaticObservation> observations =
       ObservationsFromIntervals(intervals, log.has_gyro());
-  const int n = static_cast<int>(observations.size());
-  bool has_temperature = n > 0;
   EffectParameters start;
   GyroModel gyro;
-  double temperature_sum = 0.0, time_sum = 0.0;
-  for (const StaticObservation& o : observations) {
-    has_temperature = has_temperature && std::isfinite(o.temperature());
-    temperature_sum += o.temperature();
-    time_sum += o.time();
-    gyro.bias += o.gyro_mean / n;
-  }
-  start.reference_time = n > 0 ? time_sum / n : 0.0;
-  start.reference_temperature = has_temperature ? temperature_sum / n : NAN;
+  const bool has_temperature = StartParameters(observations, &start, &gyro);
   for (Effect e : effects) {
     const EffectInfo& info = Info(e);
     if (info.regressor == EffectRegressor::kTemperature && !has_temperature) {
@@ -578,63 +714,8 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
     return fail("the fit with effects did not converge");
   }
 
-  c.accel.model.bias = fit.accel.bias;
-  c.accel.model.upper = fit.accel.upper;
-  c.accel.model.parameterization = fit.accel.parameterization;
-  c.accel.bias_std = fit.accel_bias_std;
-  c.accel.covariance = fit.accel_fit.covariance;
-  c.accel.covariance_names = fit.accel_fit.parameter_names;
-  const bool rotated = !c.accel.model.rotation.isIdentity(0.0);
-  static const char* kUpperNames[3][3] = {
-      {"u_xx", "u_xy", "u_xz"}, {"", "u_yy", "u_yz"}, {"", "", "u_zz"}};
-  for (int r = 0; r < 3; ++r) {
-    for (int col = r; col < 3; ++col) {
-      if (!rotated) c.accel.matrix_std(r, col) = StdOf(fit.accel_fit, kUpperNames[r][col]);
-    }
-  }
-  if (rotated) {
-    c.warnings.push_back(
-        "effects: accel.std.matrix is from the fit without effects (the housing rotation's "
-        "uncertainty is not propagated through the effect fit)");
-  }
-  if (fit.gyro_fit.fitted) {
-    c.gyro.estimated = true;
-    c.gyro.model.bias = fit.gyro.bias;
-    c.gyro.model.matrix.setIdentity();
-    c.gyro.bias_std = fit.gyro_bias_std;
-    c.gyro.matrix_std.setConstant(NAN);
-    c.gyro.covariance = fit.gyro_fit.covariance;
-    c.gyro.covariance_names = fit.gyro_fit.parameter_names;
-    c.warnings.push_back(
-        "gyro: static positions determine the gyroscope bias and the effects only; gyro.matrix "
-        "is the identity (not determined)");
-  }
-  double s = 0.0, m = 0.0;
-  for (double r : fit.accel_residuals) {
-    s += r * r;
-    m = std::max(m, std::fabs(r));
-  }
-  c.residual_refined = {n > 0 ? std::sqrt(s / n) : 0.0, m};
-  if (static_cast<int>(c.positions.size()) == n) {
-    for (int k = 0; k < n; ++k) c.positions[k].residual_after = fit.accel_residuals[k];
-  }
-  // The base fit's verdict on its residuals no longer applies.
-  c.warnings.erase(std::remove_if(c.warnings.begin(), c.warnings.end(),
-                                  [](const std::string& w) {
-                                    return w.find("times the noise level (chi2") !=
-                                           std::string::npos;
-                                  }),
-                   c.warnings.end());
-  if (fit.accel_fit.dof() > 0 &&
-      ChiSquareUpperTail(fit.accel_fit.chi2, fit.accel_fit.dof()) < 1e-3) {
-    std::ostringstream w;
-    w.precision(3);
-    w << "with effects the residuals are still "
-      << std::sqrt(fit.accel_fit.chi2 / fit.accel_fit.dof())
-      << " times the noise level (chi2 = " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof()
-      << " dof): gravcal discover can look for what the model still misses";
-    c.warnings.push_back(w.str());
-  }
+  CopyEffectFit(fit, &c);
+  SetEffectResiduals(fit, &c);
   c.effects.estimates = fit.estimates;
   c.effects.reference_temperature = has_temperature ? start.reference_temperature : NAN;
   c.effects.reference_time = start.reference_time;
