@@ -516,5 +516,20 @@ TEST(LogReader, IntegerCellsReadAsFromCharsWould) {
   EXPECT_NE(error.find("bad.csv:2"), std::string::npos) << error;
 }
 
+// The header row goes through the one CSV tokeniser (io/csv_table.h): quoted
+// names, blanks around them, and an unclosed quote reported.
+TEST(LogReader, HeaderUsesTheCsvTokeniser) {
+  ImuLog log;
+  std::string error;
+  ASSERT_TRUE(ParseImuLog(" \"t\" , ax,\"ay\",az \n0,1,2,3\n1,1,2,3\n", "quoted.csv",
+                          LogReaderOptions(), &log, &error))
+      << error;
+  ASSERT_EQ(log.size(), 2u);
+  EXPECT_EQ(log.accel[1].z(), 3.0);
+  EXPECT_FALSE(
+      ParseImuLog("t,ax,\"ay,az\n0,1,2,3\n", "open.csv", LogReaderOptions(), &log, &error));
+  EXPECT_EQ(error, "open.csv:1: the quoted field is not closed");
+}
+
 }  // namespace
 }  // namespace gravcal
