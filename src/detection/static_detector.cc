@@ -11,6 +11,9 @@
 #include "util/units.h"
 
 namespace gravcal {
+
+using internal::Median;
+
 namespace {
 
 // The median interval and the quantiles are taken on at most this many
