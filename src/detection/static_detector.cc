@@ -12,8 +12,6 @@
 
 namespace gravcal {
 
-using internal::Median;
-
 namespace {
 
 // The median interval and the quantiles are taken on at most this many
