@@ -11,7 +11,6 @@
 #include "util/units.h"
 
 namespace gravcal {
-
 namespace {
 
 // The median interval and the quantiles are taken on at most this many
