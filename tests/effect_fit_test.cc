@@ -18,6 +18,9 @@
 #include "util/statistics.h"
 
 namespace gravcal {
+
+using internal::FUpperTail;
+
 namespace {
 
 EffectParameters RandomParameters(std::mt19937_64* rng) {

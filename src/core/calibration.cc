@@ -4,6 +4,9 @@
 
 namespace gravcal {
 
+using internal::MaxAbs;
+using internal::Rms;
+
 ResidualSummary SummarizeResiduals(const std::vector<double>& residuals) {
   return {Rms(residuals), MaxAbs(residuals)};
 }

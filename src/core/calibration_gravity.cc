@@ -3,6 +3,7 @@
 #include <string>
 
 namespace gravcal {
+namespace internal {
 
 bool ResolveCalibrationGravity(const GravityOptions& options, Calibration* calibration) {
   Calibration& c = *calibration;
@@ -19,4 +20,5 @@ bool ResolveCalibrationGravity(const GravityOptions& options, Calibration* calib
   return true;
 }
 
+}  // namespace internal
 }  // namespace gravcal

@@ -6,6 +6,7 @@
 #include "util/so3.h"
 
 namespace gravcal {
+namespace internal {
 
 void PropagateUncertainty(const RefinementResult& refinement, const HousingRotation* housing,
                           AccelCalibration* accel) {
@@ -68,4 +69,5 @@ void PropagateUncertainty(const RefinementResult& refinement, const HousingRotat
   }
 }
 
+}  // namespace internal
 }  // namespace gravcal

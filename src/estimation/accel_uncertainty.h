@@ -9,6 +9,7 @@
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
+namespace internal {
 
 // Fills accel->bias_std, matrix_std and the covariance (with its names) from
 // the covariance of (b, free entries of U) in `refinement` and, for affine,
@@ -17,6 +18,7 @@ namespace gravcal {
 void PropagateUncertainty(const RefinementResult& refinement, const HousingRotation* housing,
                           AccelCalibration* accel);
 
+}  // namespace internal
 }  // namespace gravcal
 
 #endif  // GRAVCAL_SRC_ESTIMATION_ACCEL_UNCERTAINTY_H_

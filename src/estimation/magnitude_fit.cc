@@ -4,6 +4,7 @@
 #include <sstream>
 
 namespace gravcal {
+namespace internal {
 
 double WhitenedSumOfSquares(const std::vector<double>& residuals,
                             const std::vector<double>& sigmas) {
@@ -63,4 +64,5 @@ bool StartMagnitudeFit(const std::vector<Position>& positions, const AccelModel&
   return true;
 }
 
+}  // namespace internal
 }  // namespace gravcal

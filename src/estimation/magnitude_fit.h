@@ -12,6 +12,7 @@
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
+namespace internal {
 
 // Sum over positions of (r_k / sigma_k)^2.
 double WhitenedSumOfSquares(const std::vector<double>& residuals,
@@ -58,6 +59,7 @@ bool StartMagnitudeFit(const std::vector<Position>& positions, const AccelModel&
                            result);
 }
 
+}  // namespace internal
 }  // namespace gravcal
 
 #endif  // GRAVCAL_SRC_ESTIMATION_MAGNITUDE_FIT_H_

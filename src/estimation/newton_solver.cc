@@ -11,6 +11,11 @@
 
 namespace gravcal {
 
+using internal::MagnitudeFitStart;
+using internal::Normalization;
+using internal::StartMagnitudeFit;
+using internal::WhitenedSumOfSquares;
+
 bool NewtonOptions::IsValid(std::string* error) const {
   if (max_iterations < 1) {
     *error = "max_iterations: must be at least 1";

@@ -54,6 +54,48 @@ double LargestTilt(const ImuLog& log, size_t begin, size_t end, size_t* where) {
   return worst;
 }
 
+// The samples the noise model is taken from: the longest still interval
+// (find_still) or the whole log, which must then be still. False with a
+// message naming the log.
+bool ChooseStillRange(const ImuLog& log, const NoiseOptions& options, size_t* begin, size_t* end,
+                      std::string* message) {
+  *begin = 0;
+  *end = log.size();
+  if (options.find_still) {
+    StaticDetection detection;
+    if (!DetectStaticIntervals(log, options.detector, &detection)) {
+      *message = log.source + ": " + detection.message;
+      return false;
+    }
+    if (detection.intervals.empty()) {
+      *message = log.source +
+                 ": no still interval: the static detector found none (the noise model "
+                 "needs the sensor at rest)";
+      return false;
+    }
+    const StaticInterval* longest = &detection.intervals.front();
+    for (const StaticInterval& s : detection.intervals) {
+      if (s.count() > longest->count()) longest = &s;
+    }
+    *begin = longest->begin;
+    *end = longest->end;
+  } else {
+    size_t where = 0;
+    const double tilt = LargestTilt(log, *begin, *end, &where);
+    if (tilt > options.max_tilt_deg) {
+      std::ostringstream s;
+      s.precision(3);
+      s << log.source << ": the log moves: gravity turns by " << tilt
+        << " degrees (near t = " << log.t[where]
+        << " s), and noise_find_still is false (the whole log must be still; "
+        << "set it true to use the longest still interval)";
+      *message = s.str();
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 }  // namespace internal
 
@@ -79,38 +121,7 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
   }
   ImuNoiseModel& model = result->model;
   size_t begin = 0, end = log.size();
-  if (options.find_still) {
-    StaticDetection detection;
-    if (!DetectStaticIntervals(log, options.detector, &detection)) {
-      result->message = log.source + ": " + detection.message;
-      return false;
-    }
-    if (detection.intervals.empty()) {
-      result->message = log.source +
-                        ": no still interval: the static detector found none (the noise model "
-                        "needs the sensor at rest)";
-      return false;
-    }
-    const StaticInterval* longest = &detection.intervals.front();
-    for (const StaticInterval& s : detection.intervals) {
-      if (s.count() > longest->count()) longest = &s;
-    }
-    begin = longest->begin;
-    end = longest->end;
-  } else {
-    size_t where = 0;
-    const double tilt = internal::LargestTilt(log, begin, end, &where);
-    if (tilt > options.max_tilt_deg) {
-      std::ostringstream s;
-      s.precision(3);
-      s << log.source << ": the log moves: gravity turns by " << tilt
-        << " degrees (near t = " << log.t[where]
-        << " s), and noise_find_still is false (the whole log must be still; "
-        << "set it true to use the longest still interval)";
-      result->message = s.str();
-      return false;
-    }
-  }
+  if (!internal::ChooseStillRange(log, options, &begin, &end, &result->message)) return false;
   model.still_begin = begin;
   model.still_end = end;
   model.still_t_begin = log.t[begin];

@@ -17,6 +17,7 @@
 #include "gravcal/core/position.h"
 
 namespace gravcal {
+namespace internal {
 
 struct Normalization {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
@@ -60,6 +61,12 @@ struct Normalization {
     return d.asDiagonal() * covariance * d.asDiagonal();
   }
 };
+
+}  // namespace internal
+
+// Transitional: src/methods/effect_fit.cc (issue 12, owned by the other
+// helper) still names it unqualified; remove once it says internal::.
+using internal::Normalization;
 
 }  // namespace gravcal
 

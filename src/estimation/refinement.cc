@@ -19,6 +19,12 @@
 
 namespace gravcal {
 
+using internal::ChiSquareUpperTail;
+using internal::MagnitudeFitStart;
+using internal::MakeLoss;
+using internal::StartMagnitudeFit;
+using internal::WhitenedSumOfSquares;
+
 bool RefinementOptions::IsValid(std::string* error) const {
   if (!(loss_scale > 0.0 && std::isfinite(loss_scale))) {
     *error = "loss_scale: must be positive";

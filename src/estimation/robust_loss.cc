@@ -1,6 +1,7 @@
 #include "estimation/robust_loss.h"
 
 namespace gravcal {
+namespace internal {
 
 ceres::LossFunction* MakeLoss(LossType type, double scale) {
   switch (type) {
@@ -20,4 +21,5 @@ ceres::LossFunction* MakeLoss(LossType type, double scale) {
   return nullptr;
 }
 
+}  // namespace internal
 }  // namespace gravcal

@@ -8,10 +8,12 @@
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
+namespace internal {
 
 // A new loss with the given scale (in whitened units), or nullptr for kNone.
 ceres::LossFunction* MakeLoss(LossType type, double scale);
 
+}  // namespace internal
 }  // namespace gravcal
 
 #endif  // GRAVCAL_SRC_ESTIMATION_ROBUST_LOSS_H_

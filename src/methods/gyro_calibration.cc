@@ -21,6 +21,11 @@
 
 namespace gravcal {
 
+using internal::MaxAbs;
+using internal::Normalization;
+using internal::PropagateUncertainty;
+using internal::Rms;
+
 bool GyroCalibrationOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& what) {
     if (error) *error = what;

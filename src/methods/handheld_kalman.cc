@@ -12,6 +12,9 @@
 #include "methods/handheld_report.h"
 
 namespace gravcal {
+
+using internal::ResolveCalibrationGravity;
+
 namespace internal {
 namespace {
 

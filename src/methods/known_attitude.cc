@@ -20,6 +20,10 @@
 #include "util/units.h"
 
 namespace gravcal {
+
+using internal::ChiSquareUpperTail;
+using internal::MakeLoss;
+
 namespace {
 
 // Twelve unknowns, three equations per position.

@@ -39,6 +39,132 @@ bool AlignPositions(const ImuLog& log, const std::vector<StaticInterval>& interv
   return true;
 }
 
+// The parameterization step 4 fits: the rotation of the axes in the housing
+// is invisible to |g_a,k| = g, so affine is fitted as scale_misalignment.
+AccelParameterization Step4Parameterization(AccelParameterization requested) {
+  return requested == AccelParameterization::kAffine ? AccelParameterization::kScaleMisalignment
+                                                     : requested;
+}
+
+// Step 4: g_0 from |g_a,k| = g, the part of the self-aligned reference the
+// accelerometer's errors do not reach, with the scale (and, unless the
+// model is `scale`, the non-orthogonality) the magnitude needs to fit.
+// Fills c->refinement; false with c->message on failure.
+bool FitZeroBias(const std::vector<Position>& positions, double nominal_scale,
+                 const CalibrationOptions& options, const std::string& where, Calibration* c) {
+  RefinementOptions step4 = options.refinement;
+  step4.parameterization = Step4Parameterization(step4.parameterization);
+  AccelModel initial;
+  initial.parameterization = step4.parameterization;
+  initial.upper = nominal_scale * Eigen::Matrix3d::Identity();
+  if (!Refine(positions, initial, c->gravity, step4, &c->refinement)) {
+    c->message = where + "step 4: " + c->refinement.message;
+    return false;
+  }
+  c->solver_name = "ceres_levenberg_marquardt (step 4) + normal equations (step 5)";
+  for (const std::string& w : c->refinement.warnings) c->warnings.push_back("step 4: " + w);
+  if (!c->refinement.converged) {
+    c->not_converged = true;
+    c->message = where + "step 4 (zero bias) did not converge: " + c->refinement.message;
+    return false;
+  }
+  const std::vector<std::string>& undetermined = c->refinement.observability.undetermined;
+  if (!undetermined.empty() && !options.allow_undetermined) {
+    std::string names;
+    for (const std::string& u : undetermined) names += (names.empty() ? "" : ", ") + u;
+    c->message = where + "step 4: the positions do not determine " + names +
+                 ": use positions with other axes up, or set allow_undetermined: true";
+    return false;
+  }
+  return true;
+}
+
+// Step 5: align again on the corrected specific force (the INS with the
+// new zero bias), then K from the normal equations. Fills c->accel.model,
+// the alignments `second` and the residual sum of squares of the K fit.
+bool SolveK(const ImuLog& log, const std::vector<StaticInterval>& intervals,
+            const std::vector<Position>& positions, const StaticAlignmentOptions& align,
+            double gyro_nominal_scale, const std::string& where,
+            std::vector<StaticAlignmentResult>* second, double* fit_rss, Calibration* c) {
+  const int n = static_cast<int>(positions.size());
+  const Eigen::Vector3d g0 = c->refinement.model.bias;
+  const Eigen::Matrix3d upper = c->refinement.model.upper;
+  StaticAlignmentOptions align2 = align;
+  if (c->refinement.covariance_available) {
+    const Eigen::Matrix3d bias_cov_si =
+        upper * c->refinement.covariance.topLeftCorner<3, 3>() * upper.transpose();
+    align2.accel_bias_std = std::max(std::sqrt(bias_cov_si.diagonal().maxCoeff()), 1e-6);
+  }
+  std::string error;
+  if (!AlignPositions(
+          log, intervals, align2, gyro_nominal_scale,
+          [&](const Eigen::Vector3d& v) { return Eigen::Vector3d(upper * (v - g0)); }, second,
+          &error)) {
+    c->message = where + "step 5: " + error;
+    return false;
+  }
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d right = Eigen::Matrix3d::Zero();
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d d = positions[k].raw_mean - g0;
+    normal += d * d.transpose();
+    right += d * (*second)[k].gravity_body.transpose();
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
+  const Eigen::Matrix3d k_matrix = ldlt.solve(right).transpose();
+  if (ldlt.info() != Eigen::Success || !k_matrix.allFinite() ||
+      !AccelModel::FromMatrix(g0, k_matrix, AccelParameterization::kAffine, &c->accel.model)) {
+    c->message = where + "step 5: the normal equations for K are singular (positions coplanar?)";
+    return false;
+  }
+  *fit_rss = 0.0;
+  for (int k = 0; k < n; ++k) {
+    *fit_rss += ((*second)[k].gravity_body - k_matrix * (positions[k].raw_mean - g0)).squaredNorm();
+  }
+  return true;
+}
+
+// Uncertainty: bias and the diagonal of K from step 4 (the magnitude is
+// the information); the off-diagonal of K is not determined. Adds the
+// warning that says so and the alignments' own warnings, once each.
+void ReportStep4Uncertainty(AccelParameterization step4_parameterization,
+                            const std::vector<StaticAlignmentResult>& second, Calibration* c) {
+  if (c->refinement.covariance_available) {
+    c->accel.covariance = c->refinement.covariance;
+    c->accel.covariance_names = c->refinement.parameter_names;
+    const std::vector<std::string>& names = c->refinement.parameter_names;
+    const char* diagonal[3] = {"u_xx", "u_yy", "u_zz"};
+    for (int i = 0; i < 3; ++i) {
+      c->accel.bias_std(i) = std::sqrt(c->refinement.covariance(i, i));
+      const int at =
+          static_cast<int>(std::find(names.begin(), names.end(), diagonal[i]) - names.begin());
+      c->accel.matrix_std(i, i) = std::sqrt(c->refinement.covariance(at, at));
+    }
+  }
+  for (const std::string& u : c->refinement.observability.undetermined) {
+    if (u.rfind("bias_", 0) == 0) c->accel.bias_std(u[5] - 'x') = NAN;
+    if (u.rfind("u_", 0) == 0) c->accel.matrix_std(u[2] - 'x', u[3] - 'x') = NAN;
+  }
+  c->warnings.push_back(
+      std::string("ten_position: the reference gravity g_a comes from self-alignment on this "
+                  "accelerometer, so its direction inherits the sensor's own axes: the "
+                  "off-diagonal entries of K (installation misalignment") +
+      (step4_parameterization == AccelParameterization::kScale
+           ? " and non-orthogonality"
+           : "; the non-orthogonality in the sensor's own frame is u_xy, u_xz, u_yz of the "
+             "covariance") +
+      ") are not determined and have no standard deviation; bias and scale come from |g_a| = "
+      "g (step 4). Use known_attitude for all twelve parameters");
+  for (const StaticAlignmentResult& a : second) {
+    for (const std::string& w : a.warnings) {
+      const std::string line = "alignment: " + w;
+      if (std::find(c->warnings.begin(), c->warnings.end(), line) == c->warnings.end()) {
+        c->warnings.push_back(line);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool TenPositionOptions::IsValid(std::string* error) const {
@@ -102,113 +228,17 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
     return false;
   }
 
-  // Step 4: g_0 from |g_a,k| = g, the part of the self-aligned reference the
-  // accelerometer's errors do not reach, with the scale (and, unless the
-  // model is `scale`, the non-orthogonality) the magnitude needs to fit.
-  // The rotation of the axes in the housing is invisible to it: affine is
-  // fitted as scale_misalignment.
-  RefinementOptions step4 = options.refinement;
-  if (step4.parameterization == AccelParameterization::kAffine) {
-    step4.parameterization = AccelParameterization::kScaleMisalignment;
-  }
-  AccelModel initial;
-  initial.parameterization = step4.parameterization;
-  initial.upper = nominal_scale * Eigen::Matrix3d::Identity();
-  if (!Refine(positions, initial, c.gravity, step4, &c.refinement)) {
-    c.message = where + "step 4: " + c.refinement.message;
-    return false;
-  }
-  c.solver_name = "ceres_levenberg_marquardt (step 4) + normal equations (step 5)";
-  for (const std::string& w : c.refinement.warnings) c.warnings.push_back("step 4: " + w);
-  if (!c.refinement.converged) {
-    c.not_converged = true;
-    c.message = where + "step 4 (zero bias) did not converge: " + c.refinement.message;
-    return false;
-  }
-  const std::vector<std::string>& undetermined = c.refinement.observability.undetermined;
-  if (!undetermined.empty() && !options.allow_undetermined) {
-    std::string names;
-    for (const std::string& u : undetermined) names += (names.empty() ? "" : ", ") + u;
-    c.message = where + "step 4: the positions do not determine " + names +
-                ": use positions with other axes up, or set allow_undetermined: true";
-    return false;
-  }
-  const AccelModel& zero = c.refinement.model;
-  const Eigen::Vector3d g0 = zero.bias;
-  const Eigen::Matrix3d upper = zero.upper;
+  // Step 4: the zero bias g_0 from the magnitude.
+  if (!FitZeroBias(positions, nominal_scale, options, where, &c)) return false;
 
-  // Step 5: align again on the corrected specific force (the INS with the
-  // new zero bias), then K from the normal equations.
-  StaticAlignmentOptions align2 = align;
-  if (c.refinement.covariance_available) {
-    const Eigen::Matrix3d bias_cov_si =
-        upper * c.refinement.covariance.topLeftCorner<3, 3>() * upper.transpose();
-    align2.accel_bias_std = std::max(std::sqrt(bias_cov_si.diagonal().maxCoeff()), 1e-6);
-  }
+  // Step 5: K from the normal equations on the realigned positions.
   std::vector<StaticAlignmentResult> second;
-  if (!AlignPositions(
-          log, intervals, align2, ten.gyro_nominal_scale,
-          [&](const Eigen::Vector3d& v) { return Eigen::Vector3d(upper * (v - g0)); }, &second,
-          &error)) {
-    c.message = where + "step 5: " + error;
-    return false;
-  }
-  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d right = Eigen::Matrix3d::Zero();
-  for (int k = 0; k < n; ++k) {
-    const Eigen::Vector3d d = positions[k].raw_mean - g0;
-    normal += d * d.transpose();
-    right += d * second[k].gravity_body.transpose();
-  }
-  const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
-  const Eigen::Matrix3d k_matrix = ldlt.solve(right).transpose();
-  if (ldlt.info() != Eigen::Success || !k_matrix.allFinite() ||
-      !AccelModel::FromMatrix(g0, k_matrix, AccelParameterization::kAffine, &c.accel.model)) {
-    c.message = where + "step 5: the normal equations for K are singular (positions coplanar?)";
-    return false;
-  }
   double fit_rss = 0.0;
-  for (int k = 0; k < n; ++k) {
-    fit_rss += (second[k].gravity_body - k_matrix * (positions[k].raw_mean - g0)).squaredNorm();
+  if (!SolveK(log, intervals, positions, align, ten.gyro_nominal_scale, where, &second, &fit_rss,
+              &c)) {
+    return false;
   }
-
-  // Uncertainty: bias and the diagonal of K from step 4 (the magnitude is
-  // the information); the off-diagonal of K is not determined.
-  if (c.refinement.covariance_available) {
-    c.accel.covariance = c.refinement.covariance;
-    c.accel.covariance_names = c.refinement.parameter_names;
-    const std::vector<std::string>& names = c.refinement.parameter_names;
-    const char* diagonal[3] = {"u_xx", "u_yy", "u_zz"};
-    for (int i = 0; i < 3; ++i) {
-      c.accel.bias_std(i) = std::sqrt(c.refinement.covariance(i, i));
-      const int at =
-          static_cast<int>(std::find(names.begin(), names.end(), diagonal[i]) - names.begin());
-      c.accel.matrix_std(i, i) = std::sqrt(c.refinement.covariance(at, at));
-    }
-  }
-  for (const std::string& u : undetermined) {
-    if (u.rfind("bias_", 0) == 0) c.accel.bias_std(u[5] - 'x') = NAN;
-    if (u.rfind("u_", 0) == 0) c.accel.matrix_std(u[2] - 'x', u[3] - 'x') = NAN;
-  }
-  c.warnings.push_back(
-      std::string("ten_position: the reference gravity g_a comes from self-alignment on this "
-                  "accelerometer, so its direction inherits the sensor's own axes: the "
-                  "off-diagonal entries of K (installation misalignment") +
-      (step4.parameterization == AccelParameterization::kScale
-           ? " and non-orthogonality"
-           : "; the non-orthogonality in the sensor's own frame is u_xy, u_xz, u_yz of the "
-             "covariance") +
-      ") are not determined and have no standard deviation; bias and scale come from |g_a| = "
-      "g (step 4). Use known_attitude for all twelve parameters");
-  // The alignments' own warnings, once each.
-  for (const StaticAlignmentResult& a : second) {
-    for (const std::string& w : a.warnings) {
-      const std::string line = "alignment: " + w;
-      if (std::find(c.warnings.begin(), c.warnings.end(), line) == c.warnings.end()) {
-        c.warnings.push_back(line);
-      }
-    }
-  }
+  ReportStep4Uncertainty(Step4Parameterization(options.refinement.parameterization), second, &c);
 
   AccelModel nominal;
   nominal.upper = nominal_scale * Eigen::Matrix3d::Identity();

@@ -16,6 +16,11 @@
 
 namespace gravcal {
 
+using internal::MaxAbs;
+using internal::PropagateUncertainty;
+using internal::ResolveCalibrationGravity;
+using internal::Rms;
+
 bool CalibrationOptions::IsValid(std::string* error) const {
   if (!detector.IsValid(error) || !gravity.IsValid(error) || !coarse.IsValid(error) ||
       !refinement.IsValid(error) || !pose_noise.IsValid(error)) {

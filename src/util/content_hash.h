@@ -16,6 +16,7 @@
 #include <string_view>
 
 namespace gravcal {
+namespace internal {
 
 class ContentHash {
  public:
@@ -71,6 +72,7 @@ class ContentHash {
                     0x082efa98ec4e6c89ULL};
 };
 
+}  // namespace internal
 }  // namespace gravcal
 
 #endif  // GRAVCAL_SRC_UTIL_CONTENT_HASH_H_

@@ -4,6 +4,7 @@
 #include <cmath>
 
 namespace gravcal {
+namespace internal {
 namespace {
 
 // log Gamma(a). std::lgamma also writes the global `signgam`, a data race
@@ -132,4 +133,5 @@ double MaxAbs(const std::vector<double>& values) {
   return m;
 }
 
+}  // namespace internal
 }  // namespace gravcal

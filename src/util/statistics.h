@@ -5,6 +5,7 @@
 #include <vector>
 
 namespace gravcal {
+namespace internal {
 
 // P(X > x) for X ~ chi-square with `dof` degrees of freedom (regularised
 // upper incomplete gamma function, series / continued fraction).
@@ -20,6 +21,12 @@ double Median(std::vector<double> values);
 // Root mean square and largest absolute value.
 double Rms(const std::vector<double>& values);
 double MaxAbs(const std::vector<double>& values);
+
+}  // namespace internal
+
+// Transitional: src/methods/effect_fit.cc (issue 12, owned by the other
+// helper) still names it unqualified; remove once it says internal::.
+using internal::ChiSquareUpperTail;
 
 }  // namespace gravcal
 

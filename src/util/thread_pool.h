@@ -11,6 +11,7 @@
 #include <vector>
 
 namespace gravcal {
+namespace internal {
 
 // Runs body(i) for every i in [0, n) on min(threads, n) threads (the calling
 // thread is one of them). `body` must not throw.
@@ -28,6 +29,7 @@ void ParallelFor(size_t n, int threads, const Body& body) {
   for (std::thread& t : pool) t.join();
 }
 
+}  // namespace internal
 }  // namespace gravcal
 
 #endif  // GRAVCAL_SRC_UTIL_THREAD_POOL_H_

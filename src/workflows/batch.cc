@@ -15,6 +15,10 @@
 #endif
 
 namespace gravcal {
+
+using internal::ContentHash;
+using internal::ParallelFor;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;

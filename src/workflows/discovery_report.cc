@@ -10,6 +10,9 @@
 #include "util/statistics.h"
 
 namespace gravcal {
+
+using internal::Median;
+
 namespace {
 
 using json = nlohmann::ordered_json;

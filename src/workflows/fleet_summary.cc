@@ -14,6 +14,10 @@
 #include "util/statistics.h"
 
 namespace gravcal {
+
+using internal::ContentHash;
+using internal::Median;
+
 namespace {
 
 using Json = nlohmann::ordered_json;
