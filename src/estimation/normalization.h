@@ -64,10 +64,6 @@ struct Normalization {
 
 }  // namespace internal
 
-// Transitional: src/methods/effect_fit.cc (issue 12, owned by the other
-// helper) still names it unqualified; remove once it says internal::.
-using internal::Normalization;
-
 }  // namespace gravcal
 
 #endif  // GRAVCAL_SRC_ESTIMATION_NORMALIZATION_H_

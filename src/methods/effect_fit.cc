@@ -20,6 +20,9 @@
 #include "util/statistics.h"
 
 namespace gravcal {
+
+using internal::ChiSquareUpperTail;
+using internal::Normalization;
 namespace {
 
 // Relative tolerance of the rank test on the scaled whitened Jacobian: a

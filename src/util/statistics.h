@@ -24,10 +24,6 @@ double MaxAbs(const std::vector<double>& values);
 
 }  // namespace internal
 
-// Transitional: src/methods/effect_fit.cc (issue 12, owned by the other
-// helper) still names it unqualified; remove once it says internal::.
-using internal::ChiSquareUpperTail;
-
 }  // namespace gravcal
 
 #endif  // GRAVCAL_SRC_UTIL_STATISTICS_H_
