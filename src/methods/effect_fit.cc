@@ -86,14 +86,6 @@ void CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, int rows_per_positi
   }
 }
 
-double StdOf(const SensorFitSummary& fit, const std::string& name) {
-  const auto it = std::find(fit.parameter_names.begin(), fit.parameter_names.end(), name);
-  if (it == fit.parameter_names.end() || fit.covariance.size() == 0) return NAN;
-  const int i = static_cast<int>(it - fit.parameter_names.begin());
-  const double v = fit.covariance(i, i);
-  return v >= 0.0 ? std::sqrt(v) : NAN;
-}
-
 // Inverse of the lower Cholesky factor of a covariance, with a floor on
 // the diagonal so a constant (quantised) signal still has a finite weight.
 Eigen::Matrix3d Whitening(const Eigen::Matrix3d& covariance) {
@@ -185,7 +177,7 @@ void FinishAccel(const std::vector<StaticObservation>& observations, double grav
     d.head<3>().setConstant(scale);
     for (size_t i = 0; i < upper_free.size(); ++i) d(3 + i) = 1.0 / scale;
     fit->covariance = d.asDiagonal() * fit->covariance * d.asDiagonal();
-    for (int i = 0; i < 3; ++i) result->accel_bias_std(i) = StdOf(*fit, fit->parameter_names[i]);
+    for (int i = 0; i < 3; ++i) result->accel_bias_std(i) = fit->Std(fit->parameter_names[i]);
   }
 
   result->accel_residuals.resize(observations.size());
@@ -411,7 +403,7 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   result->parameters.gyro_bias_drift = Eigen::Vector3d(drift);
   if (options.compute_covariance) {
     CovarianceFromJacobian(jacobian, 3, &fit);
-    for (int i = 0; i < 3; ++i) result->gyro_bias_std(i) = StdOf(fit, fit.parameter_names[i]);
+    for (int i = 0; i < 3; ++i) result->gyro_bias_std(i) = fit.Std(fit.parameter_names[i]);
   }
   result->gyro_residuals.resize(n);
   result->gyro_sigmas.resize(n);
@@ -439,12 +431,20 @@ void FillEstimates(EffectFitResult* result) {
     } else {
       est.values = result->parameters.Values(e);
     }
-    for (const std::string& name : est.names) est.std.push_back(StdOf(fit, name));
+    for (const std::string& name : est.names) est.std.push_back(fit.Std(name));
     result->estimates.push_back(est);
   }
 }
 
 }  // namespace
+
+double SensorFitSummary::Std(const std::string& name) const {
+  const auto it = std::find(parameter_names.begin(), parameter_names.end(), name);
+  if (it == parameter_names.end() || covariance.size() == 0) return NAN;
+  const int i = static_cast<int>(it - parameter_names.begin());
+  const double v = covariance(i, i);
+  return v >= 0.0 ? std::sqrt(v) : NAN;
+}
 
 std::vector<StaticObservation> ObservationsFromIntervals(
     const std::vector<StaticInterval>& intervals, bool has_gyro) {
@@ -570,169 +570,6 @@ Eigen::Vector3d GyroResidual(const EffectFitResult& fit, const StaticObservation
     *whitened_squared = e.dot(observation.gyro_mean_cov.ldlt().solve(e));
   }
   return e;
-}
-
-}  // namespace gravcal
-
-namespace gravcal {
-namespace {
-
-// The references (mean time, mean temperature) and the starting gyroscope
-// bias (mean reading) of the positions; true when all have a temperature.
-// The reference temperature is NaN without one.
-bool StartParameters(const std::vector<StaticObservation>& observations, EffectParameters* start,
-                     GyroModel* gyro) {
-  const int n = static_cast<int>(observations.size());
-  bool has_temperature = n > 0;
-  double temperature_sum = 0.0, time_sum = 0.0;
-  for (const StaticObservation& o : observations) {
-    has_temperature = has_temperature && std::isfinite(o.temperature());
-    temperature_sum += o.temperature();
-    time_sum += o.time();
-    gyro->bias += o.gyro_mean / n;
-  }
-  start->reference_time = n > 0 ? time_sum / n : 0.0;
-  start->reference_temperature = has_temperature ? temperature_sum / n : NAN;
-  return has_temperature;
-}
-
-// The accelerometer and gyroscope models and uncertainties of the fit.
-void CopyEffectFit(const EffectFitResult& fit, Calibration* calibration) {
-  Calibration& c = *calibration;
-  c.accel.model.bias = fit.accel.bias;
-  c.accel.model.upper = fit.accel.upper;
-  c.accel.model.parameterization = fit.accel.parameterization;
-  c.accel.bias_std = fit.accel_bias_std;
-  c.accel.covariance = fit.accel_fit.covariance;
-  c.accel.covariance_names = fit.accel_fit.parameter_names;
-  const bool rotated = !c.accel.model.rotation.isIdentity(0.0);
-  static const char* kUpperNames[3][3] = {
-      {"u_xx", "u_xy", "u_xz"}, {"", "u_yy", "u_yz"}, {"", "", "u_zz"}};
-  for (int r = 0; r < 3; ++r) {
-    for (int col = r; col < 3; ++col) {
-      if (!rotated) c.accel.matrix_std(r, col) = StdOf(fit.accel_fit, kUpperNames[r][col]);
-    }
-  }
-  if (rotated) {
-    c.warnings.push_back(
-        "effects: accel.std.matrix is from the fit without effects (the housing rotation's "
-        "uncertainty is not propagated through the effect fit)");
-  }
-  if (fit.gyro_fit.fitted) {
-    c.gyro.estimated = true;
-    c.gyro.model.bias = fit.gyro.bias;
-    c.gyro.model.matrix.setIdentity();
-    c.gyro.bias_std = fit.gyro_bias_std;
-    c.gyro.matrix_std.setConstant(NAN);
-    c.gyro.covariance = fit.gyro_fit.covariance;
-    c.gyro.covariance_names = fit.gyro_fit.parameter_names;
-    c.warnings.push_back(
-        "gyro: static positions determine the gyroscope bias and the effects only; gyro.matrix "
-        "is the identity (not determined)");
-  }
-}
-
-// The residuals after the fit with effects, and the chi2 warning in place
-// of the base fit's.
-void SetEffectResiduals(const EffectFitResult& fit, Calibration* calibration) {
-  Calibration& c = *calibration;
-  const int n = static_cast<int>(fit.accel_residuals.size());
-  double s = 0.0, m = 0.0;
-  for (double r : fit.accel_residuals) {
-    s += r * r;
-    m = std::max(m, std::fabs(r));
-  }
-  c.residual_refined = {n > 0 ? std::sqrt(s / n) : 0.0, m};
-  if (static_cast<int>(c.positions.size()) == n) {
-    for (int k = 0; k < n; ++k) c.positions[k].residual_after = fit.accel_residuals[k];
-  }
-  // The base fit's verdict on its residuals no longer applies.
-  c.warnings.erase(std::remove_if(c.warnings.begin(), c.warnings.end(),
-                                  [](const std::string& w) {
-                                    return w.find("times the noise level (chi2") !=
-                                           std::string::npos;
-                                  }),
-                   c.warnings.end());
-  if (fit.accel_fit.dof() > 0 &&
-      ChiSquareUpperTail(fit.accel_fit.chi2, fit.accel_fit.dof()) < 1e-3) {
-    std::ostringstream w;
-    w.precision(3);
-    w << "with effects the residuals are still "
-      << std::sqrt(fit.accel_fit.chi2 / fit.accel_fit.dof())
-      << " times the noise level (chi2 = " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof()
-      << " dof): gravcal discover can look for what the model still misses";
-    c.warnings.push_back(w.str());
-  }
-}
-
-}  // namespace
-
-bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>& intervals,
-                           const CalibrationOptions& options, const std::vector<Effect>& effects,
-                           Calibration* calibration) {
-  Calibration& c = *calibration;
-  auto fail = [&](const std::string& what) {
-    c.success = false;
-    c.message = (log.source.empty() ? "" : log.source + ": ") + what;
-    return false;
-  };
-  const std::vector<StaticObservation> observations =
-      ObservationsFromIntervals(intervals, log.has_gyro());
-  EffectParameters start;
-  GyroModel gyro;
-  const bool has_temperature = StartParameters(observations, &start, &gyro);
-  for (Effect e : effects) {
-    const EffectInfo& info = Info(e);
-    if (info.regressor == EffectRegressor::kTemperature && !has_temperature) {
-      return fail(std::string("effect ") + info.name + " needs a temperature column");
-    }
-    if (info.sensor == EffectSensor::kGyroscope && !log.has_gyro()) {
-      return fail(std::string("effect ") + info.name + " needs a gyroscope");
-    }
-  }
-  if (!has_temperature) start.reference_temperature = 0.0;
-  EffectFitOptions fit_options;
-  fit_options.parameterization = options.refinement.parameterization;
-  fit_options.effects = effects;
-  fit_options.fit_gyro = std::any_of(effects.begin(), effects.end(), [](Effect e) {
-    return Info(e).sensor == EffectSensor::kGyroscope;
-  });
-  EffectFitResult fit;
-  if (!FitEffects(observations, c.accel.model, gyro, start, c.gravity, fit_options, &fit)) {
-    return fail("fit with effects: " + fit.message);
-  }
-  std::string undetermined;
-  for (const SensorFitSummary* s : {&fit.accel_fit, &fit.gyro_fit}) {
-    for (const std::string& name : s->undetermined) {
-      undetermined += (undetermined.empty() ? "" : ", ") + name;
-    }
-  }
-  if (!undetermined.empty() && !options.allow_undetermined) {
-    return fail("the positions do not determine " + undetermined +
-                " of the model with effects: record more poses (at several temperatures for "
-                "temperature effects), or set allow_undetermined: true");
-  }
-  if (!fit.accel_fit.converged || (fit.gyro_fit.fitted && !fit.gyro_fit.converged)) {
-    c.not_converged = true;
-    return fail("the fit with effects did not converge");
-  }
-
-  CopyEffectFit(fit, &c);
-  SetEffectResiduals(fit, &c);
-  c.effects.estimates = fit.estimates;
-  c.effects.reference_temperature = has_temperature ? start.reference_temperature : NAN;
-  c.effects.reference_time = start.reference_time;
-  if (!undetermined.empty()) {
-    c.warnings.push_back("the positions do not determine " + undetermined +
-                         " of the model with effects; reported without a number");
-  }
-  std::ostringstream msg;
-  msg << c.message << "; with effects";
-  for (Effect e : effects) msg << " " << ToString(e);
-  msg.precision(3);
-  msg << " (accelerometer chi2 " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof() << " dof)";
-  c.message = msg.str();
-  return true;
 }
 
 }  // namespace gravcal

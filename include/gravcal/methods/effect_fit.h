@@ -85,6 +85,9 @@ struct SensorFitSummary {
   // Sum of squared whitened residuals.
   double chi2 = 0.0;
   int dof() const { return num_residuals - num_parameters; }
+  // Standard deviation of the named parameter from the covariance; NaN
+  // when it was not estimated or no covariance was computed.
+  double Std(const std::string& name) const;
   std::vector<std::string> parameter_names;
   // (J^T J)^-1 of the free parameters, parameter_names order.
   Eigen::MatrixXd covariance;
