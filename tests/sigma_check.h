@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "util/statistics.h"
+
 namespace gravcal {
 namespace testing_util {
 
@@ -58,48 +60,14 @@ inline double NormalQuantile(double p) {
   return x - u / (1.0 + x * u / 2.0);
 }
 
-// P(a, x), the regularised lower incomplete gamma function: a series below
-// x = a + 1, a continued fraction (modified Lentz) above.
-inline double RegularizedGammaP(double a, double x) {
-  if (x <= 0.0) return 0.0;
-  const double log_prefix = a * std::log(x) - x - std::lgamma(a);
-  if (x < a + 1.0) {
-    double term = 1.0 / a;
-    double sum = term;
-    for (int n = 1; n < 10000 && std::abs(term) > 1e-16 * std::abs(sum); ++n) {
-      term *= x / (a + n);
-      sum += term;
-    }
-    return sum * std::exp(log_prefix);
-  }
-  const double tiny = 1e-300;
-  double b = x + 1.0 - a;
-  double c = 1.0 / tiny;
-  double d = 1.0 / b;
-  double h = d;
-  for (int i = 1; i < 10000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < tiny) d = tiny;
-    c = b + an / c;
-    if (std::abs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::abs(delta - 1.0) < 1e-16) break;
-  }
-  return 1.0 - std::exp(log_prefix) * h;
-}
-
-// Chi-square quantile with `dof` degrees of freedom: the x with
-// P(dof / 2, x / 2) = p, by bisection.
+// Chi-square quantile with `dof` degrees of freedom: the x whose lower tail
+// is p, by bisection on the library's upper tail (util/statistics.h).
 inline double ChiSquareQuantile(double p, int dof) {
   double lo = 0.0;
   double hi = dof + 20.0 * std::sqrt(2.0 * dof) + 50.0;
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (lo + hi);
-    (RegularizedGammaP(0.5 * dof, 0.5 * mid) < p ? lo : hi) = mid;
+    (1.0 - internal::ChiSquareUpperTail(mid, dof) < p ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }

@@ -1,9 +1,10 @@
 #include "gravcal/core/position.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "util/matrix_checks.h"
 
 namespace gravcal {
 namespace {
@@ -27,14 +28,6 @@ Eigen::Vector3d StepFor(const StaticInterval& interval, double fallback_step) {
   for (int a = 0; a < 3; ++a)
     if (!(step[a] > 0.0)) step[a] = own;
   return step;
-}
-
-// True when the symmetric matrix is not safely positive definite.
-bool IsSingular(const Eigen::Matrix3d& m) {
-  if (!m.allFinite()) return true;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m, Eigen::EigenvaluesOnly);
-  const Eigen::Vector3d ev = eig.eigenvalues();
-  return !(ev[0] > 1e-12 * ev[2]) || !(ev[2] > 0.0);
 }
 
 }  // namespace
@@ -70,7 +63,7 @@ std::vector<Position> PositionsFromIntervals(const std::vector<StaticInterval>& 
     p.t_end = s.t_end;
     p.temperature = s.temperature_mean;
     p.raw_mean_cov = s.accel_cov / static_cast<double>(std::max<size_t>(1, s.count()));
-    if (IsSingular(p.raw_mean_cov)) {
+    if (!internal::IsSafelyPositiveDefinite(p.raw_mean_cov)) {
       // Constant (quantised) data: the mean is known no better than the
       // uniform quantisation error, step^2 / 12, which averaging does not
       // reduce when the signal does not dither.

@@ -1,23 +1,15 @@
 #include "gravcal/estimation/pose_mean_covariance.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "gravcal/core/gravity.h"
+#include "util/matrix_checks.h"
 
 namespace gravcal {
 namespace internal {
 namespace {
-
-// Safely positive definite and finite.
-bool IsUsable(const Eigen::Matrix3d& m) {
-  if (!m.allFinite()) return false;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m, Eigen::EigenvaluesOnly);
-  const Eigen::Vector3d ev = eig.eigenvalues();
-  return ev[2] > 0.0 && ev[0] > 1e-12 * ev[2];
-}
 
 // The pose's duration: n samples at the interval's mean step.
 double PoseSeconds(const StaticInterval& s) {
@@ -153,7 +145,7 @@ bool SetPoseMeanCovariance(const ImuLog& log, const std::vector<StaticInterval>&
     } else if (options.model == nullptr) {
       ok = BatchMeansCovariance(log.accel, s.begin, s.end, options.batches, &cov);
     }
-    if (ok && internal::IsUsable(cov)) {
+    if (ok && internal::IsSafelyPositiveDefinite(cov)) {
       p.raw_mean_cov = cov;
     } else {
       ++fallbacks;

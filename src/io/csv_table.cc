@@ -1,5 +1,7 @@
 #include "io/csv_table.h"
 
+#include <charconv>
+
 namespace gravcal {
 namespace {
 
@@ -89,6 +91,13 @@ bool ParseCsvRecords(std::string_view text, const std::string& name,
     records->push_back(std::move(record));
   }
   return true;
+}
+
+bool ParseCsvNumber(std::string_view text, double* value) {
+  const char* first = text.data();
+  const char* last = first + text.size();
+  const auto result = std::from_chars(first, last, *value);
+  return result.ec == std::errc() && result.ptr == last;
 }
 
 std::string CsvField(std::string_view text) {

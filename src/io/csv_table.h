@@ -46,6 +46,11 @@ bool ParseCsvRecords(std::string_view text, const std::string& name,
 // "<name>:<line>:<column>: " for messages.
 std::string CsvWhere(const std::string& name, size_t line, size_t column);
 
+// A cell that is one number and nothing else (std::from_chars: no blanks,
+// no leading '+'); false otherwise. "nan" and "inf" parse: callers that need
+// a finite value check it.
+bool ParseCsvNumber(std::string_view text, double* value);
+
 // The field as written to a CSV file: quoted when it holds a comma, a quote,
 // a '#' at the start, blanks at either end or a line break (replaced by a
 // space).

@@ -237,10 +237,7 @@ bool ParseSummaryCsv(std::string_view text, const std::string& name, std::vector
         continue;
       }
       double value = 0.0;
-      const char* first = cell.text.data();
-      const char* last = first + cell.text.size();
-      const auto result = std::from_chars(first, last, value);
-      if (result.ec != std::errc() || result.ptr != last) {
+      if (!ParseCsvNumber(cell.text, &value)) {
         *error = CsvWhere(name, record.line, cell.column) + "column '" + header.cells[i].text +
                  "': '" + cell.text + "' is not a number";
         return false;

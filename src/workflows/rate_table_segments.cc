@@ -19,9 +19,7 @@ constexpr const char* kColumns[] = {"t_begin", "t_end", "rate_x_dps", "rate_y_dp
 constexpr double kTimeTolerance = 1e-6;
 
 bool ParseNumber(const std::string& text, double* v) {
-  const char* end = text.data() + text.size();
-  const auto r = std::from_chars(text.data(), end, *v);
-  return r.ec == std::errc() && r.ptr == end && std::isfinite(*v);
+  return ParseCsvNumber(text, v) && std::isfinite(*v);
 }
 
 std::string Number(double v) {
