@@ -244,38 +244,123 @@ StaticInterval MakeInterval(const ImuLog& log, size_t begin, size_t end) {
   return s;
 }
 
+namespace {
+
+// The log's columns have one length, at least 3 samples and increasing
+// finite time; the message names the log.
+bool CheckDetectionInput(const ImuLog& log, const std::string& name, std::string* message) {
+  const size_t n = log.size();
+  if (log.accel.size() != n) {
+    *message = name + ": accelerometer and time have different lengths";
+  } else if (!log.gyro.empty() && log.gyro.size() != n) {
+    *message = name + ": gyroscope and time have different lengths";
+  } else if (!log.temperature.empty() && log.temperature.size() != n) {
+    *message = name + ": temperature and time have different lengths";
+  } else if (n < 3) {
+    *message = name + ": " + std::to_string(n) + " samples are too few";
+  } else {
+    for (size_t i = 1; i < n; ++i) {
+      if (!(log.t[i] > log.t[i - 1]) || !std::isfinite(log.t[i])) {
+        *message =
+            name + ": sample " + std::to_string(i) + ": time is not finite or does not increase";
+        return false;
+      }
+    }
+    return true;
+  }
+  return false;
+}
+
+// Median sample interval (on a strided subsample of the intervals).
+double MedianSampleInterval(const std::vector<double>& t, std::vector<double>* scratch) {
+  const size_t n = t.size();
+  scratch->clear();
+  const size_t stride = std::max<size_t>(1, (n - 1 + kMaxQuantileValues - 1) / kMaxQuantileValues);
+  for (size_t i = 1; i < n; i += stride) scratch->push_back(t[i] - t[i - 1]);
+  std::nth_element(scratch->begin(), scratch->begin() + scratch->size() / 2, scratch->end());
+  return (*scratch)[scratch->size() / 2];
+}
+
+// Samples [begin, end) covered by consecutive quiet windows.
+struct QuietRun {
+  size_t begin, end;
+};
+
+// Static runs: the union of the quiet windows' samples (window k covers
+// samples [k, k + w)); gyro_var is null when the gyroscope is not used.
+std::vector<QuietRun> FindQuietRuns(const float* accel_var, const float* gyro_var,
+                                    size_t num_windows, size_t w, double accel_threshold,
+                                    double gyro_threshold) {
+  std::vector<QuietRun> runs;
+  auto quiet = [&](size_t j) {
+    return accel_var[j] <= accel_threshold &&
+           (gyro_var == nullptr || gyro_var[j] <= gyro_threshold);
+  };
+  for (size_t k = 0; k < num_windows;) {
+    if (!quiet(k)) {
+      ++k;
+      continue;
+    }
+    const size_t first = k;
+    while (k < num_windows && quiet(k)) ++k;
+    // Quiet windows less than w apart share samples: one run.
+    if (!runs.empty() && first <= runs.back().end) {
+      runs.back().end = k - 1 + w;
+    } else {
+      runs.push_back({first, k - 1 + w});
+    }
+  }
+  return runs;
+}
+
+// Trim the settling time at each end, merge neighbours that are the same pose
+// across a short gap (when the merged interval still looks still as a whole,
+// so that a real pick-up-and-put-down is not averaged in), keep what has at
+// least min_count samples.
+std::vector<StaticInterval> TrimAndMerge(const ImuLog& log, const std::vector<QuietRun>& runs,
+                                         size_t settle, size_t min_count, double max_gap,
+                                         const StaticDetectorOptions& options,
+                                         const StaticDetection& detection, bool use_gyro) {
+  std::vector<StaticInterval> pieces;
+  for (const QuietRun& run : runs) {
+    if (run.end - run.begin <= 2 * settle) continue;
+    pieces.push_back(MakeInterval(log, run.begin + settle, run.end - settle));
+  }
+  std::vector<StaticInterval> intervals;
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    StaticInterval current = pieces[i];
+    while (i + 1 < pieces.size()) {
+      const StaticInterval& next = pieces[i + 1];
+      if (!(static_cast<double>(next.begin - current.end) < max_gap) ||
+          !(AngleDeg(current.accel_mean, next.accel_mean) < options.merge_angle_deg)) {
+        break;
+      }
+      StaticInterval merged = MakeInterval(log, current.begin, next.end);
+      if (!(merged.accel_cov.trace() <= detection.accel_threshold) ||
+          (use_gyro && !(merged.gyro_cov.trace() <= detection.gyro_threshold))) {
+        break;
+      }
+      current = merged;
+      ++i;
+    }
+    if (current.count() >= min_count) intervals.push_back(current);
+  }
+  return intervals;
+}
+
+}  // namespace
+
 bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& options,
                            StaticDetection* detection) {
   if (detection == nullptr) return false;
   *detection = StaticDetection();
   std::string error;
   if (!options.IsValid(&error)) return Fail(detection, error);
-
   const std::string name = log.source.empty() ? std::string("log") : log.source;
+  if (!CheckDetectionInput(log, name, &error)) return Fail(detection, error);
   const size_t n = log.size();
-  if (log.accel.size() != n)
-    return Fail(detection, name + ": accelerometer and time have different lengths");
-  const bool has_gyro = !log.gyro.empty();
-  if (has_gyro && log.gyro.size() != n)
-    return Fail(detection, name + ": gyroscope and time have different lengths");
-  if (!log.temperature.empty() && log.temperature.size() != n)
-    return Fail(detection, name + ": temperature and time have different lengths");
-  if (n < 3) return Fail(detection, name + ": " + std::to_string(n) + " samples are too few");
-
-  // Median sample interval (on a strided subsample of the intervals).
   std::vector<double> scratch;
-  for (size_t i = 1; i < n; ++i) {
-    if (!(log.t[i] > log.t[i - 1]) || !std::isfinite(log.t[i]))
-      return Fail(detection, name + ": sample " + std::to_string(i) +
-                                 ": time is not finite or does not increase");
-  }
-  {
-    const size_t stride =
-        std::max<size_t>(1, (n - 1 + kMaxQuantileValues - 1) / kMaxQuantileValues);
-    for (size_t i = 1; i < n; i += stride) scratch.push_back(log.t[i] - log.t[i - 1]);
-    std::nth_element(scratch.begin(), scratch.begin() + scratch.size() / 2, scratch.end());
-  }
-  const double dt = scratch[scratch.size() / 2];
+  const double dt = MedianSampleInterval(log.t, &scratch);
   // Durations in samples, at most n + 1 (no overflow for absurd durations).
   auto to_samples = [dt, n](double seconds) {
     const double samples = seconds / dt;
@@ -299,7 +384,7 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
   detection->accel_noise_floor =
       NoiseFloor(accel_var.get(), num_windows, log.accel, w, options, &scratch);
   detection->accel_threshold = options.threshold_factor * detection->accel_noise_floor;
-  const bool use_gyro = has_gyro && options.use_gyro;
+  const bool use_gyro = !log.gyro.empty() && options.use_gyro;
   if (use_gyro) {
     gyro_var.reset(new float[num_windows]);
     if (!WindowVariance(log.gyro, w, gyro_var.get()))
@@ -309,67 +394,19 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
     detection->gyro_threshold = options.gyro_threshold_factor * detection->gyro_noise_floor;
   }
 
-  // Static runs: the union of the quiet windows' samples.
-  struct Run {
-    size_t begin, end;
-  };
-  std::vector<Run> runs;
-  const double accel_threshold = detection->accel_threshold;
-  const double gyro_threshold = detection->gyro_threshold;
-  for (size_t k = 0; k < num_windows;) {
-    auto quiet = [&](size_t j) {
-      return accel_var[j] <= accel_threshold && (!use_gyro || gyro_var[j] <= gyro_threshold);
-    };
-    if (!quiet(k)) {
-      ++k;
-      continue;
-    }
-    const size_t first = k;
-    while (k < num_windows && quiet(k)) ++k;
-    // Quiet windows less than w apart share samples: one run.
-    if (!runs.empty() && first <= runs.back().end) {
-      runs.back().end = k - 1 + w;
-    } else {
-      runs.push_back({first, k - 1 + w});
-    }
-  }
-
-  // Trim the settling time at each end, merge neighbours that are the same
-  // pose across a short gap, keep what is long enough.
-  const size_t settle = to_samples(options.settle_seconds);
-  const size_t min_count = std::max<size_t>(1, to_samples(options.min_duration_seconds));
-  const double max_gap = options.merge_gap_windows * static_cast<double>(w);
-  std::vector<StaticInterval> pieces;
-  for (const Run& run : runs) {
-    if (run.end - run.begin <= 2 * settle) continue;
-    pieces.push_back(MakeInterval(log, run.begin + settle, run.end - settle));
-  }
-  for (size_t i = 0; i < pieces.size(); ++i) {
-    StaticInterval current = pieces[i];
-    while (i + 1 < pieces.size()) {
-      const StaticInterval& next = pieces[i + 1];
-      if (!(static_cast<double>(next.begin - current.end) < max_gap) ||
-          !(AngleDeg(current.accel_mean, next.accel_mean) < options.merge_angle_deg)) {
-        break;
-      }
-      // The merged interval includes the gap; it must still look still as a
-      // whole, so that a real pick-up-and-put-down is not averaged in.
-      StaticInterval merged = MakeInterval(log, current.begin, next.end);
-      if (!(merged.accel_cov.trace() <= accel_threshold) ||
-          (use_gyro && !(merged.gyro_cov.trace() <= gyro_threshold))) {
-        break;
-      }
-      current = merged;
-      ++i;
-    }
-    if (current.count() >= min_count) detection->intervals.push_back(current);
-  }
+  const std::vector<QuietRun> runs =
+      FindQuietRuns(accel_var.get(), gyro_var.get(), num_windows, w, detection->accel_threshold,
+                    detection->gyro_threshold);
+  detection->intervals = TrimAndMerge(log, runs, to_samples(options.settle_seconds),
+                                      std::max<size_t>(1, to_samples(options.min_duration_seconds)),
+                                      options.merge_gap_windows * static_cast<double>(w), options,
+                                      *detection, use_gyro);
 
   std::ostringstream msg;
   msg << name << ": " << detection->intervals.size() << " static interval"
       << (detection->intervals.size() == 1 ? "" : "s") << " (window " << w
-      << " samples, accel threshold " << Num(accel_threshold);
-  if (use_gyro) msg << ", gyro threshold " << Num(gyro_threshold);
+      << " samples, accel threshold " << Num(detection->accel_threshold);
+  if (use_gyro) msg << ", gyro threshold " << Num(detection->gyro_threshold);
   msg << ")";
   detection->message = msg.str();
   return true;
