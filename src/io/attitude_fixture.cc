@@ -24,13 +24,97 @@ std::string Trim(const std::string& s) {
   return s.substr(b, e - b + 1);
 }
 
-// A finite number filling the whole field.
-bool ParseNumber(const std::string& text, double* value) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  *value = std::strtod(text.c_str(), &end);
-  return errno == 0 && end == text.c_str() + text.size() && std::isfinite(*value);
+// The header row: column name -> index; the four attitude columns and either
+// position or t_begin and t_end are required.
+bool ReadAttitudeHeader(const std::vector<std::string>& fields, std::map<std::string, int>* column,
+                        std::string* what) {
+  for (size_t i = 0; i < fields.size(); ++i) {
+    if (column->count(fields[i])) {
+      *what = "column '" + fields[i] + "' appears twice";
+      return false;
+    }
+    (*column)[fields[i]] = static_cast<int>(i);
+  }
+  for (const char* required : {"roll_deg", "pitch_deg", "roll_std_deg", "pitch_std_deg"}) {
+    if (!column->count(required)) {
+      *what = std::string("header has no column '") + required +
+              "' (needs position or t_begin,t_end; roll_deg, pitch_deg, roll_std_deg, "
+              "pitch_std_deg; optional heading_deg, heading_std_deg)";
+      return false;
+    }
+  }
+  const bool by_time = column->count("t_begin") && column->count("t_end");
+  if (!by_time && !column->count("position")) {
+    *what = "header needs a 'position' column or 't_begin' and 't_end'";
+    return false;
+  }
+  return true;
+}
+
+// One data row into *row (position rows: the position is checked against
+// those already given, position_line).
+bool ParseAttitudeRow(const std::vector<std::string>& fields,
+                      const std::map<std::string, int>& column, int line_number,
+                      std::map<int, int>* position_line, FixtureAttitude* row, std::string* what) {
+  if (fields.size() != column.size()) {
+    std::ostringstream s;
+    s << "has " << fields.size() << " fields, the header " << column.size();
+    *what = s.str();
+    return false;
+  }
+  row->line = line_number;
+  // Reads column `name` into *v, checking [lo, hi].
+  auto number = [&](const char* name, double lo, double hi, double* v) {
+    const std::string& text = fields[column.at(name)];
+    if (!ParseCsvNumber(text, v) || !std::isfinite(*v)) {
+      *what = std::string(name) + " = '" + text + "' is not a finite number";
+      return false;
+    }
+    if (*v < lo || *v > hi) {
+      std::ostringstream s;
+      s << name << " = " << *v << " is out of range (" << lo << ".." << hi << ")";
+      *what = s.str();
+      return false;
+    }
+    return true;
+  };
+  // An optional column: absent or empty leaves the default.
+  auto optional = [&](const char* name, double lo, double hi, double* v) {
+    return !column.count(name) || fields[column.at(name)].empty() || number(name, lo, hi, v);
+  };
+  if (!number("roll_deg", -180.0, 180.0, &row->roll_deg) ||
+      !number("pitch_deg", -90.0, 90.0, &row->pitch_deg) ||
+      !number("roll_std_deg", 1e-9, 90.0, &row->roll_std_deg) ||
+      !number("pitch_std_deg", 1e-9, 90.0, &row->pitch_std_deg) ||
+      !optional("heading_deg", -360.0, 360.0, &row->heading_deg) ||
+      !optional("heading_std_deg", 1e-9, 360.0, &row->heading_std_deg)) {
+    return false;
+  }
+  if (column.count("t_begin") && column.count("t_end")) {
+    if (!number("t_begin", -1e12, 1e12, &row->t_begin) ||
+        !number("t_end", -1e12, 1e12, &row->t_end)) {
+      return false;
+    }
+    if (!(row->t_end > row->t_begin)) {
+      *what = "t_end must be after t_begin";
+      return false;
+    }
+    return true;
+  }
+  double p = 0.0;
+  if (!number("position", 0.0, 1e6, &p)) return false;
+  if (p != std::floor(p)) {
+    *what = "position must be a whole number";
+    return false;
+  }
+  row->position = static_cast<int>(p);
+  if (position_line->count(row->position)) {
+    *what = "position " + std::to_string(row->position) + " already given on line " +
+            std::to_string((*position_line)[row->position]);
+    return false;
+  }
+  (*position_line)[row->position] = line_number;
+  return true;
 }
 
 }  // namespace
@@ -44,95 +128,30 @@ bool ReadFixtureAttitudes(const std::string& path, std::vector<FixtureAttitude>*
   }
   rows->clear();
   std::map<std::string, int> column;
+  std::map<int, int> position_line;
   std::string line;
   int line_number = 0;
-  auto fail = [&](const std::string& what) {
-    *error = path + ":" + std::to_string(line_number) + ": " + what;
-    return false;
-  };
-  std::map<int, int> position_line;
+  std::string what;
   while (std::getline(in, line)) {
     ++line_number;
     const std::string trimmed = Trim(line);
     if (trimmed.empty() || trimmed[0] == '#') continue;
+    std::vector<CsvCell> cells;
+    size_t cell_column = 0;
     std::vector<std::string> fields;
-    {
-      std::vector<CsvCell> cells;
-      size_t column = 0;
-      std::string what;
-      if (!internal::SplitCsvLine(trimmed, &cells, &column, &what)) return fail(what);
-      for (CsvCell& cell : cells) fields.push_back(std::move(cell.text));
+    bool ok = internal::SplitCsvLine(trimmed, &cells, &cell_column, &what);
+    for (CsvCell& cell : cells) fields.push_back(std::move(cell.text));
+    if (ok && column.empty()) {
+      ok = ReadAttitudeHeader(fields, &column, &what);
+    } else if (ok) {
+      FixtureAttitude row;
+      ok = ParseAttitudeRow(fields, column, line_number, &position_line, &row, &what);
+      if (ok) rows->push_back(row);
     }
-    if (column.empty()) {
-      for (size_t i = 0; i < fields.size(); ++i) {
-        if (column.count(fields[i])) return fail("column '" + fields[i] + "' appears twice");
-        column[fields[i]] = static_cast<int>(i);
-      }
-      for (const char* required : {"roll_deg", "pitch_deg", "roll_std_deg", "pitch_std_deg"}) {
-        if (!column.count(required)) {
-          return fail(std::string("header has no column '") + required +
-                      "' (needs position or t_begin,t_end; roll_deg, pitch_deg, roll_std_deg, "
-                      "pitch_std_deg; optional heading_deg, heading_std_deg)");
-        }
-      }
-      const bool by_time = column.count("t_begin") && column.count("t_end");
-      if (!by_time && !column.count("position")) {
-        return fail("header needs a 'position' column or 't_begin' and 't_end'");
-      }
-      continue;
-    }
-    if (fields.size() != column.size()) {
-      std::ostringstream s;
-      s << "has " << fields.size() << " fields, the header " << column.size();
-      return fail(s.str());
-    }
-    FixtureAttitude row;
-    row.line = line_number;
-    // Reads column `name` into *v, checking [lo, hi].
-    auto number = [&](const char* name, double lo, double hi, double* v) {
-      const std::string& text = fields[column.at(name)];
-      if (!ParseNumber(text, v)) {
-        return fail(std::string(name) + " = '" + text + "' is not a finite number");
-      }
-      if (*v < lo || *v > hi) {
-        std::ostringstream s;
-        s << name << " = " << *v << " is out of range (" << lo << ".." << hi << ")";
-        return fail(s.str());
-      }
-      return true;
-    };
-    if (!number("roll_deg", -180.0, 180.0, &row.roll_deg) ||
-        !number("pitch_deg", -90.0, 90.0, &row.pitch_deg) ||
-        !number("roll_std_deg", 1e-9, 90.0, &row.roll_std_deg) ||
-        !number("pitch_std_deg", 1e-9, 90.0, &row.pitch_std_deg)) {
+    if (!ok) {
+      *error = path + ":" + std::to_string(line_number) + ": " + what;
       return false;
     }
-    if (column.count("heading_deg") && !fields[column.at("heading_deg")].empty() &&
-        !number("heading_deg", -360.0, 360.0, &row.heading_deg)) {
-      return false;
-    }
-    if (column.count("heading_std_deg") && !fields[column.at("heading_std_deg")].empty() &&
-        !number("heading_std_deg", 1e-9, 360.0, &row.heading_std_deg)) {
-      return false;
-    }
-    if (column.count("t_begin") && column.count("t_end")) {
-      if (!number("t_begin", -1e12, 1e12, &row.t_begin) ||
-          !number("t_end", -1e12, 1e12, &row.t_end)) {
-        return false;
-      }
-      if (!(row.t_end > row.t_begin)) return fail("t_end must be after t_begin");
-    } else {
-      double p = 0.0;
-      if (!number("position", 0.0, 1e6, &p)) return false;
-      if (p != std::floor(p)) return fail("position must be a whole number");
-      row.position = static_cast<int>(p);
-      if (position_line.count(row.position)) {
-        return fail("position " + std::to_string(row.position) + " already given on line " +
-                    std::to_string(position_line[row.position]));
-      }
-      position_line[row.position] = line_number;
-    }
-    rows->push_back(row);
   }
   if (column.empty()) {
     *error = path + ": no header row (and no attitudes)";
