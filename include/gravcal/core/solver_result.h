@@ -60,18 +60,15 @@ struct VarianceComponent {
   std::string message = "EstimateVarianceComponent was not called";
 };
 
-struct RefinementResult {
-  AccelModel model;
+// What every least-squares solve of the library reports about itself, and
+// the covariance of its free parameters. The methods' results extend it.
+struct LeastSquaresSummary {
   bool converged = false;
   int iterations = 0;
   // The solver's own word on why it stopped.
   std::string termination;
   double solve_seconds = 0.0;
-  // 0.5 * sum of squared whitened residuals (before any loss).
-  double initial_cost = 0.0;
-  double final_cost = 0.0;
   int num_residuals = 0;
-  // Free parameters in the magnitude fit (6 or 9).
   int num_parameters = 0;
   // Sum of squared whitened residuals and its degrees of freedom: chi2 / dof
   // near 1 means the sigmas and the model fit the data.
@@ -81,6 +78,14 @@ struct RefinementResult {
   bool covariance_available = false;
   Eigen::MatrixXd covariance;
   std::vector<std::string> parameter_names;
+};
+
+// The magnitude fit: num_parameters is 6 or 9.
+struct RefinementResult : LeastSquaresSummary {
+  AccelModel model;
+  // 0.5 * sum of squared whitened residuals (before any loss).
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
   ObservabilityReport observability;
   // Per position: |a_k| - g before (initial model) and after, m/s^2, and
   // the sigma used.

@@ -101,7 +101,11 @@ struct GyroRotationReport {
   double chi2 = 0.0;
 };
 
-struct GyroCalibrationResult {
+// chi2 and dof cover the static, rotation and (joint) magnitude residuals;
+// parameter_names: bias_x..z; scale for kBias, m_xx, m_yy, m_zz for kScale,
+// m_xx, m_xy, ..., m_zz for kFull; g_xx, ..., g_zz with G (SI / raw units as
+// above).
+struct GyroCalibrationResult : LeastSquaresSummary {
   GyroModel model;
   // Zero unless estimated.
   Eigen::Matrix3d g_sensitivity = Eigen::Matrix3d::Zero();
@@ -109,12 +113,6 @@ struct GyroCalibrationResult {
   Eigen::Vector3d bias_std = Eigen::Vector3d::Constant(NAN);
   Eigen::Matrix3d matrix_std = Eigen::Matrix3d::Constant(NAN);
   Eigen::Matrix3d g_sensitivity_std = Eigen::Matrix3d::Constant(NAN);
-  // Covariance of the free parameters in parameter_names order (bias_x..z;
-  // scale for kBias, m_xx, m_yy, m_zz for kScale, m_xx, m_xy, ..., m_zz for
-  // kFull; g_xx, ..., g_zz with G), SI / raw units as above.
-  bool covariance_available = false;
-  Eigen::MatrixXd covariance;
-  std::vector<std::string> parameter_names;
   // Parameters the data does not determine (held at their initial value).
   std::vector<std::string> undetermined;
   std::vector<GyroRotationReport> rotations;
@@ -127,16 +125,6 @@ struct GyroCalibrationResult {
   // U entries in parameter_names order, residuals, sigmas); otherwise empty.
   bool accel_refined = false;
   RefinementResult accel;
-  bool converged = false;
-  int iterations = 0;
-  std::string termination;
-  double solve_seconds = 0.0;
-  int num_residuals = 0;
-  int num_parameters = 0;
-  // Sum of squared whitened residuals (static, rotation, and joint
-  // magnitude) and its degrees of freedom.
-  double chi2 = 0.0;
-  int dof = 0;
   std::vector<std::string> warnings;
   std::string message = "CalibrateGyroscope was not called";
 };
