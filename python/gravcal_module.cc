@@ -11,6 +11,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -106,8 +108,7 @@ DoubleArray AsDoubles(const py::object& obj, const char* name) {
 }
 
 // "accel: 9 samples, but t has 10".
-std::string LengthText(const char* name, py::ssize_t got, const char* reference,
-                       py::ssize_t rows) {
+std::string LengthText(const char* name, py::ssize_t got, const char* reference, py::ssize_t rows) {
   return std::string(name) + ": " + std::to_string(got) + " samples, but " + reference + " has " +
          std::to_string(rows);
 }
@@ -133,8 +134,7 @@ std::vector<double> ToScalars(const py::object& obj, const char* name, py::ssize
                               const char* reference = "t") {
   const DoubleArray a = AsDoubles(obj, name);
   if (a.ndim() != 1) {
-    throw Error(std::string(name) + ": expected an array of shape (N,), got shape " +
-                ShapeText(a));
+    throw Error(std::string(name) + ": expected an array of shape (N,), got shape " + ShapeText(a));
   }
   if (rows >= 0 && a.shape(0) != rows) {
     throw Error(LengthText(name, a.shape(0), reference, rows));
@@ -177,14 +177,29 @@ ImuLog ReadLog(const std::string& path, const Config& config) {
 
 struct PyCalibration {
   std::string json;
-  LoadedCalibration models;
+  std::string name;
+  // Read from `json` on first use (apply), as ReadCalibrationJson would.
+  mutable bool parsed = false;
+  mutable LoadedCalibration models;
 
-  static PyCalibration FromText(const std::string& text, const std::string& name) {
+  // Checks the text (every file-read calibration), or defers it (a
+  // calibration just written by the library).
+  static PyCalibration FromText(const std::string& text, const std::string& name,
+                                bool check = true) {
     PyCalibration c;
     c.json = text;
-    std::string error;
-    Check(ParseCalibrationJson(text, name, &c.models, &error), error);
+    c.name = name;
+    if (check) c.Models();
     return c;
+  }
+
+  const LoadedCalibration& Models() const {
+    if (!parsed) {
+      std::string error;
+      Check(ParseCalibrationJson(json, name, &models, &error), error);
+      parsed = true;
+    }
+    return models;
   }
 };
 
@@ -215,7 +230,7 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
   const py::ssize_t n = static_cast<py::ssize_t>(a.size());
   std::vector<Eigen::Vector3d> w;
   if (!gyro.is_none()) {
-    Check(c.models.has_gyro, "gyro: the calibration has no gyroscope model");
+    Check(c.Models().has_gyro, "gyro: the calibration has no gyroscope model");
     w = ToVectors(gyro, "gyro", n, "accel");
   }
   if (!temp.is_none()) ToScalars(temp, "temp", n, "accel");
@@ -228,15 +243,16 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
   }
   DoubleArray a_out({n, static_cast<py::ssize_t>(3)});
   DoubleArray w_out({static_cast<py::ssize_t>(w.size()), static_cast<py::ssize_t>(3)});
+  const LoadedCalibration& models = c.Models();
   {
     py::gil_scoped_release release;
     double* ao = a_out.mutable_data();
     for (size_t i = 0; i < a.size(); ++i) {
-      Eigen::Map<Eigen::Vector3d>(ao + 3 * i) = c.models.accel.Apply(a[i]);
+      Eigen::Map<Eigen::Vector3d>(ao + 3 * i) = models.accel.Apply(a[i]);
     }
     double* wo = w_out.mutable_data();
     for (size_t i = 0; i < w.size(); ++i) {
-      Eigen::Map<Eigen::Vector3d>(wo + 3 * i) = c.models.gyro.Apply(w[i]);
+      Eigen::Map<Eigen::Vector3d>(wo + 3 * i) = models.gyro.Apply(w[i]);
     }
   }
   return py::make_tuple(a_out, gyro.is_none() ? py::object(py::none()) : py::object(w_out));
@@ -261,7 +277,8 @@ PyCalibration Calibrate(const Config& config, const ImuLog& log, const std::stri
     ok = RunCalibration(config, input, &c);
   }
   Check(ok, c.message);
-  return PyCalibration::FromText(CalibrationToJson(c, config.output_covariance), input.source);
+  return PyCalibration::FromText(CalibrationToJson(c, config.output_covariance), input.source,
+                                 false);
 }
 
 // `gravcal simulate`: the truth (truth.json text), the raw log, the
@@ -341,10 +358,10 @@ std::vector<PyBatchResult> Batch(const std::vector<BatchUnit>& units, const Conf
     p.content_hash = r.content_hash;
     p.timings = r.timings;
     Config config;
-    if (r.calibration.success && EffectiveConfig(units[i], base, &config, &error)) {
+    if (r.status == BatchStatus::kOk && EffectiveConfig(units[i], base, &config, &error)) {
       // The unit's <unit>.json as `gravcal batch` writes it.
       p.calibration = py::cast(PyCalibration::FromText(
-          CalibrationToJson(r.calibration, config.output_covariance), r.unit));
+          CalibrationToJson(r.calibration, config.output_covariance), r.unit, false));
     }
   }
   return out;
@@ -412,6 +429,22 @@ py::tuple Discover(const Config& config, const ImuLog& log) {
   return py::make_tuple(DiscoveryToJson(result), DiscoveryToHtml(result));
 }
 
+// For benchmarks/python_overhead.py: seconds per RunCalibration call made
+// from C++ on a prepared input (the C++ user's cost), `repeats` calls.
+double TimeCalibrate(const Config& config, const ImuLog& log, int repeats) {
+  PipelineInput input;
+  input.log = log;
+  input.source = log.source;
+  py::gil_scoped_release release;
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < repeats; ++i) {
+    Calibration c;
+    RunCalibration(config, input, &c);
+  }
+  const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+  return elapsed.count() / std::max(repeats, 1);
+}
+
 }  // namespace
 }  // namespace python
 }  // namespace gravcal
@@ -426,10 +459,11 @@ PYBIND11_MODULE(_gravcal, m) {
   py::class_<Config>(m, "Config", "A gravcal configuration (the YAML keys).")
       .def(py::init(&MakeConfig), py::arg("path") = "", py::arg("keys") = Keys{})
       .def("with_keys", &WithKeys, py::arg("keys"))
-      .def("value", [](const Config& c, const std::string& key) {
-        Check(IsConfigKey(key), "unknown config key '" + key + "'");
-        return ConfigValueText(c, key);
-      })
+      .def("value",
+           [](const Config& c, const std::string& key) {
+             Check(IsConfigKey(key), "unknown config key '" + key + "'");
+             return ConfigValueText(c, key);
+           })
       .def_property_readonly("method", [](const Config& c) { return c.method; })
       .def("text", &ConfigText, "Every key with its value, one 'key: value' line each.");
   m.def("config_keys", []() {
@@ -440,18 +474,15 @@ PYBIND11_MODULE(_gravcal, m) {
 
   py::class_<ImuLog>(m, "Log")
       .def_property_readonly("source", [](const ImuLog& l) { return l.source; })
-      .def_property_readonly("t", [](py::object self) {
-        return Scalars(self.cast<const ImuLog&>().t, self);
-      })
-      .def_property_readonly("accel", [](py::object self) {
-        return Vectors(self.cast<const ImuLog&>().accel, self);
-      })
-      .def_property_readonly("gyro", [](py::object self) {
-        return Vectors(self.cast<const ImuLog&>().gyro, self);
-      })
-      .def_property_readonly("temp", [](py::object self) {
-        return Scalars(self.cast<const ImuLog&>().temperature, self);
-      })
+      .def_property_readonly(
+          "t", [](py::object self) { return Scalars(self.cast<const ImuLog&>().t, self); })
+      .def_property_readonly(
+          "accel", [](py::object self) { return Vectors(self.cast<const ImuLog&>().accel, self); })
+      .def_property_readonly(
+          "gyro", [](py::object self) { return Vectors(self.cast<const ImuLog&>().gyro, self); })
+      .def_property_readonly(
+          "temp",
+          [](py::object self) { return Scalars(self.cast<const ImuLog&>().temperature, self); })
       .def("__len__", &ImuLog::size)
       .def("to_csv", [](const ImuLog& l, const std::string& path) {
         std::string error;
@@ -463,10 +494,12 @@ PYBIND11_MODULE(_gravcal, m) {
 
   py::class_<PyCalibration>(m, "Calibration")
       .def_readonly("json", &PyCalibration::json)
-      .def_property_readonly("has_gyro",
-                             [](const PyCalibration& c) { return c.models.has_gyro; })
+      .def_property_readonly("has_gyro", [](const PyCalibration& c) { return c.Models().has_gyro; })
       .def_static("from_file", &CalibrationFromFile)
-      .def_static("from_text", &PyCalibration::FromText)
+      .def_static("from_text",
+                  [](const std::string& text, const std::string& name) {
+                    return PyCalibration::FromText(text, name);
+                  })
       .def("write", &WriteCalibration)
       .def("apply", &ApplyCalibration, py::arg("accel"), py::arg("gyro"), py::arg("temp"),
            py::arg("t"));
@@ -509,4 +542,5 @@ PYBIND11_MODULE(_gravcal, m) {
   m.def("batch", &Batch, py::arg("units"), py::arg("config"), py::arg("threads"));
   m.def("noise", &Noise, py::arg("config"), py::arg("log"));
   m.def("discover", &Discover, py::arg("config"), py::arg("log"));
+  m.def("_time_calibrate", &TimeCalibrate, py::arg("config"), py::arg("log"), py::arg("repeats"));
 }

@@ -61,7 +61,7 @@ def _keys(mapping):
     return [(str(k), _yaml_value(v)) for k, v in mapping.items()]
 
 
-def config(config=None, **keys):
+def _config(config=None, **keys):
     """A :class:`Config` from a YAML path, a dict of keys, or a Config, with
     ``keys`` applied on top in order (the way ``--config f --key v`` works)."""
     if isinstance(config, Config):
@@ -78,6 +78,9 @@ def config(config=None, **keys):
                 % type(config).__name__)
 
 
+config = _config
+
+
 def config_keys():
     """Every config key with its help text, as ``gravcal help`` lists them."""
     return dict(_gravcal.config_keys())
@@ -89,7 +92,7 @@ def config_keys():
 def read_log(path, config=None, **keys):
     """Reads a raw log file with the config's reader keys (``format``,
     ``columns``, ``rename``, ``gyro_path``...). Returns a :class:`Log`."""
-    return _gravcal.read_log(_os.fspath(path), globals()["config"](config, **keys))
+    return _gravcal.read_log(_os.fspath(path), _config(config, **keys))
 
 
 def _is_dataframe(x):
@@ -202,37 +205,41 @@ class _Section:
     def __init__(self, data):
         self._data = data
 
+    def _dict(self):
+        return self._data
+
     def __getattr__(self, name):
         if name.startswith("_"):
             raise AttributeError(name)
+        data = self._dict()
         try:
-            return _convert(self._data[name])
+            return _convert(data[name])
         except KeyError:
-            raise AttributeError("no key '%s' (keys: %s)" % (name, ", ".join(self._data))) \
-                from None
+            raise AttributeError("no key '%s' (keys: %s)" % (name, ", ".join(data))) from None
 
     def __getitem__(self, name):
-        return _convert(self._data[name])
+        return _convert(self._dict()[name])
 
     def __contains__(self, name):
-        return name in self._data
+        return name in self._dict()
 
     def __dir__(self):
-        return list(self._data)
+        return list(self._dict())
 
     def keys(self):
-        return self._data.keys()
+        return self._dict().keys()
 
     def to_dict(self):
-        return _json.loads(_json.dumps(self._data))
+        """The JSON object as plain dicts and lists (a copy)."""
+        return _json.loads(_json.dumps(self._dict()))
 
     def __array__(self, dtype=None):
-        if "matrix" not in self._data:
+        if "matrix" not in self._dict():
             raise TypeError("this section is not a matrix")
-        return _np.asarray(_convert(self._data["matrix"]), dtype=dtype)
+        return _np.asarray(_convert(self._dict()["matrix"]), dtype=dtype)
 
     def __repr__(self):
-        return "<gravcal section: %s>" % ", ".join(self._data)
+        return "<gravcal section: %s>" % ", ".join(self._dict())
 
 
 class Calibration(_Section):
@@ -246,8 +253,14 @@ class Calibration(_Section):
     __slots__ = ("_core",)
 
     def __init__(self, core):
-        _Section.__init__(self, _json.loads(core.json))
-        object.__setattr__(self, "_core", core)
+        # The JSON text is parsed on first use.
+        _Section.__init__(self, None)
+        self._core = core
+
+    def _dict(self):
+        if self._data is None:
+            self._data = _json.loads(self._core.json)
+        return self._data
 
     @classmethod
     def from_json(cls, path):
@@ -257,6 +270,7 @@ class Calibration(_Section):
 
     @classmethod
     def from_json_text(cls, text, name="calibration"):
+        """A calibration from JSON text; ``name`` is used in messages."""
         return cls(_gravcal.Calibration.from_text(text, name))
 
     def to_json(self, path=None):
@@ -269,7 +283,8 @@ class Calibration(_Section):
 
     @property
     def warnings(self):
-        return list(self._data.get("warnings", []))
+        """The method's warnings (the CLI prints them as 'gravcal: warning:')."""
+        return list(self._dict().get("warnings", []))
 
     def apply(self, accel, gyro=None, *, temp=None, t=None):
         """Raw samples to SI: ``accel`` (N, 3) -> m/s^2 with a = M (v - b);
@@ -279,7 +294,7 @@ class Calibration(_Section):
         ``temp`` and ``t`` are for the effect terms (temperature, time):
         their correction is not applied yet and a warning says so when the
         calibration holds such terms."""
-        effects = self._data.get("effects")
+        effects = self._dict().get("effects")
         if effects:
             names = [k for k in effects if k not in ("reference_temperature", "reference_time")]
             _warnings.warn("gravcal: the calibration's effect terms (%s) are not applied "
@@ -290,7 +305,7 @@ class Calibration(_Section):
 
     def __repr__(self):
         return "<gravcal.Calibration method=%s, gyro=%s>" % (
-            self._data.get("method"), "gyro" in self._data)
+            self._dict().get("method"), "gyro" in self._dict())
 
 
 def _batch_result_repr(self):
@@ -313,7 +328,7 @@ def calibrate(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None
     ``gravity=9.81744``) apply on top. ``attitudes``, ``segments`` and
     ``noise`` are the side files of the methods that need them. Returns a
     :class:`Calibration`; raises :class:`Error` with the CLI's message."""
-    cfg = globals()["config"](config, **keys)
+    cfg = _config(config, **keys)
     data = _as_log(log, cfg, t, accel, gyro, temp)
     source = _os.fspath(log) if isinstance(log, (str, _os.PathLike)) else data.source
 
@@ -329,7 +344,7 @@ def simulate(config=None, seed=1, *, return_files=False, **keys):
     Returns ``(truth, log)``: truth.json as a dict and the raw log. With
     ``return_files=True`` also a dict with the text of attitudes.csv and,
     for ``sim_motion: rate_table``, segments.csv."""
-    truth, data, attitudes, segments = _gravcal.simulate(globals()["config"](config, **keys),
+    truth, data, attitudes, segments = _gravcal.simulate(_config(config, **keys),
                                                          int(seed))
     if return_files:
         files = {"attitudes.csv": attitudes}
@@ -375,7 +390,7 @@ def batch(units, config=None, threads=0, *, pattern="*.csv", **keys):
     Returns one :class:`BatchResult` per unit in input order (``unit``,
     ``status``, ``message``, ``content_hash``, ``calibration`` or None,
     ``timings``); a failed unit does not raise."""
-    cfg = globals()["config"](config, **keys)
+    cfg = _config(config, **keys)
     if isinstance(units, (str, _os.PathLike)):
         p = _os.fspath(units)
         core_units = (_gravcal.units_from_folder(p, pattern) if _os.path.isdir(p)
@@ -392,7 +407,7 @@ def batch(units, config=None, threads=0, *, pattern="*.csv", **keys):
 def noise(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None, **keys):
     """The noise model of a still log (Allan deviation), as ``gravcal noise``
     writes noise.json: a dict."""
-    cfg = globals()["config"](config, **keys)
+    cfg = _config(config, **keys)
     return _json.loads(_gravcal.noise(cfg, _as_log(log, cfg, t, accel, gyro, temp)))
 
 
@@ -400,7 +415,7 @@ def discover(log=None, *, config=None, report=None, t=None, accel=None, gyro=Non
              **keys):
     """The effects the model misses, as ``gravcal discover`` writes
     discovery.json: a dict. ``report`` writes the HTML report there."""
-    cfg = globals()["config"](config, **keys)
+    cfg = _config(config, **keys)
     text, html = _gravcal.discover(cfg, _as_log(log, cfg, t, accel, gyro, temp))
     if report is not None:
         with open(_os.fspath(report), "w", encoding="utf-8") as f:
