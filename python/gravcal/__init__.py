@@ -172,6 +172,16 @@ def _log_repr(self):
         ", temp" if self.temp is not None else "")
 
 
+_log_to_csv = Log.to_csv
+
+
+def _log_to_csv_path(self, path):
+    """Writes the log as the contract's CSV (t, ax, ay, az[, gx, gy, gz][, temp]),
+    as ``gravcal simulate`` writes raw.csv."""
+    _log_to_csv(self, _os.fspath(path))
+
+
+Log.to_csv = _log_to_csv_path
 Log.to_dataframe = _log_to_dataframe
 Log.__repr__ = _log_repr
 

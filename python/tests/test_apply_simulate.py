@@ -50,8 +50,9 @@ def test_simulate_equals_cli(tmp_path):
 
 def test_simulate_rate_table_writes_segments(tmp_path):
     cfg = config_path("rate_table.yaml")
-    run_cli("simulate", "--config", cfg, "--seed", 2, "--output-dir", tmp_path)
-    truth, log, files = gravcal.simulate(cfg, 2, return_files=True)
+    run_cli("simulate", "--config", cfg, "--sim_motion", "rate_table", "--seed", 2,
+            "--output-dir", tmp_path)
+    truth, log, files = gravcal.simulate(cfg, 2, return_files=True, sim_motion="rate_table")
     assert files["segments.csv"] == (tmp_path / "segments.csv").read_text()
     assert truth == read_json(tmp_path / "truth.json")
 
