@@ -10,10 +10,11 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <time.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -142,11 +143,24 @@ std::vector<double> ToScalars(const py::object& obj, const char* name, py::ssize
   return std::vector<double>(a.data(), a.data() + a.shape(0));
 }
 
+// A Python gravcal.Log is a PipelineInput holding the log (source = the
+// log's source, no side input), never changed once made: calibrate hands it
+// to RunCalibration as it is (no copy of the samples), any number of
+// threads may read it at once, and NumPy views of its vectors stay valid.
+using LogHandle = std::shared_ptr<PipelineInput>;
+
+LogHandle WrapLog(ImuLog log) {
+  auto input = std::make_shared<PipelineInput>();
+  input->source = log.source;
+  input->log = std::move(log);
+  return input;
+}
+
 // A log from arrays: t (N,), accel (N, 3), optional gyro (N, 3) and temp
 // (N,). ImuLog::Validate names the first bad sample (NaN, time that does not
 // increase).
-ImuLog MakeLog(const py::object& t, const py::object& accel, const py::object& gyro,
-               const py::object& temp, const std::string& source) {
+LogHandle MakeLog(const py::object& t, const py::object& accel, const py::object& gyro,
+                  const py::object& temp, const std::string& source) {
   ImuLog log;
   log.source = source;
   log.t = ToScalars(t, "t", -1);
@@ -156,10 +170,10 @@ ImuLog MakeLog(const py::object& t, const py::object& accel, const py::object& g
   if (!temp.is_none()) log.temperature = ToScalars(temp, "temp", n);
   std::string error;
   Check(log.Validate(&error), error);
-  return log;
+  return WrapLog(std::move(log));
 }
 
-ImuLog ReadLog(const std::string& path, const Config& config) {
+LogHandle ReadLog(const std::string& path, const Config& config) {
   ImuLog log;
   std::string error;
   bool ok;
@@ -168,7 +182,7 @@ ImuLog ReadLog(const std::string& path, const Config& config) {
     ok = ReadImuLog(path, config.input, &log, &error);
   }
   Check(ok, error);
-  return log;
+  return WrapLog(std::move(log));
 }
 
 // ---------------------------------------------------------------------------
@@ -176,27 +190,48 @@ ImuLog ReadLog(const std::string& path, const Config& config) {
 // and the models read back from it (what `gravcal apply` uses).
 
 struct PyCalibration {
-  std::string json;
+  // The library's result, when made here (null when read from a file).
+  std::shared_ptr<const Calibration> result;
+  bool include_covariance = true;
   std::string name;
-  // Read from `json` on first use (apply), as ReadCalibrationJson would.
+  // The JSON text (built from `result` on first use) and the models read
+  // back from it, as ReadCalibrationJson would (on first apply).
+  mutable std::string json;
+  mutable bool has_json = false;
   mutable bool parsed = false;
   mutable LoadedCalibration models;
 
-  // Checks the text (every file-read calibration), or defers it (a
-  // calibration just written by the library).
-  static PyCalibration FromText(const std::string& text, const std::string& name,
-                                bool check = true) {
+  // A file's text, checked at once.
+  static PyCalibration FromText(const std::string& text, const std::string& name) {
     PyCalibration c;
     c.json = text;
+    c.has_json = true;
     c.name = name;
-    if (check) c.Models();
+    c.Models();
     return c;
+  }
+
+  static PyCalibration FromResult(Calibration&& result, bool include_covariance,
+                                  const std::string& name) {
+    PyCalibration c;
+    c.result = std::make_shared<const Calibration>(std::move(result));
+    c.include_covariance = include_covariance;
+    c.name = name;
+    return c;
+  }
+
+  const std::string& Json() const {
+    if (!has_json) {
+      json = CalibrationToJson(*result, include_covariance);
+      has_json = true;
+    }
+    return json;
   }
 
   const LoadedCalibration& Models() const {
     if (!parsed) {
       std::string error;
-      Check(ParseCalibrationJson(json, name, &models, &error), error);
+      Check(ParseCalibrationJson(Json(), name, &models, &error), error);
       parsed = true;
     }
     return models;
@@ -211,7 +246,7 @@ PyCalibration CalibrationFromFile(const std::string& path) {
 
 void WriteCalibration(const PyCalibration& c, const std::string& path) {
   std::string error;
-  Check(WriteFileAtomically(path, c.json, &error), error);
+  Check(WriteFileAtomically(path, c.Json(), &error), error);
 }
 
 // ===========================================================================
@@ -259,17 +294,8 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
 }
 // ===========================================================================
 
-// RunCalibration on a log, as `gravcal calibrate` runs it.
-PyCalibration Calibrate(const Config& config, const ImuLog& log, const std::string& source,
-                        const std::string& attitudes, const std::string& segments,
-                        const std::string& noise) {
-  CheckConfig(config);
-  PipelineInput input;
-  input.log = log;
-  input.source = source.empty() ? log.source : source;
-  input.attitudes_path = attitudes;
-  input.segments_path = segments;
-  input.noise_path = noise;
+// RunCalibration, as `gravcal calibrate` runs it.
+PyCalibration Run(const Config& config, const PipelineInput& input) {
   Calibration c;
   bool ok;
   {
@@ -277,8 +303,40 @@ PyCalibration Calibrate(const Config& config, const ImuLog& log, const std::stri
     ok = RunCalibration(config, input, &c);
   }
   Check(ok, c.message);
-  return PyCalibration::FromText(CalibrationToJson(c, config.output_covariance), input.source,
-                                 false);
+  return PyCalibration::FromResult(std::move(c), config.output_covariance, input.source);
+}
+
+// On a log in memory: the log itself when there is no side input, else a
+// copy with the side files.
+PyCalibration Calibrate(const Config& config, const LogHandle& log, const std::string& attitudes,
+                        const std::string& segments, const std::string& noise) {
+  CheckConfig(config);
+  if (attitudes.empty() && segments.empty() && noise.empty()) return Run(config, *log);
+  PipelineInput input = *log;
+  input.attitudes_path = attitudes;
+  input.segments_path = segments;
+  input.noise_path = noise;
+  return Run(config, input);
+}
+
+// On a log file, read straight into the pipeline's input.
+PyCalibration CalibrateFile(const Config& config, const std::string& path,
+                            const std::string& attitudes, const std::string& segments,
+                            const std::string& noise) {
+  CheckConfig(config);
+  PipelineInput input;
+  input.source = path;
+  input.attitudes_path = attitudes;
+  input.segments_path = segments;
+  input.noise_path = noise;
+  std::string error;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = ReadImuLog(path, config.input, &input.log, &error);
+  }
+  Check(ok, error);
+  return Run(config, input);
 }
 
 // `gravcal simulate`: the truth (truth.json text), the raw log, the
@@ -309,7 +367,7 @@ py::tuple SimulateSession(const Config& config, uint64_t seed) {
   const std::string segments_csv =
       segments.empty() ? "" : RateTableSegmentsToCsv(segments, session.log);
   const std::string truth = TruthToJson(session, config.simulation);
-  return py::make_tuple(truth, std::move(session.log), fixture, segments_csv);
+  return py::make_tuple(truth, WrapLog(std::move(session.log)), fixture, segments_csv);
 }
 
 // ---------------------------------------------------------------------------
@@ -360,8 +418,8 @@ std::vector<PyBatchResult> Batch(const std::vector<BatchUnit>& units, const Conf
     Config config;
     if (r.status == BatchStatus::kOk && EffectiveConfig(units[i], base, &config, &error)) {
       // The unit's <unit>.json as `gravcal batch` writes it.
-      p.calibration = py::cast(PyCalibration::FromText(
-          CalibrationToJson(r.calibration, config.output_covariance), r.unit, false));
+      p.calibration = py::cast(PyCalibration::FromResult(std::move(results[i].calibration),
+                                                         config.output_covariance, r.unit));
     }
   }
   return out;
@@ -372,7 +430,7 @@ std::vector<BatchUnit> UnitsFromSpecs(const std::vector<UnitSpec>& specs) {
   for (size_t i = 0; i < specs.size(); ++i) {
     units[i].id = specs[i].id;
     units[i].path = specs[i].path;
-    if (!specs[i].log.is_none()) units[i].log = specs[i].log.cast<const ImuLog&>();
+    if (!specs[i].log.is_none()) units[i].log = specs[i].log.cast<const PipelineInput&>().log;
     units[i].attitudes_path = specs[i].attitudes;
     units[i].overrides = specs[i].overrides;
   }
@@ -398,7 +456,8 @@ std::vector<BatchUnit> UnitsFromFolder(const std::string& folder, const std::str
 // ---------------------------------------------------------------------------
 // Noise and discovery: the JSON text of noise.json and discovery.json.
 
-std::string Noise(const Config& config, const ImuLog& log) {
+std::string Noise(const Config& config, const LogHandle& input) {
+  const ImuLog& log = input->log;
   // The same options `gravcal noise` builds from the config.
   NoiseOptions options = config.noise;
   options.accel_scale = config.calibration.nominal_scale;
@@ -417,7 +476,8 @@ std::string Noise(const Config& config, const ImuLog& log) {
   return NoiseToJson(noise);
 }
 
-py::tuple Discover(const Config& config, const ImuLog& log) {
+py::tuple Discover(const Config& config, const LogHandle& input) {
+  const ImuLog& log = input->log;
   CheckConfig(config);
   DiscoveryResult result;
   bool ok;
@@ -429,20 +489,34 @@ py::tuple Discover(const Config& config, const ImuLog& log) {
   return py::make_tuple(DiscoveryToJson(result), DiscoveryToHtml(result));
 }
 
-// For benchmarks/python_overhead.py: seconds per RunCalibration call made
-// from C++ on a prepared input (the C++ user's cost), `repeats` calls.
-double TimeCalibrate(const Config& config, const ImuLog& log, int repeats) {
-  PipelineInput input;
-  input.log = log;
-  input.source = log.source;
+// CPU seconds of the calling thread (the library is single-threaded here:
+// Ceres runs with num_threads 1), which a loaded machine does not inflate
+// the way it does wall time.
+double ThreadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// For benchmarks/python_overhead.py: CPU seconds per call of the C++ user's
+// code, `repeats` calls: ReadImuLog + RunCalibration on `path` (as `gravcal
+// calibrate`), or, with an empty path, RunCalibration on the log in memory.
+double TimeCalibrate(const Config& config, const LogHandle& log, const std::string& path,
+                     int repeats) {
   py::gil_scoped_release release;
-  const auto start = std::chrono::steady_clock::now();
+  const double start = ThreadCpuSeconds();
   for (int i = 0; i < repeats; ++i) {
     Calibration c;
-    RunCalibration(config, input, &c);
+    if (path.empty()) {
+      RunCalibration(config, *log, &c);
+      continue;
+    }
+    PipelineInput input;
+    input.source = path;
+    std::string error;
+    if (ReadImuLog(path, config.input, &input.log, &error)) RunCalibration(config, input, &c);
   }
-  const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
-  return elapsed.count() / std::max(repeats, 1);
+  return (ThreadCpuSeconds() - start) / std::max(repeats, 1);
 }
 
 }  // namespace
@@ -472,28 +546,34 @@ PYBIND11_MODULE(_gravcal, m) {
     return keys;
   });
 
-  py::class_<ImuLog>(m, "Log")
-      .def_property_readonly("source", [](const ImuLog& l) { return l.source; })
+  py::class_<PipelineInput, LogHandle>(m, "Log")
+      .def_property_readonly("source", [](const PipelineInput& l) { return l.log.source; })
       .def_property_readonly(
-          "t", [](py::object self) { return Scalars(self.cast<const ImuLog&>().t, self); })
+          "t",
+          [](py::object self) { return Scalars(self.cast<const PipelineInput&>().log.t, self); })
+      .def_property_readonly("accel",
+                             [](py::object self) {
+                               return Vectors(self.cast<const PipelineInput&>().log.accel, self);
+                             })
       .def_property_readonly(
-          "accel", [](py::object self) { return Vectors(self.cast<const ImuLog&>().accel, self); })
-      .def_property_readonly(
-          "gyro", [](py::object self) { return Vectors(self.cast<const ImuLog&>().gyro, self); })
-      .def_property_readonly(
-          "temp",
-          [](py::object self) { return Scalars(self.cast<const ImuLog&>().temperature, self); })
-      .def("__len__", &ImuLog::size)
-      .def("to_csv", [](const ImuLog& l, const std::string& path) {
+          "gyro",
+          [](py::object self) { return Vectors(self.cast<const PipelineInput&>().log.gyro, self); })
+      .def_property_readonly("temp",
+                             [](py::object self) {
+                               return Scalars(self.cast<const PipelineInput&>().log.temperature,
+                                              self);
+                             })
+      .def("__len__", [](const PipelineInput& l) { return l.log.size(); })
+      .def("to_csv", [](const PipelineInput& l, const std::string& path) {
         std::string error;
-        Check(WriteImuLogCsv(l, path, &error), error);
+        Check(WriteImuLogCsv(l.log, path, &error), error);
       });
   m.def("make_log", &MakeLog, py::arg("t"), py::arg("accel"), py::arg("gyro"), py::arg("temp"),
         py::arg("source"));
   m.def("read_log", &ReadLog, py::arg("path"), py::arg("config"));
 
   py::class_<PyCalibration>(m, "Calibration")
-      .def_readonly("json", &PyCalibration::json)
+      .def_property_readonly("json", &PyCalibration::Json)
       .def_property_readonly("has_gyro", [](const PyCalibration& c) { return c.Models().has_gyro; })
       .def_static("from_file", &CalibrationFromFile)
       .def_static("from_text",
@@ -503,8 +583,10 @@ PYBIND11_MODULE(_gravcal, m) {
       .def("write", &WriteCalibration)
       .def("apply", &ApplyCalibration, py::arg("accel"), py::arg("gyro"), py::arg("temp"),
            py::arg("t"));
-  m.def("calibrate", &Calibrate, py::arg("config"), py::arg("log"), py::arg("source"),
-        py::arg("attitudes"), py::arg("segments"), py::arg("noise"));
+  m.def("calibrate", &Calibrate, py::arg("config"), py::arg("log"), py::arg("attitudes"),
+        py::arg("segments"), py::arg("noise"));
+  m.def("calibrate_file", &CalibrateFile, py::arg("config"), py::arg("path"), py::arg("attitudes"),
+        py::arg("segments"), py::arg("noise"));
   m.def("simulate", &SimulateSession, py::arg("config"), py::arg("seed"));
 
   py::class_<BatchUnit>(m, "BatchUnit").def_readonly("id", &BatchUnit::id);
@@ -542,5 +624,6 @@ PYBIND11_MODULE(_gravcal, m) {
   m.def("batch", &Batch, py::arg("units"), py::arg("config"), py::arg("threads"));
   m.def("noise", &Noise, py::arg("config"), py::arg("log"));
   m.def("discover", &Discover, py::arg("config"), py::arg("log"));
-  m.def("_time_calibrate", &TimeCalibrate, py::arg("config"), py::arg("log"), py::arg("repeats"));
+  m.def("_time_calibrate", &TimeCalibrate, py::arg("config"), py::arg("log"), py::arg("path"),
+        py::arg("repeats"));
 }

@@ -145,7 +145,7 @@ def _as_log(data, cfg, t, accel, gyro, temp):
     if isinstance(data, Log):
         return data
     if isinstance(data, (str, bytes, _os.PathLike)):
-        return _gravcal.read_log(_os.fspath(data), cfg)
+        return _gravcal.read_log(_os.fsdecode(data), cfg)
     if _is_dataframe(data):
         return _log_from_dataframe(data, "DataFrame")
     raise Error("log: expected a gravcal.Log, a file path or a pandas DataFrame, got %s"
@@ -339,14 +339,13 @@ def calibrate(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None
     ``noise`` are the side files of the methods that need them. Returns a
     :class:`Calibration`; raises :class:`Error` with the CLI's message."""
     cfg = _config(config, **keys)
-    data = _as_log(log, cfg, t, accel, gyro, temp)
-    source = _os.fspath(log) if isinstance(log, (str, _os.PathLike)) else data.source
-
-    def path(p):
-        return "" if p is None else _os.fspath(p)
-
-    return Calibration(_gravcal.calibrate(cfg, data, source, path(attitudes), path(segments),
-                                          path(noise)))
+    side = ["" if p is None else _os.fspath(p) for p in (attitudes, segments, noise)]
+    if isinstance(log, (str, bytes, _os.PathLike)):
+        if any(x is not None for x in (t, accel, gyro, temp)):
+            raise Error("give either a log (Log, path or DataFrame) or arrays t/accel, not both")
+        # Read straight into the pipeline, as gravcal calibrate --input does.
+        return Calibration(_gravcal.calibrate_file(cfg, _os.fsdecode(log), *side))
+    return Calibration(_gravcal.calibrate(cfg, _as_log(log, cfg, t, accel, gyro, temp), *side))
 
 
 def simulate(config=None, seed=1, *, return_files=False, **keys):
