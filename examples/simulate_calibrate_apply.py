@@ -36,7 +36,7 @@ def main():
                                                    cal.accel.std.bias, precision=2))
 
     accel, gyro = cal.apply(log.accel, log.gyro, temp=log.temp, t=log.t)
-    g = truth["gravity"] if isinstance(truth["gravity"], float) else cal.gravity.value
+    g = truth["gravity"]
     norm = np.linalg.norm(accel, axis=1)
     still = np.abs(np.linalg.norm(gyro, axis=1)) < 0.05
     print("|a| - g while still: rms %.4f m/s^2 over %d samples" %
