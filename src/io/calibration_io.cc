@@ -220,9 +220,17 @@ bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration
     *error = path + ": cannot open";
     return false;
   }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return ParseCalibrationJson(text.str(), path, calibration, error);
+}
+
+bool ParseCalibrationJson(const std::string& text, const std::string& name,
+                          LoadedCalibration* calibration, std::string* error) {
+  const std::string& path = name;
   json j;
   try {
-    j = json::parse(in);
+    j = json::parse(text);
   } catch (const json::parse_error& e) {
     *error = path + ": not valid JSON (" + e.what() + ")";
     return false;

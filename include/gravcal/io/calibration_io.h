@@ -37,6 +37,10 @@ struct LoadedCalibration {
 // Reads a calibration JSON file; errors name the file and the key.
 bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration,
                          std::string* error);
+// Same as ReadCalibrationJson on JSON text in memory; `name` is used in
+// messages in place of the path.
+bool ParseCalibrationJson(const std::string& text, const std::string& name,
+                          LoadedCalibration* calibration, std::string* error);
 
 }  // namespace gravcal
 

@@ -1,0 +1,432 @@
+"""gravcal: IMU calibration with gravity as the only reference, from Python.
+
+NumPy in and out, over the same C++ library as the ``gravcal`` command:
+a calibration made here is the calibration JSON the CLI writes, number for
+number. Configuration is a YAML file (``configs/*.yaml``), a dict with the
+same keys, or keyword arguments with those keys (``gravity=9.81744``).
+Every failure raises :class:`gravcal.Error` (a ``ValueError``) with the
+CLI's one-line message. Long calls release the GIL, so threads help.
+
+>>> import gravcal
+>>> truth, log = gravcal.simulate(config="configs/twelve_position.yaml", seed=7)
+>>> cal = gravcal.calibrate(log, config="configs/twelve_position.yaml")
+>>> accel_si, _ = cal.apply(log.accel)
+
+See docs/python.md.
+"""
+
+import json as _json
+import math as _math
+import os as _os
+import warnings as _warnings
+
+import numpy as _np
+
+from . import _gravcal
+from ._gravcal import Error, Log
+
+__version__ = _gravcal.__version__
+
+__all__ = [
+    "Error", "Log", "Calibration", "BatchResult", "Config", "config", "read_log", "log",
+    "calibrate", "simulate", "batch", "noise", "discover", "config_keys", "__version__",
+]
+
+Config = _gravcal.Config
+BatchResult = _gravcal.BatchResult
+
+
+# ---------------------------------------------------------------------------
+# Configuration.
+
+def _yaml_value(value):
+    """A Python value as the YAML text SetConfigValue parses."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and not _math.isfinite(value):
+        return ".nan" if _math.isnan(value) else (".inf" if value > 0 else "-.inf")
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, (list, tuple, dict)):
+        # JSON flow syntax is YAML.
+        return _json.dumps(value)
+    if isinstance(value, _np.generic):
+        return _yaml_value(value.item())
+    raise Error("config value %r: expected a string, number, bool, list or dict" % (value,))
+
+
+def _keys(mapping):
+    return [(str(k), _yaml_value(v)) for k, v in mapping.items()]
+
+
+def _config(config=None, **keys):
+    """A :class:`Config` from a YAML path, a dict of keys, or a Config, with
+    ``keys`` applied on top in order (the way ``--config f --key v`` works)."""
+    if isinstance(config, Config):
+        return config.with_keys(_keys(keys)) if keys else config
+    if config is None:
+        return Config("", _keys(keys))
+    if isinstance(config, (str, bytes, _os.PathLike)):
+        return Config(_os.fsdecode(config), _keys(keys))
+    if isinstance(config, dict):
+        merged = dict(config)
+        merged.update(keys)
+        return Config("", _keys(merged))
+    raise Error("config: expected a YAML path, a dict of keys or a gravcal.Config, got %s"
+                % type(config).__name__)
+
+
+config = _config
+
+
+def config_keys():
+    """Every config key with its help text, as ``gravcal help`` lists them."""
+    return dict(_gravcal.config_keys())
+
+
+# ---------------------------------------------------------------------------
+# Logs.
+
+def read_log(path, config=None, **keys):
+    """Reads a raw log file with the config's reader keys (``format``,
+    ``columns``, ``rename``, ``gyro_path``...). Returns a :class:`Log`."""
+    return _gravcal.read_log(_os.fspath(path), _config(config, **keys))
+
+
+def _is_dataframe(x):
+    return type(x).__name__ == "DataFrame" and hasattr(x, "columns")
+
+
+def log(t=None, accel=None, gyro=None, temp=None, *, source="arrays"):
+    """A :class:`Log` from arrays: ``t`` (N,) seconds, strictly increasing;
+    ``accel`` (N, 3) raw; optional ``gyro`` (N, 3) raw and ``temp`` (N,)
+    degrees C. A pandas DataFrame with the contract's column names (t, ax,
+    ay, az[, gx, gy, gz][, temp]) may be passed as ``t``. Bad arrays raise
+    :class:`Error` naming the array (shape, NaN, time that does not
+    increase)."""
+    if _is_dataframe(t):
+        return _log_from_dataframe(t, source)
+    if t is None or accel is None:
+        raise Error("a log needs t and accel (or a DataFrame with columns t, ax, ay, az)")
+    return _gravcal.make_log(t, accel, gyro, temp, source)
+
+
+def _log_from_dataframe(frame, source):
+    columns = set(frame.columns)
+    missing = [c for c in ("t", "ax", "ay", "az") if c not in columns]
+    if missing:
+        raise Error("DataFrame: column '%s' is missing (the contract's names: t, ax, ay, az, "
+                    "gx, gy, gz, temp)" % missing[0])
+
+    def block(names):
+        return frame[names].to_numpy(dtype=float)
+
+    gyro = None
+    if any(c in columns for c in ("gx", "gy", "gz")):
+        absent = [c for c in ("gx", "gy", "gz") if c not in columns]
+        if absent:
+            raise Error("DataFrame: column '%s' is missing (gyroscope needs gx, gy, gz)"
+                        % absent[0])
+        gyro = block(["gx", "gy", "gz"])
+    temp = frame["temp"].to_numpy(dtype=float) if "temp" in columns else None
+    return _gravcal.make_log(frame["t"].to_numpy(dtype=float), block(["ax", "ay", "az"]), gyro,
+                             temp, source)
+
+
+def _as_log(data, cfg, t, accel, gyro, temp):
+    """A Log from whatever the caller gave: a Log, a path, a DataFrame, or
+    arrays."""
+    if data is None:
+        return log(t, accel, gyro, temp)
+    if any(x is not None for x in (t, accel, gyro, temp)):
+        raise Error("give either a log (Log, path or DataFrame) or arrays t/accel, not both")
+    if isinstance(data, Log):
+        return data
+    if isinstance(data, (str, bytes, _os.PathLike)):
+        return _gravcal.read_log(_os.fsdecode(data), cfg)
+    if _is_dataframe(data):
+        return _log_from_dataframe(data, "DataFrame")
+    raise Error("log: expected a gravcal.Log, a file path or a pandas DataFrame, got %s"
+                % type(data).__name__)
+
+
+def _log_to_dataframe(self):
+    """The log as a pandas DataFrame with the contract's column names."""
+    import pandas
+    data = {"t": self.t}
+    for i, axis in enumerate("xyz"):
+        data["a" + axis] = self.accel[:, i]
+    if self.gyro is not None:
+        for i, axis in enumerate("xyz"):
+            data["g" + axis] = self.gyro[:, i]
+    if self.temp is not None:
+        data["temp"] = self.temp
+    return pandas.DataFrame(data)
+
+
+def _log_repr(self):
+    return "<gravcal.Log %r: %d samples%s%s>" % (
+        self.source, len(self), ", gyro" if self.gyro is not None else "",
+        ", temp" if self.temp is not None else "")
+
+
+_log_to_csv = Log.to_csv
+
+
+def _log_to_csv_path(self, path):
+    """Writes the log as the contract's CSV (t, ax, ay, az[, gx, gy, gz][, temp]),
+    as ``gravcal simulate`` writes raw.csv."""
+    _log_to_csv(self, _os.fspath(path))
+
+
+Log.to_csv = _log_to_csv_path
+Log.to_dataframe = _log_to_dataframe
+Log.__repr__ = _log_repr
+
+
+# ---------------------------------------------------------------------------
+# Results.
+
+def _convert(value):
+    """JSON values for attribute access: dicts become sections, lists of
+    numbers (null = NaN) become float arrays, other lists stay lists."""
+    if isinstance(value, dict):
+        return _Section(value)
+    if isinstance(value, list) and value and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) or x is None
+            or (isinstance(x, list) and x and all(
+                isinstance(y, (int, float)) and not isinstance(y, bool) or y is None for y in x))
+            for x in value):
+        nan = float("nan")
+        return _np.array([[nan if y is None else y for y in x] if isinstance(x, list)
+                          else (nan if x is None else x) for x in value], dtype=float)
+    return value
+
+
+class _Section:
+    """One object of a result's JSON, read as attributes (``cal.accel.std.bias``)
+    or items (``cal["accel"]["std"]``). ``np.asarray`` of a section with a
+    ``matrix`` (a covariance) gives the matrix."""
+
+    __slots__ = ("_data",)
+
+    def __init__(self, data):
+        self._data = data
+
+    def _dict(self):
+        return self._data
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        data = self._dict()
+        try:
+            return _convert(data[name])
+        except KeyError:
+            raise AttributeError("no key '%s' (keys: %s)" % (name, ", ".join(data))) from None
+
+    def __getitem__(self, name):
+        return _convert(self._dict()[name])
+
+    def __contains__(self, name):
+        return name in self._dict()
+
+    def __dir__(self):
+        return list(self._dict())
+
+    def keys(self):
+        return self._dict().keys()
+
+    def to_dict(self):
+        """The JSON object as plain dicts and lists (a copy)."""
+        return _json.loads(_json.dumps(self._dict()))
+
+    def __array__(self, dtype=None):
+        if "matrix" not in self._dict():
+            raise TypeError("this section is not a matrix")
+        return _np.asarray(_convert(self._dict()["matrix"]), dtype=dtype)
+
+    def __repr__(self):
+        return "<gravcal section: %s>" % ", ".join(self._dict())
+
+
+class Calibration(_Section):
+    """A calibration result: the calibration JSON of ``gravcal calibrate``.
+
+    Attributes follow the JSON (docs/data_contract.md): ``cal.accel.bias``,
+    ``cal.accel.matrix``, ``cal.accel.std.bias``, ``cal.accel.covariance``
+    (``.parameters``, ``.matrix``), ``cal.gyro``, ``cal.gravity``,
+    ``cal.warnings``... Arrays are NumPy float arrays (null = NaN)."""
+
+    __slots__ = ("_core",)
+
+    def __init__(self, core):
+        # The JSON text is parsed on first use.
+        _Section.__init__(self, None)
+        self._core = core
+
+    def _dict(self):
+        if self._data is None:
+            self._data = _json.loads(self._core.json)
+        return self._data
+
+    @classmethod
+    def from_json(cls, path):
+        """Reads a calibration JSON file (from ``gravcal calibrate`` or
+        :meth:`to_json`)."""
+        return cls(_gravcal.Calibration.from_file(_os.fspath(path)))
+
+    @classmethod
+    def from_json_text(cls, text, name="calibration"):
+        """A calibration from JSON text; ``name`` is used in messages."""
+        return cls(_gravcal.Calibration.from_text(text, name))
+
+    def to_json(self, path=None):
+        """Writes the calibration JSON file, byte for byte what ``gravcal
+        calibrate`` writes (atomically). Without a path, returns the text."""
+        if path is None:
+            return self._core.json
+        self._core.write(_os.fspath(path))
+        return None
+
+    @property
+    def warnings(self):
+        """The method's warnings (the CLI prints them as 'gravcal: warning:')."""
+        return list(self._dict().get("warnings", []))
+
+    def apply(self, accel, gyro=None, *, temp=None, t=None):
+        """Raw samples to SI: ``accel`` (N, 3) -> m/s^2 with a = M (v - b);
+        ``gyro`` (N, 3) -> rad/s with w = M_g (u - b_g). Returns ``accel_si``
+        when only accel is given, else ``(accel_si, gyro_si)``. Vectorised
+        in C++ without the GIL; the same numbers as ``gravcal apply``.
+        ``temp`` and ``t`` are for the effect terms (temperature, time):
+        their correction is not applied yet and a warning says so when the
+        calibration holds such terms."""
+        effects = self._dict().get("effects")
+        if effects:
+            names = [k for k in effects if k not in ("reference_temperature", "reference_time")]
+            _warnings.warn("gravcal: the calibration's effect terms (%s) are not applied "
+                           "(apply corrects the linear model only, as gravcal apply does)"
+                           % ", ".join(names), stacklevel=2)
+        a, w = self._core.apply(accel, gyro, temp, t)
+        return a if gyro is None else (a, w)
+
+    def __repr__(self):
+        return "<gravcal.Calibration method=%s, gyro=%s>" % (
+            self._dict().get("method"), "gyro" in self._dict())
+
+
+def _batch_result_repr(self):
+    return "<gravcal.BatchResult %s: %s>" % (self.unit, self.status)
+
+
+BatchResult.__repr__ = _batch_result_repr
+
+
+# ---------------------------------------------------------------------------
+# Commands.
+
+def calibrate(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None,
+              attitudes=None, segments=None, noise=None, **keys):
+    """Calibrates one session with the config's method (``method`` key).
+
+    ``log`` is a :class:`Log`, a raw log path, or a pandas DataFrame; or
+    give arrays ``t``, ``accel`` (and ``gyro``, ``temp``). ``config`` is a
+    YAML path, a dict of keys or a :class:`Config`; ``keys`` (e.g.
+    ``gravity=9.81744``) apply on top. ``attitudes``, ``segments`` and
+    ``noise`` are the side files of the methods that need them. Returns a
+    :class:`Calibration`; raises :class:`Error` with the CLI's message."""
+    cfg = _config(config, **keys)
+    side = ["" if p is None else _os.fspath(p) for p in (attitudes, segments, noise)]
+    if isinstance(log, (str, bytes, _os.PathLike)):
+        if any(x is not None for x in (t, accel, gyro, temp)):
+            raise Error("give either a log (Log, path or DataFrame) or arrays t/accel, not both")
+        # Read straight into the pipeline, as gravcal calibrate --input does.
+        return Calibration(_gravcal.calibrate_file(cfg, _os.fsdecode(log), *side))
+    return Calibration(_gravcal.calibrate(cfg, _as_log(log, cfg, t, accel, gyro, temp), *side))
+
+
+def simulate(config=None, seed=1, *, return_files=False, **keys):
+    """Simulates a session exactly as ``gravcal simulate --seed`` does.
+    Returns ``(truth, log)``: truth.json as a dict and the raw log. With
+    ``return_files=True`` also a dict with the text of attitudes.csv and,
+    for ``sim_motion: rate_table``, segments.csv."""
+    truth, data, attitudes, segments = _gravcal.simulate(_config(config, **keys),
+                                                         int(seed))
+    if return_files:
+        files = {"attitudes.csv": attitudes}
+        if segments:
+            files["segments.csv"] = segments
+        return _json.loads(truth), data, files
+    return _json.loads(truth), data
+
+
+def _unit_spec(i, unit):
+    if isinstance(unit, (str, _os.PathLike)):
+        p = _os.fspath(unit)
+        return (_os.path.splitext(_os.path.basename(p))[0], p, None, "", [])
+    if isinstance(unit, Log):
+        return (unit.source if unit.source not in ("", "arrays") else "unit%d" % i, "", unit, "",
+                [])
+    if isinstance(unit, dict):
+        unknown = set(unit) - {"id", "path", "log", "attitudes", "overrides"}
+        if unknown:
+            raise Error("batch unit %d: unknown field '%s' (id, path, log, attitudes, overrides)"
+                        % (i, sorted(unknown)[0]))
+        data = unit.get("log")
+        if _is_dataframe(data):
+            data = _log_from_dataframe(data, str(unit.get("id", "DataFrame")))
+        if data is not None and not isinstance(data, Log):
+            raise Error("batch unit %d: 'log' must be a gravcal.Log or a DataFrame" % i)
+        if (data is None) == (unit.get("path") is None):
+            raise Error("batch unit %d: give exactly one of 'path' and 'log'" % i)
+        ident = unit.get("id")
+        if ident is None:
+            ident = _unit_spec(i, unit["path"])[0] if data is None else "unit%d" % i
+        return (str(ident), "" if data is not None else _os.fspath(unit["path"]), data,
+                _os.fspath(unit.get("attitudes") or ""), _keys(unit.get("overrides") or {}))
+    raise Error("batch unit %d: expected a path, a gravcal.Log or a dict, got %s"
+                % (i, type(unit).__name__))
+
+
+def batch(units, config=None, threads=0, *, pattern="*.csv", **keys):
+    """Calibrates many units in parallel (C++ threads, the GIL released), each
+    exactly as ``gravcal batch`` would. ``units`` is a list (paths, Logs, or
+    dicts with id, path or log, attitudes, overrides), a manifest CSV path, or
+    a folder (every file matching ``pattern``). ``threads`` 0 = one per core.
+    Returns one :class:`BatchResult` per unit in input order (``unit``,
+    ``status``, ``message``, ``content_hash``, ``calibration`` or None,
+    ``timings``); a failed unit does not raise."""
+    cfg = _config(config, **keys)
+    if isinstance(units, (str, _os.PathLike)):
+        p = _os.fspath(units)
+        core_units = (_gravcal.units_from_folder(p, pattern) if _os.path.isdir(p)
+                      else _gravcal.units_from_manifest(p, cfg))
+    else:
+        core_units = _gravcal.units([_unit_spec(i, u) for i, u in enumerate(units)])
+    results = _gravcal.batch(core_units, cfg, int(threads))
+    for r in results:
+        if r.calibration is not None:
+            r.calibration = Calibration(r.calibration)
+    return results
+
+
+def noise(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None, **keys):
+    """The noise model of a still log (Allan deviation), as ``gravcal noise``
+    writes noise.json: a dict."""
+    cfg = _config(config, **keys)
+    return _json.loads(_gravcal.noise(cfg, _as_log(log, cfg, t, accel, gyro, temp)))
+
+
+def discover(log=None, *, config=None, report=None, t=None, accel=None, gyro=None, temp=None,
+             **keys):
+    """The effects the model misses, as ``gravcal discover`` writes
+    discovery.json: a dict. ``report`` writes the HTML report there."""
+    cfg = _config(config, **keys)
+    text, html = _gravcal.discover(cfg, _as_log(log, cfg, t, accel, gyro, temp))
+    if report is not None:
+        with open(_os.fspath(report), "w", encoding="utf-8") as f:
+            f.write(html)
+    return _json.loads(text)

@@ -1,0 +1,629 @@
+// gravcal._gravcal: the Python extension module, a thin layer over the
+// public C++ API (include/gravcal/). Arrays cross as NumPy arrays; results
+// cross as the library's own JSON text (the calibration JSON, truth.json,
+// noise.json, discovery.json), so the Python objects and the CLI's files are
+// the same numbers by construction. No calibration logic lives here: each
+// function converts its arguments, calls the library (without the GIL for
+// anything that can take long) and turns a false return into gravcal.Error
+// with the library's one-line message. The Pythonic surface (keyword
+// arguments, pandas, attribute access) is python/gravcal/__init__.py.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gravcal/gravcal.h"
+
+namespace py = pybind11;
+
+namespace gravcal {
+namespace python {
+namespace {
+
+// Raised as gravcal.Error (a ValueError) with the library's message.
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+void Check(bool ok, const std::string& message) {
+  if (!ok) throw Error(message);
+}
+
+// ImuLog stores its 3-vectors back to back: an (N, 3) array of doubles.
+static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "Vector3d must be unpadded");
+
+using Keys = std::vector<std::pair<std::string, std::string>>;
+
+// The configuration: a YAML file (optional) and then keys with values
+// written as YAML, in order, exactly as `gravcal <command> --config path
+// --key value` builds it.
+Config MakeConfig(const std::string& path, const Keys& keys) {
+  Config config;
+  std::string error;
+  if (!path.empty()) Check(LoadConfigFile(path, &config, &error), error);
+  for (const auto& [key, value] : keys) Check(SetConfigValue(key, value, &config, &error), error);
+  return config;
+}
+
+Config WithKeys(const Config& base, const Keys& keys) {
+  Config config = base;
+  std::string error;
+  for (const auto& [key, value] : keys) Check(SetConfigValue(key, value, &config, &error), error);
+  return config;
+}
+
+void CheckConfig(const Config& config) {
+  std::string error;
+  Check(config.IsValid(&error), error);
+}
+
+// ---------------------------------------------------------------------------
+// Arrays.
+
+// A read-only NumPy view of memory owned by `owner` (kept alive by it).
+py::array View(const double* data, std::vector<py::ssize_t> shape, std::vector<py::ssize_t> strides,
+               py::handle owner) {
+  py::array a(py::dtype::of<double>(), std::move(shape), std::move(strides), data, owner);
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+py::object Vectors(const std::vector<Eigen::Vector3d>& v, py::handle owner) {
+  if (v.empty()) return py::none();
+  return View(v.front().data(), {static_cast<py::ssize_t>(v.size()), 3},
+              {3 * sizeof(double), sizeof(double)}, owner);
+}
+
+py::object Scalars(const std::vector<double>& v, py::handle owner) {
+  if (v.empty()) return py::none();
+  return View(v.data(), {static_cast<py::ssize_t>(v.size())}, {sizeof(double)}, owner);
+}
+
+std::string ShapeText(const py::array& a) {
+  std::string text = "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) {
+    text += (i ? ", " : "") + std::to_string(a.shape(i));
+  }
+  return text + (a.ndim() == 1 ? ",)" : ")");
+}
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// `obj` as a C-contiguous float64 array (copied only when it is not one).
+DoubleArray AsDoubles(const py::object& obj, const char* name) {
+  DoubleArray a = DoubleArray::ensure(obj);
+  if (!a) {
+    PyErr_Clear();
+    throw Error(std::string(name) + ": not an array of numbers");
+  }
+  return a;
+}
+
+// "accel: 9 samples, but t has 10".
+std::string LengthText(const char* name, py::ssize_t got, const char* reference, py::ssize_t rows) {
+  return std::string(name) + ": " + std::to_string(got) + " samples, but " + reference + " has " +
+         std::to_string(rows);
+}
+
+// An (N, 3) array into 3-vectors; `rows` = N expected (the length of
+// `reference`), or -1 for any.
+std::vector<Eigen::Vector3d> ToVectors(const py::object& obj, const char* name, py::ssize_t rows,
+                                       const char* reference = "t") {
+  const DoubleArray a = AsDoubles(obj, name);
+  if (a.ndim() != 2 || a.shape(1) != 3) {
+    throw Error(std::string(name) + ": expected an array of shape (N, 3), got shape " +
+                ShapeText(a));
+  }
+  if (rows >= 0 && a.shape(0) != rows) {
+    throw Error(LengthText(name, a.shape(0), reference, rows));
+  }
+  std::vector<Eigen::Vector3d> out(a.shape(0));
+  if (!out.empty()) std::copy(a.data(), a.data() + 3 * out.size(), out.front().data());
+  return out;
+}
+
+std::vector<double> ToScalars(const py::object& obj, const char* name, py::ssize_t rows,
+                              const char* reference = "t") {
+  const DoubleArray a = AsDoubles(obj, name);
+  if (a.ndim() != 1) {
+    throw Error(std::string(name) + ": expected an array of shape (N,), got shape " + ShapeText(a));
+  }
+  if (rows >= 0 && a.shape(0) != rows) {
+    throw Error(LengthText(name, a.shape(0), reference, rows));
+  }
+  return std::vector<double>(a.data(), a.data() + a.shape(0));
+}
+
+// A Python gravcal.Log is a PipelineInput holding the log (source = the
+// log's source, no side input), never changed once made: calibrate hands it
+// to RunCalibration as it is (no copy of the samples), any number of
+// threads may read it at once, and NumPy views of its vectors stay valid.
+using LogHandle = std::shared_ptr<PipelineInput>;
+
+LogHandle WrapLog(ImuLog log) {
+  auto input = std::make_shared<PipelineInput>();
+  input->source = log.source;
+  input->log = std::move(log);
+  return input;
+}
+
+// A log from arrays: t (N,), accel (N, 3), optional gyro (N, 3) and temp
+// (N,). ImuLog::Validate names the first bad sample (NaN, time that does not
+// increase).
+LogHandle MakeLog(const py::object& t, const py::object& accel, const py::object& gyro,
+                  const py::object& temp, const std::string& source) {
+  ImuLog log;
+  log.source = source;
+  log.t = ToScalars(t, "t", -1);
+  const py::ssize_t n = static_cast<py::ssize_t>(log.t.size());
+  log.accel = ToVectors(accel, "accel", n);
+  if (!gyro.is_none()) log.gyro = ToVectors(gyro, "gyro", n);
+  if (!temp.is_none()) log.temperature = ToScalars(temp, "temp", n);
+  std::string error;
+  Check(log.Validate(&error), error);
+  return WrapLog(std::move(log));
+}
+
+LogHandle ReadLog(const std::string& path, const Config& config) {
+  ImuLog log;
+  std::string error;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = ReadImuLog(path, config.input, &log, &error);
+  }
+  Check(ok, error);
+  return WrapLog(std::move(log));
+}
+
+// ---------------------------------------------------------------------------
+// Calibration: the calibration JSON text (what `gravcal calibrate` writes)
+// and the models read back from it (what `gravcal apply` uses).
+
+struct PyCalibration {
+  // The library's result, when made here (null when read from a file).
+  std::shared_ptr<const Calibration> result;
+  bool include_covariance = true;
+  std::string name;
+  // The JSON text (built from `result` on first use) and the models read
+  // back from it, as ReadCalibrationJson would (on first apply).
+  mutable std::string json;
+  mutable bool has_json = false;
+  mutable bool parsed = false;
+  mutable LoadedCalibration models;
+
+  // A file's text, checked at once.
+  static PyCalibration FromText(const std::string& text, const std::string& name) {
+    PyCalibration c;
+    c.json = text;
+    c.has_json = true;
+    c.name = name;
+    c.Models();
+    return c;
+  }
+
+  static PyCalibration FromResult(Calibration&& result, bool include_covariance,
+                                  const std::string& name) {
+    PyCalibration c;
+    c.result = std::make_shared<const Calibration>(std::move(result));
+    c.include_covariance = include_covariance;
+    c.name = name;
+    return c;
+  }
+
+  const std::string& Json() const {
+    if (!has_json) {
+      json = CalibrationToJson(*result, include_covariance);
+      has_json = true;
+    }
+    return json;
+  }
+
+  const LoadedCalibration& Models() const {
+    if (!parsed) {
+      std::string error;
+      Check(ParseCalibrationJson(Json(), name, &models, &error), error);
+      parsed = true;
+    }
+    return models;
+  }
+};
+
+PyCalibration CalibrationFromFile(const std::string& path) {
+  std::string text, error;
+  Check(ReadFileBytes(path, &text, &error), error);
+  return PyCalibration::FromText(text, path);
+}
+
+void WriteCalibration(const PyCalibration& c, const std::string& path) {
+  std::string error;
+  Check(WriteFileAtomically(path, c.Json(), &error), error);
+}
+
+// ===========================================================================
+// APPLY (transitional, issue 16): the one place where the bindings correct
+// raw samples. Until the library's "apply everything" corrector lands, this
+// is what `gravcal apply` does: a = M (v - b) for every accelerometer row
+// and w = M_g (u - b_g) for every gyroscope row when the calibration has a
+// gyroscope. The effect terms (temperature, time, nonlinearity,
+// g-sensitivity) are not applied here; python/gravcal/__init__.py warns
+// when the calibration holds any. `temp` and `t` are checked for shape only,
+// for the corrector that will use them. Swap the body for the library call
+// after the merge.
+py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, const py::object& gyro,
+                           const py::object& temp, const py::object& t) {
+  std::vector<Eigen::Vector3d> a = ToVectors(accel, "accel", -1);
+  const py::ssize_t n = static_cast<py::ssize_t>(a.size());
+  std::vector<Eigen::Vector3d> w;
+  if (!gyro.is_none()) {
+    Check(c.Models().has_gyro, "gyro: the calibration has no gyroscope model");
+    w = ToVectors(gyro, "gyro", n, "accel");
+  }
+  if (!temp.is_none()) ToScalars(temp, "temp", n, "accel");
+  if (!t.is_none()) ToScalars(t, "t", n, "accel");
+  for (const auto* v : {&a, &w}) {
+    for (size_t i = 0; i < v->size(); ++i) {
+      Check((*v)[i].allFinite(), std::string(v == &a ? "accel" : "gyro") + ": row " +
+                                     std::to_string(i) + " is not finite");
+    }
+  }
+  DoubleArray a_out({n, static_cast<py::ssize_t>(3)});
+  DoubleArray w_out({static_cast<py::ssize_t>(w.size()), static_cast<py::ssize_t>(3)});
+  const LoadedCalibration& models = c.Models();
+  {
+    py::gil_scoped_release release;
+    double* ao = a_out.mutable_data();
+    for (size_t i = 0; i < a.size(); ++i) {
+      Eigen::Map<Eigen::Vector3d>(ao + 3 * i) = models.accel.Apply(a[i]);
+    }
+    double* wo = w_out.mutable_data();
+    for (size_t i = 0; i < w.size(); ++i) {
+      Eigen::Map<Eigen::Vector3d>(wo + 3 * i) = models.gyro.Apply(w[i]);
+    }
+  }
+  return py::make_tuple(a_out, gyro.is_none() ? py::object(py::none()) : py::object(w_out));
+}
+// ===========================================================================
+
+// RunCalibration, as `gravcal calibrate` runs it.
+PyCalibration Run(const Config& config, const PipelineInput& input) {
+  Calibration c;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = RunCalibration(config, input, &c);
+  }
+  Check(ok, c.message);
+  return PyCalibration::FromResult(std::move(c), config.output_covariance, input.source);
+}
+
+// On a log in memory: the log itself when there is no side input, else a
+// copy with the side files.
+PyCalibration Calibrate(const Config& config, const LogHandle& log, const std::string& attitudes,
+                        const std::string& segments, const std::string& noise) {
+  CheckConfig(config);
+  if (attitudes.empty() && segments.empty() && noise.empty()) return Run(config, *log);
+  PipelineInput input = *log;
+  input.attitudes_path = attitudes;
+  input.segments_path = segments;
+  input.noise_path = noise;
+  return Run(config, input);
+}
+
+// On a log file, read straight into the pipeline's input.
+PyCalibration CalibrateFile(const Config& config, const std::string& path,
+                            const std::string& attitudes, const std::string& segments,
+                            const std::string& noise) {
+  CheckConfig(config);
+  PipelineInput input;
+  input.source = path;
+  input.attitudes_path = attitudes;
+  input.segments_path = segments;
+  input.noise_path = noise;
+  std::string error;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = ReadImuLog(path, config.input, &input.log, &error);
+  }
+  Check(ok, error);
+  return Run(config, input);
+}
+
+// `gravcal simulate`: the truth (truth.json text), the raw log, the
+// fixture's attitudes (attitudes.csv text) and, for sim_motion rate_table,
+// the segments (segments.csv text, else empty).
+py::tuple SimulateSession(const Config& config, uint64_t seed) {
+  CheckConfig(config);
+  SimulatedSession session;
+  std::vector<RateTableSegment> segments;
+  std::string error;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    if (!config.sim_motion.empty()) {
+      MotionOptions motion = config.motion;
+      FromString(config.sim_motion, &motion.profile);
+      MotionSession moving;
+      ok = SimulateMotion(config.simulation, motion, seed, &moving, &error);
+      segments = moving.segments;
+      session = std::move(moving.sensor);
+    } else {
+      ok = Simulate(config.simulation, seed, &session, &error);
+    }
+  }
+  Check(ok, error);
+  const std::string fixture = FixtureAttitudesToCsv(
+      SimulatedFixtureAttitudes(session, config.simulation.fixture_attitude_noise_deg, seed));
+  const std::string segments_csv =
+      segments.empty() ? "" : RateTableSegmentsToCsv(segments, session.log);
+  const std::string truth = TruthToJson(session, config.simulation);
+  return py::make_tuple(truth, WrapLog(std::move(session.log)), fixture, segments_csv);
+}
+
+// ---------------------------------------------------------------------------
+// Batch.
+
+struct PyBatchResult {
+  std::string unit;
+  std::string status;
+  bool skipped = false;
+  std::string message;
+  std::string content_hash;
+  py::object calibration = py::none();
+  BatchTimings timings;
+};
+
+// One unit as Python describes it: id, path (or empty), log (or None),
+// attitudes path, config overrides.
+struct UnitSpec {
+  std::string id;
+  std::string path;
+  py::object log;
+  std::string attitudes;
+  Keys overrides;
+};
+
+std::vector<PyBatchResult> Batch(const std::vector<BatchUnit>& units, const Config& base,
+                                 int threads) {
+  BatchOptions options;
+  options.threads = threads;
+  std::vector<BatchResult> results;
+  std::string error;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = CalibrateBatch(units, base, options, &results, &error);
+  }
+  Check(ok, error);
+  std::vector<PyBatchResult> out(results.size());
+  for (size_t i = 0; i < results.size(); ++i) {
+    const BatchResult& r = results[i];
+    PyBatchResult& p = out[i];
+    p.unit = r.unit;
+    p.status = ToString(r.status);
+    p.skipped = r.skipped;
+    p.message = r.message;
+    p.content_hash = r.content_hash;
+    p.timings = r.timings;
+    Config config;
+    if (r.status == BatchStatus::kOk && EffectiveConfig(units[i], base, &config, &error)) {
+      // The unit's <unit>.json as `gravcal batch` writes it.
+      p.calibration = py::cast(PyCalibration::FromResult(std::move(results[i].calibration),
+                                                         config.output_covariance, r.unit));
+    }
+  }
+  return out;
+}
+
+std::vector<BatchUnit> UnitsFromSpecs(const std::vector<UnitSpec>& specs) {
+  std::vector<BatchUnit> units(specs.size());
+  for (size_t i = 0; i < specs.size(); ++i) {
+    units[i].id = specs[i].id;
+    units[i].path = specs[i].path;
+    if (!specs[i].log.is_none()) units[i].log = specs[i].log.cast<const PipelineInput&>().log;
+    units[i].attitudes_path = specs[i].attitudes;
+    units[i].overrides = specs[i].overrides;
+  }
+  return units;
+}
+
+// The units of a manifest CSV or of a folder (every file matching
+// `pattern`), as `gravcal batch --manifest` / `--input-dir` find them.
+std::vector<BatchUnit> UnitsFromManifest(const std::string& path, const Config& base) {
+  std::vector<BatchUnit> units;
+  std::string error;
+  Check(ReadBatchManifest(path, base, &units, &error), error);
+  return units;
+}
+
+std::vector<BatchUnit> UnitsFromFolder(const std::string& folder, const std::string& pattern) {
+  std::vector<BatchUnit> units;
+  std::string error;
+  Check(UnitsFromDirectory(folder, pattern, &units, &error), error);
+  return units;
+}
+
+// ---------------------------------------------------------------------------
+// Noise and discovery: the JSON text of noise.json and discovery.json.
+
+std::string Noise(const Config& config, const LogHandle& input) {
+  const ImuLog& log = input->log;
+  // The same options `gravcal noise` builds from the config.
+  NoiseOptions options = config.noise;
+  options.accel_scale = config.calibration.nominal_scale;
+  options.gyro_scale = config.handheld.gyro_nominal_scale;
+  options.detector = config.calibration.detector;
+  std::string error;
+  Check(config.input.IsValid(&error), "input: " + error);
+  Check(options.IsValid(&error), error);
+  ImuNoise noise;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = CharacteriseNoise(log, options, &noise);
+  }
+  Check(ok, noise.message);
+  return NoiseToJson(noise);
+}
+
+py::tuple Discover(const Config& config, const LogHandle& input) {
+  const ImuLog& log = input->log;
+  CheckConfig(config);
+  DiscoveryResult result;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = DiscoverEffects(log, config.calibration, config.effects, config.discovery, &result);
+  }
+  Check(ok, result.message);
+  return py::make_tuple(DiscoveryToJson(result), DiscoveryToHtml(result));
+}
+
+// CPU seconds of the calling thread (the library is single-threaded here:
+// Ceres runs with num_threads 1), which a loaded machine does not inflate
+// the way it does wall time.
+double ThreadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// For benchmarks/python_overhead.py: CPU seconds per call of the C++ user's
+// code, `repeats` calls: ReadImuLog + RunCalibration on `path` (as `gravcal
+// calibrate`), or, with an empty path, RunCalibration on the log in memory.
+double TimeCalibrate(const Config& config, const LogHandle& log, const std::string& path,
+                     int repeats) {
+  py::gil_scoped_release release;
+  const double start = ThreadCpuSeconds();
+  for (int i = 0; i < repeats; ++i) {
+    Calibration c;
+    if (path.empty()) {
+      RunCalibration(config, *log, &c);
+      continue;
+    }
+    PipelineInput input;
+    input.source = path;
+    std::string error;
+    if (ReadImuLog(path, config.input, &input.log, &error)) RunCalibration(config, input, &c);
+  }
+  return (ThreadCpuSeconds() - start) / std::max(repeats, 1);
+}
+
+}  // namespace
+}  // namespace python
+}  // namespace gravcal
+
+PYBIND11_MODULE(_gravcal, m) {
+  using namespace gravcal;
+  using namespace gravcal::python;
+  m.doc() = "gravcal's C++ core; use the gravcal package, not this module.";
+  py::register_exception<gravcal::python::Error>(m, "Error", PyExc_ValueError);
+  m.attr("__version__") = GravcalVersion();
+
+  py::class_<Config>(m, "Config", "A gravcal configuration (the YAML keys).")
+      .def(py::init(&MakeConfig), py::arg("path") = "", py::arg("keys") = Keys{})
+      .def("with_keys", &WithKeys, py::arg("keys"))
+      .def("value",
+           [](const Config& c, const std::string& key) {
+             Check(IsConfigKey(key), "unknown config key '" + key + "'");
+             return ConfigValueText(c, key);
+           })
+      .def_property_readonly("method", [](const Config& c) { return c.method; })
+      .def("text", &ConfigText, "Every key with its value, one 'key: value' line each.");
+  m.def("config_keys", []() {
+    std::vector<std::pair<std::string, std::string>> keys;
+    for (const ConfigKey& k : ConfigKeys()) keys.emplace_back(k.name, k.help);
+    return keys;
+  });
+
+  py::class_<PipelineInput, LogHandle>(m, "Log")
+      .def_property_readonly("source", [](const PipelineInput& l) { return l.log.source; })
+      .def_property_readonly(
+          "t",
+          [](py::object self) { return Scalars(self.cast<const PipelineInput&>().log.t, self); })
+      .def_property_readonly("accel",
+                             [](py::object self) {
+                               return Vectors(self.cast<const PipelineInput&>().log.accel, self);
+                             })
+      .def_property_readonly(
+          "gyro",
+          [](py::object self) { return Vectors(self.cast<const PipelineInput&>().log.gyro, self); })
+      .def_property_readonly("temp",
+                             [](py::object self) {
+                               return Scalars(self.cast<const PipelineInput&>().log.temperature,
+                                              self);
+                             })
+      .def("__len__", [](const PipelineInput& l) { return l.log.size(); })
+      .def("to_csv", [](const PipelineInput& l, const std::string& path) {
+        std::string error;
+        Check(WriteImuLogCsv(l.log, path, &error), error);
+      });
+  m.def("make_log", &MakeLog, py::arg("t"), py::arg("accel"), py::arg("gyro"), py::arg("temp"),
+        py::arg("source"));
+  m.def("read_log", &ReadLog, py::arg("path"), py::arg("config"));
+
+  py::class_<PyCalibration>(m, "Calibration")
+      .def_property_readonly("json", &PyCalibration::Json)
+      .def_property_readonly("has_gyro", [](const PyCalibration& c) { return c.Models().has_gyro; })
+      .def_static("from_file", &CalibrationFromFile)
+      .def_static("from_text",
+                  [](const std::string& text, const std::string& name) {
+                    return PyCalibration::FromText(text, name);
+                  })
+      .def("write", &WriteCalibration)
+      .def("apply", &ApplyCalibration, py::arg("accel"), py::arg("gyro"), py::arg("temp"),
+           py::arg("t"));
+  m.def("calibrate", &Calibrate, py::arg("config"), py::arg("log"), py::arg("attitudes"),
+        py::arg("segments"), py::arg("noise"));
+  m.def("calibrate_file", &CalibrateFile, py::arg("config"), py::arg("path"), py::arg("attitudes"),
+        py::arg("segments"), py::arg("noise"));
+  m.def("simulate", &SimulateSession, py::arg("config"), py::arg("seed"));
+
+  py::class_<BatchUnit>(m, "BatchUnit").def_readonly("id", &BatchUnit::id);
+  py::class_<PyBatchResult>(m, "BatchResult")
+      .def_readonly("unit", &PyBatchResult::unit)
+      .def_readonly("status", &PyBatchResult::status)
+      .def_readonly("skipped", &PyBatchResult::skipped)
+      .def_readonly("message", &PyBatchResult::message)
+      .def_readonly("content_hash", &PyBatchResult::content_hash)
+      .def_readwrite("calibration", &PyBatchResult::calibration)
+      .def_property_readonly("timings", [](const PyBatchResult& r) {
+        py::dict d;
+        d["read_seconds"] = r.timings.read_seconds;
+        d["detect_seconds"] = r.timings.detect_seconds;
+        d["solve_seconds"] = r.timings.solve_seconds;
+        d["total_seconds"] = r.timings.total_seconds;
+        return d;
+      });
+  m.def("units_from_manifest", &UnitsFromManifest, py::arg("path"), py::arg("config"));
+  m.def("units_from_folder", &UnitsFromFolder, py::arg("folder"), py::arg("pattern"));
+  m.def(
+      "units",
+      [](const std::vector<py::tuple>& specs) {
+        std::vector<UnitSpec> s(specs.size());
+        for (size_t i = 0; i < specs.size(); ++i) {
+          s[i].id = specs[i][0].cast<std::string>();
+          s[i].path = specs[i][1].cast<std::string>();
+          s[i].log = specs[i][2];
+          s[i].attitudes = specs[i][3].cast<std::string>();
+          s[i].overrides = specs[i][4].cast<Keys>();
+        }
+        return UnitsFromSpecs(s);
+      },
+      py::arg("specs"));
+  m.def("batch", &Batch, py::arg("units"), py::arg("config"), py::arg("threads"));
+  m.def("noise", &Noise, py::arg("config"), py::arg("log"));
+  m.def("discover", &Discover, py::arg("config"), py::arg("log"));
+  m.def("_time_calibrate", &TimeCalibrate, py::arg("config"), py::arg("log"), py::arg("path"),
+        py::arg("repeats"));
+}
