@@ -1,24 +1,25 @@
 # The readers of bags and MCAP files (src/io/formats, docs/data_contract.md
 # "Formats"): SQLite for rosbag2 .db3, zstd and lz4 for compressed MCAP
-# chunks (required), and, when Debian's librosbag-storage-dev is installed,
+# chunks and zlib for their CRC (required), and, when Debian's librosbag-storage-dev is installed,
 # the ROS project's reader for ROS 1 bags (optional: without it a ROS 1 bag
 # is named and refused).
 find_library(GRAVCAL_SQLITE3_LIBRARY sqlite3)
 find_path(GRAVCAL_SQLITE3_INCLUDE sqlite3.h)
 find_library(GRAVCAL_ZSTD_LIBRARY zstd)
 find_path(GRAVCAL_ZSTD_INCLUDE zstd.h)
+find_library(GRAVCAL_ZLIB_LIBRARY z)
 find_library(GRAVCAL_LZ4_LIBRARY lz4)
 find_path(GRAVCAL_LZ4_INCLUDE lz4frame.h)
-foreach(var GRAVCAL_SQLITE3_LIBRARY GRAVCAL_SQLITE3_INCLUDE GRAVCAL_ZSTD_LIBRARY
+foreach(var GRAVCAL_ZLIB_LIBRARY GRAVCAL_SQLITE3_LIBRARY GRAVCAL_SQLITE3_INCLUDE GRAVCAL_ZSTD_LIBRARY
             GRAVCAL_ZSTD_INCLUDE GRAVCAL_LZ4_LIBRARY GRAVCAL_LZ4_INCLUDE)
   if(NOT ${var})
-    message(FATAL_ERROR "${var} not found: install libsqlite3-dev libzstd-dev liblz4-dev")
+    message(FATAL_ERROR "${var} not found: install libsqlite3-dev libzstd-dev liblz4-dev zlib1g-dev")
   endif()
 endforeach()
 target_include_directories(gravcal SYSTEM PRIVATE
   ${GRAVCAL_SQLITE3_INCLUDE} ${GRAVCAL_ZSTD_INCLUDE} ${GRAVCAL_LZ4_INCLUDE})
 target_link_libraries(gravcal PRIVATE
-  ${GRAVCAL_SQLITE3_LIBRARY} ${GRAVCAL_ZSTD_LIBRARY} ${GRAVCAL_LZ4_LIBRARY})
+  ${GRAVCAL_SQLITE3_LIBRARY} ${GRAVCAL_ZSTD_LIBRARY} ${GRAVCAL_LZ4_LIBRARY} ${GRAVCAL_ZLIB_LIBRARY})
 
 # Debian's rosbag_storage headers include the ROS 2 pluginlib, class_loader,
 # rcpputils, rcutils and ament_index_cpp headers, each in its own folder.

@@ -3,8 +3,10 @@
 // footer and the magic again. Channels and schemas come from the summary
 // section when the footer points to one, otherwise from a first pass over
 // the data section. Chunks are decompressed one at a time (none, zstd, lz4
-// frame), so memory stays bounded by the largest chunk.
+// frame) and checked against their CRC, so memory stays bounded by the
+// largest chunk.
 #include <lz4frame.h>
+#include <zlib.h>
 #include <zstd.h>
 
 #include <cerrno>
@@ -222,7 +224,7 @@ class McapFile : public MessageRecording {
     c->U64();  // message start time
     c->U64();  // message end time
     const uint64_t uncompressed_size = c->U64();
-    c->U32();  // uncompressed CRC
+    const uint32_t crc = c->U32();  // CRC-32 of the uncompressed records; 0 = none.
     const std::string compression = c->String();
     const uint64_t records_size = c->U64();
     const uint8_t* records = c->Bytes(records_size);
@@ -251,6 +253,9 @@ class McapFile : public MessageRecording {
         return Fail(error, where + "chunk compression '" + compression + "' is not supported");
       }
       plain = chunk_.data();
+    }
+    if (crc != 0 && crc32(0L, plain, static_cast<uInt>(uncompressed_size)) != crc) {
+      return Fail(error, where + "chunk fails its CRC check (damaged)");
     }
     // Records inside a chunk are never chunks, so chunk_ stays as it is
     // while they are read.
