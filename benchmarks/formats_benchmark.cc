@@ -4,7 +4,8 @@
 // gravcal, then as EuRoC CSV, rosbag2 .db3 and ROS 1 bags (none, bz2, lz4)
 // by tests/formats/write_formats.py, and as MCAP (plain, zstd, lz4) by
 // tests/formats/write_mcap.mjs when <build>/npm_formats has @mcap/core.
-// A format whose writer is missing is skipped with a message.
+// A format whose writer is missing is skipped with a message. The session is
+// written under /tmp, or read from GRAVCAL_FORMATS_DIR when set.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -22,6 +23,8 @@ constexpr int kSamples = 200000;
 
 const std::string& Folder() {
   static const std::string folder = [] {
+    // GRAVCAL_FORMATS_DIR: a folder already written (the writers take minutes).
+    if (const char* ready = std::getenv("GRAVCAL_FORMATS_DIR")) return std::string(ready);
     const std::string dir = "/tmp/gravcal_formats_benchmark_" + std::to_string(getpid());
     std::filesystem::create_directories(dir);
     ImuLog log;
@@ -83,3 +86,5 @@ BENCHMARK_CAPTURE(BM_ReadFormat, mcap_lz4, "mcap_lz4.mcap")->Unit(benchmark::kMi
 
 }  // namespace
 }  // namespace gravcal
+
+BENCHMARK_MAIN();

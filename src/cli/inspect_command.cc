@@ -23,7 +23,7 @@ int RunInspect(const CommandArgs& args) {
                 t.imu ? "" : "  (not read by gravcal)");
     std::printf("  messages %lld", static_cast<long long>(t.messages));
     if (t.messages > 0) {
-      std::printf(", time %.9g .. %.9g s (span %.6g s)", t.first_s, t.last_s, t.last_s - t.first_s);
+      std::printf(", time %.6f .. %.6f s (span %.6g s)", t.first_s, t.last_s, t.last_s - t.first_s);
     }
     if (t.rate_hz > 0.0) std::printf(", %.6g Hz", t.rate_hz);
     std::printf("\n");
