@@ -21,6 +21,12 @@
 namespace gravcal {
 namespace fuzz {
 
+// Says which part of the invariant broke, then aborts.
+[[noreturn]] inline void Broken(const char* what, const std::string& error) {
+  std::fprintf(stderr, "fuzz invariant broken: %s; error: '%s'\n", what, error.c_str());
+  std::abort();
+}
+
 inline int CheckReader(const uint8_t* data, size_t size, const std::string& prefix,
                        const std::string& extension) {
   const std::string path = "/tmp/gravcal_fuzz_" + std::to_string(getpid()) + extension;
@@ -35,15 +41,14 @@ inline int CheckReader(const uint8_t* data, size_t size, const std::string& pref
   std::remove(path.c_str());
   if (ok) {
     std::string why;
-    if (log.t.empty() || !log.Validate(&why)) std::abort();
+    if (log.t.empty() || !log.Validate(&why)) Broken("log breaks the contract", why);
     for (size_t i = 1; i < log.t.size(); ++i) {
-      if (!(log.t[i] > log.t[i - 1])) std::abort();
+      if (!(log.t[i] > log.t[i - 1])) Broken("time does not increase", "");
     }
-    if (!error.empty() && error.find('\n') != std::string::npos) std::abort();
     return 0;
   }
-  if (error.empty() || error.find('\n') != std::string::npos) std::abort();
-  if (error.compare(0, path.size(), path) != 0) std::abort();
+  if (error.empty() || error.find('\n') != std::string::npos) Broken("not one line", error);
+  if (error.compare(0, path.size(), path) != 0) Broken("does not name the file", error);
   return 0;
 }
 

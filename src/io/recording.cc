@@ -40,7 +40,7 @@ void SummariseTimes(const std::vector<double>& t, TopicSummary* topic) {
 bool InspectMessages(internal::MessageRecording* recording, const std::string& path,
                      const LogReaderOptions& options, RecordingSummary* summary,
                      std::string* error) {
-  const std::vector<internal::RecordingTopic>& topics = recording->topics();
+  const std::vector<internal::RecordingTopic> topics = recording->topics();
   std::vector<TopicSummary> out(topics.size());
   // Times of IMU topics are kept for the interval statistics (8 bytes per
   // message); other topics only count.
@@ -73,8 +73,8 @@ bool InspectMessages(internal::MessageRecording* recording, const std::string& p
   };
   if (!recording->Read(wanted, visit, error)) {
     if (failure.empty()) return false;
-    return SetError(error, path + ": topic '" + topics[failed_topic].name + "' message " +
-                               std::to_string(failed_message) + ": " + failure);
+    return SetError(error, path + ": topic '" + internal::OneLine(topics[failed_topic].name) +
+                               "' message " + std::to_string(failed_message) + ": " + failure);
   }
   for (size_t i = 0; i < topics.size(); ++i) {
     TopicSummary& s = out[i];

@@ -32,6 +32,8 @@ constexpr uint8_t kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x
 constexpr uint64_t kFooterRecord = 1 + 8 + 20;
 // A chunk that claims more than this uncompressed is refused as corrupt.
 constexpr uint64_t kMaxChunkBytes = uint64_t{1} << 30;
+// The topic index of a channel first seen while reading.
+constexpr size_t kNotListed = static_cast<size_t>(-1);
 
 struct FileCloser {
   void operator()(std::FILE* f) const {
@@ -164,6 +166,12 @@ class McapFile : public MessageRecording {
       const std::string encoding = c.String();
       if (!c.ok()) return Fail(error, where + "corrupt channel record");
       if (topic_of_channel_.count(id) != 0) return true;
+      // While reading, topics() must not change: a channel the summary did
+      // not list is not asked for, and its messages are passed over.
+      if (visit != nullptr) {
+        topic_of_channel_[id] = kNotListed;
+        return true;
+      }
       RecordingTopic t;
       t.name = std::move(topic);
       const auto s = schema_names_.find(schema);
@@ -250,7 +258,8 @@ class McapFile : public MessageRecording {
           return Fail(error, where + "lz4 chunk does not decompress");
         }
       } else {
-        return Fail(error, where + "chunk compression '" + compression + "' is not supported");
+        return Fail(error,
+                    where + "chunk compression '" + OneLine(compression) + "' is not supported");
       }
       plain = chunk_.data();
     }

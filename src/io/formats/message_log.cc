@@ -20,7 +20,7 @@ std::string Listing(const std::vector<RecordingTopic>& topics, bool imu_only) {
   std::string out;
   for (const RecordingTopic& t : topics) {
     if (imu_only && !IsImuType(t.type)) continue;
-    out += (out.empty() ? "" : ", ") + t.name + " (" + t.type + ")";
+    out += (out.empty() ? "" : ", ") + OneLine(t.name) + " (" + OneLine(t.type) + ")";
   }
   return out.empty() ? std::string("none") : out;
 }
@@ -35,7 +35,7 @@ bool SelectImuTopic(const MessageRecording& recording, const std::string& path,
     for (size_t i = 0; i < topics.size(); ++i) {
       if (topics[i].name != topic) continue;
       if (!IsImuType(topics[i].type)) {
-        return SetError(error, path + ": topic '" + topic + "' holds " + topics[i].type +
+        return SetError(error, path + ": topic '" + topic + "' holds " + OneLine(topics[i].type) +
                                    ", not sensor_msgs/Imu");
       }
       *index = i;
@@ -83,13 +83,13 @@ bool ReadMessageLog(MessageRecording* recording, const std::string& path,
                     const LogReaderOptions& options, ImuLog* log, std::string* error) {
   size_t index = 0;
   if (!SelectImuTopic(*recording, path, options.topic, &index, error)) return false;
-  const RecordingTopic& topic = recording->topics()[index];
+  const RecordingTopic topic = recording->topics()[index];
   if (topic.encoding == MessageEncoding::kRos1 && !topic.md5sum.empty() &&
       topic.md5sum != kRos1ImuMd5) {
-    return SetError(error, path + ": topic '" + topic.name +
+    return SetError(error, path + ": topic '" + OneLine(topic.name) +
                                "' has a sensor_msgs/Imu definition other than the standard one "
                                "(MD5 " +
-                               topic.md5sum + ")");
+                               OneLine(topic.md5sum) + ")");
   }
   ImuLog read;
   if (topic.messages > 0) {
@@ -99,7 +99,7 @@ bool ReadMessageLog(MessageRecording* recording, const std::string& path,
   }
   std::vector<bool> wanted(recording->topics().size(), false);
   wanted[index] = true;
-  const std::string where = path + ": topic '" + topic.name + "' message ";
+  const std::string where = path + ": topic '" + OneLine(topic.name) + "' message ";
   auto visit = [&](const RecordedMessage& message) {
     int64_t stamp_ns = 0;
     Eigen::Vector3d gyro, accel;
@@ -124,7 +124,8 @@ bool ReadMessageLog(MessageRecording* recording, const std::string& path,
     return true;
   };
   if (!recording->Read(wanted, visit, error)) return false;
-  if (read.t.empty()) return SetError(error, path + ": topic '" + topic.name + "' has no messages");
+  if (read.t.empty())
+    return SetError(error, path + ": topic '" + OneLine(topic.name) + "' has no messages");
   read.source = path;
   *log = std::move(read);
   return true;

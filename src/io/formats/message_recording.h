@@ -59,11 +59,26 @@ class MessageRecording {
   // Reads what the file holds (its topics). Errors are one line
   // "<path>: what is wrong".
   virtual bool Open(const std::string& path, std::string* error) = 0;
+  // Fixed once Open returns: Read never adds to it.
   virtual const std::vector<RecordingTopic>& topics() const = 0;
   // Visits every message of a topic i with wanted[i], in file order.
   virtual bool Read(const std::vector<bool>& wanted, const MessageVisitor& visit,
                     std::string* error) = 0;
 };
+
+// A message from a library (SQLite, librosbag) as one line: line breaks and
+// other control characters become spaces, runs of spaces one, at most 200
+// characters.
+inline std::string OneLine(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    const bool blank = static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == ' ';
+    if (blank && (out.empty() || out.back() == ' ')) continue;
+    out += blank ? ' ' : c;
+    if (out.size() >= 200) return out + "...";
+  }
+  return out;
+}
 
 std::unique_ptr<MessageRecording> NewRos1Bag();
 std::unique_ptr<MessageRecording> NewRosbag2Sqlite();

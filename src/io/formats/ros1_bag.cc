@@ -57,7 +57,7 @@ class Ros1Bag : public MessageRecording {
         topic.messages = one.size();
       }
     } catch (const std::exception& e) {
-      return Fail(error, std::string("not a readable ROS 1 bag: ") + e.what());
+      return Fail(error, "not a readable ROS 1 bag: " + OneLine(e.what()));
     }
     return true;
   }
@@ -84,7 +84,7 @@ class Ros1Bag : public MessageRecording {
         if (!visit(message)) return false;
       }
     } catch (const std::exception& e) {
-      return Fail(error, std::string("corrupt ROS 1 bag: ") + e.what());
+      return Fail(error, "corrupt ROS 1 bag: " + OneLine(e.what()));
     }
     return true;
   }

@@ -99,7 +99,7 @@ class Rosbag2Sqlite : public MessageRecording {
     return false;
   }
   std::string Why(const std::string& what) const {
-    return what + " (" + sqlite3_errmsg(db_.get()) + ")";
+    return what + " (" + OneLine(sqlite3_errmsg(db_.get())) + ")";
   }
   bool Prepare(const char* sql, Statement* statement, std::string* error) {
     sqlite3_stmt* s = nullptr;
