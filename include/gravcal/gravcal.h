@@ -45,6 +45,7 @@
 #include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
+#include "gravcal/io/recording.h"
 
 // simulation
 #include "gravcal/simulation/handheld_simulator.h"

@@ -193,8 +193,15 @@ int ExitCode(const FleetStatistics& s) {
 
 int RunBatch(const CommandArgs& args) {
   if (args.output_dir.empty()) return Fail("batch needs --output-dir <folder>");
-  if (args.manifest.empty() == args.input_dir.empty()) {
-    return Fail("batch needs either --manifest <units.csv> or --input-dir <folder>");
+  const bool by_topic = !args.topics.empty();
+  if (by_topic && (args.topics != "all" || args.input.empty())) {
+    return Fail("--topics takes 'all', with --input <bag or MCAP file>");
+  }
+  if (by_topic ? !args.manifest.empty() || !args.input_dir.empty()
+               : args.manifest.empty() == args.input_dir.empty()) {
+    return Fail(
+        "batch needs either --manifest <units.csv>, --input-dir <folder> or --input "
+        "<bag> --topics all");
   }
   std::string error;
   if (!args.config.IsValid(&error)) return Fail(error);
@@ -210,7 +217,8 @@ int RunBatch(const CommandArgs& args) {
   if (!args.shard.empty() && !ParseShard(args.shard, &shard, &error)) return Fail(error);
 
   std::vector<BatchUnit> fleet;
-  const bool listed = args.manifest.empty()
+  const bool listed = by_topic ? UnitsFromTopics(args.input, &fleet, &error)
+                      : args.manifest.empty()
                           ? UnitsFromDirectory(args.input_dir, args.pattern, &fleet, &error)
                           : ReadBatchManifest(args.manifest, args.config, &fleet, &error);
   if (!listed) return Fail(error);

@@ -42,6 +42,8 @@ struct CommandArgs {
   int outlier_min_units = 5;
   // Arguments that are not flags (merge-summaries: the shard folders).
   std::vector<std::string> positional;
+  // batch: "all" makes one unit per sensor_msgs/Imu topic of --input.
+  std::string topics;
 };
 
 int RunDemo(const CommandArgs& args);
@@ -57,6 +59,8 @@ int RunMergeSummaries(const CommandArgs& args);
 int RunDiscover(const CommandArgs& args);
 // noise_command.cc: 0 written; 1 bad input (nothing written).
 int RunNoise(const CommandArgs& args);
+// inspect_command.cc: 0 the file was read; 1 it cannot be.
+int RunInspect(const CommandArgs& args);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

@@ -43,6 +43,8 @@ DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) h
 DEFINE_string(report, "", "HTML report to write (discover)");
 DEFINE_string(kalibr, "", "noise: also write Kalibr's imu.yaml (continuous-time densities) here");
 DEFINE_string(handheld, "", "noise: also write the handheld filter's hk_* noise keys (YAML) here");
+DEFINE_string(topics, "",
+              "batch: 'all' makes one unit per sensor_msgs/Imu topic of the bag --input");
 DEFINE_string(noise, "",
               "noise.json from 'gravcal noise': the variance of each pose's mean, and the "
               "handheld filter's noise, from the noise model");
@@ -83,7 +85,7 @@ const std::vector<CommandInfo>& Commands() {
        "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
        "statistics)",
        {"manifest", "input_dir", "pattern", "config", "output_dir", "threads", "shard",
-        "outlier_sigmas", "outlier_min_units"},
+        "outlier_sigmas", "outlier_min_units", "input", "topics"},
        gravcal::cli::RunBatch},
       {"merge-summaries",
        "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
@@ -100,6 +102,10 @@ const std::vector<CommandInfo>& Commands() {
        "Kalibr's imu.yaml",
        {"input", "config", "output", "kalibr", "handheld"},
        gravcal::cli::RunNoise},
+      {"inspect",
+       "what a log file holds: format, topics and types, message counts, rates, time span, gaps",
+       {"input", "config"},
+       gravcal::cli::RunInspect},
       {"help",
        "list commands, or the flags and config keys of one: gravcal help <command>",
        {},
@@ -279,6 +285,7 @@ int main(int argc, char** argv) {
   args.kalibr = FLAGS_kalibr;
   args.handheld = FLAGS_handheld;
   args.noise = FLAGS_noise;
+  args.topics = FLAGS_topics;
 
   return info->run(args);
 }

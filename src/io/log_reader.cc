@@ -16,6 +16,8 @@
 
 #include "io/csv_table.h"
 #include "io/file_text.h"
+#include "io/formats/file_format.h"
+#include "io/formats/message_log.h"
 
 namespace gravcal {
 namespace {
@@ -438,8 +440,20 @@ bool ParseImpl(std::string_view text, const std::string& name, const LogReaderOp
                ImuLog* log, std::string* error) {
   std::string why;
   if (!options.IsValid(&why)) return SetError(error, name + ": invalid options: " + why);
+  internal::FileFormat format = internal::FileFormat::kText;
+  if (!internal::DetectFileFormat(text.substr(0, 4096), &format, &why)) {
+    return SetError(error, name + ": " + why);
+  }
+  if (internal::NewMessageRecording(format) != nullptr) {
+    return SetError(error, name + ": a " + internal::FileFormatName(format) +
+                               " is read from its file, not from memory");
+  }
+  // An EuRoC / TUM-VI header is the header row once its '#' is dropped.
+  const bool euroc = format == internal::FileFormat::kEuroc && internal::LayoutFromFile(options);
+  const LogReaderOptions& layout = euroc ? internal::EurocOptions(options) : options;
+  if (euroc) text.remove_prefix(1);
   ImuLog parsed;
-  Parser parser(name, options, nullptr, name);
+  Parser parser(name, layout, nullptr, name);
   if (!parser.Parse(text, &parsed, error)) return false;
   if (parsed.t.empty()) return SetError(error, name + ": no samples");
 
@@ -535,6 +549,15 @@ bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog
                 std::string* error) {
   if (log == nullptr) return SetError(error, path + ": no log to read into");
   try {
+    internal::FileFormat format = internal::FileFormat::kText;
+    if (!internal::DetectFileFormatOf(path, &format, error)) return false;
+    if (std::unique_ptr<internal::MessageRecording> recording =
+            internal::NewMessageRecording(format)) {
+      std::string why;
+      if (!options.IsValid(&why)) return SetError(error, path + ": invalid options: " + why);
+      return recording->Open(path, error) &&
+             internal::ReadMessageLog(recording.get(), path, options, log, error);
+    }
     FileText text;
     if (!text.Read(path, error)) return false;
     return ParseImpl(text.view(), path, options, log, error);

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "gravcal/io/log_reader.h"
+#include "gravcal/io/recording.h"
 #include "gravcal/workflows/pipeline.h"
 #include "util/content_hash.h"
 #include "util/thread_pool.h"
@@ -80,7 +81,11 @@ void RunUnit(size_t index, const BatchUnit& unit, const Config& base, const Batc
   } else {
     // Exactly what ReadImuLog does after reading the file.
     input.source = unit.path;
-    if (!ParseImuLog(log_bytes, unit.path, config.input, &input.log, &error)) return stop(error);
+    // Bags and MCAP files are read from the file, message by message.
+    const bool read = IsMessageRecording(std::string_view(log_bytes).substr(0, 4096))
+                          ? ReadImuLog(unit.path, config.input, &input.log, &error)
+                          : ParseImuLog(log_bytes, unit.path, config.input, &input.log, &error);
+    if (!read) return stop(error);
   }
   const Clock::time_point read_end = Clock::now();
   const bool ok = RunCalibration(config, input, &r->calibration);

@@ -12,6 +12,7 @@
 #include <system_error>
 
 #include "gravcal/io/log_reader.h"
+#include "gravcal/io/recording.h"
 #include "io/csv_table.h"
 
 namespace gravcal {
@@ -204,6 +205,33 @@ bool UnitsFromDirectory(const std::string& folder, const std::string& pattern,
     const auto [it, inserted] = file_of_unit.emplace(unit.id, file);
     if (!inserted) {
       *error = unit.path + ": unit id '" + unit.id + "' is also the id of " + it->second;
+      return false;
+    }
+    out.push_back(std::move(unit));
+  }
+  *units = std::move(out);
+  return true;
+}
+
+bool UnitsFromTopics(const std::string& path, std::vector<BatchUnit>* units, std::string* error) {
+  std::vector<std::string> topics;
+  if (!ListImuTopics(path, &topics, error)) return false;
+  std::vector<BatchUnit> out;
+  std::set<std::string> ids;
+  for (const std::string& topic : topics) {
+    if (topic.empty()) {
+      *error = path + ": --topics all needs a bag or MCAP file; this is a text log";
+      return false;
+    }
+    BatchUnit unit;
+    unit.id = topic.substr(topic[0] == '/' ? 1 : 0);
+    std::replace(unit.id.begin(), unit.id.end(), '/', '_');
+    unit.path = path;
+    unit.overrides = {{"topic", topic}};
+    std::string why;
+    if (!IsValidUnitId(unit.id, &why) || !ids.insert(unit.id).second) {
+      *error = path + ": topic '" + topic + "' does not make a unit id: " +
+               (why.empty() ? "another topic gives the same id" : why);
       return false;
     }
     out.push_back(std::move(unit));

@@ -13,6 +13,10 @@
 // drops metadata lines before the header, and a log without a time column gets
 // t = index / sample_rate.
 //
+// ROS 1 bags, rosbag2 .db3, MCAP files and EuRoC / TUM-VI CSV are recognised
+// from their first bytes (gravcal/io/recording.h); for them the layout keys
+// above do not apply.
+//
 // Every error names the file and line: "session.csv:17: column 'ay': 'abc' is
 // not a number".
 #ifndef GRAVCAL_IO_LOG_READER_H_
@@ -46,6 +50,12 @@ struct LogReaderOptions {
   // gyro_columns), sample for sample with the first.
   std::string gyro_path;
   std::vector<std::string> gyro_columns = {"t", "gx", "gy", "gz"};
+  // Bags and MCAP files (gravcal/io/recording.h): the sensor_msgs/Imu topic
+  // to read; empty takes the only one (several are an error listing them).
+  std::string topic;
+  // Bags and MCAP files: t is the time the recorder received each message
+  // instead of its header.stamp.
+  bool record_time = false;
 
   bool IsValid(std::string* error) const;
 };

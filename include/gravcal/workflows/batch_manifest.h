@@ -44,6 +44,11 @@ bool ParseBatchManifest(std::string_view text, const std::string& name, const st
 bool UnitsFromDirectory(const std::string& folder, const std::string& pattern,
                         std::vector<BatchUnit>* units, std::string* error);
 
+// One unit per sensor_msgs/Imu topic of the bag or MCAP file at `path`
+// (batch --topics all): id = the topic without its leading '/', other '/'
+// as '_' ("/imu0" -> "imu0"), with the override topic = the topic's name.
+bool UnitsFromTopics(const std::string& path, std::vector<BatchUnit>* units, std::string* error);
+
 // Shard K of N: the units whose 0-based position i in the whole list has
 // i mod N == K - 1. Deterministic, balanced to one unit, and independent of
 // the files' contents.

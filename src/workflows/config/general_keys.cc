@@ -73,6 +73,10 @@ ConfigSection InputSection() {
                          "multiplies the time column (1e-9 for nanoseconds)"),
           GRAVCAL_STRING("gyro_path", input.gyro_path,
                          "second whitespace file with t gx gy gz sharing the timestamps"),
+          GRAVCAL_STRING("topic", input.topic,
+                         "bags and MCAP: the sensor_msgs/Imu topic (empty: the only one)"),
+          GRAVCAL_BOOL("record_time", input.record_time,
+                       "bags and MCAP: t from the recorder's receive time, not header.stamp"),
       }};
 }
 

@@ -1,0 +1,11 @@
+// libFuzzer target: rosbag2 SQLite bags (the whole file is fuzzed; seed with a .db3) through
+// ReadImuLog. Invariant (fuzz_recording.h): a contract-satisfying log or a one-line error naming
+// the file.
+#include <cstddef>
+#include <cstdint>
+
+#include "fuzz_recording.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  return gravcal::fuzz::CheckReader(data, size, "", ".db3");
+}
