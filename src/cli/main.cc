@@ -40,7 +40,7 @@ DEFINE_string(segments, "",
               "CSV of the constant-rate segments, t_begin, t_end, rates (methods that need a rate "
               "table)");
 DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
-DEFINE_string(report, "", "HTML report to write (discover)");
+DEFINE_string(report, "", "HTML report to write (calibrate, batch, noise, discover)");
 DEFINE_string(kalibr, "", "noise: also write Kalibr's imu.yaml (continuous-time densities) here");
 DEFINE_string(handheld, "", "noise: also write the handheld filter's hk_* noise keys (YAML) here");
 DEFINE_string(noise, "",
@@ -68,7 +68,7 @@ const std::vector<CommandInfo>& Commands() {
       {"calibrate",
        "calibrate the sensors from a log with the config's method (the config key 'method' "
        "lists them)",
-       {"input", "config", "output", "attitudes", "segments", "history", "noise"},
+       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report"},
        gravcal::cli::RunCalibrate},
       {"apply",
        "apply a calibration to a raw log, writing SI units",
@@ -83,7 +83,7 @@ const std::vector<CommandInfo>& Commands() {
        "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
        "statistics)",
        {"manifest", "input_dir", "pattern", "config", "output_dir", "threads", "shard",
-        "outlier_sigmas", "outlier_min_units"},
+        "outlier_sigmas", "outlier_min_units", "report"},
        gravcal::cli::RunBatch},
       {"merge-summaries",
        "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
@@ -98,7 +98,7 @@ const std::vector<CommandInfo>& Commands() {
       {"noise",
        "the noise model of a still log (Allan deviation: N, B, K per axis): noise.json, and "
        "Kalibr's imu.yaml",
-       {"input", "config", "output", "kalibr", "handheld"},
+       {"input", "config", "output", "kalibr", "handheld", "report"},
        gravcal::cli::RunNoise},
       {"help",
        "list commands, or the flags and config keys of one: gravcal help <command>",
