@@ -168,25 +168,23 @@ std::string ResidualPlots(const Calibration& c) {
   Series nominal, coarse, refined;
   nominal.style = SeriesStyle::kBars;
   nominal.color = "#7f7f7f";
-  nominal.name = "|a| - g with the nominal scale";
   coarse.style = refined.style = SeriesStyle::kPoints;
   coarse.name = "after the coarse fit";
   coarse.color = "#ff7f0e";
   refined.name = "after refinement";
   refined.color = "#1f77b4";
   refined.css_class = "pose-residual";
-  bool have_nominal = false, have_sigma = false;
+  bool have_nominal = false;
   for (size_t k = 0; k < n; ++k) {
     const PositionReport& p = c.positions[k];
     const double x = static_cast<double>(k + 1);
     nominal.x.push_back(x);
     nominal.y.push_back(p.residual_nominal);
     have_nominal |= std::isfinite(p.residual_nominal);
-    coarse.x.push_back(x - 0.12);
+    coarse.x.push_back(x);
     coarse.y.push_back(p.sigma > 0 ? p.residual_coarse / p.sigma : NAN);
-    refined.x.push_back(x + 0.12);
+    refined.x.push_back(x);
     refined.y.push_back(AfterSigma(p));
-    have_sigma |= std::isfinite(refined.y.back());
     refined.titles.push_back("pose " + std::to_string(k + 1) + ": " +
                              FormatNumber(refined.y.back(), "%.2f") + " sigma (" +
                              FormatNumber(p.residual_after, "%.3g") + " m/s^2)");
@@ -194,23 +192,27 @@ std::string ResidualPlots(const Calibration& c) {
   std::string out;
   if (have_nominal) {
     Plot p;
-    p.title = "Before calibration: |a| - g per pose with the nominal scale";
+    p.title = "|a| - g per pose, nominal scale";
     p.x = {"pose", internal::AxisScale::kLinear, 0.4, n + 0.6, false, true};
     p.y.label = "|a| - g, m/s^2";
     p.y.include_zero = true;
-    p.width = 560;
-    nominal.name.clear();
+    p.width = 370;
     p.series.push_back(nominal);
     out += internal::RenderPlot(p);
   }
-  if (have_sigma) {
+  // Coarse and refined residuals apart: the coarse ones can be a hundred
+  // times the refined ones, which would flatten the +-3 sigma band.
+  for (const Series* s : {&coarse, &refined}) {
+    bool any = false;
+    for (double y : s->y) any |= std::isfinite(y);
+    if (!any) continue;
     Plot p;
-    p.title = "Per pose |a| - g in sigma; the band is +-3 sigma";
+    p.title = "|a| - g / sigma, " + s->name;
     p.x = {"pose", internal::AxisScale::kLinear, 0.4, n + 0.6, false, true};
     p.y.label = "|a| - g / sigma of the pose";
     p.y.include_zero = true;
-    p.width = 560;
-    p.css_class = "plot-residuals";
+    p.width = 370;
+    p.css_class = s == &refined ? "plot-residuals" : "plot-residuals-coarse";
     for (double level : {-3.0, 3.0}) {
       Rule r;
       r.value = level;
@@ -218,14 +220,9 @@ std::string ResidualPlots(const Calibration& c) {
       r.label = level > 0 ? "+3 sigma" : "-3 sigma";
       p.rules.push_back(r);
     }
-    for (double level : {-1.0, 1.0}) {
-      Rule r;
-      r.value = level;
-      r.color = "#bbb";
-      p.rules.push_back(r);
-    }
-    p.series.push_back(coarse);
-    p.series.push_back(refined);
+    Series points = *s;
+    points.name.clear();
+    p.series.push_back(points);
     out += internal::RenderPlot(p);
   }
   return out;

@@ -88,8 +88,9 @@ AxisMap SettleAxis(const AxisSpec& spec, double data_lo, double data_hi) {
     return a;
   }
   if (!std::isfinite(lo) || !std::isfinite(hi)) lo = 0.0, hi = 1.0;
-  NiceTicks t = MakeNiceTicks(lo, hi, 6);
-  if (spec.integer && t.step < 1.0) t = MakeNiceTicks(std::floor(lo), std::ceil(hi), 1);
+  // Integer axes (poses, rotations) label every integer up to 20 of them.
+  const int target = spec.integer ? std::max(6, std::min(20, static_cast<int>(hi - lo))) : 6;
+  NiceTicks t = MakeNiceTicks(lo, hi, target);
   if (spec.integer && t.step < 1.0) {
     t.step = 1.0;
     t.values.clear();
@@ -217,7 +218,7 @@ std::string RenderPlot(const Plot& plot) {
       Extend(r.value, &y_lo, &y_hi);
     }
   }
-  const double left = 84, right = any_end_label ? 170 : 24, top = any_legend ? 50 : 34, bottom = 50;
+  const double left = 84, right = any_end_label ? 200 : 24, top = any_legend ? 50 : 34, bottom = 50;
   const double w = plot.width - left - right, h = plot.height - top - bottom;
   AxisMap xa = SettleAxis(plot.x, x_lo, x_hi);
   AxisMap ya = SettleAxis(plot.y, y_lo, y_hi);
@@ -364,7 +365,8 @@ std::string RenderPlot(const Plot& plot) {
       o << "<line x1='0' x2='" << Px(w) << "' y1='" << Px(py) << "' y2='" << Px(py) << "' stroke='"
         << r.color << "' stroke-width='1.4'" << Dash(r.dashed) << "/>";
       if (!r.label.empty()) {
-        o << "<text x='" << Px(w - 4) << "' y='" << Px(py - 4)
+        // Below a line under zero, above one over it: +-k pairs stay apart.
+        o << "<text x='" << Px(w - 4) << "' y='" << Px(r.value < 0 ? py + 13 : py - 4)
           << "' class='rule-label' text-anchor='end' fill='" << r.color << "'>"
           << HtmlEscape(r.label) << "</text>";
       }
@@ -378,8 +380,10 @@ std::string RenderPlot(const Plot& plot) {
   for (const Series& s : plot.series) {
     if (s.end_label.empty()) continue;
     for (size_t i = std::min(s.x.size(), s.y.size()); i-- > 0;) {
+      // The last point inside the area (a term's line may leave it).
       if (!xa.Valid(s.x[i]) || !ya.Valid(s.y[i])) continue;
-      const double py = std::max(0.0, std::min(h, ya(s.y[i])));
+      const double py = ya(s.y[i]);
+      if (py < 0 || py > h) continue;
       ends.push_back(
           {top + py, "<tspan fill='" + s.color + "'>" + HtmlEscape(s.end_label) + "</tspan>"});
       break;
@@ -497,7 +501,7 @@ std::string RenderSphere(const std::string& title, const std::vector<Eigen::Vect
   std::ostringstream o;
   o << "<svg xmlns='http://www.w3.org/2000/svg' class='plot sphere' width='620' height='330'>"
     << "<text x='310' y='20' class='plot-title'>" << HtmlEscape(title) << "</text>";
-  const char* names[2] = {"+z half (z up to the side)", "-z half"};
+  const char* names[2] = {"z >= 0 (seen from +z)", "z < 0 (seen through from +z)"};
   for (int half = 0; half < 2; ++half) {
     o << "<text x='" << Px(cx[half]) << "' y='44' text-anchor='middle' class='axis-label'>"
       << names[half] << "</text>";
