@@ -146,6 +146,11 @@ std::string RawPlot(const ImuLog& log, const std::vector<Eigen::Vector3d>& v, co
   Plot p;
   p.title = std::string(what) + " against time; shaded and numbered: the static intervals used";
   p.x.label = "time, s";
+  // The time axis spans the log exactly (ticks inside it).
+  if (!log.t.empty()) {
+    p.x.lo = log.t.front();
+    p.x.hi = log.t.back();
+  }
   p.y.label = std::string(what) + ", raw units";
   p.width = 1120;
   p.height = 330;

@@ -126,7 +126,7 @@ std::string FleetToHtml(const FleetStatistics& s, const std::vector<SummaryRow>&
     << "</b></div>\n";
 
   h << "<h2 id='throughput'>Throughput</h2><table class='throughput'>"
-    << "<tr><th>units calibrated</th><td class='num'>" << t.computed << "</td></tr>"
+    << "<tr><th>units run</th><td class='num'>" << t.computed << "</td></tr>"
     << "<tr><th>reused (stored result up to date)</th><td class='num'>" << t.skipped << "</td></tr>"
     << "<tr><th>wall-clock time, s</th><td class='num'>" << FormatNumber(t.elapsed_seconds, "%.2f")
     << "</td></tr><tr><th>units per second</th><td class='num'>"
