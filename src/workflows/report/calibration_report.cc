@@ -74,9 +74,9 @@ Verdict Judge(const Calibration& c) {
                               (c.warnings.size() > 1 ? "s" : "") + " (explained below)");
   }
   if (v.reasons.empty()) {
-    v.reasons.push_back(
-        "every pose within 3 sigma, the residuals match the noise, every parameter determined "
-        "and no warning");
+    v.reasons.push_back(std::string(c.positions.empty() ? "" : "every pose within 3 sigma, ") +
+                        "the residuals match the noise, every parameter determined and no "
+                        "warning");
   }
   return v;
 }
