@@ -72,4 +72,5 @@
 #include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/pipeline.h"
 #include "gravcal/workflows/rate_table_segments.h"
+#include "gravcal/workflows/report.h"
 #endif  // GRAVCAL_GRAVCAL_H_

@@ -30,6 +30,7 @@
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/batch_manifest.h"
 #include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/report.h"
 
 namespace gravcal {
 namespace cli {
@@ -306,6 +307,13 @@ int RunBatch(const CommandArgs& args) {
   if (!WriteSummary(out, rows, info, fleet_options, &statistics, &error)) return Fail(error);
   ReportFleet(statistics);
   const size_t computed = units.size() - skipped;
+  if (!args.report.empty()) {
+    const BatchThroughput throughput = {elapsed,          computed,           skipped,
+                                        sum.read_seconds, sum.detect_seconds, sum.solve_seconds};
+    if (!WriteFileAtomically(args.report, FleetToHtml(statistics, rows, throughput), &error)) {
+      return Fail(error);
+    }
+  }
   const double busy = sum.read_seconds + sum.detect_seconds + sum.solve_seconds;
   std::fprintf(
       stderr,

@@ -14,6 +14,7 @@
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/pipeline.h"
 #include "gravcal/workflows/rate_table_segments.h"
+#include "gravcal/workflows/report.h"
 
 namespace gravcal {
 namespace cli {
@@ -115,6 +116,11 @@ int RunCalibrate(const CommandArgs& args) {
   Calibration c;
   const bool ok = RunCalibration(args.config, input, &c);
   PrintWarnings(c);
+  // The report also for a failed calibration: it says why.
+  if (!args.report.empty() &&
+      !WriteFileAtomically(args.report, CalibrationToHtml(c, input.log, args.input), &error)) {
+    return Fail(error);
+  }
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
   if (!args.history.empty() && !WriteHistoryCsv(c, args.history, &error)) return Fail(error);

@@ -24,7 +24,7 @@ struct CommandArgs {
   std::string segments;
   // calibrate: the time history CSV of recursive methods (--history).
   std::string history;
-  // discover: the HTML report to write (optional).
+  // calibrate, batch, noise, discover: the HTML report to write (optional).
   std::string report;
   // noise: Kalibr's imu.yaml and the handheld filter's keys (optional).
   std::string kalibr;

@@ -40,7 +40,7 @@ DEFINE_string(segments, "",
               "CSV of the constant-rate segments, t_begin, t_end, rates (methods that need a rate "
               "table)");
 DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
-DEFINE_string(report, "", "HTML report to write (discover)");
+DEFINE_string(report, "", "HTML report to write (calibrate, batch, noise, discover)");
 DEFINE_string(kalibr, "", "noise: also write Kalibr's imu.yaml (continuous-time densities) here");
 DEFINE_string(handheld, "", "noise: also write the handheld filter's hk_* noise keys (YAML) here");
 DEFINE_string(topics, "",
@@ -70,7 +70,7 @@ const std::vector<CommandInfo>& Commands() {
       {"calibrate",
        "calibrate the sensors from a log with the config's method (the config key 'method' "
        "lists them)",
-       {"input", "config", "output", "attitudes", "segments", "history", "noise"},
+       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report"},
        gravcal::cli::RunCalibrate},
       {"apply",
        "apply a calibration to a raw log, writing SI units",
@@ -85,7 +85,7 @@ const std::vector<CommandInfo>& Commands() {
        "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
        "statistics)",
        {"manifest", "input_dir", "pattern", "config", "output_dir", "threads", "shard",
-        "outlier_sigmas", "outlier_min_units", "input", "topics"},
+        "outlier_sigmas", "outlier_min_units", "input", "topics", "report"},
        gravcal::cli::RunBatch},
       {"merge-summaries",
        "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
@@ -100,7 +100,7 @@ const std::vector<CommandInfo>& Commands() {
       {"noise",
        "the noise model of a still log (Allan deviation: N, B, K per axis): noise.json, and "
        "Kalibr's imu.yaml",
-       {"input", "config", "output", "kalibr", "handheld"},
+       {"input", "config", "output", "kalibr", "handheld", "report"},
        gravcal::cli::RunNoise},
       {"inspect",
        "what a log file holds: format, topics and types, message counts, rates, time span, gaps",

@@ -9,6 +9,7 @@
 #include "gravcal/core/gravity.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
+#include "gravcal/workflows/report.h"
 
 namespace gravcal {
 namespace cli {
@@ -88,7 +89,8 @@ int RunNoise(const CommandArgs& args) {
     return true;
   };
   if (!write(args.output, NoiseToJson(noise)) || !write(args.kalibr, kalibr) ||
-      !write(args.handheld, NoiseToHandheldYaml(noise.model))) {
+      !write(args.handheld, NoiseToHandheldYaml(noise.model)) ||
+      !write(args.report, args.report.empty() ? "" : NoiseToHtml(noise, args.input))) {
     return Fail(error);
   }
   const char* axes = "xyz";

@@ -81,6 +81,7 @@ void ReportPositions(const std::vector<Position>& positions, const AccelModel& n
   for (size_t k = 0; k < positions.size(); ++k) {
     c.positions.push_back(
         MakePositionReport(positions[k], before[k], after[k], k < sigmas.size() ? sigmas[k] : NAN));
+    c.positions.back().residual_nominal = before[k];
   }
 }
 

@@ -156,8 +156,11 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
   // Residual summaries.
   AccelModel nominal;
   nominal.upper = options.nominal_scale * Eigen::Matrix3d::Identity();
-  c.residual_nominal = Summarise(MagnitudeResiduals(placed, nominal, c.gravity));
-  c.residual_coarse = Summarise(MagnitudeResiduals(placed, c.coarse.model, c.gravity));
+  const std::vector<double> nominal_residuals = MagnitudeResiduals(placed, nominal, c.gravity);
+  const std::vector<double> coarse_residuals =
+      MagnitudeResiduals(placed, c.coarse.model, c.gravity);
+  c.residual_nominal = Summarise(nominal_residuals);
+  c.residual_coarse = Summarise(coarse_residuals);
   c.residual_refined = Summarise(MagnitudeResiduals(placed, c.accel.model, c.gravity));
 
   AddHousingRotation(placed, p, &c);
@@ -167,6 +170,8 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
     c.positions.push_back(internal::MakePositionReport(
         placed[k], c.refinement.residuals_before[k],
         c.refinement.residuals_after.empty() ? NAN : c.refinement.residuals_after[k], sigmas[k]));
+    c.positions.back().residual_nominal = nominal_residuals[k];
+    c.positions.back().residual_coarse = coarse_residuals[k];
   }
 
   const std::vector<std::string>& undetermined = c.refinement.observability.undetermined;

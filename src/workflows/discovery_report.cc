@@ -8,6 +8,7 @@
 
 #include "io/json_helpers.h"
 #include "util/statistics.h"
+#include "workflows/report/svg_plot.h"
 
 namespace gravcal {
 
@@ -161,171 +162,64 @@ json ModelJson(const ModelAssessment& m) {
 }
 
 // ---------------------------------------------------------------------------
-// HTML.
+// HTML, drawn with the report plotting module (workflows/report/svg_plot.h).
 
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+using internal::HtmlEscape;
+using internal::Series;
+using internal::SeriesStyle;
 
-std::string Num(double v, const char* format = "%.4g") {
-  if (!std::isfinite(v)) return "&ndash;";
-  char b[64];
-  std::snprintf(b, sizeof(b), format, v);
-  return b;
-}
-
-struct Series {
-  std::string name;
-  std::string color;
-  std::vector<double> x;
-  std::vector<double> y;
-};
-
-// Plot frame: 560 x 300 px with margins; maps data to pixels.
-struct Frame {
-  double x0 = 0, x1 = 1, y0 = 0, y1 = 1;
-  static constexpr double kW = 560, kH = 300, kL = 70, kR = 20, kT = 30, kB = 45;
-  double X(double x) const { return kL + (x - x0) / (x1 - x0) * (kW - kL - kR); }
-  double Y(double y) const { return kH - kB - (y - y0) / (y1 - y0) * (kH - kT - kB); }
-};
-
-void Range(const std::vector<double>& v, double* lo, double* hi) {
-  for (double x : v) {
-    if (!std::isfinite(x)) continue;
-    *lo = std::min(*lo, x);
-    *hi = std::max(*hi, x);
-  }
-}
-
-void Pad(double* lo, double* hi) {
-  if (!(*hi > *lo)) {
-    const double c = std::isfinite(*lo) ? *lo : 0.0;
-    *lo = c - 1.0;
-    *hi = c + 1.0;
-    return;
-  }
-  const double p = 0.06 * (*hi - *lo);
-  *lo -= p;
-  *hi += p;
-}
-
-std::string Axes(const Frame& f, const std::string& title, const std::string& xlabel,
-                 const std::string& ylabel) {
-  std::ostringstream s;
-  s << "<rect x='" << Frame::kL << "' y='" << Frame::kT << "' width='"
-    << Frame::kW - Frame::kL - Frame::kR << "' height='" << Frame::kH - Frame::kT - Frame::kB
-    << "' fill='none' stroke='#888'/>";
-  for (int i = 0; i <= 4; ++i) {
-    const double xv = f.x0 + (f.x1 - f.x0) * i / 4.0;
-    const double yv = f.y0 + (f.y1 - f.y0) * i / 4.0;
-    s << "<text x='" << f.X(xv) << "' y='" << Frame::kH - Frame::kB + 15
-      << "' font-size='10' text-anchor='middle'>" << Num(xv, "%.3g") << "</text>";
-    s << "<text x='" << Frame::kL - 4 << "' y='" << f.Y(yv) + 3
-      << "' font-size='10' text-anchor='end'>" << Num(yv, "%.3g") << "</text>";
-  }
-  s << "<text x='" << Frame::kW / 2 << "' y='16' font-size='13' text-anchor='middle'>"
-    << Escape(title) << "</text>";
-  s << "<text x='" << (Frame::kL + Frame::kW - Frame::kR) / 2 << "' y='" << Frame::kH - 8
-    << "' font-size='11' text-anchor='middle'>" << Escape(xlabel) << "</text>";
-  s << "<text x='14' y='" << Frame::kH / 2 << "' font-size='11' text-anchor='middle' "
-    << "transform='rotate(-90 14 " << Frame::kH / 2 << ")'>" << Escape(ylabel) << "</text>";
-  return s.str();
-}
-
-std::string Legend(const std::vector<Series>& series) {
-  std::ostringstream s;
-  double x = Frame::kL + 8;
-  for (const Series& sr : series) {
-    s << "<circle cx='" << x << "' cy='" << Frame::kT + 10 << "' r='4' fill='" << sr.color
-      << "'/><text x='" << x + 8 << "' y='" << Frame::kT + 14 << "' font-size='11'>"
-      << Escape(sr.name) << "</text>";
-    x += 16 + 7 * sr.name.size();
-  }
-  return s.str();
-}
+using internal::FormatNumber;
 
 std::string Scatter(const std::string& title, const std::string& xlabel, const std::string& ylabel,
                     const std::vector<Series>& series) {
-  Frame f;
-  f.x0 = f.y0 = INFINITY;
-  f.x1 = f.y1 = -INFINITY;
-  for (const Series& s : series) {
-    Range(s.x, &f.x0, &f.x1);
-    Range(s.y, &f.y0, &f.y1);
-  }
-  f.y0 = std::min(f.y0, 0.0);
-  f.y1 = std::max(f.y1, 0.0);
-  Pad(&f.x0, &f.x1);
-  Pad(&f.y0, &f.y1);
-  std::ostringstream s;
-  s << "<svg xmlns='http://www.w3.org/2000/svg' width='" << Frame::kW << "' height='" << Frame::kH
-    << "'>" << Axes(f, title, xlabel, ylabel);
-  s << "<line x1='" << Frame::kL << "' x2='" << Frame::kW - Frame::kR << "' y1='" << f.Y(0)
-    << "' y2='" << f.Y(0) << "' stroke='#bbb' stroke-dasharray='4 3'/>";
-  for (const Series& sr : series) {
-    for (size_t i = 0; i < sr.x.size() && i < sr.y.size(); ++i) {
-      if (!std::isfinite(sr.x[i]) || !std::isfinite(sr.y[i])) continue;
-      s << "<circle cx='" << f.X(sr.x[i]) << "' cy='" << f.Y(sr.y[i]) << "' r='3.5' fill='"
-        << sr.color << "' fill-opacity='0.8'/>";
-    }
-  }
-  s << Legend(series) << "</svg>";
-  return s.str();
+  internal::Plot p;
+  p.title = title;
+  p.x.label = xlabel;
+  p.y.label = ylabel;
+  p.y.include_zero = true;
+  p.width = 580;
+  p.height = 320;
+  p.series = series;
+  internal::Rule zero;
+  zero.value = 0.0;
+  zero.color = "#bbb";
+  p.rules.push_back(zero);
+  return internal::RenderPlot(p);
 }
 
 // Bars of a value per position, with dashed lines at +-1 and +-3.
 std::string Bars(const std::string& title, const std::string& ylabel,
                  const std::vector<double>& values, const std::string& color) {
-  Frame f;
-  f.x0 = -0.5;
-  f.x1 = values.size() - 0.5;
-  f.y0 = -3.5;
-  f.y1 = 3.5;
-  Range(values, &f.y0, &f.y1);
-  Pad(&f.y0, &f.y1);
-  std::ostringstream s;
-  s << "<svg xmlns='http://www.w3.org/2000/svg' width='" << Frame::kW << "' height='" << Frame::kH
-    << "'>" << Axes(f, title, "position", ylabel);
+  internal::Plot p;
+  p.title = title;
+  p.x = {"position", internal::AxisScale::kLinear, -0.6, values.size() - 0.4, false, true};
+  p.y.label = ylabel;
+  p.width = 580;
+  p.height = 320;
   for (double level : {-3.0, -1.0, 1.0, 3.0}) {
-    s << "<line x1='" << Frame::kL << "' x2='" << Frame::kW - Frame::kR << "' y1='" << f.Y(level)
-      << "' y2='" << f.Y(level) << "' stroke='" << (std::fabs(level) > 2 ? "#d33" : "#bbb")
-      << "' stroke-dasharray='4 3'/>";
+    internal::Rule r;
+    r.value = level;
+    r.color = std::fabs(level) > 2 ? "#d33" : "#bbb";
+    if (std::fabs(level) > 2) r.label = level > 0 ? "+3 sigma" : "-3 sigma";
+    p.rules.push_back(r);
   }
-  const double w = std::max(1.0, 0.7 * (f.X(1) - f.X(0)));
+  Series bars;
+  bars.style = SeriesStyle::kBars;
+  bars.color = color;
+  bars.bar_width = 0.7;
   for (size_t k = 0; k < values.size(); ++k) {
-    if (!std::isfinite(values[k])) continue;
-    const double top = std::min(f.Y(values[k]), f.Y(0));
-    s << "<rect x='" << f.X(k) - w / 2 << "' y='" << top << "' width='" << w << "' height='"
-      << std::fabs(f.Y(values[k]) - f.Y(0)) << "' fill='" << color << "'/>";
+    bars.x.push_back(static_cast<double>(k));
+    bars.y.push_back(values[k]);
   }
-  s << "</svg>";
-  return s.str();
+  p.series.push_back(bars);
+  return internal::RenderPlot(p);
 }
 
 std::string GapCells(const Gap& before, const Gap& after, bool accel) {
   std::ostringstream s;
-  s << "<td>" << Num(Of(before, accel)) << " &rarr; " << Num(Of(after, accel)) << "</td><td>"
-    << Num(SigmaOf(before, accel), "%.3g") << " &rarr; " << Num(SigmaOf(after, accel), "%.3g")
-    << "</td>";
+  s << "<td>" << FormatNumber(Of(before, accel)) << " &rarr; " << FormatNumber(Of(after, accel))
+    << "</td><td>" << FormatNumber(SigmaOf(before, accel), "%.3g") << " &rarr; "
+    << FormatNumber(SigmaOf(after, accel), "%.3g") << "</td>";
   return s.str();
 }
 
@@ -347,9 +241,9 @@ std::string GroupsTable(const Disagreement& d) {
   s << "<table><tr><th>by</th><th>group</th><th>positions</th><th>accel rms, sigma</th>"
     << "<th>gyro rms, sigma</th></tr>";
   for (const GroupDisagreement& g : d.groups) {
-    s << "<tr><td>" << g.by << "</td><td>" << Escape(g.group) << "</td><td>" << g.count
-      << "</td><td>" << Num(g.accel_sigma, "%.3g") << "</td><td>" << Num(g.gyro_sigma, "%.3g")
-      << "</td></tr>";
+    s << "<tr><td>" << g.by << "</td><td>" << HtmlEscape(g.group) << "</td><td>" << g.count
+      << "</td><td>" << FormatNumber(g.accel_sigma, "%.3g") << "</td><td>"
+      << FormatNumber(g.gyro_sigma, "%.3g") << "</td></tr>";
   }
   s << "</table>";
   return s.str();
@@ -361,9 +255,10 @@ std::string CandidatesTable(const std::vector<CandidateScore>& scores) {
        "sigma</th><th>verdict</th></tr>";
   for (const CandidateScore& c : scores) {
     const bool accel = IsAccel(c.effect);
-    s << "<tr><td>" << ToString(c.effect) << "</td><td>" << Num(c.p_value, "%.3g") << "</td><td>"
-      << Num(c.delta_bic, "%.1f") << "</td><td>" << Num(SigmaOf(c.cv_gap, accel), "%.3g")
-      << "</td><td>" << (c.significant ? "significant" : Escape(c.reason)) << "</td></tr>";
+    s << "<tr><td>" << ToString(c.effect) << "</td><td>" << FormatNumber(c.p_value, "%.3g")
+      << "</td><td>" << FormatNumber(c.delta_bic, "%.1f") << "</td><td>"
+      << FormatNumber(SigmaOf(c.cv_gap, accel), "%.3g") << "</td><td>"
+      << (c.significant ? "significant" : HtmlEscape(c.reason)) << "</td></tr>";
   }
   s << "</table>";
   return s.str();
@@ -382,6 +277,8 @@ std::vector<Series> BeforeAfter(const DiscoveryStep& s, bool accel, bool against
     a.name = "after" + suffix;
     b.color = colors_before[axis];
     a.color = colors_after[axis];
+    b.style = a.style = SeriesStyle::kPoints;
+    b.opacity = a.opacity = 0.8;
     for (size_t k = 0; k < s.regressor.size(); ++k) {
       const double x = against_contribution ? s.contribution[k](axis) : s.regressor[k];
       b.x.push_back(x);
@@ -467,18 +364,12 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
 
 std::string DiscoveryToHtml(const DiscoveryResult& r) {
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>gravcal discovery: "
-    << Escape(r.source) << "</title><style>"
-    << "body{font-family:sans-serif;max-width:1180px;margin:1em auto;color:#222}"
-    << "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 7px;"
-    << "font-size:13px;text-align:left}th{background:#eee}svg{margin:4px;border:1px solid #eee}"
-    << ".verdict{font-size:1.2em;padding:.5em;background:#eef5ee}.warn{color:#8a4b00}"
-    << "</style></head><body>\n";
-  h << "<h1>Model discrepancy report</h1><p>" << Escape(r.source) << " &mdash; "
-    << r.observations.size() << " static positions, gravity " << Num(r.gravity, "%.6g")
-    << " m/s^2 (" << Escape(r.gravity_source) << "), " << Num(r.seconds * 1e3, "%.1f")
+  h << internal::HtmlPageStart("gravcal discovery: " + r.source);
+  h << "<h1>Model discrepancy report</h1><p>" << HtmlEscape(r.source) << " &mdash; "
+    << r.observations.size() << " static positions, gravity " << FormatNumber(r.gravity, "%.6g")
+    << " m/s^2 (" << HtmlEscape(r.gravity_source) << "), " << FormatNumber(r.seconds * 1e3, "%.1f")
     << " ms</p>\n";
-  h << "<p class='verdict'><b>Verdict:</b> " << Escape(r.verdict) << "</p>\n";
+  h << "<p class='verdict'><b>Verdict:</b> " << HtmlEscape(r.verdict) << "</p>\n";
 
   h << "<h2>How to read this</h2><p>Each static position's measured reading is compared with the "
        "reading the fitted model predicts (accelerometer: |a| - g; gyroscope: the mean rate at "
@@ -492,18 +383,21 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
   h << "<h2>Models</h2><table><tr><th>step</th><th>model</th><th>effect</th><th>p-value</th>"
     << "<th>delta BIC</th><th>gap</th><th>gap, sigma</th><th>CV gap</th><th>CV gap, sigma</th>"
     << "</tr>";
-  h << "<tr><td>baseline</td><td>" << Escape(ModelName(r.baseline)) << "</td><td></td><td></td>"
-    << "<td></td><td>accel " << Num(r.baseline.gap.accel) << " m/s^2; gyro "
-    << Num(r.baseline.gap.gyro) << "</td><td>" << Num(r.baseline.gap.accel_sigma, "%.3g") << "; "
-    << Num(r.baseline.gap.gyro_sigma, "%.3g") << "</td><td>" << Num(r.baseline.cv_gap.accel) << "; "
-    << Num(r.baseline.cv_gap.gyro) << "</td><td>" << Num(r.baseline.cv_gap.accel_sigma, "%.3g")
-    << "; " << Num(r.baseline.cv_gap.gyro_sigma, "%.3g") << "</td></tr>";
+  h << "<tr><td>baseline</td><td>" << HtmlEscape(ModelName(r.baseline)) << "</td><td></td><td></td>"
+    << "<td></td><td>accel " << FormatNumber(r.baseline.gap.accel) << " m/s^2; gyro "
+    << FormatNumber(r.baseline.gap.gyro) << "</td><td>"
+    << FormatNumber(r.baseline.gap.accel_sigma, "%.3g") << "; "
+    << FormatNumber(r.baseline.gap.gyro_sigma, "%.3g") << "</td><td>"
+    << FormatNumber(r.baseline.cv_gap.accel) << "; " << FormatNumber(r.baseline.cv_gap.gyro)
+    << "</td><td>" << FormatNumber(r.baseline.cv_gap.accel_sigma, "%.3g") << "; "
+    << FormatNumber(r.baseline.cv_gap.gyro_sigma, "%.3g") << "</td></tr>";
   for (size_t i = 0; i < r.steps.size(); ++i) {
     const DiscoveryStep& s = r.steps[i];
     const bool accel = IsAccel(s.effect);
     h << "<tr><td>" << i + 1 << "</td><td>+ " << ToString(s.effect) << "</td><td>"
-      << Escape(Info(s.effect).description) << "</td><td>" << Num(s.p_value, "%.3g") << "</td><td>"
-      << Num(s.delta_bic, "%.1f") << "</td>" << GapCells(s.gap_before, s.gap_after, accel)
+      << HtmlEscape(Info(s.effect).description) << "</td><td>" << FormatNumber(s.p_value, "%.3g")
+      << "</td><td>" << FormatNumber(s.delta_bic, "%.1f") << "</td>"
+      << GapCells(s.gap_before, s.gap_after, accel)
       << GapCells(s.cv_gap_before, s.cv_gap_after, accel) << "</tr>";
   }
   h << "</table><p>Gaps of a step are for the sensor of its effect ("
@@ -516,26 +410,27 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
       h << "<li>step " << a.step + 1 << ": ";
       for (size_t i = 0; i < a.effects.size(); ++i) {
         h << (i ? " vs " : "") << "<b>" << ToString(a.effects[i]) << "</b> (delta BIC "
-          << Num(a.delta_bic[i], "%.1f") << ")";
+          << FormatNumber(a.delta_bic[i], "%.1f") << ")";
       }
-      h << ". " << Escape(a.advice) << "</li>";
+      h << ". " << HtmlEscape(a.advice) << "</li>";
     }
     h << "</ul>\n";
   }
 
-  h << "<h2>Baseline: where the model disagrees</h2><p>" << Escape(r.baseline_where.summary)
+  h << "<h2>Baseline: where the model disagrees</h2><p>" << HtmlEscape(r.baseline_where.summary)
     << "</p>" << WherePlots(r.baseline_where, "baseline") << GroupsTable(r.baseline_where) << "\n";
 
   for (size_t i = 0; i < r.steps.size(); ++i) {
     const DiscoveryStep& s = r.steps[i];
     const bool accel = IsAccel(s.effect);
     h << "<h2>Step " << i + 1 << ": " << ToString(s.effect) << "</h2><p>"
-      << Escape(Info(s.effect).description)
-      << ". Where the model before this step disagreed: " << Escape(s.where.summary) << "</p>";
+      << HtmlEscape(Info(s.effect).description)
+      << ". Where the model before this step disagreed: " << HtmlEscape(s.where.summary) << "</p>";
     h << "<table><tr><th>parameter</th><th>value</th><th>std</th><th>unit</th></tr>";
     for (size_t k = 0; k < s.estimate.names.size(); ++k) {
-      h << "<tr><td>" << s.estimate.names[k] << "</td><td>" << Num(s.estimate.values[k], "%.4g")
-        << "</td><td>" << Num(s.estimate.std[k], "%.2g") << "</td><td>" << Escape(s.estimate.unit)
+      h << "<tr><td>" << s.estimate.names[k] << "</td><td>"
+        << FormatNumber(s.estimate.values[k], "%.4g") << "</td><td>"
+        << FormatNumber(s.estimate.std[k], "%.2g") << "</td><td>" << HtmlEscape(s.estimate.unit)
         << "</td></tr>";
     }
     h << "</table>";
@@ -549,8 +444,8 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
     h << "<h3>Candidates tried</h3>" << CandidatesTable(s.candidates) << "\n";
   }
 
-  h << "<h2>Final model: " << Escape(ModelName(r.final_model)) << "</h2><p>"
-    << Escape(r.final_where.summary) << "</p>" << WherePlots(r.final_where, "final")
+  h << "<h2>Final model: " << HtmlEscape(ModelName(r.final_model)) << "</h2><p>"
+    << HtmlEscape(r.final_where.summary) << "</p>" << WherePlots(r.final_where, "final")
     << GroupsTable(r.final_where);
   if (!r.final_candidates.empty()) {
     h << "<h3>Candidates of the last round (none significant)</h3>"
@@ -558,10 +453,10 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
   }
   if (!r.warnings.empty()) {
     h << "<h2>Warnings</h2><ul>";
-    for (const std::string& w : r.warnings) h << "<li class='warn'>" << Escape(w) << "</li>";
+    for (const std::string& w : r.warnings) h << "<li class='warn'>" << HtmlEscape(w) << "</li>";
     h << "</ul>";
   }
-  h << "\n</body></html>\n";
+  h << internal::HtmlPageEnd();
   return h.str();
 }
 

@@ -79,6 +79,10 @@ struct PositionReport {
   double residual_before = 0.0;
   double residual_after = 0.0;
   double sigma = 0.0;
+  // |a| - g, m/s^2, with the nominal scale and after the coarse fit (for
+  // the report); NaN where the method has no such stage.
+  double residual_nominal = NAN;
+  double residual_coarse = NAN;
   // The attitude the method used for this position (ten_position: from
   // static alignment; known_attitude: as estimated with the fixture's
   // prior), degrees, and its standard deviation; NaN when the method has none.

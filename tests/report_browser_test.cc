@@ -1,0 +1,463 @@
+// Issue 17: every HTML report (calibrate, batch, noise, discover --report)
+// opened in a real browser. Headless Chromium loads the file (file://, no
+// network); a test fails on any console message (the reports log nothing, so
+// any message is an error or a warning), checks the sections in the DOM the
+// browser built (for example one shaded interval per position of the
+// calibration JSON), checks that every axis's tick labels are round numbers,
+// and saves a full-page screenshot into <build>/report_screenshots/. Skipped
+// with a message when no Chromium is installed (.ci/run installs the Debian
+// package `chromium`).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli_runner.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/workflows/report.h"
+#include "still_log.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+using testing_util::RunCli;
+using testing_util::ScratchDir;
+using testing_util::Slurp;
+
+// The first Chromium on PATH; empty when there is none.
+std::string Browser() {
+  static const std::string path = [] {
+    const char* env = std::getenv("PATH");
+    std::string dirs = env ? env : "/usr/bin";
+    for (const char* name : {"chromium", "chromium-browser", "google-chrome"}) {
+      size_t start = 0;
+      while (start <= dirs.size()) {
+        const size_t end = std::min(dirs.find(':', start), dirs.size());
+        const std::string candidate = dirs.substr(start, end - start) + "/" + name;
+        if (access(candidate.c_str(), X_OK) == 0) return candidate;
+        start = end + 1;
+      }
+    }
+    return std::string();
+  }();
+  return path;
+}
+
+#define SKIP_WITHOUT_BROWSER()                                                             \
+  if (Browser().empty()) {                                                                 \
+    GTEST_SKIP() << "no Chromium on PATH (install the Debian package 'chromium'; .ci/run " \
+                    "does): the reports are not opened in a browser";                      \
+  }
+
+// Runs the browser with `args` (no shell); stdout and stderr into files.
+int RunBrowser(std::vector<std::string> args, const std::string& out, const std::string& err) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int null = open("/dev/null", O_RDWR);
+    const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(null, 0);
+    dup2(o, 1);
+    dup2(e, 2);
+    std::string program = Browser();
+    std::vector<char*> argv = {program.data()};
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(program.c_str(), argv.data());
+    _exit(127);
+  }
+  return testing_util::WaitForExit(pid);
+}
+
+std::vector<std::string> HeadlessFlags() {
+  // --no-sandbox: CI runs as root; no GPU in a container.
+  return {
+      "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--enable-logging=stderr",
+      "--v=0"};
+}
+
+struct LoadedPage {
+  int exit_code = -1;
+  std::string dom;
+  // Every console line the page produced.
+  std::vector<std::string> console;
+};
+
+std::string FileUrl(const std::string& path) {
+  return "file://" + std::filesystem::absolute(path).string();
+}
+
+LoadedPage Load(const std::string& html, const ScratchDir& dir) {
+  std::vector<std::string> args = HeadlessFlags();
+  args.push_back("--dump-dom");
+  args.push_back(FileUrl(html));
+  LoadedPage page;
+  page.exit_code = RunBrowser(args, dir / "dom.html", dir / "browser.log");
+  page.dom = Slurp(dir / "dom.html");
+  std::istringstream log(Slurp(dir / "browser.log"));
+  for (std::string line; std::getline(log, line);) {
+    if (line.find(":CONSOLE") != std::string::npos) page.console.push_back(line);
+  }
+  return page;
+}
+
+size_t Count(const std::string& text, const std::string& needle) {
+  size_t n = 0;
+  for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
+  return n;
+}
+
+// The value of attribute `name` of the first element after `from`.
+std::string Attribute(const std::string& dom, const std::string& name, size_t from = 0) {
+  const std::string key = name + "=\"";
+  const size_t at = dom.find(key, from);
+  if (at == std::string::npos) return "";
+  const size_t begin = at + key.size();
+  return dom.substr(begin, dom.find('"', begin) - begin);
+}
+
+struct AxisTicks {
+  std::string scale;
+  std::vector<std::string> labels;
+};
+
+// Every <g class="axis"> of the DOM with its tick labels.
+std::vector<AxisTicks> Axes(const std::string& dom) {
+  std::vector<AxisTicks> axes;
+  const std::string open = "<g class=\"axis\"";
+  for (size_t at = dom.find(open); at != std::string::npos; at = dom.find(open, at + 1)) {
+    const size_t end = dom.find("</g>", at);
+    const std::string g = dom.substr(at, end - at);
+    AxisTicks a;
+    a.scale = Attribute(g, "data-scale");
+    const std::string tick = "class=\"tick\"";
+    for (size_t t = g.find(tick); t != std::string::npos; t = g.find(tick, t + 1)) {
+      const size_t begin = g.find('>', t) + 1;
+      a.labels.push_back(g.substr(begin, g.find('<', begin) - begin));
+    }
+    axes.push_back(a);
+  }
+  return axes;
+}
+
+// 1, 2 or 5 times a power of ten (within rounding).
+bool IsOneTwoFive(double v) {
+  if (!(v > 0)) return false;
+  const double m = v / std::pow(10.0, std::floor(std::log10(v) + 1e-9));
+  for (double nice : {1.0, 2.0, 5.0, 10.0}) {
+    if (std::fabs(m - nice) < 1e-6 * nice) return true;
+  }
+  return false;
+}
+
+// Empty when the labels are round: on a linear axis equally spaced at a
+// step of 1, 2 or 5 times a power of ten, each a whole multiple of it; on a
+// log axis each 1, 2 or 5 times a power of ten. Otherwise what is wrong.
+std::string TickProblem(const AxisTicks& axis) {
+  std::vector<double> v;
+  for (const std::string& label : axis.labels) {
+    char* end = nullptr;
+    v.push_back(std::strtod(label.c_str(), &end));
+    if (end == label.c_str() || *end != '\0') return "label '" + label + "' is not a number";
+  }
+  if (v.size() < 2) return "fewer than two ticks";
+  if (axis.scale == "log") {
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (!IsOneTwoFive(v[i])) return "log tick '" + axis.labels[i] + "' is not 1, 2 or 5 x 10^k";
+    }
+    return "";
+  }
+  // Ascending (axes) or descending (the heat map's colour bar).
+  const double step = v[1] - v[0];
+  if (!IsOneTwoFive(std::fabs(step))) {
+    return "step " + std::to_string(step) + " is not 1, 2 or 5 x 10^k";
+  }
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (i > 0 && std::fabs(v[i] - v[i - 1] - step) > 1e-6 * std::fabs(step)) {
+      return "ticks '" + axis.labels[i - 1] + "', '" + axis.labels[i] + "' not one step apart";
+    }
+    const double k = v[i] / step;
+    if (std::fabs(k - std::round(k)) > 1e-6) {
+      return "tick '" + axis.labels[i] + "' is not a multiple of the step";
+    }
+  }
+  return "";
+}
+
+void ExpectRoundTicks(const std::string& dom, size_t min_axes) {
+  const std::vector<AxisTicks> axes = Axes(dom);
+  EXPECT_GE(axes.size(), min_axes);
+  for (size_t i = 0; i < axes.size(); ++i) {
+    std::string labels;
+    for (const std::string& l : axes[i].labels) labels += l + " ";
+    EXPECT_EQ(TickProblem(axes[i]), "") << "axis " << i << " (" << axes[i].scale << "): " << labels;
+  }
+}
+
+std::string ScreenshotDir() {
+  const std::string d =
+      std::filesystem::path(GRAVCAL_CLI_PATH).parent_path().string() + "/report_screenshots";
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+// Loads the report, fails on console messages, checks the ticks, saves a
+// full-page screenshot <build>/report_screenshots/<name>.png; returns the DOM.
+std::string OpenReport(const std::string& html, const std::string& name, const ScratchDir& dir,
+                       size_t min_axes) {
+  const LoadedPage page = Load(html, dir);
+  EXPECT_EQ(page.exit_code, 0) << Slurp(dir / "browser.log");
+  EXPECT_TRUE(page.console.empty()) << "console: " << page.console[0];
+  EXPECT_NE(page.dom.find("data-load-ms"), std::string::npos) << "the load event did not run";
+  ExpectRoundTicks(page.dom, min_axes);
+  const int height =
+      std::max(600, std::min(16000, std::atoi(Attribute(page.dom, "data-height").c_str())));
+  std::vector<std::string> args = HeadlessFlags();
+  const std::string png = ScreenshotDir() + "/" + name + ".png";
+  args.push_back("--window-size=1280," + std::to_string(height));
+  args.push_back("--screenshot=" + png);
+  args.push_back(FileUrl(html));
+  EXPECT_EQ(RunBrowser(args, dir / "shot.out", dir / "shot.log"), 0);
+  EXPECT_TRUE(testing_util::FileExists(png));
+  ::testing::Test::RecordProperty("screenshot", png);
+  ::testing::Test::RecordProperty("load_ms", Attribute(page.dom, "data-load-ms"));
+  return page.dom;
+}
+
+std::string ConfigPath(const std::string& name) {
+  return testing_util::SourceDir() + "/configs/" + name;
+}
+
+// Simulates a session with `config` and runs `command` (calibrate or
+// discover) on it with --output <name>.json --report <name>.html; returns
+// the report's path.
+std::string SimulateAndReport(const std::string& command, const std::string& config, int seed,
+                              const std::string& name, const ScratchDir& dir) {
+  EXPECT_EQ(RunCli("simulate --config " + config + " --seed " + std::to_string(seed) +
+                       " --output-dir " + (dir / "sim"),
+                   dir)
+                .exit_code,
+            0);
+  const std::string html = dir / (name + ".html");
+  const testing_util::CliResult r =
+      RunCli(command + " --input " + (dir / "sim/raw.csv") + " --config " + config + " --output " +
+                 (dir / (name + ".json")) + " --report " + html,
+             dir);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return html;
+}
+
+// The checkers themselves catch what they are for: a page that writes to
+// the console, and axes labelled like the old discovery report's.
+TEST(ReportBrowser, CheckersCatchPlantedMistakes) {
+  AxisTicks bad{"linear", {"-0.5", "9", "18.5"}};
+  EXPECT_NE(TickProblem(bad), "");
+  bad.labels = {"8.72", "4.44", "0.151"};
+  EXPECT_NE(TickProblem(bad), "");
+  bad.labels = {"0", "0.3", "0.6"};
+  EXPECT_NE(TickProblem(bad), "");
+  const AxisTicks good{"linear", {"-1", "-0.5", "0", "0.5", "1"}};
+  EXPECT_EQ(TickProblem(good), "");
+  EXPECT_EQ(TickProblem({"log", {"0.01", "0.1", "1", "10"}}), "");
+  EXPECT_NE(TickProblem({"log", {"0.01", "0.03", "1"}}), "");
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  const std::string html =
+      dir.Write("planted.html",
+                "<html><body><p>x</p><script>console.error('planted');</script></body></html>");
+  const LoadedPage page = Load(html, dir);
+  ASSERT_EQ(page.console.size(), 1u);
+  EXPECT_NE(page.console[0].find("planted"), std::string::npos) << page.console[0];
+}
+
+// calibrate --report on a simulated twelve-position session with the
+// gyroscope: one shaded interval per position of calib.json in each raw
+// plot, one dot on the sphere and one refined residual per position, and
+// every section.
+TEST(ReportBrowser, CalibrationReport) {
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  const std::string html =
+      SimulateAndReport("calibrate", ConfigPath("twelve_position_gyro.yaml"), 4, "calib", dir);
+  ASSERT_FALSE(HasFailure());
+  const nlohmann::json calib = nlohmann::json::parse(Slurp(dir / "calib.json"));
+  const size_t n = calib["positions"].size();
+  ASSERT_GE(n, 12u);
+  const std::string dom = OpenReport(html, "calibration", dir, 8);
+  EXPECT_EQ(Count(dom, "class=\"plot plot-raw"), 2u);
+  EXPECT_EQ(Count(dom, "class=\"static-interval\""), 2 * n);
+  EXPECT_EQ(Count(dom, "class=\"pose-dot\""), n);
+  EXPECT_EQ(Count(dom, "class=\"pose-residual\""), n);
+  EXPECT_EQ(Count(dom, "class=\"rotation-residual\""),
+            calib["gyro"]["rotation_residual_deg"].size());
+  for (const char* id : {"verdict", "signals", "poses", "residuals", "parameters", "correlation",
+                         "rotations", "warnings", "solver"}) {
+    EXPECT_NE(dom.find(std::string("id=\"") + id + "\""), std::string::npos) << id;
+  }
+  EXPECT_NE(dom.find("+3 sigma"), std::string::npos);
+  EXPECT_NE(dom.find("magnitude fit"), std::string::npos);
+}
+
+// A failed calibration still gets its report, and it says "record again".
+TEST(ReportBrowser, FailedCalibrationSaysRecordAgain) {
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  ASSERT_EQ(RunCli("simulate --sim_scheme random:6 --seed 5 --output-dir " + (dir / "sim"), dir)
+                .exit_code,
+            0);
+  const std::string html = dir / "failed.html";
+  const testing_util::CliResult r =
+      RunCli("calibrate --input " + (dir / "sim/raw.csv") + " --output " + (dir / "c.json") +
+                 " --report " + html,
+             dir);
+  ASSERT_NE(r.exit_code, 0);
+  const std::string dom = OpenReport(html, "calibration_failed", dir, 2);
+  EXPECT_NE(dom.find("class=\"verdict again\""), std::string::npos);
+  EXPECT_NE(dom.find("Record the session again"), std::string::npos);
+}
+
+// The handheld filter: one convergence plot per state of the report.
+TEST(ReportBrowser, HandheldConvergence) {
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  ASSERT_EQ(RunCli("simulate --sim_motion handheld --sim_accel_misalignment 0 "
+                   "--sim_gyro_misalignment 0 --seed 3 --output-dir " +
+                       (dir / "sim"),
+                   dir)
+                .exit_code,
+            0);
+  const std::string html = dir / "handheld.html";
+  const testing_util::CliResult r =
+      RunCli("calibrate --input " + (dir / "sim/raw.csv") + " --config " +
+                 ConfigPath("handheld_kalman.yaml") +
+                 " --nominal_scale 0.00059855 --gyro_nominal_scale 0.000133231 --gravity 9.80665 "
+                 "--output " +
+                 (dir / "c.json") + " --report " + html,
+             dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json calib = nlohmann::json::parse(Slurp(dir / "c.json"));
+  const std::string dom = OpenReport(html, "calibration_handheld", dir, 4);
+  EXPECT_NE(dom.find("id=\"convergence\""), std::string::npos);
+  EXPECT_GE(Count(dom, "class=\"plot plot-convergence\""), 6u);
+}
+
+// batch --report: a histogram per varying parameter, the planted outlier
+// marked and named, the failed units with their messages.
+TEST(ReportBrowser, FleetReport) {
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  Config base;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(ConfigPath("twelve_position.yaml"), &base, &error)) << error;
+  SimulatorOptions sim = base.simulation;
+  sim.hold_seconds = 4.0;
+  sim.initial_still_seconds = 4.0;
+  sim.rotation_seconds = 2.0;
+  sim.accel_bias_std = 0.05;
+  std::string manifest = "unit,path\n";
+  for (int k = 0; k < 8; ++k) {
+    SimulatedSession s;
+    ASSERT_TRUE(Simulate(sim, 200 + k, &s, &error)) << error;
+    if (k == 3) {
+      for (Eigen::Vector3d& a : s.log.accel) a.x() += 1500.0;
+    }
+    const std::string name = "unit" + std::to_string(k);
+    ASSERT_TRUE(WriteImuLogCsv(s.log, dir / (name + ".csv"), &error)) << error;
+    manifest += name + "," + (dir / (name + ".csv")) + "\n";
+  }
+  manifest += "broken," + (dir / "missing.csv") + "\n";
+  const std::string html = dir / "fleet.html";
+  const testing_util::CliResult r =
+      RunCli({"batch", "--manifest", dir.Write("units.csv", manifest), "--config",
+              ConfigPath("twelve_position.yaml"), "--output-dir", dir / "out", "--threads", "2",
+              "--report", html},
+             dir);
+  ASSERT_EQ(r.exit_code, 1) << r.err;  // the missing unit
+  const std::string dom = OpenReport(html, "fleet", dir, 10);
+  EXPECT_GE(Count(dom, "class=\"plot plot-histogram\""), 6u);
+  EXPECT_GE(Count(dom, "class=\"outlier-mark\""), 1u);
+  EXPECT_NE(dom.find("unit3"), std::string::npos);
+  EXPECT_NE(dom.find("missing.csv"), std::string::npos);
+  for (const char* id : {"throughput", "parameters", "outliers", "failures"}) {
+    EXPECT_NE(dom.find(std::string("id=\"") + id + "\""), std::string::npos) << id;
+  }
+}
+
+// noise --report on a simulated still log: six log-log plots with their
+// points and the fitted terms as lines.
+TEST(ReportBrowser, NoiseReport) {
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  NoiseProcessOptions accel;
+  accel.rate_hz = 100.0;
+  accel.white_noise = 2e-3;
+  accel.random_walk = 1.2e-3;
+  NoiseProcessOptions gyro = accel;
+  gyro.white_noise = 2e-4;
+  gyro.random_walk = 3.5e-4;
+  std::string error;
+  const std::string log = dir / "still.csv";
+  ASSERT_TRUE(WriteImuLogCsv(testing_util::StillLog(accel, gyro, 1e-3, 6, 1200.0), log, &error))
+      << error;
+  const std::string html = dir / "noise.html";
+  const testing_util::CliResult r =
+      RunCli("noise --input " + log + " --gyro_nominal_scale 0.001 --output " +
+                 (dir / "noise.json") + " --report " + html,
+             dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string dom = OpenReport(html, "noise", dir, 12);
+  EXPECT_EQ(Count(dom, "class=\"plot plot-allan\""), 6u);
+  EXPECT_GE(Count(dom, "class=\"allan-point\""), 6u * 8);
+  EXPECT_GE(Count(dom, "class=\"noise-term\""), 6u);
+  EXPECT_EQ(Count(dom, "data-scale=\"log\""), 12u);
+}
+
+// discover --report goes through the same plotting module.
+TEST(ReportBrowser, DiscoveryReport) {
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  const std::string html =
+      SimulateAndReport("discover", ConfigPath("discovery.yaml"), 2, "discovery", dir);
+  ASSERT_FALSE(HasFailure());
+  OpenReport(html, "discovery", dir, 4);
+}
+
+// A one-hour 200 Hz session: the report stays under 2 MB (min/max
+// envelopes), and the browser's load time is recorded (no wall-clock
+// assertion: benchmarks/RESULTS.md has the measurement).
+TEST(ReportBrowser, HourLongSessionStaysSmall) {
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(ConfigPath("twelve_position_gyro.yaml"), &config, &error)) << error;
+  SimulatorOptions sim = config.simulation;
+  sim.sample_rate = 200.0;
+  sim.hold_seconds = 300.0;
+  sim.initial_still_seconds = 20.0;
+  PipelineInput input;
+  SimulatedSession s;
+  ASSERT_TRUE(Simulate(sim, 7, &s, &error)) << error;
+  input.log = s.log;
+  ASSERT_GE(input.log.t.back() - input.log.t.front(), 3600.0);
+  Calibration c;
+  ASSERT_TRUE(RunCalibration(config, input, &c)) << c.message;
+  const std::string html = CalibrationToHtml(c, input.log, "one hour at 200 Hz");
+  EXPECT_LT(html.size(), 2u << 20);
+  ::testing::Test::RecordProperty("bytes", std::to_string(html.size()));
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  const std::string dom = OpenReport(dir.Write("hour.html", html), "calibration_hour", dir, 8);
+  EXPECT_EQ(Count(dom, "class=\"static-interval\""), 2 * c.positions.size());
+  std::printf("one-hour report: %zu bytes, load %s ms in Chromium\n", html.size(),
+              Attribute(dom, "data-load-ms").c_str());
+}
+
+}  // namespace
+}  // namespace gravcal
