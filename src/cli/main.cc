@@ -47,6 +47,8 @@ DEFINE_string(noise, "",
               "noise.json from 'gravcal noise': the variance of each pose's mean, and the "
               "handheld filter's noise, from the noise model");
 
+DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
+
 namespace {
 
 struct CommandInfo {
@@ -71,7 +73,8 @@ const std::vector<CommandInfo>& Commands() {
        {"input", "config", "output", "attitudes", "segments", "history", "noise"},
        gravcal::cli::RunCalibrate},
       {"apply",
-       "apply a calibration to a raw log, writing SI units",
+       "apply every term of a calibration to a contract CSV log (streaming; - for standard "
+       "input/output), writing SI units",
        {"calibration", "input", "output"},
        gravcal::cli::RunApply},
       {"simulate",
@@ -100,6 +103,10 @@ const std::vector<CommandInfo>& Commands() {
        "Kalibr's imu.yaml",
        {"input", "config", "output", "kalibr", "handheld"},
        gravcal::cli::RunNoise},
+      {"export",
+       "write a calibration for kalibr, openvins, ros, px4, ardupilot or as C source (c)",
+       {"calibration", "noise", "to", "output", "output_dir"},
+       gravcal::cli::RunExport},
       {"help",
        "list commands, or the flags and config keys of one: gravcal help <command>",
        {},
@@ -279,6 +286,7 @@ int main(int argc, char** argv) {
   args.kalibr = FLAGS_kalibr;
   args.handheld = FLAGS_handheld;
   args.noise = FLAGS_noise;
+  args.to = FLAGS_to;
 
   return info->run(args);
 }
