@@ -90,7 +90,7 @@ void BM_ApplyEveryTerm(benchmark::State& state) {
                           static_cast<int64_t>(bytes.size()));
   std::remove(output.c_str());
 }
-BENCHMARK(BM_ApplyEveryTerm)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ApplyEveryTerm)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace gravcal
