@@ -75,7 +75,7 @@ const std::vector<CommandInfo>& Commands() {
       {"apply",
        "apply every term of a calibration to a contract CSV log (streaming; - for standard "
        "input/output), writing SI units",
-       {"calibration", "input", "output"},
+       {"calibration", "input", "output", "config"},
        gravcal::cli::RunApply},
       {"simulate",
        "simulate a session: raw.csv, truth.json, the fixture's attitudes.csv (and, for "

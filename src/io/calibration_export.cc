@@ -296,50 +296,73 @@ bool AutopilotScales(const ImuCorrector& t, const char* target, std::string* err
   return true;
 }
 
-std::string Px4Params(const LoadedCalibration& c, const ExportOptions& o, const ExportResult& r,
-                      const ImuCorrector& t) {
+// PX4 and ArduPilot write the same nine numbers under their own names and
+// line format.
+struct AutopilotFormat {
+  // Comment lines after the provenance: the target's equation and format.
+  std::vector<std::string> header;
+  // Name prefixes of the accelerometer offset and scale and the gyroscope
+  // offset, and the suffix after the axis letter.
+  const char* accel_offset;
+  const char* accel_scale;
+  const char* gyro_offset;
+  const char* offset_suffix;
+  const char* scale_suffix;
+  // One parameter line from the name and the value.
+  std::string (*line)(const std::string& name, const std::string& value);
+};
+
+std::string AutopilotParameters(const LoadedCalibration& c, const ExportOptions& o,
+                                const ExportResult& r, const ImuCorrector& t,
+                                const AutopilotFormat& f) {
   std::ostringstream s;
-  s << Comment(Provenance(c, o), "#") << Comment(DroppedComment(r), "#")
-    << "# PX4 (src/lib/sensor_calibration): a = rot (diag(SCALE) (a_m - OFF)) in m/s^2,\n"
-    << "# w = rot (w_m - OFF) in rad/s; a_m, w_m the driver's readings in the sensor frame.\n"
-    << "# CAL_*_ID and CAL_*_ROT are left as they are on the vehicle.\n"
-    << "# QGroundControl parameter file: vehicle, component, name, value, type (9 = float).\n"
-    << "# MAV ID  COMPONENT ID  PARAM NAME  VALUE (FLOAT)\n";
+  s << Comment(Provenance(c, o), "#") << Comment(DroppedComment(r), "#") << Comment(f.header, "#");
   const char* axes[3] = {"X", "Y", "Z"};
   for (int i = 0; i < 3; ++i) {
-    s << "1\t1\tCAL_ACC0_" << axes[i] << "OFF\t" << ExactNumber(t.accel.bias(i)) << "\t9\n";
+    s << f.line(std::string(f.accel_offset) + axes[i] + f.offset_suffix,
+                ExactNumber(t.accel.bias(i)));
   }
   for (int i = 0; i < 3; ++i) {
-    s << "1\t1\tCAL_ACC0_" << axes[i] << "SCALE\t" << ExactNumber(t.accel.upper(i, i)) << "\t9\n";
+    s << f.line(std::string(f.accel_scale) + axes[i] + f.scale_suffix,
+                ExactNumber(t.accel.upper(i, i)));
   }
-  if (t.has_gyro) {
-    for (int i = 0; i < 3; ++i) {
-      s << "1\t1\tCAL_GYRO0_" << axes[i] << "OFF\t" << ExactNumber(t.gyro.bias(i)) << "\t9\n";
-    }
+  for (int i = 0; t.has_gyro && i < 3; ++i) {
+    s << f.line(std::string(f.gyro_offset) + axes[i] + f.offset_suffix,
+                ExactNumber(t.gyro.bias(i)));
   }
   return s.str();
 }
 
-std::string ArduPilotParm(const LoadedCalibration& c, const ExportOptions& o, const ExportResult& r,
-                          const ImuCorrector& t) {
-  std::ostringstream s;
-  s << Comment(Provenance(c, o), "#") << Comment(DroppedComment(r), "#")
-    << "# ArduPilot (AP_InertialSensor_Backend): a = rot (diag(ACCSCAL) (a_m - ACCOFFS)) in\n"
-    << "# m/s^2, w = rot (w_m - GYROFFS) in rad/s, sensor frame before the board rotation.\n"
-    << "# Parameter file: NAME VALUE per line.\n";
-  const char* axes[3] = {"X", "Y", "Z"};
-  for (int i = 0; i < 3; ++i) {
-    s << "INS_ACCOFFS_" << axes[i] << " " << ExactNumber(t.accel.bias(i)) << "\n";
-  }
-  for (int i = 0; i < 3; ++i) {
-    s << "INS_ACCSCAL_" << axes[i] << " " << ExactNumber(t.accel.upper(i, i)) << "\n";
-  }
-  if (t.has_gyro) {
-    for (int i = 0; i < 3; ++i) {
-      s << "INS_GYROFFS_" << axes[i] << " " << ExactNumber(t.gyro.bias(i)) << "\n";
-    }
-  }
-  return s.str();
+const AutopilotFormat& Px4Format() {
+  static const AutopilotFormat format = {
+      {"PX4 (src/lib/sensor_calibration): a = rot (diag(SCALE) (a_m - OFF)) in m/s^2,",
+       "w = rot (w_m - OFF) in rad/s; a_m, w_m the driver's readings in the sensor frame.",
+       "CAL_*_ID and CAL_*_ROT are left as they are on the vehicle.",
+       "QGroundControl parameter file: vehicle, component, name, value, type (9 = float).",
+       "MAV ID  COMPONENT ID  PARAM NAME  VALUE (FLOAT)"},
+      "CAL_ACC0_",
+      "CAL_ACC0_",
+      "CAL_GYRO0_",
+      "OFF",
+      "SCALE",
+      [](const std::string& name, const std::string& value) {
+        return "1\t1\t" + name + "\t" + value + "\t9\n";
+      }};
+  return format;
+}
+
+const AutopilotFormat& ArduPilotFormat() {
+  static const AutopilotFormat format = {
+      {"ArduPilot (AP_InertialSensor_Backend): a = rot (diag(ACCSCAL) (a_m - ACCOFFS)) in",
+       "m/s^2, w = rot (w_m - GYROFFS) in rad/s, sensor frame before the board rotation.",
+       "Parameter file: NAME VALUE per line."},
+      "INS_ACCOFFS_",
+      "INS_ACCSCAL_",
+      "INS_GYROFFS_",
+      "",
+      "",
+      [](const std::string& name, const std::string& value) { return name + " " + value + "\n"; }};
+  return format;
 }
 
 }  // namespace
@@ -436,11 +459,11 @@ bool ExportCalibration(const LoadedCalibration& calibration, const ExportOptions
       break;
     case ExportTarget::kPx4:
       if (!AutopilotScales(truncated, "px4", error)) return false;
-      text = Px4Params(calibration, options, *result, truncated);
+      text = AutopilotParameters(calibration, options, *result, truncated, Px4Format());
       break;
     case ExportTarget::kArduPilot:
       if (!AutopilotScales(truncated, "ardupilot", error)) return false;
-      text = ArduPilotParm(calibration, options, *result, truncated);
+      text = AutopilotParameters(calibration, options, *result, truncated, ArduPilotFormat());
       break;
     case ExportTarget::kC: {
       std::vector<std::string> comment = Provenance(calibration, options);
