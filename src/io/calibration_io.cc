@@ -470,12 +470,14 @@ bool CalibrationFromJson(const std::string& text, const std::string& name,
 bool LogProvenance(const std::string& path, CalibrationProvenance* provenance, std::string* error) {
   std::string bytes;
   if (!ReadFileBytes(path, &bytes, error)) return false;
+  *provenance = LogProvenanceOfBytes(path, bytes);
+  return true;
+}
+
+CalibrationProvenance LogProvenanceOfBytes(const std::string& path, const std::string& bytes) {
   internal::ContentHash hash;
   hash.Add(bytes);
-  provenance->log_file = path;
-  provenance->log_hash = hash.Hex();
-  provenance->gravcal_version = GRAVCAL_VERSION;
-  return true;
+  return {path, hash.Hex(), GRAVCAL_VERSION};
 }
 
 bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration,

@@ -65,6 +65,8 @@ bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration
 // The provenance of a calibration made from the log at `path`: its file name
 // as given, the content hash of its bytes and this gravcal's version.
 bool LogProvenance(const std::string& path, CalibrationProvenance* provenance, std::string* error);
+// The same from the log's bytes already in memory (batch).
+CalibrationProvenance LogProvenanceOfBytes(const std::string& path, const std::string& bytes);
 
 }  // namespace gravcal
 
