@@ -499,68 +499,67 @@ double DiagonalRms(const LoadedCalibration& c, const Eigen::Vector3d& offset,
   return std::sqrt(sum / c.positions.size());
 }
 
-TEST(Export, Px4FileParsesAndItsTruncationErrorIsRecomputed) {
+// Exports the SI calibration to `target` through the CLI, parses every
+// non-comment line with `parse` (false = not the format), and checks the
+// truncation error in the comment against a recomputation from the file's
+// own offsets and scales. `names`: accelerometer offset X, Y, Z, scale X, Y, Z.
+void CheckAutopilotExport(const std::string& target,
+                          bool (*parse)(const std::string& line, std::string* name, double* value),
+                          const std::vector<std::string>& names) {
   const ScratchDir scratch;
   const std::string calib = WriteCalibration(scratch, SiCalibration());
-  const std::string out = scratch / "gravcal.params";
+  const std::string out = scratch / "parameters.txt";
   const testing_util::CliResult r =
-      RunCli("export --calibration " + calib + " --to px4 --output " + out, scratch);
+      RunCli("export --calibration " + calib + " --to " + target + " --output " + out, scratch);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("drops: effect terms"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("cross-axis"), std::string::npos) << r.err;
   const std::string text = Slurp(out);
   std::map<std::string, double> params;
   std::istringstream lines(text);
   for (std::string line; std::getline(lines, line);) {
     if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    int vehicle, component, type;
     std::string name;
     double value;
-    ASSERT_TRUE(fields >> vehicle >> component >> name >> value >> type) << line;
-    EXPECT_EQ(type, 9) << line;
+    ASSERT_TRUE(parse(line, &name, &value)) << line;
     params[name] = value;
   }
   ASSERT_EQ(params.size(), 9u);
-  const Eigen::Vector3d offset(params["CAL_ACC0_XOFF"], params["CAL_ACC0_YOFF"],
-                               params["CAL_ACC0_ZOFF"]);
-  const Eigen::Vector3d scale(params["CAL_ACC0_XSCALE"], params["CAL_ACC0_YSCALE"],
-                              params["CAL_ACC0_ZSCALE"]);
+  const Eigen::Vector3d offset(params[names[0]], params[names[1]], params[names[2]]);
+  const Eigen::Vector3d scale(params[names[3]], params[names[4]], params[names[5]]);
   const LoadedCalibration c = Loaded(SiCalibration());
   const double recomputed = DiagonalRms(c, offset, scale);
-  EXPECT_NEAR(NumberAfter(text, "static positions: "), recomputed, 1e-5 * recomputed);
   EXPECT_GT(recomputed, 1e-4);  // the dropped terms matter here
+  // The comment prints 6 significant digits.
+  EXPECT_NEAR(NumberAfter(text, "static positions: "), recomputed, 1e-5 * recomputed);
+  const double full = PositionResidualRms(c.corrector, c.positions, c.gravity);
+  EXPECT_NEAR(NumberAfter(text, "m/s^2 with what this file holds, "), full, 1e-5 * full);
+}
+
+// QGroundControl: vehicle, component, name, value, type 9 (float).
+bool ParsePx4Line(const std::string& line, std::string* name, double* value) {
+  std::istringstream fields(line);
+  int vehicle, component, type;
+  return (fields >> vehicle >> component >> *name >> *value >> type) && type == 9;
+}
+
+// .parm: NAME VALUE and nothing else.
+bool ParseArduPilotLine(const std::string& line, std::string* name, double* value) {
+  std::istringstream fields(line);
+  std::string rest;
+  return (fields >> *name >> *value) && !(fields >> rest);
+}
+
+TEST(Export, Px4FileParsesAndItsTruncationErrorIsRecomputed) {
+  CheckAutopilotExport("px4", ParsePx4Line,
+                       {"CAL_ACC0_XOFF", "CAL_ACC0_YOFF", "CAL_ACC0_ZOFF", "CAL_ACC0_XSCALE",
+                        "CAL_ACC0_YSCALE", "CAL_ACC0_ZSCALE"});
 }
 
 TEST(Export, ArduPilotFileParsesAndItsTruncationErrorIsRecomputed) {
-  const ScratchDir scratch;
-  const std::string calib = WriteCalibration(scratch, SiCalibration());
-  const std::string out = scratch / "gravcal.parm";
-  const testing_util::CliResult r =
-      RunCli("export --calibration " + calib + " --to ardupilot --output " + out, scratch);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string text = Slurp(out);
-  std::map<std::string, double> params;
-  std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    std::string name, rest;
-    double value;
-    ASSERT_TRUE(fields >> name >> value) << line;
-    EXPECT_FALSE(fields >> rest) << line;
-    params[name] = value;
-  }
-  ASSERT_EQ(params.size(), 9u);
-  const Eigen::Vector3d offset(params["INS_ACCOFFS_X"], params["INS_ACCOFFS_Y"],
-                               params["INS_ACCOFFS_Z"]);
-  const Eigen::Vector3d scale(params["INS_ACCSCAL_X"], params["INS_ACCSCAL_Y"],
-                              params["INS_ACCSCAL_Z"]);
-  const LoadedCalibration c = Loaded(SiCalibration());
-  const double recomputed = DiagonalRms(c, offset, scale);
-  EXPECT_NEAR(NumberAfter(text, "static positions: "), recomputed, 1e-5 * recomputed);
-  // The comment prints 6 significant digits.
-  const double full = PositionResidualRms(c.corrector, c.positions, c.gravity);
-  EXPECT_NEAR(NumberAfter(text, "m/s^2 with what this file holds, "), full, 1e-5 * full);
+  CheckAutopilotExport("ardupilot", ParseArduPilotLine,
+                       {"INS_ACCOFFS_X", "INS_ACCOFFS_Y", "INS_ACCOFFS_Z", "INS_ACCSCAL_X",
+                        "INS_ACCSCAL_Y", "INS_ACCSCAL_Z"});
 }
 
 TEST(Export, Px4RefusesRawCounts) {
