@@ -231,7 +231,7 @@ struct PyCalibration {
   const LoadedCalibration& Models() const {
     if (!parsed) {
       std::string error;
-      Check(ParseCalibrationJson(Json(), name, &models, &error), error);
+      Check(CalibrationFromJson(Json(), name, &models, &error), error);
       parsed = true;
     }
     return models;
@@ -249,27 +249,29 @@ void WriteCalibration(const PyCalibration& c, const std::string& path) {
   Check(WriteFileAtomically(path, c.Json(), &error), error);
 }
 
-// ===========================================================================
-// APPLY (transitional, issue 16): the one place where the bindings correct
-// raw samples. Until the library's "apply everything" corrector lands, this
-// is what `gravcal apply` does: a = M (v - b) for every accelerometer row
-// and w = M_g (u - b_g) for every gyroscope row when the calibration has a
-// gyroscope. The effect terms (temperature, time, nonlinearity,
-// g-sensitivity) are not applied here; python/gravcal/__init__.py warns
-// when the calibration holds any. `temp` and `t` are checked for shape only,
-// for the corrector that will use them. Swap the body for the library call
-// after the merge.
+// Applies everything the calibration holds (core/imu_corrector.h, the same
+// corrector as `gravcal apply`) to every row: accel (N, 3) raw -> m/s^2 and,
+// when given, gyro (N, 3) raw -> rad/s with the corrected accel for the
+// g-sensitivity. temp (N) and t (N) feed the temperature and time terms and
+// are required by name when the calibration has such terms.
 py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, const py::object& gyro,
                            const py::object& temp, const py::object& t) {
   std::vector<Eigen::Vector3d> a = ToVectors(accel, "accel", -1);
   const py::ssize_t n = static_cast<py::ssize_t>(a.size());
+  const ImuCorrector& corrector = c.Models().corrector;
   std::vector<Eigen::Vector3d> w;
   if (!gyro.is_none()) {
-    Check(c.Models().has_gyro, "gyro: the calibration has no gyroscope model");
+    Check(corrector.has_gyro, "gyro: the calibration has no gyroscope model");
     w = ToVectors(gyro, "gyro", n, "accel");
   }
-  if (!temp.is_none()) ToScalars(temp, "temp", n, "accel");
-  if (!t.is_none()) ToScalars(t, "t", n, "accel");
+  Check(!corrector.RequiresTemperature() || !temp.is_none(),
+        "temp: the calibration has temperature effects and needs the temperature of every row");
+  Check(!corrector.RequiresTime() || !t.is_none(),
+        "t: the calibration has time (drift) effects and needs the time of every row");
+  std::vector<double> temperature =
+      temp.is_none() ? std::vector<double>(a.size(), NAN) : ToScalars(temp, "temp", n, "accel");
+  std::vector<double> time =
+      t.is_none() ? std::vector<double>(a.size(), 0.0) : ToScalars(t, "t", n, "accel");
   for (const auto* v : {&a, &w}) {
     for (size_t i = 0; i < v->size(); ++i) {
       Check((*v)[i].allFinite(), std::string(v == &a ? "accel" : "gyro") + ": row " +
@@ -278,21 +280,30 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
   }
   DoubleArray a_out({n, static_cast<py::ssize_t>(3)});
   DoubleArray w_out({static_cast<py::ssize_t>(w.size()), static_cast<py::ssize_t>(3)});
-  const LoadedCalibration& models = c.Models();
+  size_t bad_row = a.size();
   {
     py::gil_scoped_release release;
     double* ao = a_out.mutable_data();
-    for (size_t i = 0; i < a.size(); ++i) {
-      Eigen::Map<Eigen::Vector3d>(ao + 3 * i) = models.accel.Apply(a[i]);
-    }
     double* wo = w_out.mutable_data();
-    for (size_t i = 0; i < w.size(); ++i) {
-      Eigen::Map<Eigen::Vector3d>(wo + 3 * i) = models.gyro.Apply(w[i]);
+    for (size_t i = 0; i < a.size(); ++i) {
+      Eigen::Vector3d si;
+      if (!corrector.CorrectAccel(a[i], temperature[i], time[i], &si)) {
+        bad_row = i;
+        break;
+      }
+      Eigen::Map<Eigen::Vector3d>(ao + 3 * i) = si;
+      if (!w.empty()) {
+        Eigen::Map<Eigen::Vector3d>(wo + 3 * i) =
+            corrector.CorrectGyro(w[i], si, temperature[i], time[i]);
+      }
     }
   }
+  Check(bad_row == a.size(),
+        "accel: row " + std::to_string(bad_row) +
+            ": the quadratic term has no real root (reading outside the calibrated range)");
   return py::make_tuple(a_out, gyro.is_none() ? py::object(py::none()) : py::object(w_out));
 }
-// ===========================================================================
+
 
 // RunCalibration, as `gravcal calibrate` runs it.
 PyCalibration Run(const Config& config, const PipelineInput& input) {

@@ -217,6 +217,12 @@ TEST_F(BatchTest, LibraryResultsEqualRunCalibrationAloneInInputOrder) {
     }
     Calibration alone;
     ASSERT_TRUE(RunCalibration(config, input, &alone)) << alone.message;
+    // Issue 16: batch records the log's provenance, as calibrate does.
+    if (!units[i].path.empty()) {
+      std::string bytes;
+      ASSERT_TRUE(ReadFileBytes(units[i].path, &bytes, &error)) << error;
+      alone.provenance = LogProvenanceOfBytes(units[i].path, bytes);
+    }
     EXPECT_EQ(WithoutTime(CalibrationToJson(results[i].calibration, true)),
               WithoutTime(CalibrationToJson(alone, true)));
     EXPECT_EQ(results[i].content_hash.size(), 32u);

@@ -87,19 +87,19 @@ TEST_P(CalibrationRoundTrip, ReaderAndApplyReproduceTheWrittenModel) {
   LoadedCalibration loaded;
   std::string error;
   ASSERT_TRUE(ReadCalibrationJson(calib, &loaded, &error)) << error;
-  EXPECT_EQ(loaded.accel.bias, accel_bias);
-  EXPECT_LT((loaded.accel.matrix() - accel_matrix).norm(), 1e-14 * accel_matrix.norm())
-      << loaded.accel.matrix() << "\nvs the file's\n"
+  EXPECT_EQ(loaded.corrector.accel.bias, accel_bias);
+  EXPECT_LT((loaded.corrector.accel.matrix() - accel_matrix).norm(), 1e-14 * accel_matrix.norm())
+      << loaded.corrector.accel.matrix() << "\nvs the file's\n"
       << accel_matrix;
   EXPECT_EQ(loaded.gravity, j["gravity"]["value"].get<double>());
-  EXPECT_EQ(loaded.has_gyro, m.gyro);
+  EXPECT_EQ(loaded.corrector.has_gyro, m.gyro);
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();
   Eigen::Matrix3d gyro_matrix = Eigen::Matrix3d::Identity();
   if (m.gyro) {
     gyro_bias = JsonVector(j["gyro"]["bias"]);
     gyro_matrix = JsonMatrix(j["gyro"]["matrix"]);
-    EXPECT_EQ(loaded.gyro.bias, gyro_bias);
-    EXPECT_EQ(loaded.gyro.matrix, gyro_matrix);
+    EXPECT_EQ(loaded.corrector.gyro.bias, gyro_bias);
+    EXPECT_EQ(loaded.corrector.gyro.matrix, gyro_matrix);
   }
 
   // apply: every sample, every column, against M (raw - b) with the file's
@@ -121,9 +121,26 @@ TEST_P(CalibrationRoundTrip, ReaderAndApplyReproduceTheWrittenModel) {
   auto relative = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     return (a - b).cwiseAbs().cwiseQuotient(a.cwiseAbs().cwiseMax(1.0)).maxCoeff();
   };
+  // Issue 16: apply applies the effect terms too; the effects case has one,
+  // accel_temperature_bias: a = R (U (v - b) - beta (T - T_ref)).
+  Eigen::Vector3d beta = Eigen::Vector3d::Zero();
+  double reference_temperature = 0.0;
+  if (j.contains("effects")) {
+    ASSERT_EQ(j["effects"].size(), 3u) << "the test knows accel_temperature_bias only";
+    beta = JsonVector(j["effects"]["accel_temperature_bias"]["value"]);
+    reference_temperature = j["effects"]["reference_temperature"].get<double>();
+  }
+  const Eigen::Matrix3d upper = JsonMatrix(j["accel"]["upper"]);
+  const Eigen::Matrix3d rotation = JsonMatrix(j["accel"]["rotation"]);
   for (size_t i = 0; i < raw.size(); ++i) {
     worst_t = std::max(worst_t, std::abs(out.t[i] - raw.t[i]));
-    const double ea = relative(accel_matrix * (raw.accel[i] - accel_bias), out.accel[i]);
+    const double temperature_offset =
+        raw.temperature.empty() ? 0.0 : raw.temperature[i] - reference_temperature;
+    const Eigen::Vector3d expected =
+        j.contains("effects") ? Eigen::Vector3d(rotation * (upper * (raw.accel[i] - accel_bias) -
+                                                            beta * temperature_offset))
+                              : Eigen::Vector3d(accel_matrix * (raw.accel[i] - accel_bias));
+    const double ea = relative(expected, out.accel[i]);
     const double eg = relative(gyro_matrix * (raw.gyro[i] - gyro_bias), out.gyro[i]);
     if (ea > worst_accel) worst_accel = ea, worst_accel_at = i;
     if (eg > worst_gyro) worst_gyro = eg, worst_gyro_at = i;

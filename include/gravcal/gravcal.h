@@ -9,6 +9,7 @@
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/gravity.h"
 #include "gravcal/core/gyro_model.h"
+#include "gravcal/core/imu_corrector.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/noise_model.h"
@@ -41,8 +42,10 @@
 
 // io
 #include "gravcal/io/attitude_fixture.h"
+#include "gravcal/io/calibration_export.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/files.h"
+#include "gravcal/io/imu_stream.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/io/recording.h"

@@ -297,19 +297,13 @@ class Calibration(_Section):
         return list(self._dict().get("warnings", []))
 
     def apply(self, accel, gyro=None, *, temp=None, t=None):
-        """Raw samples to SI: ``accel`` (N, 3) -> m/s^2 with a = M (v - b);
-        ``gyro`` (N, 3) -> rad/s with w = M_g (u - b_g). Returns ``accel_si``
-        when only accel is given, else ``(accel_si, gyro_si)``. Vectorised
-        in C++ without the GIL; the same numbers as ``gravcal apply``.
-        ``temp`` and ``t`` are for the effect terms (temperature, time):
-        their correction is not applied yet and a warning says so when the
-        calibration holds such terms."""
-        effects = self._dict().get("effects")
-        if effects:
-            names = [k for k in effects if k not in ("reference_temperature", "reference_time")]
-            _warnings.warn("gravcal: the calibration's effect terms (%s) are not applied "
-                           "(apply corrects the linear model only, as gravcal apply does)"
-                           % ", ".join(names), stacklevel=2)
+        """Raw samples to SI with every term of the calibration (the same
+        corrector as ``gravcal apply``): ``accel`` (N, 3) -> m/s^2,
+        ``gyro`` (N, 3) -> rad/s (its g-sensitivity uses the corrected
+        accel). ``temp`` and ``t`` (N) feed the temperature and time terms
+        and are required when the calibration has them. Returns
+        ``accel_si`` when only accel is given, else ``(accel_si, gyro_si)``.
+        Vectorised in C++ without the GIL."""
         a, w = self._core.apply(accel, gyro, temp, t)
         return a if gyro is None else (a, w)
 

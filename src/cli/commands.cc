@@ -113,8 +113,11 @@ int RunCalibrate(const CommandArgs& args) {
   input.segments_path = args.segments;
   input.noise_path = args.noise;
   if (!ReadImuLog(args.input, args.config.input, &input.log, &error)) return Fail(error);
+  CalibrationProvenance provenance;
+  if (!LogProvenance(args.input, &provenance, &error)) return Fail(error);
   Calibration c;
   const bool ok = RunCalibration(args.config, input, &c);
+  c.provenance = provenance;
   PrintWarnings(c);
   // The report also for a failed calibration: it says why.
   if (!args.report.empty() &&
@@ -130,24 +133,6 @@ int RunCalibrate(const CommandArgs& args) {
   }
   std::fprintf(stderr, "gravcal: %s; |a| - g rms %.5f -> %.5f m/s^2; wrote %s\n", c.message.c_str(),
                c.residual_nominal.rms, c.residual_refined.rms, args.output.c_str());
-  return 0;
-}
-
-int RunApply(const CommandArgs& args) {
-  if (args.calibration.empty()) return Fail("apply needs --calibration <calib.json>");
-  if (args.input.empty()) return Fail("apply needs --input <raw log>");
-  if (args.output.empty()) return Fail("apply needs --output <corrected.csv>");
-  std::string error;
-  if (!CheckConfig(args.config, &error)) return Fail(error);
-  LoadedCalibration calibration;
-  if (!ReadCalibrationJson(args.calibration, &calibration, &error)) return Fail(error);
-  ImuLog log;
-  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
-  for (Eigen::Vector3d& a : log.accel) a = calibration.accel.Apply(a);
-  if (calibration.has_gyro) {
-    for (Eigen::Vector3d& w : log.gyro) w = calibration.gyro.Apply(w);
-  }
-  if (!WriteImuLogCsv(log, args.output, &error)) return Fail(error);
   return 0;
 }
 

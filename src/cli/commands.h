@@ -31,6 +31,8 @@ struct CommandArgs {
   std::string handheld;
   // calibrate: the noise model from gravcal noise (--noise).
   std::string noise;
+  // export: the target (--to).
+  std::string to;
   uint64_t seed = 1;
   // batch and merge-summaries.
   std::string manifest;
@@ -61,6 +63,10 @@ int RunDiscover(const CommandArgs& args);
 int RunNoise(const CommandArgs& args);
 // inspect_command.cc: 0 the file was read; 1 it cannot be.
 int RunInspect(const CommandArgs& args);
+// apply_command.cc: 0 written; 1 bad input (no output file).
+// export_command.cc: 0 written; 1 bad input or a target that cannot take the
+// calibration (nothing written).
+int RunExport(const CommandArgs& args);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

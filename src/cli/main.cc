@@ -49,6 +49,8 @@ DEFINE_string(noise, "",
               "noise.json from 'gravcal noise': the variance of each pose's mean, and the "
               "handheld filter's noise, from the noise model");
 
+DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
+
 namespace {
 
 struct CommandInfo {
@@ -73,8 +75,9 @@ const std::vector<CommandInfo>& Commands() {
        {"input", "config", "output", "attitudes", "segments", "history", "noise", "report"},
        gravcal::cli::RunCalibrate},
       {"apply",
-       "apply a calibration to a raw log, writing SI units",
-       {"calibration", "input", "output"},
+       "apply every term of a calibration to a contract CSV log (streaming; - for standard "
+       "input/output), writing SI units",
+       {"calibration", "input", "output", "config"},
        gravcal::cli::RunApply},
       {"simulate",
        "simulate a session: raw.csv, truth.json, the fixture's attitudes.csv (and, for "
@@ -106,6 +109,10 @@ const std::vector<CommandInfo>& Commands() {
        "what a log file holds: format, topics and types, message counts, rates, time span, gaps",
        {"input", "config"},
        gravcal::cli::RunInspect},
+      {"export",
+       "write a calibration for kalibr, openvins, ros, px4, ardupilot or as C source (c)",
+       {"calibration", "noise", "to", "output", "output_dir"},
+       gravcal::cli::RunExport},
       {"help",
        "list commands, or the flags and config keys of one: gravcal help <command>",
        {},
@@ -286,6 +293,7 @@ int main(int argc, char** argv) {
   args.handheld = FLAGS_handheld;
   args.noise = FLAGS_noise;
   args.topics = FLAGS_topics;
+  args.to = FLAGS_to;
 
   return info->run(args);
 }

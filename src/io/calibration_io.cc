@@ -1,12 +1,14 @@
 #include "gravcal/io/calibration_io.h"
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <utility>
 
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "io/json_helpers.h"
+#include "util/content_hash.h"
 #include "util/units.h"
 
 namespace gravcal {
@@ -20,23 +22,26 @@ using nlohmann::json;
 
 }  // namespace
 
-std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
+namespace {
+
+// accel: the model, its standard deviations and, when present, covariance,
+// pose variance and placement error.
+json AccelJson(const AccelCalibration& a, bool include_covariance) {
   json accel;
-  accel["model"] = ToString(c.accel.model.parameterization);
-  accel["bias"] = JsonVector(c.accel.model.bias);
-  accel["matrix"] = JsonMatrix(c.accel.model.matrix());
-  accel["upper"] = JsonMatrix(c.accel.model.upper);
-  accel["rotation"] = JsonMatrix(c.accel.model.rotation);
-  accel["std"] = {{"bias", JsonVector(c.accel.bias_std)},
-                  {"matrix", JsonMatrix(c.accel.matrix_std)}};
-  if (include_covariance && c.accel.covariance.size() > 0) {
-    accel["covariance"] = {{"parameters", c.accel.covariance_names},
-                           {"matrix", JsonMatrix(c.accel.covariance)}};
+  accel["model"] = ToString(a.model.parameterization);
+  accel["bias"] = JsonVector(a.model.bias);
+  accel["matrix"] = JsonMatrix(a.model.matrix());
+  accel["upper"] = JsonMatrix(a.model.upper);
+  accel["rotation"] = JsonMatrix(a.model.rotation);
+  accel["std"] = {{"bias", JsonVector(a.bias_std)}, {"matrix", JsonMatrix(a.matrix_std)}};
+  if (include_covariance && a.covariance.size() > 0) {
+    accel["covariance"] = {{"parameters", a.covariance_names},
+                           {"matrix", JsonMatrix(a.covariance)}};
   }
-  if (c.accel.pose_variance.estimated) {
+  if (a.pose_variance.estimated) {
     // s^2 of |a| between poses beyond the white noise, its standard
     // deviation, s itself, and whether the standard deviations carry it.
-    const VarianceComponent& v = c.accel.pose_variance;
+    const VarianceComponent& v = a.pose_variance;
     accel["pose_variance"] = {{"value", JsonNumber(v.variance)},
                               {"std", JsonNumber(v.variance_std)},
                               {"unit", "(m/s^2)^2"},
@@ -44,105 +49,137 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
                               {"absorbed", v.absorbed},
                               {"dof", v.dof}};
   }
-  if (c.accel.model.parameterization == AccelParameterization::kAffine) {
-    accel["placement_error_deg"] = JsonNumber(c.accel.tilt_rms * internal::kRadToDeg);
+  if (a.model.parameterization == AccelParameterization::kAffine) {
+    accel["placement_error_deg"] = JsonNumber(a.tilt_rms * internal::kRadToDeg);
   }
-  json out;
-  out["method"] = c.method;
-  out["accel"] = accel;
-  if (c.gyro.estimated) {
-    json gyro;
-    gyro["bias"] = JsonVector(c.gyro.model.bias);
-    gyro["matrix"] = JsonMatrix(c.gyro.model.matrix);
-    gyro["std"] = {{"bias", JsonVector(c.gyro.bias_std)},
-                   {"matrix", JsonMatrix(c.gyro.matrix_std)}};
-    if (include_covariance && c.gyro.covariance.size() > 0) {
-      gyro["covariance"] = {{"parameters", c.gyro.covariance_names},
-                            {"matrix", JsonMatrix(c.gyro.covariance)}};
-    }
-    json extra = json::object();
-    for (size_t i = 0; i < c.gyro.extra_names.size(); ++i) {
-      extra[c.gyro.extra_names[i]] = {{"value", JsonNumber(c.gyro.extra_values[i])},
-                                      {"std", JsonNumber(c.gyro.extra_std[i])}};
-    }
-    if (!extra.empty()) gyro["extra"] = extra;
-    if (!c.gyro.rotation_residual_deg.empty()) {
-      gyro["rotation_residual_deg"] = JsonArray(c.gyro.rotation_residual_deg);
-    }
-    out["gyro"] = gyro;
+  return accel;
+}
+
+// gyro: the model, standard deviations, covariance, method extras and
+// rotation residuals.
+json GyroJson(const GyroCalibration& g, bool include_covariance) {
+  json gyro;
+  gyro["bias"] = JsonVector(g.model.bias);
+  gyro["matrix"] = JsonMatrix(g.model.matrix);
+  gyro["std"] = {{"bias", JsonVector(g.bias_std)}, {"matrix", JsonMatrix(g.matrix_std)}};
+  if (include_covariance && g.covariance.size() > 0) {
+    gyro["covariance"] = {{"parameters", g.covariance_names}, {"matrix", JsonMatrix(g.covariance)}};
   }
-  // Issue 6: effects beyond the textbook model, by catalogue name.
-  if (!c.effects.estimates.empty()) {
-    json effects = {{"reference_temperature", JsonNumber(c.effects.reference_temperature)},
-                    {"reference_time", JsonNumber(c.effects.reference_time)}};
-    for (const EffectEstimate& e : c.effects.estimates) {
-      json values = json::array(), stds = json::array();
-      for (size_t i = 0; i < e.values.size(); ++i) {
-        values.push_back(JsonNumber(e.values[i]));
-        stds.push_back(JsonNumber(i < e.std.size() ? e.std[i] : NAN));
-      }
-      effects[ToString(e.effect)] = {
-          {"parameters", e.names}, {"value", values}, {"std", stds}, {"unit", e.unit}};
-    }
-    out["effects"] = effects;
+  json extra = json::object();
+  for (size_t i = 0; i < g.extra_names.size(); ++i) {
+    extra[g.extra_names[i]] = {{"value", JsonNumber(g.extra_values[i])},
+                               {"std", JsonNumber(g.extra_std[i])}};
   }
-  out["gravity"] = {{"value", c.gravity}, {"source", c.gravity_source}};
+  if (!extra.empty()) gyro["extra"] = extra;
+  if (!g.rotation_residual_deg.empty()) {
+    gyro["rotation_residual_deg"] = JsonArray(g.rotation_residual_deg);
+  }
+  return gyro;
+}
+
+// Issue 6: effects beyond the textbook model, by catalogue name.
+json EffectsJson(const EffectCalibration& e) {
+  json effects = {{"reference_temperature", JsonNumber(e.reference_temperature)},
+                  {"reference_time", JsonNumber(e.reference_time)}};
+  for (const EffectEstimate& estimate : e.estimates) {
+    json values = json::array(), stds = json::array();
+    for (size_t i = 0; i < estimate.values.size(); ++i) {
+      values.push_back(JsonNumber(estimate.values[i]));
+      stds.push_back(JsonNumber(i < estimate.std.size() ? estimate.std[i] : NAN));
+    }
+    effects[ToString(estimate.effect)] = {
+        {"parameters", estimate.names}, {"value", values}, {"std", stds}, {"unit", estimate.unit}};
+  }
+  return effects;
+}
+
+json ResidualJson(const Calibration& c) {
   auto summary = [](const ResidualSummary& s) {
     return json{{"rms", JsonNumber(s.rms)}, {"max", JsonNumber(s.max)}};
   };
-  out["residual"] = {{"unit", "m/s^2"},
-                     {"quantity", "|a| - g over static positions"},
-                     {"before", summary(c.residual_nominal)},
-                     {"coarse", summary(c.residual_coarse)},
-                     {"after", summary(c.residual_refined)}};
-  json positions = json::array();
-  for (const PositionReport& r : c.positions) {
-    json p = {{"t_begin", r.position.t_begin},
-              {"t_end", r.position.t_end},
-              {"samples", r.position.sample_count},
-              {"raw_mean", JsonVector(r.position.raw_mean)},
-              {"raw_std", JsonVector(r.raw_std)},
-              {"nominal_up", NominalAxisName(r.nominal_up)},
-              {"residual_before", JsonNumber(r.residual_before)},
-              {"residual_after", JsonNumber(r.residual_after)},
-              {"sigma", JsonNumber(r.sigma)}};
-    // Only the methods that use an attitude per position have one.
-    if (std::isfinite(r.roll_deg) && std::isfinite(r.pitch_deg)) {
-      p["attitude_deg"] = {{"roll", r.roll_deg},
-                           {"pitch", r.pitch_deg},
-                           {"roll_std", JsonNumber(r.roll_std_deg)},
-                           {"pitch_std", JsonNumber(r.pitch_std_deg)}};
-    }
-    positions.push_back(p);
+  return {{"unit", "m/s^2"},
+          {"quantity", "|a| - g over static positions"},
+          {"before", summary(c.residual_nominal)},
+          {"coarse", summary(c.residual_coarse)},
+          {"after", summary(c.residual_refined)}};
+}
+
+json PositionJson(const PositionReport& r) {
+  json p = {{"t_begin", r.position.t_begin},
+            {"t_end", r.position.t_end},
+            {"samples", r.position.sample_count},
+            {"raw_mean", JsonVector(r.position.raw_mean)},
+            {"raw_std", JsonVector(r.raw_std)},
+            {"nominal_up", NominalAxisName(r.nominal_up)},
+            {"residual_before", JsonNumber(r.residual_before)},
+            {"residual_after", JsonNumber(r.residual_after)},
+            {"sigma", JsonNumber(r.sigma)}};
+  if (std::isfinite(r.position.temperature)) p["temperature"] = r.position.temperature;
+  // Only the methods that use an attitude per position have one.
+  if (std::isfinite(r.roll_deg) && std::isfinite(r.pitch_deg)) {
+    p["attitude_deg"] = {{"roll", r.roll_deg},
+                         {"pitch", r.pitch_deg},
+                         {"roll_std", JsonNumber(r.roll_std_deg)},
+                         {"pitch_std", JsonNumber(r.pitch_std_deg)}};
   }
-  out["positions"] = positions;
+  return p;
+}
+
+json SolverJson(const Calibration& c) {
   const RefinementResult& f = c.refinement;
-  out["solver"] = {{"method", c.solver_name},
-                   {"coarse", ToString(c.coarse.method)},
-                   {"iterations", f.iterations},
-                   {"termination", f.termination},
-                   {"converged", f.converged},
-                   {"time_s", f.solve_seconds},
-                   {"initial_cost", f.initial_cost},
-                   {"final_cost", f.final_cost},
-                   {"chi2", f.chi2},
-                   {"dof", f.dof},
-                   {"message", f.message}};
-  // Issue 4: per-parameter convergence of recursive methods.
-  if (!c.convergence.entries.empty()) {
-    json entries = json::object();
-    for (const ConvergenceEntry& e : c.convergence.entries) {
-      entries[e.name] = {{"value", JsonNumber(e.value)},
-                         {"unit", e.unit},
-                         {"sigma_initial", JsonNumber(e.sigma_initial)},
-                         {"sigma_final", JsonNumber(e.sigma_final)},
-                         {"converged", e.converged},
-                         {"time_s", JsonNumber(e.time)}};
-    }
-    out["convergence"] = {{"criterion", c.convergence.criterion}, {"parameters", entries}};
+  return {{"method", c.solver_name},
+          {"coarse", ToString(c.coarse.method)},
+          {"iterations", f.iterations},
+          {"termination", f.termination},
+          {"converged", f.converged},
+          {"time_s", f.solve_seconds},
+          {"initial_cost", f.initial_cost},
+          {"final_cost", f.final_cost},
+          {"chi2", f.chi2},
+          {"dof", f.dof},
+          {"message", f.message}};
+}
+
+// Issue 4: per-parameter convergence of recursive methods.
+json ConvergenceJson(const ConvergenceReport& report) {
+  json entries = json::object();
+  for (const ConvergenceEntry& e : report.entries) {
+    entries[e.name] = {{"value", JsonNumber(e.value)},
+                       {"unit", e.unit},
+                       {"sigma_initial", JsonNumber(e.sigma_initial)},
+                       {"sigma_final", JsonNumber(e.sigma_final)},
+                       {"converged", e.converged},
+                       {"time_s", JsonNumber(e.time)}};
   }
+  return {{"criterion", report.criterion}, {"parameters", entries}};
+}
+
+// Issue 16: the log the calibration came from, and this gravcal's version.
+json ProvenanceJson(const CalibrationProvenance& p) {
+  json out = {{"gravcal_version", p.gravcal_version.empty() ? GRAVCAL_VERSION : p.gravcal_version}};
+  if (!p.log_file.empty()) out["log_file"] = p.log_file;
+  if (!p.log_hash.empty()) out["log_hash"] = p.log_hash;
+  return out;
+}
+
+}  // namespace
+
+std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
+  json out;
+  out["method"] = c.method;
+  out["accel"] = AccelJson(c.accel, include_covariance);
+  if (c.gyro.estimated) out["gyro"] = GyroJson(c.gyro, include_covariance);
+  if (!c.effects.estimates.empty()) out["effects"] = EffectsJson(c.effects);
+  out["gravity"] = {{"value", c.gravity}, {"source", c.gravity_source}};
+  out["residual"] = ResidualJson(c);
+  json positions = json::array();
+  for (const PositionReport& r : c.positions) positions.push_back(PositionJson(r));
+  out["positions"] = positions;
+  out["solver"] = SolverJson(c);
+  if (!c.convergence.entries.empty()) out["convergence"] = ConvergenceJson(c.convergence);
   out["warnings"] = c.warnings;
   out["message"] = c.message;
+  out["provenance"] = ProvenanceJson(c.provenance);
   return out.dump(2) + "\n";
 }
 
@@ -172,101 +209,282 @@ bool WriteCalibrationJson(const Calibration& calibration, bool include_covarianc
 
 namespace {
 
-bool ReadVector(const json& j, const std::string& key, const std::string& where, Eigen::Vector3d* v,
-                std::string* error) {
-  if (!j.contains(key) || !j[key].is_array() || j[key].size() != 3) {
-    *error = where + ": key '" + key + "' must be an array of 3 numbers";
+// Reading: every check names the key by its dotted path.
+class JsonReader {
+ public:
+  JsonReader(std::string name, std::string* error) : name_(std::move(name)), error_(error) {}
+
+  bool Fail(const std::string& key, const std::string& what) {
+    *error_ = name_ + ": key '" + key + "': " + what;
     return false;
   }
-  for (int i = 0; i < 3; ++i) {
-    if (!j[key][i].is_number()) {
-      *error = where + ": key '" + key + "' must be an array of 3 numbers";
+  // A number; `allow_null` reads null as NaN.
+  bool Number(const json& j, const std::string& key, bool allow_null, double* v) {
+    if (allow_null && j.is_null()) {
+      *v = NAN;
+      return true;
+    }
+    if (!j.is_number())
+      return Fail(key, allow_null ? "must be a number or null" : "must be a number");
+    *v = j.get<double>();
+    return true;
+  }
+  bool Vector(const json& parent, const std::string& field, const std::string& key,
+              Eigen::Vector3d* v) {
+    if (!parent.contains(field)) return Fail(key, "is missing");
+    const json& j = parent[field];
+    if (!j.is_array() || j.size() != 3) return Fail(key, "must be an array of 3 numbers");
+    for (int i = 0; i < 3; ++i) {
+      if (!j[i].is_number()) return Fail(key, "must be an array of 3 numbers");
+      (*v)(i) = j[i].get<double>();
+    }
+    return true;
+  }
+  bool Matrix(const json& parent, const std::string& field, const std::string& key,
+              Eigen::Matrix3d* m) {
+    if (!parent.contains(field)) return Fail(key, "is missing");
+    const json& j = parent[field];
+    const char* what = "must be a 3x3 array of numbers";
+    if (!j.is_array() || j.size() != 3) return Fail(key, what);
+    for (int r = 0; r < 3; ++r) {
+      if (!j[r].is_array() || j[r].size() != 3) return Fail(key, what);
+      for (int c = 0; c < 3; ++c) {
+        if (!j[r][c].is_number()) return Fail(key, what);
+        (*m)(r, c) = j[r][c].get<double>();
+      }
+    }
+    return true;
+  }
+  bool Object(const json& parent, const std::string& field, const std::string& key) {
+    if (!parent.contains(field)) return Fail(key, "is missing");
+    if (!parent[field].is_object()) return Fail(key, "must be an object");
+    return true;
+  }
+
+ private:
+  std::string name_;
+  std::string* error_;
+};
+
+bool ReadAccel(const json& j, JsonReader* r, AccelModel* model) {
+  if (!r->Object(j, "accel", "accel")) return false;
+  const json& a = j["accel"];
+  Eigen::Matrix3d m;
+  Eigen::Vector3d b;
+  if (!r->Vector(a, "bias", "accel.bias", &b) || !r->Matrix(a, "matrix", "accel.matrix", &m)) {
+    return false;
+  }
+  AccelParameterization p = AccelParameterization::kAffine;
+  if (a.contains("model")) {
+    if (!a["model"].is_string() || !FromString(a["model"].get<std::string>(), &p)) {
+      return r->Fail("accel.model", "must be one of the accelerometer parameterisations");
+    }
+  }
+  if (!AccelModel::FromMatrix(b, m, p, model)) {
+    return r->Fail("accel.matrix", "is singular or a reflection");
+  }
+  // The file's upper and rotation, when present, are the decomposition the
+  // effects were fitted in; the QR of M gives the same up to rounding.
+  if (a.contains("upper") || a.contains("rotation")) {
+    Eigen::Matrix3d upper, rotation;
+    if (!r->Matrix(a, "upper", "accel.upper", &upper) ||
+        !r->Matrix(a, "rotation", "accel.rotation", &rotation)) {
       return false;
     }
-    (*v)(i) = j[key][i].get<double>();
+    model->upper = upper;
+    model->rotation = rotation;
   }
   return true;
 }
 
-bool ReadMatrix(const json& j, const std::string& key, const std::string& where, Eigen::Matrix3d* m,
-                std::string* error) {
-  const std::string message = where + ": key '" + key + "' must be a 3x3 array of numbers";
-  if (!j.contains(key) || !j[key].is_array() || j[key].size() != 3) {
-    *error = message;
+bool ReadGyro(const json& j, JsonReader* r, ImuCorrector* c) {
+  if (!j.contains("gyro")) return true;
+  if (!r->Object(j, "gyro", "gyro")) return false;
+  if (!r->Vector(j["gyro"], "bias", "gyro.bias", &c->gyro.bias) ||
+      !r->Matrix(j["gyro"], "matrix", "gyro.matrix", &c->gyro.matrix)) {
     return false;
   }
-  for (int r = 0; r < 3; ++r) {
-    if (!j[key][r].is_array() || j[key][r].size() != 3) {
-      *error = message;
+  c->has_gyro = true;
+  return true;
+}
+
+// effects.<name>.value into the parameter the name stands for.
+bool ReadEffect(const json& entry, Effect effect, const std::string& key, JsonReader* r,
+                LoadedCalibration* out) {
+  if (!entry.is_object()) return r->Fail(key, "must be an object");
+  if (!entry.contains("value") || !entry["value"].is_array()) {
+    return r->Fail(key + ".value", "must be an array of numbers");
+  }
+  const json& values = entry["value"];
+  const int n = Info(effect).num_parameters;
+  if (effect == Effect::kAccelMisalignment) return true;  // lives in accel.upper
+  if (static_cast<int>(values.size()) != n) {
+    return r->Fail(key + ".value", "must have " + std::to_string(n) + " numbers");
+  }
+  std::vector<double> v(n);
+  for (int i = 0; i < n; ++i) {
+    if (!r->Number(values[i], key + ".value", true, &v[i])) return false;
+    if (!std::isfinite(v[i])) {
+      out->undetermined.push_back(key + "." + Info(effect).parameter_names[i]);
+      v[i] = 0.0;
+    }
+  }
+  EffectParameters& p = out->corrector.effects;
+  const Eigen::Vector3d three(v[0], v[1], v[2]);
+  switch (effect) {
+    case Effect::kAccelQuadratic:
+      p.accel_quadratic = three;
+      break;
+    case Effect::kAccelTemperatureBias:
+      p.accel_temperature_bias = three;
+      break;
+    case Effect::kAccelTemperatureScale:
+      p.accel_temperature_scale = three;
+      break;
+    case Effect::kAccelBiasDrift:
+      p.accel_bias_drift = three;
+      break;
+    case Effect::kGyroTemperatureBias:
+      p.gyro_temperature_bias = three;
+      break;
+    case Effect::kGyroBiasDrift:
+      p.gyro_bias_drift = three;
+      break;
+    case Effect::kGyroGSensitivity:
+      for (int i = 0; i < 9; ++i) p.gyro_g_sensitivity(i / 3, i % 3) = v[i];
+      break;
+    case Effect::kAccelMisalignment:
+      break;
+  }
+  if (Info(effect).sensor == EffectSensor::kGyroscope && !out->corrector.has_gyro) {
+    return r->Fail(key, "is a gyroscope effect but the file has no 'gyro' section");
+  }
+  out->corrector.active_effects.push_back(effect);
+  return true;
+}
+
+bool ReadEffects(const json& j, JsonReader* r, LoadedCalibration* out) {
+  if (!j.contains("effects")) return true;
+  if (!r->Object(j, "effects", "effects")) return false;
+  const json& e = j["effects"];
+  EffectParameters& p = out->corrector.effects;
+  if (!e.contains("reference_time")) return r->Fail("effects.reference_time", "is missing");
+  if (!e.contains("reference_temperature")) {
+    return r->Fail("effects.reference_temperature", "is missing");
+  }
+  if (!r->Number(e["reference_time"], "effects.reference_time", false, &p.reference_time) ||
+      !r->Number(e["reference_temperature"], "effects.reference_temperature", true,
+                 &p.reference_temperature)) {
+    return false;
+  }
+  for (auto it = e.begin(); it != e.end(); ++it) {
+    if (it.key() == "reference_time" || it.key() == "reference_temperature") continue;
+    Effect effect;
+    if (!FromString(it.key(), &effect)) {
+      return r->Fail("effects." + it.key(), "is not an effect of the catalogue");
+    }
+    if (!ReadEffect(it.value(), effect, "effects." + it.key(), r, out)) return false;
+  }
+  if (out->corrector.RequiresTemperature() && !std::isfinite(p.reference_temperature)) {
+    return r->Fail("effects.reference_temperature",
+                   "must be a number when a temperature effect is present");
+  }
+  if (!std::isfinite(p.reference_temperature)) p.reference_temperature = 0.0;
+  return true;
+}
+
+bool ReadPositions(const json& j, JsonReader* r, std::vector<RecordedPosition>* positions) {
+  if (!j.contains("positions")) return true;
+  if (!j["positions"].is_array()) return r->Fail("positions", "must be an array");
+  for (size_t k = 0; k < j["positions"].size(); ++k) {
+    const json& p = j["positions"][k];
+    const std::string key = "positions[" + std::to_string(k) + "]";
+    if (!p.is_object()) return r->Fail(key, "must be an object");
+    RecordedPosition out;
+    double t_begin = 0.0, t_end = 0.0;
+    if (!r->Vector(p, "raw_mean", key + ".raw_mean", &out.raw_mean)) return false;
+    for (const char* field : {"t_begin", "t_end"}) {
+      if (!p.contains(field)) return r->Fail(key + "." + field, "is missing");
+    }
+    if (!r->Number(p["t_begin"], key + ".t_begin", false, &t_begin) ||
+        !r->Number(p["t_end"], key + ".t_end", false, &t_end)) {
       return false;
     }
-    for (int c = 0; c < 3; ++c) {
-      if (!j[key][r][c].is_number()) {
-        *error = message;
-        return false;
-      }
-      (*m)(r, c) = j[key][r][c].get<double>();
+    out.time = 0.5 * (t_begin + t_end);
+    if (p.contains("temperature") &&
+        !r->Number(p["temperature"], key + ".temperature", true, &out.temperature)) {
+      return false;
     }
+    positions->push_back(out);
+  }
+  return true;
+}
+
+bool ReadProvenance(const json& j, JsonReader* r, CalibrationProvenance* provenance) {
+  if (!j.contains("provenance")) return true;
+  if (!r->Object(j, "provenance", "provenance")) return false;
+  const json& p = j["provenance"];
+  const std::pair<const char*, std::string*> fields[] = {
+      {"log_file", &provenance->log_file},
+      {"log_hash", &provenance->log_hash},
+      {"gravcal_version", &provenance->gravcal_version}};
+  for (const auto& [field, value] : fields) {
+    if (!p.contains(field)) continue;
+    if (!p[field].is_string())
+      return r->Fail(std::string("provenance.") + field, "must be a string");
+    *value = p[field].get<std::string>();
   }
   return true;
 }
 
 }  // namespace
 
-bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration,
-                         std::string* error) {
-  std::ifstream in(path);
-  if (!in) {
-    *error = path + ": cannot open";
-    return false;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseCalibrationJson(text.str(), path, calibration, error);
-}
-
-bool ParseCalibrationJson(const std::string& text, const std::string& name,
-                          LoadedCalibration* calibration, std::string* error) {
-  const std::string& path = name;
+bool CalibrationFromJson(const std::string& text, const std::string& name,
+                         LoadedCalibration* calibration, std::string* error) {
   json j;
   try {
     j = json::parse(text);
   } catch (const json::parse_error& e) {
-    *error = path + ": not valid JSON (" + e.what() + ")";
+    *error = name + ": not valid JSON (" + e.what() + ")";
     return false;
   }
-  if (!j.is_object() || !j.contains("accel") || !j["accel"].is_object()) {
-    *error = path + ": key 'accel' is missing";
-    return false;
-  }
+  JsonReader r(name, error);
+  if (!j.is_object()) return r.Fail("accel", "is missing (the file is not a JSON object)");
   LoadedCalibration out;
-  Eigen::Matrix3d m;
-  Eigen::Vector3d b;
-  if (!ReadVector(j["accel"], "bias", path + ": accel", &b, error) ||
-      !ReadMatrix(j["accel"], "matrix", path + ": accel", &m, error)) {
+  if (!ReadAccel(j, &r, &out.corrector.accel) || !ReadGyro(j, &r, &out.corrector) ||
+      !ReadEffects(j, &r, &out) || !ReadPositions(j, &r, &out.positions) ||
+      !ReadProvenance(j, &r, &out.provenance)) {
     return false;
   }
-  AccelParameterization p = AccelParameterization::kAffine;
-  if (j["accel"].contains("model") && j["accel"]["model"].is_string()) {
-    FromString(j["accel"]["model"].get<std::string>(), &p);
+  if (j.contains("gravity")) {
+    if (!r.Object(j, "gravity", "gravity")) return false;
+    if (!j["gravity"].contains("value")) return r.Fail("gravity.value", "is missing");
+    if (!r.Number(j["gravity"]["value"], "gravity.value", false, &out.gravity)) return false;
+    if (!(out.gravity > 0.0)) return r.Fail("gravity.value", "must be positive");
   }
-  if (!AccelModel::FromMatrix(b, m, p, &out.accel)) {
-    *error = path + ": accel.matrix is singular or a reflection";
-    return false;
-  }
-  if (j.contains("gyro") && j["gyro"].is_object()) {
-    if (!ReadVector(j["gyro"], "bias", path + ": gyro", &out.gyro.bias, error) ||
-        !ReadMatrix(j["gyro"], "matrix", path + ": gyro", &out.gyro.matrix, error)) {
-      return false;
-    }
-    out.has_gyro = true;
-  }
-  if (j.contains("gravity") && j["gravity"].is_object() && j["gravity"].contains("value") &&
-      j["gravity"]["value"].is_number()) {
-    out.gravity = j["gravity"]["value"].get<double>();
-  }
-  *calibration = out;
+  if (j.contains("method") && j["method"].is_string()) out.method = j["method"].get<std::string>();
+  *calibration = std::move(out);
   return true;
+}
+
+bool LogProvenance(const std::string& path, CalibrationProvenance* provenance, std::string* error) {
+  std::string bytes;
+  if (!ReadFileBytes(path, &bytes, error)) return false;
+  *provenance = LogProvenanceOfBytes(path, bytes);
+  return true;
+}
+
+CalibrationProvenance LogProvenanceOfBytes(const std::string& path, const std::string& bytes) {
+  internal::ContentHash hash;
+  hash.Add(bytes);
+  return {path, hash.Hex(), GRAVCAL_VERSION};
+}
+
+bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration,
+                         std::string* error) {
+  std::string text;
+  if (!ReadFileBytes(path, &text, error)) return false;
+  return CalibrationFromJson(text, path, calibration, error);
 }
 
 }  // namespace gravcal

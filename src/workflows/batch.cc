@@ -5,6 +5,7 @@
 #include <mutex>
 #include <thread>
 
+#include "gravcal/io/calibration_io.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/recording.h"
 #include "gravcal/workflows/pipeline.h"
@@ -89,6 +90,8 @@ void RunUnit(size_t index, const BatchUnit& unit, const Config& base, const Batc
   }
   const Clock::time_point read_end = Clock::now();
   const bool ok = RunCalibration(config, input, &r->calibration);
+  // Issue 16: the same provenance as calibrate records.
+  if (!unit.path.empty()) r->calibration.provenance = LogProvenanceOfBytes(unit.path, log_bytes);
   const Clock::time_point end = Clock::now();
   r->message = r->calibration.message;
   r->status = ok                             ? BatchStatus::kOk

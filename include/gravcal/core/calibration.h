@@ -120,6 +120,15 @@ struct ConvergenceReport {
   std::vector<ConvergenceEntry> entries;
 };
 
+// Where a calibration came from (calibration JSON key `provenance`): the
+// log's file name and content hash (32 hex digits, util/content_hash.h over
+// the file's bytes), and the gravcal version that wrote it. Empty = unknown.
+struct CalibrationProvenance {
+  std::string log_file;
+  std::string log_hash;
+  std::string gravcal_version;
+};
+
 struct Calibration {
   bool success = false;
   // The refinement ran and did not converge (the coarse result is kept).
@@ -148,6 +157,8 @@ struct Calibration {
   // Issue 4: filled by recursive methods only.
   EstimateHistory history;
   ConvergenceReport convergence;
+  // Issue 16: the input log (set by the caller that read it).
+  CalibrationProvenance provenance;
 };
 
 }  // namespace gravcal

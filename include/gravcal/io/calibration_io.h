@@ -1,15 +1,19 @@
 // gravcal/io/calibration_io.h: the calibration JSON file (docs/data_contract.md, "Calibration
 // JSON"): accel.{model, bias, matrix, std.{bias, matrix}, covariance},
-// gravity, residual, positions, solver, warnings. Standard deviations that
+// gravity, residual, positions, solver, warnings, provenance. Standard deviations that
 // were not estimated are null. Written atomically.
 #ifndef GRAVCAL_IO_CALIBRATION_IO_H_
 #define GRAVCAL_IO_CALIBRATION_IO_H_
 
+#include <Eigen/Core>
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/gyro_model.h"
+#include "gravcal/core/imu_corrector.h"
 
 namespace gravcal {
 
@@ -25,22 +29,44 @@ bool WriteCalibrationJson(const Calibration& calibration, bool include_covarianc
 // (naming the path) when there is no history or the file cannot be written.
 bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error);
 
-// What `apply` needs from a calibration file: the accelerometer model and,
-// when the file has one, the gyroscope model.
-struct LoadedCalibration {
-  AccelModel accel;
-  bool has_gyro = false;
-  GyroModel gyro;
-  double gravity = kStandardGravity;
+// One static position as the file records it (positions[k]): the mean raw
+// accelerometer vector, the middle of its interval (s) and its mean
+// temperature (NaN when the file has none).
+struct RecordedPosition {
+  Eigen::Vector3d raw_mean = Eigen::Vector3d::Zero();
+  double time = 0.0;
+  double temperature = NAN;
 };
 
-// Reads a calibration JSON file; errors name the file and the key.
+// What `apply` and `export` need from a calibration file: everything the
+// correction uses (core/imu_corrector.h), the static positions, the gravity
+// and where the calibration came from.
+struct LoadedCalibration {
+  ImuCorrector corrector;
+  double gravity = kStandardGravity;
+  std::string method;
+  std::vector<RecordedPosition> positions;
+  // provenance (empty in files written before it existed).
+  CalibrationProvenance provenance;
+  // Effect parameters the file reports as undetermined (null), read as 0.
+  std::vector<std::string> undetermined;
+};
+
+// Parses calibration JSON text; `name` is used in messages. Every error is
+// one line naming the file and the key ("calib.json: key 'accel.bias': must
+// be an array of 3 numbers"). Keys added after version 0.2.0 (provenance,
+// positions[].temperature) are optional.
+bool CalibrationFromJson(const std::string& text, const std::string& name,
+                         LoadedCalibration* calibration, std::string* error);
+// The same for a file.
 bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration,
                          std::string* error);
-// Same as ReadCalibrationJson on JSON text in memory; `name` is used in
-// messages in place of the path.
-bool ParseCalibrationJson(const std::string& text, const std::string& name,
-                          LoadedCalibration* calibration, std::string* error);
+
+// The provenance of a calibration made from the log at `path`: its file name
+// as given, the content hash of its bytes and this gravcal's version.
+bool LogProvenance(const std::string& path, CalibrationProvenance* provenance, std::string* error);
+// The same from the log's bytes already in memory (batch).
+CalibrationProvenance LogProvenanceOfBytes(const std::string& path, const std::string& bytes);
 
 }  // namespace gravcal
 

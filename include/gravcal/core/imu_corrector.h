@@ -1,0 +1,66 @@
+// gravcal/core/imu_corrector.h: everything a calibration holds, applied to one
+// sample. The one place the full correction is written: `gravcal apply`, the
+// exporters' truncation errors, the generated C corrector's reference and the
+// Python bindings all call it.
+//
+// Accelerometer, raw reading v (raw units), temperature T (degrees C), time t
+// (s), result a in m/s^2 in the housing frame:
+//
+//   m = U (v - b)                      linear model in the orthogonalised
+//                                      sensor frame (accel_model.h)
+//   s = h^-1(m, T - T_ref, t - t_ref)  effect terms removed (model_effects.h:
+//                                      temperature and drift bias, temperature
+//                                      scale, quadratic nonlinearity)
+//   a = R s                            housing alignment
+//
+// Gyroscope, raw reading u (raw units), corrected specific force a (housing
+// frame, m/s^2, the output above), result w in rad/s:
+//
+//   w = M_g (u - b_g - G R^T a - gamma (T - T_ref) - eta (t - t_ref))
+//
+// G, gamma, eta in raw gyroscope units (model_effects.h); R^T a is the
+// specific force in the sensor frame G was fitted in. Effects that are not
+// switched on are zero; all zero = the textbook model M (v - b), M_g (u - b_g).
+// A temperature of NaN contributes no temperature term (callers that need a
+// temperature check RequiresTemperature() first).
+#ifndef GRAVCAL_CORE_IMU_CORRECTOR_H_
+#define GRAVCAL_CORE_IMU_CORRECTOR_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "gravcal/core/accel_model.h"
+#include "gravcal/core/gyro_model.h"
+#include "gravcal/core/model_effects.h"
+
+namespace gravcal {
+
+struct ImuCorrector {
+  AccelModel accel;
+  bool has_gyro = false;
+  GyroModel gyro;
+  // The values of the effects (zero = off) and which are switched on.
+  EffectParameters effects;
+  std::vector<Effect> active_effects;
+
+  // True when an active effect uses the temperature (T) or the time (t).
+  bool RequiresTemperature() const;
+  bool RequiresTime() const;
+
+  // a from v. False (a unchanged) only when the quadratic term has no real
+  // root for this reading (a reading far outside the sensor's range).
+  bool CorrectAccel(const Eigen::Vector3d& raw, double temperature, double time,
+                    Eigen::Vector3d* a) const;
+  // w from u and the corrected a. Without a gyroscope model, returns u.
+  Eigen::Vector3d CorrectGyro(const Eigen::Vector3d& raw, const Eigen::Vector3d& accel,
+                              double temperature, double time) const;
+
+  // The same model with only the terms a target can hold: the effects in
+  // `keep` (others dropped). Used to measure what an export truncates.
+  ImuCorrector WithEffects(const std::vector<Effect>& keep) const;
+};
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_CORE_IMU_CORRECTOR_H_

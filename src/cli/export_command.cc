@@ -1,0 +1,65 @@
+// gravcal export: a calibration written for Kalibr, OpenVINS, ROS, PX4,
+// ArduPilot or as C source (io/calibration_export.h). What the target cannot
+// hold is said on standard error and in the file. Exit 0 written; 1 bad
+// input or a calibration the target cannot take (nothing written).
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <string>
+
+#include "cli/commands.h"
+#include "gravcal/io/calibration_export.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/io/files.h"
+#include "gravcal/io/noise_io.h"
+
+namespace gravcal {
+namespace cli {
+
+int RunExport(const CommandArgs& args) {
+  if (args.calibration.empty()) return Fail("export needs --calibration <calib.json>");
+  ExportOptions options;
+  if (!FromString(args.to, &options.target)) {
+    return Fail("export needs --to <target>, one of " + ExportTargetNames() +
+                (args.to.empty() ? "" : " (not '" + args.to + "')"));
+  }
+  const bool c_target = options.target == ExportTarget::kC;
+  if (c_target && args.output_dir.empty()) {
+    return Fail("export --to c needs --output-dir <folder> (writes gravcal_correct.h and .c)");
+  }
+  if (!c_target && args.output.empty()) return Fail("export needs --output <file>");
+  std::string error;
+  LoadedCalibration calibration;
+  if (!ReadCalibrationJson(args.calibration, &calibration, &error)) return Fail(error);
+  ImuNoise noise;
+  if (!args.noise.empty()) {
+    if (!ReadNoiseJson(args.noise, &noise, &error)) return Fail(error);
+    options.noise = &noise.model;
+  }
+  options.calibration_name = args.calibration;
+  ExportResult result;
+  if (!ExportCalibration(calibration, options, &result, &error)) return Fail(error);
+  for (const std::string& line : result.dropped) {
+    std::fprintf(stderr, "gravcal: export --to %s drops: %s\n", args.to.c_str(), line.c_str());
+  }
+  std::vector<std::string> written;
+  for (const ExportedFile& file : result.files) {
+    std::string path = args.output;
+    if (c_target) {
+      mkdir(args.output_dir.c_str(), 0755);
+      path = args.output_dir + "/" + file.name;
+    }
+    if (!WriteFileAtomically(path, file.text, &error)) {
+      for (const std::string& w : written) std::remove(w.c_str());
+      return Fail(error);
+    }
+    written.push_back(path);
+  }
+  std::string names;
+  for (const std::string& w : written) names += (names.empty() ? "" : " and ") + w;
+  std::fprintf(stderr, "gravcal: %s; wrote %s\n", result.message.c_str(), names.c_str());
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace gravcal

@@ -1,0 +1,57 @@
+#include "gravcal/core/imu_corrector.h"
+
+#include <algorithm>
+
+namespace gravcal {
+
+namespace {
+
+bool UsesRegressor(const std::vector<Effect>& effects, EffectRegressor regressor) {
+  return std::any_of(effects.begin(), effects.end(),
+                     [&](Effect e) { return Info(e).regressor == regressor; });
+}
+
+}  // namespace
+
+bool ImuCorrector::RequiresTemperature() const {
+  return UsesRegressor(active_effects, EffectRegressor::kTemperature);
+}
+
+bool ImuCorrector::RequiresTime() const {
+  return UsesRegressor(active_effects, EffectRegressor::kTime);
+}
+
+bool ImuCorrector::CorrectAccel(const Eigen::Vector3d& raw, double temperature, double time,
+                                Eigen::Vector3d* a) const {
+  const Eigen::Vector3d m = accel.upper * (raw - accel.bias);
+  Eigen::Vector3d s = m;
+  if (!active_effects.empty() &&
+      !gravcal::CorrectAccel(effects, active_effects, m, temperature, time, &s)) {
+    return false;
+  }
+  *a = accel.rotation * s;
+  return true;
+}
+
+Eigen::Vector3d ImuCorrector::CorrectGyro(const Eigen::Vector3d& raw,
+                                          const Eigen::Vector3d& accel_housing, double temperature,
+                                          double time) const {
+  if (!has_gyro) return raw;
+  Eigen::Vector3d u = raw - gyro.bias;
+  if (!active_effects.empty()) {
+    const Eigen::Vector3d force = accel.rotation.transpose() * accel_housing;
+    u -= GyroOffset(effects, active_effects, force, temperature, time);
+  }
+  return gyro.matrix * u;
+}
+
+ImuCorrector ImuCorrector::WithEffects(const std::vector<Effect>& keep) const {
+  ImuCorrector out = *this;
+  out.active_effects.clear();
+  for (Effect e : active_effects) {
+    if (Contains(keep, e)) out.active_effects.push_back(e);
+  }
+  return out;
+}
+
+}  // namespace gravcal
