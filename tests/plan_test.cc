@@ -127,6 +127,8 @@ TEST(Plan, MeetsTargetsAndNeverTakesLongerThanTheSeedsTwelvePositions) {
     for (const char* set : {"faces+45", "free"}) {
       PlanRequest request = Request(target);
       request.pose_set = set;
+      // Long enough for the twelve positions to meet the last target.
+      request.max_hold_seconds = 3600.0;
       RecordingPlan plan;
       std::string error;
       ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << target << ": " << error;

@@ -336,19 +336,21 @@ Eigen::VectorXd DeterminedStd(const Eigen::MatrixXd& fisher, const Eigen::Vector
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(f);
     if (eigen.info() != Eigen::Success || !f.allFinite()) return out;
     const Eigen::VectorXd lambda = eigen.eigenvalues();
-    Eigen::Index hold = -1;
-    if (!(lambda(0) > 1e-14 * lambda(n - 1))) {
-      eigen.eigenvectors().col(0).cwiseAbs().maxCoeff(&hold);
-    } else {
-      const Eigen::VectorXd ratio = (eigen.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
-                                     eigen.eigenvectors().transpose())
-                                        .diagonal()
-                                        .cwiseSqrt();
-      if (ratio.maxCoeff(&hold) <= 1.0) {
+    // Nonsingular and every sigma within its limit: done. Otherwise hold the
+    // parameter that moves most along the weakest direction.
+    if (lambda(0) > 1e-14 * lambda(n - 1)) {
+      const Eigen::VectorXd ratio =
+          (eigen.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
+           eigen.eigenvectors().transpose())
+              .diagonal()
+              .cwiseSqrt();
+      if (ratio.maxCoeff() <= 1.0) {
         for (Eigen::Index a = 0; a < n; ++a) out(active[a]) = ratio(a) * limits(active[a]);
         return out;
       }
     }
+    Eigen::Index hold = 0;
+    eigen.eigenvectors().col(0).cwiseAbs().maxCoeff(&hold);
     active.erase(active.begin() + hold);
   }
   return out;

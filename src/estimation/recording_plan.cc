@@ -1,5 +1,6 @@
 #include "gravcal/estimation/recording_plan.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -87,12 +87,14 @@ Eigen::Quaterniond RollPitch(double roll_deg, double pitch_deg) {
          AxisAngle(roll_deg * d, Eigen::Vector3d::UnitX());
 }
 
-// The smallest rotation taking the body direction up (not straight down) to
-// navigation z.
+// The smallest rotation taking the body direction up to navigation z (half
+// a turn about body x when up points straight down).
 Eigen::Quaterniond UpToZenith(const Eigen::Vector3d& up) {
   const Eigen::Vector3d u = up.normalized();
   const Eigen::Vector3d axis = u.cross(Eigen::Vector3d::UnitZ());
-  if (axis.norm() < 1e-12) return Eigen::Quaterniond::Identity();
+  if (axis.norm() < 1e-12) {
+    return u.z() > 0.0 ? Eigen::Quaterniond::Identity() : AxisAngle(kPi, Eigen::Vector3d::UnitX());
+  }
   return AxisAngle(std::atan2(axis.norm(), u.z()), axis.normalized());
 }
 

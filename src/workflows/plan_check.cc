@@ -14,6 +14,7 @@ namespace gravcal {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kFaceSnapDeg = 10.0;
 
 // The parameters DeterminedStd held (infinite standard deviation).
 std::vector<std::string> Undetermined(const std::vector<std::string>& names,
@@ -79,9 +80,20 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
     holds.push_back(p.t_end - p.t_begin);
   }
   const double scale = model.gravity / Median(norms);
+  // The nominal sensor sees each pose along its measured direction; a pose
+  // within kFaceSnapDeg of a face counts as that face: the placement error
+  // of a few degrees (and the bias, which tilts opposite faces alike) carries
+  // only weak, unreliable information on the cross terms, which the
+  // refinement could not separate from its undetermined directions either.
   std::vector<Position> scaled = positions;
   for (Position& p : scaled) {
-    p.raw_mean *= scale;
+    Eigen::Vector3d up = p.raw_mean.normalized();
+    Eigen::Index axis = 0;
+    up.cwiseAbs().maxCoeff(&axis);
+    if (std::fabs(up(axis)) > std::cos(kFaceSnapDeg * M_PI / 180.0)) {
+      up = Eigen::Vector3d::Unit(axis) * (up(axis) > 0.0 ? 1.0 : -1.0);
+    }
+    p.raw_mean = model.gravity * up;
     p.raw_mean_cov *= scale * scale;
   }
   AccelModel nominal;
