@@ -186,7 +186,7 @@ TEST(Plan, UnknownTargetNamesAreNamed) {
 }
 
 TEST(Plan, ImpossibleWithinMaxTimeSaysWhatIsAchievable) {
-  PlanRequest request = Request("accel_bias=0.01mg accel_scale=5ppm");
+  PlanRequest request = Request("accel_bias=0.02mg accel_scale=10ppm");
   request.max_time_seconds = 300.0;
   RecordingPlan plan;
   std::string error;

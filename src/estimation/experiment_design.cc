@@ -130,17 +130,24 @@ Eigen::MatrixXd WhitenedRows(const Eigen::MatrixXd& unit_rows,
   return rows;
 }
 
-// Duplicated directions as one pose holding their summed time (one
-// overhead fewer); the order of first appearance is kept.
-std::vector<DesignPose> MergeRepeats(const std::vector<DesignPose>& poses) {
+// Directions closer than `separation_deg` as one pose holding their summed
+// time, along their hold-weighted mean direction (one overhead fewer, and a
+// person or the static detector could not tell them apart anyway); the
+// order of first appearance is kept.
+std::vector<DesignPose> MergeRepeats(const std::vector<DesignPose>& poses, double separation_deg) {
+  const double cos_limit = std::cos(separation_deg * M_PI / 180.0);
   std::vector<DesignPose> merged;
+  std::vector<Eigen::Vector3d> sums;
   for (const DesignPose& p : poses) {
-    auto same = std::find_if(merged.begin(), merged.end(),
-                             [&](const DesignPose& m) { return (m.up - p.up).norm() < 1e-9; });
-    if (same == merged.end()) {
+    size_t m = 0;
+    while (m < merged.size() && merged[m].up.dot(p.up) < cos_limit) ++m;
+    if (m == merged.size()) {
       merged.push_back(p);
+      sums.push_back(p.hold_seconds * p.up);
     } else {
-      same->hold_seconds += p.hold_seconds;
+      merged[m].hold_seconds += p.hold_seconds;
+      sums[m] += p.hold_seconds * p.up;
+      merged[m].up = sums[m].normalized();
     }
   }
   return merged;
@@ -288,12 +295,19 @@ Eigen::VectorXd PredictedStd(const Eigen::MatrixXd& fisher) {
   Eigen::VectorXd out = Eigen::VectorXd::Constant(p, kInf);
   if (p == 0 || !fisher.allFinite()) return out;
   // Judged with unit diagonal, as AnalyzeObservability judges the Jacobian.
+  // A column at rounding level (1e-12 of the largest) is a zero column:
+  // scaling it up to unit norm would turn rounding into information.
   Eigen::VectorXd scale = fisher.diagonal().cwiseMax(0.0).cwiseSqrt();
+  const double largest = scale.maxCoeff();
+  Eigen::MatrixXd scaled = fisher;
   for (Eigen::Index i = 0; i < p; ++i) {
-    if (!(scale(i) > 0.0)) scale(i) = 1.0;
+    if (!(scale(i) > 1e-12 * largest)) {
+      scale(i) = 1.0;
+      scaled.row(i).setZero();
+      scaled.col(i).setZero();
+    }
   }
-  const Eigen::MatrixXd scaled =
-      scale.cwiseInverse().asDiagonal() * fisher * scale.cwiseInverse().asDiagonal();
+  scaled = scale.cwiseInverse().asDiagonal() * scaled * scale.cwiseInverse().asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
   if (eigen.info() != Eigen::Success) return out;
   const Eigen::VectorXd lambda = eigen.eigenvalues();
@@ -339,11 +353,10 @@ Eigen::VectorXd DeterminedStd(const Eigen::MatrixXd& fisher, const Eigen::Vector
     // Nonsingular and every sigma within its limit: done. Otherwise hold the
     // parameter that moves most along the weakest direction.
     if (lambda(0) > 1e-14 * lambda(n - 1)) {
-      const Eigen::VectorXd ratio =
-          (eigen.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
-           eigen.eigenvectors().transpose())
-              .diagonal()
-              .cwiseSqrt();
+      const Eigen::VectorXd ratio = (eigen.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
+                                     eigen.eigenvectors().transpose())
+                                        .diagonal()
+                                        .cwiseSqrt();
       if (ratio.maxCoeff() <= 1.0) {
         for (Eigen::Index a = 0; a < n; ++a) out(active[a]) = ratio(a) * limits(active[a]);
         return out;
@@ -414,8 +427,13 @@ bool DesignOptions::IsValid(const DesignModel& model, std::string* error) const 
         "max_hold_seconds";
     return false;
   }
-  if (max_poses < p || !(max_time_seconds >= 0.0)) {
-    *error = "DesignOptions: max_poses >= " + std::to_string(p) + " and max_time_seconds >= 0";
+  if (!(min_separation_deg >= 0.0 && min_separation_deg <= 90.0)) {
+    *error = "DesignOptions.min_separation_deg: 0 to 90";
+    return false;
+  }
+  if (redundancy < 0 || max_poses < p + redundancy || !(max_time_seconds >= 0.0)) {
+    *error = "DesignOptions: redundancy >= 0, max_poses >= parameters + redundancy (" +
+             std::to_string(p + redundancy) + ") and max_time_seconds >= 0";
     return false;
   }
   return true;
@@ -462,6 +480,7 @@ bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignMod
   const Eigen::VectorXd weights = options.targets.cwiseAbs2().cwiseInverse();
   const Eigen::MatrixXd unit_rows = UnitRows(candidates, model);
   const bool max_time_mode = options.max_time_seconds > 0.0;
+  const int min_poses = p + options.redundancy;
 
   DesignResult best;
   bool have = false;
@@ -470,12 +489,16 @@ bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignMod
   auto consider_hold_search = [&](const std::vector<Eigen::Vector3d>& ups) {
     DesignResult r;
     if (!ShortestHold(ups, model, noise, options, &r)) return;
-    KeepBetter(r, options, &best, &have);
-    // Merged repeats, rescaled: no worse under white noise, fewer overheads.
-    const std::vector<DesignPose> merged = MergeRepeats(r.poses);
-    if (merged.size() < r.poses.size() && ShortestScaling(merged, model, noise, options, &r)) {
-      KeepBetter(r, options, &best, &have);
+    // Repeats merged and the holds rescaled: the same information under
+    // white noise with fewer overheads. Kept apart (set down again) only
+    // when the merged pose would have to exceed max_hold.
+    const std::vector<DesignPose> merged = MergeRepeats(r.poses, options.min_separation_deg);
+    if (merged.size() < r.poses.size()) {
+      if (static_cast<int>(merged.size()) < min_poses) return;
+      DesignResult m;
+      if (ShortestScaling(merged, model, noise, options, &m)) r = m;
     }
+    KeepBetter(r, options, &best, &have);
   };
   // The best design within max_time at n poses of a common hold.
   auto consider_within = [&](const std::vector<Eigen::Vector3d>& ups) {
@@ -483,7 +506,10 @@ bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignMod
     const double hold =
         std::min(options.max_hold_seconds, options.max_time_seconds / n - options.overhead_seconds);
     if (!(hold >= options.min_hold_seconds)) return;
-    KeepBetter(EvaluateDesign(PosesAt(ups, hold), model, noise, options), options, &best, &have);
+    const std::vector<DesignPose> merged =
+        MergeRepeats(PosesAt(ups, hold), options.min_separation_deg);
+    if (static_cast<int>(merged.size()) < min_poses) return;
+    KeepBetter(EvaluateDesign(merged, model, noise, options), options, &best, &have);
   };
   for (const std::vector<Eigen::Vector3d>& ups : options.reference_designs) {
     consider_hold_search(ups);
@@ -493,7 +519,7 @@ bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignMod
   double hold = options.min_hold_seconds;
   Eigen::MatrixXd rows = WhitenedRows(unit_rows, candidates, model, noise, hold);
   std::vector<int> chosen;
-  for (int n = p; n <= options.max_poses; ++n) {
+  for (int n = min_poses; n <= options.max_poses; ++n) {
     const double floor = n * (options.min_hold_seconds + options.overhead_seconds);
     if (max_time_mode && floor > options.max_time_seconds) break;
     if (!max_time_mode && have && best.meets_targets && floor >= best.total_seconds) break;

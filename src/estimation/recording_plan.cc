@@ -46,19 +46,27 @@ std::string PoseInstruction(const Eigen::Vector3d& up) {
              " (housing face on the table)";
     }
   }
-  // Elevation of each axis above the horizontal plane: asin(up_i).
-  std::string text;
-  int level = 0;
+  // Elevation of each axis above the horizontal plane, asin(up_i): the
+  // tilted axes first, then the level ones.
+  std::string tilted, level;
+  int levels = 0, wedge = 0;
   for (int a = 0; a < 3; ++a) {
     const double elevation = std::asin(std::clamp(up(a), -1.0, 1.0)) * internal::kRadToDeg;
-    if (std::fabs(elevation) < 0.05) ++level;
     char part[64];
-    std::snprintf(part, sizeof(part), "%s%s axis %.0f degrees %s", text.empty() ? "" : ", ",
-                  kAxisNames[a], std::fabs(elevation),
-                  elevation >= 0 ? "above level" : "below level");
-    text += part;
+    if (std::fabs(elevation) < 0.5) {
+      std::snprintf(part, sizeof(part), "%s%s", level.empty() ? "" : " and ", kAxisNames[a]);
+      level += part;
+      ++levels;
+      continue;
+    }
+    if (std::fabs(std::fabs(elevation) - 45.0) < 0.5) ++wedge;
+    std::snprintf(part, sizeof(part), "%s%s axis %.0f degrees %s", tilted.empty() ? "" : ", ",
+                  kAxisNames[a], std::fabs(elevation), elevation > 0 ? "up" : "down");
+    tilted += part;
   }
-  if (level == 1) text += " (a 45-degree wedge when the other two are equal)";
+  std::string text = tilted;
+  if (levels > 0) text += ", " + level + (levels > 1 ? " axes level" : " axis level");
+  if (levels == 1 && wedge == 2) text += " (on a 45-degree wedge)";
   return text;
 }
 

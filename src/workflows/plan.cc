@@ -61,7 +61,10 @@ std::vector<Eigen::Vector3d> SchemeUps(const std::string& scheme) {
   std::vector<Eigen::Vector3d> ups;
   if (!SchemeAttitudes(scheme, 0, &attitudes, &nominal_up, &error)) return ups;
   for (const Eigen::Quaterniond& q : attitudes) {
-    ups.push_back((q.conjugate() * Eigen::Vector3d::UnitZ()).normalized());
+    Eigen::Vector3d up = q.conjugate() * Eigen::Vector3d::UnitZ();
+    // Exact zeros where the scheme means them (the quaternions round).
+    for (int i = 0; i < 3; ++i) up(i) = std::fabs(up(i)) < 1e-12 ? 0.0 : up(i);
+    ups.push_back(up.normalized());
   }
   return ups;
 }
@@ -101,8 +104,8 @@ bool DesignOver(const std::string& pose_set, int free_candidates, const DesignMo
   if (!DesignPoses(candidates, model, noise, options, &subset)) return true;
   const bool better = subset.meets_targets && result->meets_targets
                           ? subset.total_seconds < result->total_seconds
-                          : (subset.meets_targets || (!result->meets_targets &&
-                                                      subset.worst_ratio < result->worst_ratio));
+                          : (subset.meets_targets ||
+                             (!result->meets_targets && subset.worst_ratio < result->worst_ratio));
   if (better) *result = subset;
   return true;
 }
@@ -264,7 +267,8 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   options.overhead_seconds = request.overhead_seconds;
   options.min_hold_seconds = std::max(request.min_hold_seconds, model.trimmed_seconds + 1.0);
   options.max_hold_seconds = std::max(request.max_hold_seconds, options.min_hold_seconds);
-  options.max_poses = std::max(request.max_poses, static_cast<int>(names.size()));
+  options.max_poses =
+      std::max(request.max_poses, static_cast<int>(names.size()) + options.redundancy);
   std::vector<Eigen::Vector3d> candidates;
   CandidateDirections(request.pose_set, request.free_candidates, &candidates);
   const std::vector<std::pair<std::string, std::vector<Eigen::Vector3d>>> schemes = {
@@ -299,7 +303,8 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
       std::ostringstream s;
       s.precision(4);
       s << "the targets cannot be met within --max_time " << request.max_time_seconds << " s";
-      if (DesignOver(request.pose_set, request.free_candidates, model, noise, within, &best) && std::isfinite(best.worst_ratio)) {
+      if (DesignOver(request.pose_set, request.free_candidates, model, noise, within, &best) &&
+          std::isfinite(best.worst_ratio)) {
         s << "; achievable within it (" << best.poses.size()
           << " poses): " << Shortfalls(names, best.predicted_std, targets);
       } else {

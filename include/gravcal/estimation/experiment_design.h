@@ -118,6 +118,16 @@ struct DesignOptions {
   // Shortest and longest hold of one pose, seconds.
   double min_hold_seconds = 5.0;
   double max_hold_seconds = 600.0;
+  // Poses closer than this, degrees, are one pose (held their summed time):
+  // the static detector merges neighbouring poses within 3 degrees, and a
+  // placement error of a few degrees makes closer ones indistinguishable.
+  double min_separation_deg = 10.0;
+  // At least (parameters + this) poses: degrees of freedom left for the
+  // fit's own chi-square check, and robustness to the placement error (a
+  // design with as many poses as parameters is exactly determined, and its
+  // sigmas came out 6-20 % above the prediction over 400 simulated seeds
+  // with 2 degrees of placement error).
+  int redundancy = 3;
   // At most this many poses.
   int max_poses = 40;
   // > 0: the total time (poses and overhead) may not exceed this; the design
@@ -158,8 +168,8 @@ bool ShortestHold(const std::vector<Eigen::Vector3d>& ups, const DesignModel& mo
 // The design over `candidates` (unit up vectors): without max_time, the
 // least total time that meets every target; with it, the best worst_ratio
 // within max_time. Greedy selection with Fedorov exchange on the criterion
-// above for each pose count, the common hold found by bisection, repeated
-// directions merged into one longer pose when that is no worse. Returns
+// above for each pose count, the common hold found by bisection, directions
+// closer than min_separation_deg merged into one longer pose. Returns
 // false (result->message) on invalid options; a design that cannot meet the
 // targets returns true with meets_targets false and the best it found.
 bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignModel& model,
