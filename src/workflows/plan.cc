@@ -11,6 +11,7 @@
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/simulation/simulator.h"
 #include "util/units.h"
+#include "workflows/plan_start.h"
 
 namespace gravcal {
 
@@ -235,15 +236,41 @@ bool PlanDesignModel(const Config& config, DesignModel* model, std::string* erro
   return true;
 }
 
+namespace internal {
+
+bool StartPlan(const Config& config, const PlanRequest& request, PlanStart* start,
+               std::string* error) {
+  if (!request.IsValid(error)) return false;
+  PlanStart out;
+  if (!PlanDesignModel(config, &out.model, error)) return false;
+  out.names = MagnitudeParameterNames(out.model.parameterization);
+  Eigen::VectorXd stated;
+  if (!ParsePlanTargets(request.targets, out.model.parameterization, &stated, error)) return false;
+  const RefinementOptions& r = config.calibration.refinement;
+  const Eigen::Index p = static_cast<Eigen::Index>(out.names.size());
+  out.limits.resize(p);
+  out.targets.resize(p);
+  out.targeted.resize(p);
+  for (Eigen::Index i = 0; i < p; ++i) {
+    out.limits(i) = i < 3 ? r.max_bias_std : r.max_matrix_std;
+    out.targeted[i] = std::isfinite(stated(i));
+    out.targets(i) = out.targeted[i] ? stated(i) : out.limits(i);
+  }
+  *start = out;
+  return true;
+}
+
+}  // namespace internal
+
 bool MakeRecordingPlan(const Config& config, const PlanRequest& request, RecordingPlan* plan,
                        std::string* error) {
-  if (!request.IsValid(error)) return false;
-  DesignModel model;
-  if (!PlanDesignModel(config, &model, error)) return false;
-  const std::vector<std::string> names = MagnitudeParameterNames(model.parameterization);
-  Eigen::VectorXd stated;
-  if (!ParsePlanTargets(request.targets, model.parameterization, &stated, error)) return false;
-  const bool any_stated = stated.array().isFinite().any();
+  internal::PlanStart start;
+  if (!internal::StartPlan(config, request, &start, error)) return false;
+  const DesignModel& model = start.model;
+  const std::vector<std::string>& names = start.names;
+  const Eigen::VectorXd& targets = start.targets;
+  const bool any_stated =
+      std::any_of(start.targeted.begin(), start.targeted.end(), [](bool t) { return t; });
   if (!any_stated && !(request.max_time_seconds > 0.0)) {
     *error = "give --target (e.g. accel_bias=0.5mg accel_scale=50ppm) or --max_time";
     return false;
@@ -251,17 +278,8 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   DesignNoise noise;
   RecordingPlan out;
   if (!PlanDesignNoise(request, &noise, &out.noise_source, error)) return false;
+  out.targeted = start.targeted;
 
-  // A parameter without a stated target must still be determined: its
-  // target is the refinement's limit for a determined parameter.
-  const RefinementOptions& limits = config.calibration.refinement;
-  Eigen::VectorXd targets(names.size());
-  out.targeted.resize(names.size());
-  for (size_t i = 0; i < names.size(); ++i) {
-    out.targeted[i] = std::isfinite(stated(i));
-    targets(i) =
-        out.targeted[i] ? stated(i) : (i < 3 ? limits.max_bias_std : limits.max_matrix_std);
-  }
   DesignOptions options;
   options.targets = targets;
   options.overhead_seconds = request.overhead_seconds;

@@ -8,6 +8,7 @@
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/workflows/plan.h"
 #include "methods/static_positions.h"
+#include "workflows/plan_start.h"
 
 namespace gravcal {
 
@@ -51,12 +52,10 @@ double Median(std::vector<double> v) {
 
 bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& request,
                     CoverageReport* report, std::string* error) {
-  if (!request.IsValid(error)) return false;
-  DesignModel model;
-  if (!PlanDesignModel(config, &model, error)) return false;
-  const std::vector<std::string> names = MagnitudeParameterNames(model.parameterization);
-  Eigen::VectorXd stated;
-  if (!ParsePlanTargets(request.targets, model.parameterization, &stated, error)) return false;
+  internal::PlanStart start;
+  if (!internal::StartPlan(config, request, &start, error)) return false;
+  const DesignModel& model = start.model;
+  const std::vector<std::string>& names = start.names;
 
   // The poses, by the calibration's own front end.
   CalibrationOptions options = config.calibration;
@@ -109,19 +108,15 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
   out.parameter_names = names;
   out.positions = static_cast<int>(positions.size());
   out.nominal_scale = scale;
-  const RefinementOptions& limits = config.calibration.refinement;
-  Eigen::VectorXd limit(names.size());
-  for (size_t i = 0; i < names.size(); ++i) {
-    limit(i) = i < 3 ? limits.max_bias_std : limits.max_matrix_std;
-  }
+  const Eigen::VectorXd& limit = start.limits;
   out.predicted_std_scale_free = DeterminedStd(fisher, limit);
   out.predicted_std = StdInRawUnits(out.predicted_std_scale_free, scale);
-  out.targets_scale_free.resize(names.size());
-  out.targeted.resize(names.size());
+  out.targets_scale_free = start.targets;
+  out.targeted = start.targeted;
   for (size_t i = 0; i < names.size(); ++i) {
-    out.targeted[i] = std::isfinite(stated(i));
-    out.targets_scale_free(i) =
-        out.targeted[i] ? stated(i) : (i < 3 ? limits.max_bias_std : limits.max_matrix_std);
+    if (out.targeted[i] && !(out.predicted_std_scale_free(i) <= out.targets_scale_free(i))) {
+      out.short_of_target.push_back(names[i]);
+    }
   }
   out.undetermined = Undetermined(names, out.predicted_std_scale_free);
   // Proposals are ranked against the stated targets, else the yardstick.
