@@ -30,11 +30,13 @@
 #include "gravcal/estimation/allan_deviation.h"
 #include "gravcal/estimation/coarse_fit.h"
 #include "gravcal/estimation/error_state_layout.h"
+#include "gravcal/estimation/experiment_design.h"
 #include "gravcal/estimation/housing_rotation.h"
 #include "gravcal/estimation/newton_solver.h"
 #include "gravcal/estimation/noise_characterisation.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/pose_mean_covariance.h"
+#include "gravcal/estimation/recording_plan.h"
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/estimation/solver_tolerances.h"
 #include "gravcal/estimation/static_alignment.h"
@@ -49,6 +51,7 @@
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/io/recording.h"
+#include "gravcal/io/plan_io.h"
 
 // simulation
 #include "gravcal/simulation/handheld_simulator.h"
@@ -74,6 +77,7 @@
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/pipeline.h"
+#include "gravcal/workflows/plan.h"
 #include "gravcal/workflows/rate_table_segments.h"
 #include "gravcal/workflows/report.h"
 #endif  // GRAVCAL_GRAVCAL_H_

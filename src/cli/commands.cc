@@ -8,6 +8,7 @@
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/io/plan_io.h"
 #include "gravcal/methods/twelve_position.h"
 #include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/simulation/simulated_attitudes.h"
@@ -141,18 +142,28 @@ int RunSimulate(const CommandArgs& args) {
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
   SimulatedSession session;
+  SimulatorOptions sim = args.config.simulation;
+  // Issue 15: a plan's poses, in order, each its own hold, no extra still
+  // period before the first.
+  if (!args.plan.empty()) {
+    std::vector<PlannedPose> poses;
+    if (!ReadPlanPoses(args.plan, &poses, &error)) return Fail(error);
+    sim.planned_poses.clear();
+    for (const PlannedPose& p : poses) sim.planned_poses.push_back({p.up, p.hold_seconds});
+    sim.initial_still_seconds = 0.0;
+  }
   // The rate table's constant-rate segments (motion profile rate_table).
   std::vector<RateTableSegment> segments;
   if (!args.config.sim_motion.empty()) {
     MotionOptions motion = args.config.motion;
     FromString(args.config.sim_motion, &motion.profile);
     MotionSession moving;
-    if (!SimulateMotion(args.config.simulation, motion, args.seed, &moving, &error)) {
+    if (!SimulateMotion(sim, motion, args.seed, &moving, &error)) {
       return Fail(error);
     }
     segments = moving.segments;
     session = std::move(moving.sensor);
-  } else if (!Simulate(args.config.simulation, args.seed, &session, &error)) {
+  } else if (!Simulate(sim, args.seed, &session, &error)) {
     return Fail(error);
   }
   mkdir(args.output_dir.c_str(), 0755);
@@ -164,13 +175,13 @@ int RunSimulate(const CommandArgs& args) {
   const std::string truth = args.output_dir + "/truth.json";
   const std::string attitudes = args.output_dir + "/attitudes.csv";
   if (!WriteImuLogCsv(session.log, raw, &error)) return Fail(error);
-  if (!WriteFileAtomically(truth, TruthToJson(session, args.config.simulation), &error)) {
+  if (!WriteFileAtomically(truth, TruthToJson(session, sim), &error)) {
     std::remove(raw.c_str());
     return Fail(error);
   }
   // What a fixture (or an inclinometer) would say about each pose.
-  const std::string fixture = FixtureAttitudesToCsv(SimulatedFixtureAttitudes(
-      session, args.config.simulation.fixture_attitude_noise_deg, args.seed));
+  const std::string fixture = FixtureAttitudesToCsv(
+      SimulatedFixtureAttitudes(session, sim.fixture_attitude_noise_deg, args.seed));
   if (!WriteFileAtomically(attitudes, fixture, &error)) {
     std::remove(raw.c_str());
     std::remove(truth.c_str());

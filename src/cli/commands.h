@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "gravcal/workflows/config.h"
+#include "gravcal/workflows/plan.h"
 
 namespace gravcal {
 namespace cli {
@@ -42,6 +43,10 @@ struct CommandArgs {
   std::string shard;
   double outlier_sigmas = 5.0;
   int outlier_min_units = 5;
+  // plan and check: the request from --target, --pose_set, ... (not the
+  // noise model, which --noise names); simulate: --plan.
+  PlanRequest plan_request;
+  std::string plan;
   // Arguments that are not flags (merge-summaries: the shard folders).
   std::vector<std::string> positional;
   // batch: "all" makes one unit per sensor_msgs/Imu topic of --input.
@@ -67,6 +72,11 @@ int RunInspect(const CommandArgs& args);
 // export_command.cc: 0 written; 1 bad input or a target that cannot take the
 // calibration (nothing written).
 int RunExport(const CommandArgs& args);
+
+// plan_command.cc: 0 written; 1 bad input, unmet targets (nothing written).
+int RunPlan(const CommandArgs& args);
+// 0 reported; 1 bad input.
+int RunCheck(const CommandArgs& args);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

@@ -48,6 +48,27 @@ DEFINE_string(topics, "",
 DEFINE_string(noise, "",
               "noise.json from 'gravcal noise': the variance of each pose's mean, and the "
               "handheld filter's noise, from the noise model");
+// Issue 15: gravcal plan / check / simulate --plan.
+DEFINE_string(target, "",
+              "plan, check: targets, e.g. \"accel_bias=0.5mg accel_scale=50ppm "
+              "accel_misalignment=0.1mrad\" (or parameter names bias_x ... u_zz)");
+DEFINE_string(pose_set, gravcal::PlanRequest().pose_set,
+              "plan, check: candidate orientations: faces, faces+45 or free");
+DEFINE_int32(candidates, gravcal::PlanRequest().free_candidates,
+             "plan, check: directions of the free pose set (besides faces+45)");
+DEFINE_double(max_time, 0.0, "plan: the session may not take longer, seconds (0 = no limit)");
+DEFINE_double(overhead, gravcal::PlanRequest().overhead_seconds,
+              "plan: seconds to move and settle the housing before each pose");
+DEFINE_double(min_hold, gravcal::PlanRequest().min_hold_seconds, "plan: shortest hold, s");
+DEFINE_double(max_hold, gravcal::PlanRequest().max_hold_seconds, "plan: longest hold, s");
+DEFINE_double(accel_noise_density, 0.0,
+              "plan, check: accelerometer white noise N, m/s^2/sqrt(Hz) (datasheet; instead of "
+              "--noise)");
+DEFINE_double(accel_bias_instability, 0.0, "plan, check: accelerometer bias instability B, m/s^2");
+DEFINE_double(accel_random_walk, 0.0, "plan, check: accelerometer random walk K, m/s^3/sqrt(Hz)");
+DEFINE_double(pose_disturbance, 0.0,
+              "plan, check: per-pose disturbance of |a|, m/s^2 rms (0 = none)");
+DEFINE_string(plan, "", "simulate: plan.json from gravcal plan (its poses replace sim_scheme)");
 
 DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
 
@@ -82,8 +103,21 @@ const std::vector<CommandInfo>& Commands() {
       {"simulate",
        "simulate a session: raw.csv, truth.json, the fixture's attitudes.csv (and, for "
        "sim_motion rate_table, segments.csv)",
-       {"config", "seed", "output_dir"},
+       {"config", "seed", "output_dir", "plan"},
        gravcal::cli::RunSimulate},
+      {"plan",
+       "plan a recording before it is made: plan.json with the poses, holds and predicted "
+       "sigmas (least time meeting --target, or best within --max_time)",
+       {"config", "output", "noise", "target", "pose_set", "candidates", "max_time", "overhead",
+        "min_hold", "max_hold", "accel_noise_density", "accel_bias_instability",
+        "accel_random_walk", "pose_disturbance", "report"},
+       gravcal::cli::RunPlan},
+      {"check",
+       "what a recorded session determines: predicted sigma per parameter, what is "
+       "undetermined or short of --target, and the extra poses that would help most",
+       {"input", "config", "noise", "target", "pose_set", "candidates", "accel_noise_density",
+        "accel_bias_instability", "accel_random_walk", "pose_disturbance"},
+       gravcal::cli::RunCheck},
       {"batch",
        "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
        "statistics)",
@@ -294,6 +328,18 @@ int main(int argc, char** argv) {
   args.noise = FLAGS_noise;
   args.topics = FLAGS_topics;
   args.to = FLAGS_to;
+  args.plan = FLAGS_plan;
+  args.plan_request.targets = FLAGS_target;
+  args.plan_request.pose_set = FLAGS_pose_set;
+  args.plan_request.free_candidates = FLAGS_candidates;
+  args.plan_request.max_time_seconds = FLAGS_max_time;
+  args.plan_request.overhead_seconds = FLAGS_overhead;
+  args.plan_request.min_hold_seconds = FLAGS_min_hold;
+  args.plan_request.max_hold_seconds = FLAGS_max_hold;
+  args.plan_request.accel_noise_density = FLAGS_accel_noise_density;
+  args.plan_request.accel_bias_instability = FLAGS_accel_bias_instability;
+  args.plan_request.accel_random_walk = FLAGS_accel_random_walk;
+  args.plan_request.pose_disturbance = FLAGS_pose_disturbance;
 
   return info->run(args);
 }

@@ -87,12 +87,14 @@ Eigen::Quaterniond RollPitch(double roll_deg, double pitch_deg) {
          AxisAngle(roll_deg * d, Eigen::Vector3d::UnitX());
 }
 
-// The smallest rotation taking the body direction up (not straight down) to
-// navigation z.
+// The smallest rotation taking the body direction up to navigation z (half
+// a turn about body x when up points straight down).
 Eigen::Quaterniond UpToZenith(const Eigen::Vector3d& up) {
   const Eigen::Vector3d u = up.normalized();
   const Eigen::Vector3d axis = u.cross(Eigen::Vector3d::UnitZ());
-  if (axis.norm() < 1e-12) return Eigen::Quaterniond::Identity();
+  if (axis.norm() < 1e-12) {
+    return u.z() > 0.0 ? Eigen::Quaterniond::Identity() : AxisAngle(kPi, Eigen::Vector3d::UnitX());
+  }
   return AxisAngle(std::atan2(axis.norm(), u.z()), axis.normalized());
 }
 
@@ -196,7 +198,15 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   if (!options.IsValid(error)) return false;
   std::vector<Eigen::Quaterniond> nominal;
   std::vector<int> nominal_up;
-  if (!SchemeAttitudes(options.scheme, seed, &nominal, &nominal_up, error)) return false;
+  if (options.planned_poses.empty()) {
+    if (!SchemeAttitudes(options.scheme, seed, &nominal, &nominal_up, error)) return false;
+  }
+  std::vector<double> hold_seconds(nominal.size(), options.hold_seconds);
+  for (const PlannedHold& p : options.planned_poses) {
+    nominal.push_back(UpToZenith(p.up));
+    nominal_up.push_back(UpAxis(nominal.back()));
+    hold_seconds.push_back(p.hold_seconds);
+  }
   const size_t pose_count = nominal.size();
 
   std::mt19937_64 rng(seed);
@@ -249,8 +259,9 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
 
   const double rate = options.sample_rate;
   const double dt = 1.0 / rate;
-  const long first_still = SampleCount(options.initial_still_seconds + options.hold_seconds, rate);
-  const long hold = SampleCount(options.hold_seconds, rate);
+  std::vector<long> hold(pose_count);
+  for (size_t k = 0; k < pose_count; ++k) hold[k] = SampleCount(hold_seconds[k], rate);
+  const long first_still = SampleCount(options.initial_still_seconds + hold_seconds[0], rate);
   const bool hand = options.rotation_profile == "hand";
   // The hand profiles draw from a stream of their own (G with the other
   // effects in DrawEffects), so switching them on leaves every other number
@@ -262,14 +273,16 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
     profiles[k] = HandProfile::Random(options, &extra_rng);
     rotation[k] = std::max(1L, SampleCount(profiles[k].seconds, rate));
   }
-  size_t total = static_cast<size_t>(first_still) + (pose_count - 1) * static_cast<size_t>(hold);
+  size_t total = static_cast<size_t>(first_still);
+  for (size_t k = 1; k < pose_count; ++k) total += static_cast<size_t>(hold[k]);
   for (long r : rotation) total += static_cast<size_t>(r);
   if (static_cast<double>(total) > kMaxSamples) {
     return fail("the session is too long (" + std::to_string(total) + " samples)");
   }
 
   ImuLog& log = s.log;
-  log.source = "simulated " + options.scheme + " seed " + std::to_string(seed);
+  log.source = "simulated " + (options.planned_poses.empty() ? options.scheme : "plan") + " seed " +
+               std::to_string(seed);
   log.t.resize(total);
   log.accel.resize(total);
   log.gyro.resize(total);
@@ -344,7 +357,7 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   size_t i = 0;
   for (size_t k = 0; k < pose_count; ++k) {
     // Still period.
-    const size_t still = static_cast<size_t>(k == 0 ? first_still : hold);
+    const size_t still = static_cast<size_t>(k == 0 ? first_still : hold[k]);
     SimulatedPose& pose = s.poses[k];
     pose.begin = i;
     pose.end = i + still;
@@ -452,6 +465,16 @@ bool SimulatorOptions::IsValid(std::string* error) const {
   }
   if (!positive("sample_rate", sample_rate)) return false;
   if (!one_sample("hold_seconds", hold_seconds)) return false;
+  double planned_seconds = 0.0;
+  for (const PlannedHold& p : planned_poses) {
+    if (!one_sample("planned_poses.hold_seconds", p.hold_seconds)) return false;
+    if (!(p.up.allFinite() && p.up.norm() > 0.5)) {
+      if (error) *error = "SimulatorOptions.planned_poses: every up must be a unit vector";
+      return false;
+    }
+    planned_seconds += p.hold_seconds;
+  }
+  if (!planned_poses.empty()) pose_count = static_cast<long>(planned_poses.size());
   if (!non_negative("initial_still_seconds", initial_still_seconds)) return false;
   if (!one_sample("rotation_seconds", rotation_seconds)) return false;
   if (!positive("gravity", gravity)) return false;
@@ -500,9 +523,10 @@ bool SimulatorOptions::IsValid(std::string* error) const {
   if (!finite("effect_reference_temperature", effect_reference_temperature)) return false;
 
   const double samples =
-      (initial_still_seconds + hold_seconds +
+      (initial_still_seconds +
+       (planned_poses.empty() ? hold_seconds * static_cast<double>(pose_count) : planned_seconds) +
        static_cast<double>(pose_count - 1) *
-           (hold_seconds + (rotation_profile == "hand" ? hand_max_seconds : rotation_seconds))) *
+           (rotation_profile == "hand" ? hand_max_seconds : rotation_seconds)) *
       sample_rate;
   if (!(samples <= kMaxSamples)) {
     std::ostringstream msg;

@@ -28,10 +28,21 @@
 
 namespace gravcal {
 
+// One pose of a planned session (gravcal plan): the sensor-frame direction
+// that points up (the accelerometer reads +g along it) and how long it is
+// held, seconds.
+struct PlannedHold {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  double hold_seconds = 10.0;
+};
+
 struct SimulatorOptions {
   // "six", "twelve" (the seed's six faces plus six 45-degree poses), "ten"
   // (ten poses of differing roll and pitch), or "random:N".
   std::string scheme = "twelve";
+  // Issue 15: when not empty, these poses in this order, each held its own
+  // time, replace `scheme` and `hold_seconds`.
+  std::vector<PlannedHold> planned_poses;
   // Time held still in each pose, and the initial still period, seconds.
   double hold_seconds = 10.0;
   double initial_still_seconds = 10.0;

@@ -1,0 +1,96 @@
+// gravcal/workflows/plan.h: planning a recording before it is made
+// (gravcal plan) and saying what a recorded one lacks (gravcal check).
+//
+// The maths is estimation/experiment_design.h (Fisher information of the
+// magnitude model at the nominal sensor, target-weighted A-optimal design);
+// this layer reads the request (targets in the user's units, the candidate
+// set, the noise from noise.json or datasheet densities), compares the
+// seed's schemes, and orders the poses for a person to follow
+// (estimation/recording_plan.h).
+//
+// Only the accelerometer's magnitude model is planned: the gyroscope's
+// between-poses model is not in the Fisher information yet (the plan lists
+// the turns between poses all the same).
+#ifndef GRAVCAL_WORKFLOWS_PLAN_H_
+#define GRAVCAL_WORKFLOWS_PLAN_H_
+
+#include <Eigen/Core>
+#include <string>
+
+#include "gravcal/core/imu_log.h"
+#include "gravcal/core/noise_model.h"
+#include "gravcal/estimation/experiment_design.h"
+#include "gravcal/estimation/recording_plan.h"
+#include "gravcal/workflows/config.h"
+
+namespace gravcal {
+
+struct PlanRequest {
+  // "accel_bias=0.5mg accel_scale=50ppm accel_misalignment=0.1mrad": group
+  // names (accel_bias: bias_x..z, accel_scale: u_xx u_yy u_zz,
+  // accel_misalignment: u_xy u_xz u_yz) or parameter names, each with a
+  // unit: mg, ug, m/s^2 for a bias; ppm, %, mrad, urad, rad, deg for U.
+  std::string targets;
+  // faces, faces+45 or free (experiment_design.h).
+  std::string pose_set = "faces+45";
+  // Directions of the free set besides faces+45.
+  int free_candidates = 500;
+  // > 0: the total time may not exceed this, seconds.
+  double max_time_seconds = 0.0;
+  // Seconds to move and settle the housing before each pose.
+  double overhead_seconds = 10.0;
+  double min_hold_seconds = 5.0;
+  double max_hold_seconds = 600.0;
+  int max_poses = 40;
+  // The noise: the model of `gravcal noise` (SI, not owned) when set, else
+  // the datasheet densities below (accel_noise_density required).
+  const ImuNoiseModel* noise_model = nullptr;
+  // m/s^2/sqrt(Hz), m/s^2, m/s^3/sqrt(Hz) (core/noise_model.h's N, B, K).
+  double accel_noise_density = 0.0;
+  double accel_bias_instability = 0.0;
+  double accel_random_walk = 0.0;
+  // Per-pose disturbance of |a|, m/s^2 rms; 0 = none.
+  double pose_disturbance = 0.0;
+  // Extra poses `check` proposes when every parameter is determined (as many
+  // as there are undetermined directions otherwise).
+  int extra_poses = 2;
+
+  bool IsValid(std::string* error) const;
+};
+
+// Parses `text` (above) into scale-free targets per parameter of `p`
+// (MagnitudeParameterNames order; NaN = none stated). Errors name every
+// unknown name, or the entry with a bad value or unit.
+bool ParsePlanTargets(const std::string& text, AccelParameterization p, Eigen::VectorXd* targets,
+                      std::string* error);
+
+// The noise of the request; *source says where it came from.
+bool PlanDesignNoise(const PlanRequest& request, DesignNoise* noise, std::string* source,
+                     std::string* error);
+
+// The design model of a config: its parameterisation and gravity, and the
+// seconds of a hold its static detector does not keep.
+bool PlanDesignModel(const Config& config, DesignModel* model, std::string* error);
+
+// The plan. Returns false with *error (and *plan untouched) on bad input,
+// targets that cannot be met within max_time (the message says what is
+// achievable within it and how long meeting them would take), or targets no
+// design within the limits meets.
+bool MakeRecordingPlan(const Config& config, const PlanRequest& request, RecordingPlan* plan,
+                       std::string* error);
+
+// What `log` determines: its poses found by the config's static detector,
+// each weighted by its own pose-mean covariance (or the request's noise
+// model when one is given), at the nominal sensor of the data's own scale
+// (g / median |raw mean|). Proposed extra poses come from the request's
+// pose set, held the median recorded hold. False with *error on bad input.
+bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& request,
+                    CoverageReport* report, std::string* error);
+
+// A few lines for a person: per parameter the predicted sigma (readable
+// units), target and verdict, then the proposed poses.
+std::string CoverageReportText(const CoverageReport& report);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_WORKFLOWS_PLAN_H_

@@ -1,0 +1,61 @@
+// gravcal plan and gravcal check (workflows/plan.h).
+#include <cstdio>
+
+#include "cli/commands.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/io/noise_io.h"
+#include "gravcal/io/plan_io.h"
+#include "gravcal/workflows/plan.h"
+
+namespace gravcal {
+namespace cli {
+
+namespace {
+
+// The request from the flags; reads --noise into *noise (kept alive by the
+// caller). False with *error on an unreadable noise file.
+bool RequestFromArgs(const CommandArgs& args, ImuNoise* noise, PlanRequest* request,
+                     std::string* error) {
+  *request = args.plan_request;
+  if (!args.noise.empty()) {
+    if (!ReadNoiseJson(args.noise, noise, error)) return false;
+    request->noise_model = &noise->model;
+  }
+  return true;
+}
+
+}  // namespace
+
+int RunPlan(const CommandArgs& args) {
+  if (args.output.empty()) return Fail("plan needs --output <plan.json>");
+  if (!args.report.empty()) {
+    return Fail("plan: --report (the plan's HTML report) is not available yet; write plan.json");
+  }
+  std::string error;
+  ImuNoise noise;
+  PlanRequest request;
+  if (!RequestFromArgs(args, &noise, &request, &error)) return Fail(error);
+  RecordingPlan plan;
+  if (!MakeRecordingPlan(args.config, request, &plan, &error)) return Fail(error);
+  if (!WritePlanJson(plan, args.output, &error)) return Fail(error);
+  std::fprintf(stderr, "gravcal: wrote %s: %s\n", args.output.c_str(), plan.message.c_str());
+  return 0;
+}
+
+int RunCheck(const CommandArgs& args) {
+  if (args.input.empty()) return Fail("check needs --input <session.csv>");
+  std::string error;
+  ImuNoise noise;
+  PlanRequest request;
+  if (!RequestFromArgs(args, &noise, &request, &error)) return Fail(error);
+  if (!args.config.input.IsValid(&error)) return Fail("input: " + error);
+  ImuLog log;
+  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  CoverageReport report;
+  if (!CheckRecording(log, args.config, request, &report, &error)) return Fail(error);
+  std::printf("%s", CoverageReportText(report).c_str());
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace gravcal

@@ -1,0 +1,133 @@
+#include "gravcal/io/plan_io.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "gravcal/io/files.h"
+#include "io/json_helpers.h"
+
+namespace gravcal {
+
+namespace {
+
+using internal::JsonNumber;
+using internal::JsonVector;
+using Json = nlohmann::ordered_json;
+
+Json StdObject(const std::vector<std::string>& names, const Eigen::VectorXd& std) {
+  Json out = Json::object();
+  for (size_t i = 0; i < names.size() && static_cast<Eigen::Index>(i) < std.size(); ++i) {
+    out[names[i]] = JsonNumber<Json>(std(i));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string PlanToJson(const RecordingPlan& plan) {
+  Json poses = Json::array();
+  for (const PlannedPose& p : plan.poses) {
+    poses.push_back({{"up", JsonVector<Json>(p.up)},
+                     {"hold_s", JsonNumber<Json>(p.hold_seconds)},
+                     {"instruction", p.instruction}});
+  }
+  Json rotations = Json::array();
+  for (const PlannedRotation& r : plan.rotations) {
+    rotations.push_back({{"from", r.from},
+                         {"to", r.to},
+                         {"axis", JsonVector<Json>(r.axis)},
+                         {"angle_deg", JsonNumber<Json>(r.angle_deg)},
+                         {"instruction", r.instruction}});
+  }
+  Json readable = Json::object(), targets = Json::object();
+  for (size_t i = 0; i < plan.parameter_names.size(); ++i) {
+    const ReadableUnit unit = ReadableUnitOf(plan.parameter_names[i]);
+    readable[plan.parameter_names[i]] = {
+        {"value", JsonNumber<Json>(plan.predicted_std_scale_free(i) * unit.factor)},
+        {"unit", unit.unit}};
+    if (static_cast<Eigen::Index>(i) < plan.targets_scale_free.size()) {
+      targets[plan.parameter_names[i]] = {
+          {"value", JsonNumber<Json>(plan.targets_scale_free(i) * unit.factor)},
+          {"unit", unit.unit},
+          {"stated", i < plan.targeted.size() && plan.targeted[i]}};
+    }
+  }
+  Json schemes = Json::object();
+  for (const SchemeComparison& s : plan.schemes) {
+    schemes[s.name] = {{"poses", s.poses},
+                       {"hold_s", JsonNumber<Json>(s.hold_seconds)},
+                       {"total_time_s", JsonNumber<Json>(s.total_seconds)},
+                       {"meets_targets", s.meets_targets},
+                       {"predicted_std", StdObject(plan.parameter_names, s.predicted_std)}};
+  }
+  Json out;
+  out["poses"] = poses;
+  out["rotations"] = rotations;
+  out["predicted_std"] = StdObject(plan.parameter_names, plan.predicted_std);
+  out["predicted_std_readable"] = readable;
+  out["targets"] = targets;
+  out["total_time_s"] = JsonNumber<Json>(plan.total_seconds);
+  out["overhead_s"] = JsonNumber<Json>(plan.overhead_seconds);
+  out["meets_targets"] = plan.meets_targets;
+  out["nominal_scale"] = JsonNumber<Json>(plan.nominal_scale);
+  out["gravity"] = JsonNumber<Json>(plan.gravity);
+  out["criterion"] = plan.criterion;
+  out["pose_set"] = plan.pose_set;
+  out["noise"] = plan.noise_source;
+  out["schemes"] = schemes;
+  out["message"] = plan.message;
+  return out.dump(2) + "\n";
+}
+
+bool WritePlanJson(const RecordingPlan& plan, const std::string& path, std::string* error) {
+  return WriteFileAtomically(path, PlanToJson(plan), error);
+}
+
+bool PlanPosesFromJson(const std::string& text, const std::string& name,
+                       std::vector<PlannedPose>* poses, std::string* error) {
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    *error = name + ": not a JSON object";
+    return false;
+  }
+  if (!j.contains("poses") || !j["poses"].is_array() || j["poses"].empty()) {
+    *error = name + ": key 'poses' must be a non-empty array";
+    return false;
+  }
+  std::vector<PlannedPose> out;
+  for (size_t k = 0; k < j["poses"].size(); ++k) {
+    const nlohmann::json& p = j["poses"][k];
+    const std::string where = name + ": poses[" + std::to_string(k) + "]";
+    PlannedPose pose;
+    bool ok = p.is_object() && p.contains("up") && p["up"].is_array() && p["up"].size() == 3;
+    for (int i = 0; ok && i < 3; ++i) {
+      ok = p["up"][i].is_number();
+      if (ok) pose.up(i) = p["up"][i].get<double>();
+    }
+    if (!ok || !pose.up.allFinite() || !(pose.up.norm() > 0.5 && pose.up.norm() < 1.5)) {
+      *error = where + ": 'up' must be a unit vector of 3 numbers";
+      return false;
+    }
+    pose.up.normalize();
+    if (!p.contains("hold_s") || !p["hold_s"].is_number() ||
+        !(p["hold_s"].get<double>() > 0.0 && std::isfinite(p["hold_s"].get<double>()))) {
+      *error = where + ": 'hold_s' must be a positive number of seconds";
+      return false;
+    }
+    pose.hold_seconds = p["hold_s"].get<double>();
+    if (p.contains("instruction") && p["instruction"].is_string()) {
+      pose.instruction = p["instruction"].get<std::string>();
+    }
+    out.push_back(pose);
+  }
+  *poses = std::move(out);
+  return true;
+}
+
+bool ReadPlanPoses(const std::string& path, std::vector<PlannedPose>* poses, std::string* error) {
+  std::string text;
+  if (!ReadFileBytes(path, &text, error)) return false;
+  return PlanPosesFromJson(text, path, poses, error);
+}
+
+}  // namespace gravcal

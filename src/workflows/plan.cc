@@ -1,0 +1,388 @@
+#include "gravcal/workflows/plan.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <sstream>
+
+#include "gravcal/core/gravity.h"
+#include "gravcal/estimation/refinement.h"
+#include "gravcal/simulation/simulator.h"
+#include "util/units.h"
+#include "workflows/plan_start.h"
+
+namespace gravcal {
+
+namespace {
+
+// Unit -> factor to scale-free (m/s^2 for a bias, relative for U).
+bool UnitFactor(const std::string& unit, bool bias, double* factor) {
+  static const std::map<std::string, double> kBias = {
+      {"mg", 1e-3 * kStandardGravity}, {"ug", 1e-6 * kStandardGravity}, {"m/s^2", 1.0}};
+  static const std::map<std::string, double> kMatrix = {
+      {"ppm", 1e-6},  {"%", 1e-2},  {"mrad", 1e-3},
+      {"urad", 1e-6}, {"rad", 1.0}, {"deg", internal::kDegToRad}};
+  const auto& table = bias ? kBias : kMatrix;
+  const auto it = table.find(unit);
+  if (it == table.end()) return false;
+  *factor = it->second;
+  return true;
+}
+
+// The parameters a target name stands for (indices into the names).
+std::vector<int> TargetColumns(const std::string& name, const std::vector<std::string>& names) {
+  static const std::map<std::string, std::vector<std::string>> kGroups = {
+      {"accel_bias", {"bias_x", "bias_y", "bias_z"}},
+      {"accel_scale", {"u_xx", "u_yy", "u_zz"}},
+      {"accel_misalignment", {"u_xy", "u_xz", "u_yz"}}};
+  std::vector<std::string> members = {name};
+  const auto group = kGroups.find(name);
+  if (group != kGroups.end()) members = group->second;
+  std::vector<int> columns;
+  for (const std::string& m : members) {
+    const auto it = std::find(names.begin(), names.end(), m);
+    if (it != names.end()) columns.push_back(static_cast<int>(it - names.begin()));
+  }
+  return columns;
+}
+
+std::string Join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+// The sensor-frame up direction of each pose of a seed scheme.
+std::vector<Eigen::Vector3d> SchemeUps(const std::string& scheme) {
+  std::vector<Eigen::Quaterniond> attitudes;
+  std::vector<int> nominal_up;
+  std::string error;
+  std::vector<Eigen::Vector3d> ups;
+  if (!SchemeAttitudes(scheme, 0, &attitudes, &nominal_up, &error)) return ups;
+  for (const Eigen::Quaterniond& q : attitudes) {
+    Eigen::Vector3d up = q.conjugate() * Eigen::Vector3d::UnitZ();
+    // Exact zeros where the scheme means them (the quaternions round).
+    for (int i = 0; i < 3; ++i) up(i) = std::fabs(up(i)) < 1e-12 ? 0.0 : up(i);
+    ups.push_back(up.normalized());
+  }
+  return ups;
+}
+
+bool AllIn(const std::vector<Eigen::Vector3d>& ups, const std::vector<Eigen::Vector3d>& set) {
+  return std::all_of(ups.begin(), ups.end(), [&](const Eigen::Vector3d& u) {
+    return std::any_of(set.begin(), set.end(),
+                       [&](const Eigen::Vector3d& c) { return (u - c).norm() < 1e-6; });
+  });
+}
+
+// "bias_x 0.62 mg (target 0.5)" for every parameter above its target.
+std::string Shortfalls(const std::vector<std::string>& names, const Eigen::VectorXd& std,
+                       const Eigen::VectorXd& targets) {
+  std::ostringstream s;
+  s.precision(3);
+  for (size_t i = 0; i < names.size(); ++i) {
+    const ReadableUnit unit = ReadableUnitOf(names[i]);
+    s << (i ? ", " : "") << names[i] << " " << std(i) * unit.factor << " " << unit.unit
+      << " (target " << targets(i) * unit.factor << ")";
+  }
+  return s.str();
+}
+
+// DesignPoses over the pose set; for `free` also over its faces+45 subset
+// (the greedy search over thousands of directions can miss the balanced
+// 45-degree designs), keeping the better: meeting the targets in less time,
+// else the smaller worst ratio.
+bool DesignOver(const std::string& pose_set, int free_candidates, const DesignModel& model,
+                const DesignNoise& noise, const DesignOptions& options, DesignResult* result) {
+  std::vector<Eigen::Vector3d> candidates;
+  CandidateDirections(pose_set, free_candidates, &candidates);
+  if (!DesignPoses(candidates, model, noise, options, result)) return false;
+  if (pose_set != "free") return true;
+  CandidateDirections("faces+45", 0, &candidates);
+  DesignResult subset;
+  if (!DesignPoses(candidates, model, noise, options, &subset)) return true;
+  const bool better = subset.meets_targets && result->meets_targets
+                          ? subset.total_seconds < result->total_seconds
+                          : (subset.meets_targets ||
+                             (!result->meets_targets && subset.worst_ratio < result->worst_ratio));
+  if (better) *result = subset;
+  return true;
+}
+
+}  // namespace
+
+bool PlanRequest::IsValid(std::string* error) const {
+  if (pose_set != "faces" && pose_set != "faces+45" && pose_set != "free") {
+    *error = "pose_set '" + pose_set + "': expected faces, faces+45 or free";
+    return false;
+  }
+  if (free_candidates < 1 || free_candidates > 100000) {
+    *error = "candidates: 1 to 100000 free directions";
+    return false;
+  }
+  if (!(max_time_seconds >= 0.0) || !(overhead_seconds >= 0.0) || !(min_hold_seconds > 0.0) ||
+      !(max_hold_seconds >= min_hold_seconds) || !std::isfinite(max_hold_seconds) ||
+      max_poses < 1 || extra_poses < 1) {
+    *error =
+        "max_time >= 0, overhead >= 0, 0 < min_hold <= max_hold, max_poses >= 1, extra_poses >= 1";
+    return false;
+  }
+  for (double v :
+       {accel_noise_density, accel_bias_instability, accel_random_walk, pose_disturbance}) {
+    if (!(v >= 0.0 && std::isfinite(v))) {
+      *error = "noise densities and pose_disturbance must be >= 0";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool ParsePlanTargets(const std::string& text, AccelParameterization p, Eigen::VectorXd* targets,
+                      std::string* error) {
+  const std::vector<std::string> names = MagnitudeParameterNames(p);
+  Eigen::VectorXd out = Eigen::VectorXd::Constant(names.size(), NAN);
+  std::istringstream in(text);
+  std::string entry;
+  std::vector<std::string> unknown;
+  while (in >> entry) {
+    const size_t eq = entry.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      *error = "target '" + entry + "': expected name=value<unit>, e.g. accel_bias=0.5mg";
+      return false;
+    }
+    const std::string name = entry.substr(0, eq);
+    const std::vector<int> columns = TargetColumns(name, names);
+    if (columns.empty()) {
+      unknown.push_back(name);
+      continue;
+    }
+    const std::string value_text = entry.substr(eq + 1);
+    char* end = nullptr;
+    const double value = std::strtod(value_text.c_str(), &end);
+    const std::string unit = end ? std::string(end) : "";
+    double factor = 0.0;
+    if (end == value_text.c_str() || !(value > 0.0 && std::isfinite(value)) ||
+        !UnitFactor(unit, columns.front() < 3, &factor)) {
+      *error = "target '" + entry + "': expected a positive number and a unit (" +
+               (columns.front() < 3 ? "mg, ug, m/s^2" : "ppm, %, mrad, urad, rad, deg") + ")";
+      return false;
+    }
+    for (int c : columns) out(c) = value * factor;
+  }
+  if (!unknown.empty()) {
+    const bool gyro = std::any_of(unknown.begin(), unknown.end(),
+                                  [](const std::string& n) { return n.rfind("gyro", 0) == 0; });
+    *error = "unknown parameter name(s) in --target: " + Join(unknown) +
+             " (known: accel_bias, accel_scale, accel_misalignment, " + Join(names) + ")" +
+             (gyro ? "; gyroscope targets are not planned yet" : "");
+    return false;
+  }
+  *targets = out;
+  return true;
+}
+
+bool PlanDesignNoise(const PlanRequest& request, DesignNoise* noise, std::string* source,
+                     std::string* error) {
+  DesignNoise out;
+  if (request.noise_model != nullptr) {
+    out.accel = request.noise_model->accel;
+    for (const AxisNoiseModel& axis : out.accel) {
+      if (!axis.white_noise.visible()) {
+        *error = "the noise model shows no accelerometer white noise: give --accel_noise_density";
+        return false;
+      }
+    }
+    *source = "noise model (gravcal noise)";
+  } else if (request.accel_noise_density > 0.0) {
+    out = WhiteDesignNoise(request.accel_noise_density);
+    for (AxisNoiseModel& axis : out.accel) {
+      if (request.accel_bias_instability > 0.0)
+        axis.bias_instability.value = request.accel_bias_instability;
+      if (request.accel_random_walk > 0.0) axis.random_walk.value = request.accel_random_walk;
+    }
+    std::ostringstream s;
+    s << "datasheet densities: N = " << request.accel_noise_density << " m/s^2/sqrt(Hz)";
+    if (request.accel_bias_instability > 0.0) s << ", B = " << request.accel_bias_instability;
+    if (request.accel_random_walk > 0.0) s << ", K = " << request.accel_random_walk;
+    *source = s.str();
+  } else {
+    *error = "no noise: give --noise noise.json (gravcal noise) or --accel_noise_density";
+    return false;
+  }
+  out.pose_disturbance = request.pose_disturbance;
+  if (request.pose_disturbance > 0.0) {
+    std::ostringstream s;
+    s << "; per-pose disturbance " << request.pose_disturbance << " m/s^2";
+    *source += s.str();
+  }
+  *noise = out;
+  return true;
+}
+
+bool PlanDesignModel(const Config& config, DesignModel* model, std::string* error) {
+  DesignModel out;
+  out.parameterization = config.calibration.refinement.parameterization;
+  std::string source;
+  if (!ResolveGravity(config.calibration.gravity, &out.gravity, &source, error)) return false;
+  // Measured with the simulator's turns: the detector keeps about the hold
+  // (10.1 s of a 10 s hold: a turn starts and ends slowly, so the quiet
+  // windows reach into it, and `settle` is trimmed from each end); the plan
+  // counts the hold minus one `settle`.
+  out.trimmed_seconds = config.calibration.detector.settle_seconds;
+  if (!out.IsValid(error)) return false;
+  *model = out;
+  return true;
+}
+
+namespace internal {
+
+bool StartPlan(const Config& config, const PlanRequest& request, PlanStart* start,
+               std::string* error) {
+  if (!request.IsValid(error)) return false;
+  PlanStart out;
+  if (!PlanDesignModel(config, &out.model, error)) return false;
+  out.names = MagnitudeParameterNames(out.model.parameterization);
+  Eigen::VectorXd stated;
+  if (!ParsePlanTargets(request.targets, out.model.parameterization, &stated, error)) return false;
+  const RefinementOptions& r = config.calibration.refinement;
+  const Eigen::Index p = static_cast<Eigen::Index>(out.names.size());
+  out.limits.resize(p);
+  out.targets.resize(p);
+  out.targeted.resize(p);
+  for (Eigen::Index i = 0; i < p; ++i) {
+    out.limits(i) = i < 3 ? r.max_bias_std : r.max_matrix_std;
+    out.targeted[i] = std::isfinite(stated(i));
+    out.targets(i) = out.targeted[i] ? stated(i) : out.limits(i);
+  }
+  *start = out;
+  return true;
+}
+
+}  // namespace internal
+
+bool MakeRecordingPlan(const Config& config, const PlanRequest& request, RecordingPlan* plan,
+                       std::string* error) {
+  internal::PlanStart start;
+  if (!internal::StartPlan(config, request, &start, error)) return false;
+  const DesignModel& model = start.model;
+  const std::vector<std::string>& names = start.names;
+  const Eigen::VectorXd& targets = start.targets;
+  const bool any_stated =
+      std::any_of(start.targeted.begin(), start.targeted.end(), [](bool t) { return t; });
+  if (!any_stated && !(request.max_time_seconds > 0.0)) {
+    *error = "give --target (e.g. accel_bias=0.5mg accel_scale=50ppm) or --max_time";
+    return false;
+  }
+  DesignNoise noise;
+  RecordingPlan out;
+  if (!PlanDesignNoise(request, &noise, &out.noise_source, error)) return false;
+  out.targeted = start.targeted;
+
+  DesignOptions options;
+  options.targets = targets;
+  options.overhead_seconds = request.overhead_seconds;
+  options.min_hold_seconds = std::max(request.min_hold_seconds, model.trimmed_seconds + 1.0);
+  options.max_hold_seconds = std::max(request.max_hold_seconds, options.min_hold_seconds);
+  options.max_poses =
+      std::max(request.max_poses, static_cast<int>(names.size()) + options.redundancy);
+  std::vector<Eigen::Vector3d> candidates;
+  CandidateDirections(request.pose_set, request.free_candidates, &candidates);
+  const std::vector<std::pair<std::string, std::vector<Eigen::Vector3d>>> schemes = {
+      {"twelve", SchemeUps("twelve")}, {"six", SchemeUps("six")}, {"ten", SchemeUps("ten")}};
+  for (const auto& [name, ups] : schemes) {
+    if (AllIn(ups, candidates)) options.reference_designs.push_back(ups);
+  }
+
+  DesignResult design;
+  if (!any_stated) {
+    // Best accuracy within max_time: rank designs by the largest sigma
+    // relative to 1 mg, 100 ppm and 0.1 mrad, i.e. targets far below reach.
+    DesignOptions accuracy = options;
+    for (size_t i = 0; i < names.size(); ++i) accuracy.targets(i) = 1e-9 * ReferenceStd(names[i]);
+    accuracy.max_time_seconds = request.max_time_seconds;
+    if (!DesignOver(request.pose_set, request.free_candidates, model, noise, accuracy, &design)) {
+      *error = design.message;
+      return false;
+    }
+    design = EvaluateDesign(design.poses, model, noise, options);
+  } else {
+    if (!DesignOver(request.pose_set, request.free_candidates, model, noise, options, &design)) {
+      *error = design.message;
+      return false;
+    }
+    if (request.max_time_seconds > 0.0 &&
+        !(design.meets_targets && design.total_seconds <= request.max_time_seconds)) {
+      // What can be done within max_time, and how long the targets need.
+      DesignOptions within = options;
+      within.max_time_seconds = request.max_time_seconds;
+      DesignResult best;
+      std::ostringstream s;
+      s.precision(4);
+      s << "the targets cannot be met within --max_time " << request.max_time_seconds << " s";
+      if (DesignOver(request.pose_set, request.free_candidates, model, noise, within, &best) &&
+          std::isfinite(best.worst_ratio)) {
+        s << "; achievable within it (" << best.poses.size()
+          << " poses): " << Shortfalls(names, best.predicted_std, targets);
+      } else {
+        s << "; no design within it determines every parameter";
+      }
+      if (design.meets_targets) {
+        s << "; meeting them takes " << design.total_seconds << " s (" << design.poses.size()
+          << " poses)";
+      }
+      *error = s.str();
+      return false;
+    }
+  }
+  if (!design.meets_targets || !std::isfinite(design.worst_ratio)) {
+    std::ostringstream s;
+    s << "no design of at most " << options.max_poses << " poses held at most "
+      << options.max_hold_seconds << " s meets the targets";
+    if (std::isfinite(design.worst_ratio) && design.predicted_std.size() > 0) {
+      s << "; the best found: " << Shortfalls(names, design.predicted_std, targets);
+    }
+    *error = s.str();
+    return false;
+  }
+
+  std::vector<PlannedPose> poses;
+  for (const DesignPose& p : design.poses) poses.push_back({p.up, p.hold_seconds, ""});
+  OrderForHandling(poses, &out);
+  out.parameter_names = names;
+  out.nominal_scale = config.calibration.nominal_scale;
+  out.gravity = model.gravity;
+  out.overhead_seconds = request.overhead_seconds;
+  out.predicted_std_scale_free = design.predicted_std;
+  out.predicted_std = StdInRawUnits(design.predicted_std, out.nominal_scale);
+  out.targets_scale_free = targets;
+  out.total_seconds = design.total_seconds;
+  out.meets_targets = design.meets_targets;
+  out.pose_set = request.pose_set;
+  out.criterion =
+      "target-weighted A-optimal: minimise sum_i (sigma_i / target_i)^2 over the candidate "
+      "orientations (greedy + Fedorov exchange), least total time (holds + overhead) with "
+      "every sigma_i <= target_i";
+  for (const auto& [name, ups] : schemes) {
+    SchemeComparison c;
+    c.name = name;
+    c.poses = static_cast<int>(ups.size());
+    DesignResult r;
+    c.meets_targets = ShortestHold(ups, model, noise, options, &r);
+    if (!c.meets_targets) {
+      std::vector<DesignPose> at_max;
+      for (const Eigen::Vector3d& u : ups) at_max.push_back({u, options.max_hold_seconds});
+      r = EvaluateDesign(at_max, model, noise, options);
+    }
+    c.hold_seconds = c.meets_targets ? r.poses.front().hold_seconds : NAN;
+    c.total_seconds = c.meets_targets ? r.total_seconds : NAN;
+    c.predicted_std = StdInRawUnits(r.predicted_std, out.nominal_scale);
+    out.schemes.push_back(c);
+  }
+  out.message = design.message;
+  *plan = out;
+  return true;
+}
+
+}  // namespace gravcal

@@ -1,0 +1,35 @@
+// Private: the set-up shared by gravcal plan and gravcal check
+// (workflows/plan.h): the request checked, the design model of the config,
+// and the targets per parameter.
+#ifndef GRAVCAL_SRC_WORKFLOWS_PLAN_START_H_
+#define GRAVCAL_SRC_WORKFLOWS_PLAN_START_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "gravcal/workflows/plan.h"
+
+namespace gravcal {
+namespace internal {
+
+struct PlanStart {
+  DesignModel model;
+  // MagnitudeParameterNames of the config's parameterisation.
+  std::vector<std::string> names;
+  // Scale-free targets: the stated ones, else the refinement's limit of a
+  // determined parameter (max_bias_std, max_matrix_std); `targeted` marks
+  // the stated ones.
+  Eigen::VectorXd targets;
+  std::vector<bool> targeted;
+  // The refinement's limits per parameter (scale-free).
+  Eigen::VectorXd limits;
+};
+
+bool StartPlan(const Config& config, const PlanRequest& request, PlanStart* start,
+               std::string* error);
+
+}  // namespace internal
+}  // namespace gravcal
+
+#endif  // GRAVCAL_SRC_WORKFLOWS_PLAN_START_H_

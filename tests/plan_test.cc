@@ -1,0 +1,279 @@
+// gravcal plan / check (issue 15): the design maths against the refinement's
+// own residual, the plan against the seed's schemes, the coverage check of a
+// six-face session, and bad input.
+#include "gravcal/workflows/plan.h"
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "cli_runner.h"
+#include "gravcal/estimation/experiment_design.h"
+#include "gravcal/estimation/refinement.h"
+#include "gravcal/io/plan_io.h"
+#include "gravcal/residuals/gravity_magnitude_residual.h"
+#include "gravcal/simulation/simulator.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+using testing_util::SourceDir;
+
+constexpr double kDensity = 0.002;  // m/s^2/sqrt(Hz): sim_accel_noise 0.02 at 100 Hz.
+
+Config TwelveConfig() {
+  Config config;
+  std::string error;
+  EXPECT_TRUE(LoadConfigFile(SourceDir() + "/configs/twelve_position.yaml", &config, &error))
+      << error;
+  return config;
+}
+
+PlanRequest Request(const std::string& targets) {
+  PlanRequest request;
+  request.targets = targets;
+  request.accel_noise_density = kDensity;
+  return request;
+}
+
+int Index(const std::vector<std::string>& names, const std::string& name) {
+  return static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin());
+}
+
+TEST(ExperimentDesign, JacobianIsTheAutodiffResidualAtTheNominalSensor) {
+  DesignModel model;
+  model.trimmed_seconds = 1.6;
+  const DesignNoise noise = WhiteDesignNoise(kDensity);
+  std::vector<DesignPose> poses = {{Eigen::Vector3d(1, 2, -2).normalized(), 12.0},
+                                   {-Eigen::Vector3d::UnitY(), 7.0}};
+  const Eigen::MatrixXd j = DesignJacobian(poses, model, noise);
+  ASSERT_EQ(j.cols(), 9);
+  for (size_t k = 0; k < poses.size(); ++k) {
+    const double sigma =
+        std::sqrt(PoseMagnitudeVariance(noise, model, poses[k].up, poses[k].hold_seconds));
+    EXPECT_NEAR(sigma, kDensity / std::sqrt(poses[k].hold_seconds - 1.6), 1e-15);
+    std::unique_ptr<ceres::CostFunction> cost(
+        GravityMagnitudeResidual::Create(model.gravity * poses[k].up, model.gravity, sigma));
+    double bias[3] = {0, 0, 0};
+    double upper[6] = {1, 0, 0, 1, 0, 1};
+    const double* parameters[2] = {bias, upper};
+    double residual = 0, jb[3], ju[6];
+    double* jacobians[2] = {jb, ju};
+    ASSERT_TRUE(cost->Evaluate(parameters, &residual, jacobians));
+    EXPECT_NEAR(residual, 0.0, 1e-9);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(j(k, i), jb[i], 1e-9 * std::fabs(jb[i]) + 1e-9);
+    for (int i = 0; i < 6; ++i) EXPECT_NEAR(j(k, 3 + i), ju[i], 1e-9 * std::fabs(ju[i]) + 1e-9);
+  }
+}
+
+TEST(ExperimentDesign, SixFacesLeaveTheNonOrthogonalityUndetermined) {
+  DesignModel model;
+  std::vector<Eigen::Vector3d> faces;
+  ASSERT_TRUE(CandidateDirections("faces", 0, &faces));
+  std::vector<DesignPose> poses;
+  for (const Eigen::Vector3d& u : faces) poses.push_back({u, 10.0});
+  const Eigen::MatrixXd j = DesignJacobian(poses, model, WhiteDesignNoise(kDensity));
+  const Eigen::VectorXd std = PredictedStd(j.transpose() * j);
+  const std::vector<std::string> names = MagnitudeParameterNames(model.parameterization);
+  for (const char* name : {"u_xy", "u_xz", "u_yz"}) {
+    EXPECT_TRUE(std::isinf(std(Index(names, name)))) << name;
+  }
+  for (const char* name : {"bias_x", "bias_y", "bias_z", "u_xx", "u_yy", "u_zz"}) {
+    // Two opposite faces of N^2 / 10 each: sigma = N / sqrt(20) (bias) and
+    // N / (g sqrt(20)) (scale), closed form.
+    const double expected = kDensity / std::sqrt(20.0) / (name[0] == 'u' ? model.gravity : 1.0);
+    EXPECT_NEAR(std(Index(names, name)), expected, 1e-9 * expected) << name;
+  }
+}
+
+TEST(ExperimentDesign, MoreTimeLowersSigmaAsTheNoiseModelSays) {
+  DesignModel model;
+  std::vector<Eigen::Vector3d> twelve;
+  ASSERT_TRUE(CandidateDirections("faces+45", 0, &twelve));
+  auto sigma_at = [&](double hold, const DesignNoise& noise) {
+    std::vector<DesignPose> poses;
+    for (const Eigen::Vector3d& u : twelve) poses.push_back({u, hold});
+    const Eigen::MatrixXd j = DesignJacobian(poses, model, noise);
+    return PredictedStd(j.transpose() * j);
+  };
+  const DesignNoise white = WhiteDesignNoise(kDensity);
+  const Eigen::VectorXd ratio = sigma_at(40.0, white).cwiseQuotient(sigma_at(10.0, white));
+  for (Eigen::Index i = 0; i < ratio.size(); ++i) EXPECT_NEAR(ratio(i), 0.5, 1e-9);
+  // A bias-instability floor stops the gain: four times the hold helps less.
+  DesignNoise floor = white;
+  for (AxisNoiseModel& axis : floor.accel) axis.bias_instability.value = 1e-3;
+  const Eigen::VectorXd floored = sigma_at(40.0, floor).cwiseQuotient(sigma_at(10.0, floor));
+  EXPECT_GT(floored.minCoeff(), 0.6);
+}
+
+TEST(Plan, MeetsTargetsAndNeverTakesLongerThanTheSeedsTwelvePositions) {
+  const Config config = TwelveConfig();
+  // From loose to demanding (consumer accelerometer noise).
+  const char* targets[] = {
+      "accel_bias=0.5mg accel_scale=200ppm accel_misalignment=0.2mrad",
+      "accel_bias=0.1mg accel_scale=50ppm accel_misalignment=0.05mrad",
+      "accel_bias=0.05mg accel_scale=20ppm accel_misalignment=0.02mrad",
+      "accel_bias=0.02mg accel_scale=10ppm accel_misalignment=0.01mrad",
+      "accel_bias=0.05mg accel_scale=20ppm",
+  };
+  bool strictly_less = false;
+  for (const char* target : targets) {
+    for (const char* set : {"faces+45", "free"}) {
+      PlanRequest request = Request(target);
+      request.pose_set = set;
+      // Long enough for the twelve positions to meet the last target.
+      request.max_hold_seconds = 3600.0;
+      RecordingPlan plan;
+      std::string error;
+      ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << target << ": " << error;
+      EXPECT_TRUE(plan.meets_targets);
+      for (size_t i = 0; i < plan.parameter_names.size(); ++i) {
+        EXPECT_LE(plan.predicted_std_scale_free(i), plan.targets_scale_free(i) * (1 + 1e-9))
+            << target << " " << plan.parameter_names[i];
+      }
+      const SchemeComparison& twelve = plan.schemes[0];
+      ASSERT_EQ(twelve.name, "twelve");
+      ASSERT_TRUE(twelve.meets_targets) << target;
+      EXPECT_LE(plan.total_seconds, twelve.total_seconds * (1 + 1e-9)) << target << " " << set;
+      if (plan.total_seconds < 0.95 * twelve.total_seconds) strictly_less = true;
+      std::printf("%-70s %-9s plan %2zu poses %7.1f s | twelve hold %6.1f s %7.1f s\n", target, set,
+                  plan.poses.size(), plan.total_seconds, twelve.hold_seconds, twelve.total_seconds);
+    }
+  }
+  EXPECT_TRUE(strictly_less);
+}
+
+TEST(Plan, PosesAreOrderedWithTurnsBetweenThem) {
+  RecordingPlan plan;
+  std::string error;
+  ASSERT_TRUE(MakeRecordingPlan(TwelveConfig(), Request("accel_bias=0.1mg"), &plan, &error))
+      << error;
+  ASSERT_GE(plan.poses.size(), 9u);
+  ASSERT_EQ(plan.rotations.size(), plan.poses.size() - 1);
+  for (const PlannedRotation& r : plan.rotations) {
+    // Turning about `axis` by the angle takes the up direction from one pose
+    // to the next: up' = R(axis, -angle) up.
+    const Eigen::Vector3d moved =
+        Eigen::AngleAxisd(-r.angle_deg * M_PI / 180.0, r.axis) * plan.poses[r.from].up;
+    EXPECT_LT((moved - plan.poses[r.to].up).norm(), 1e-9) << r.instruction;
+  }
+  for (const PlannedPose& p : plan.poses) EXPECT_FALSE(p.instruction.empty());
+  // The JSON round trip of the poses simulate reads.
+  std::vector<PlannedPose> read;
+  ASSERT_TRUE(PlanPosesFromJson(PlanToJson(plan), "plan", &read, &error)) << error;
+  ASSERT_EQ(read.size(), plan.poses.size());
+  for (size_t k = 0; k < read.size(); ++k) {
+    EXPECT_LT((read[k].up - plan.poses[k].up).norm(), 1e-12);
+    EXPECT_DOUBLE_EQ(read[k].hold_seconds, plan.poses[k].hold_seconds);
+  }
+}
+
+TEST(Plan, UnknownTargetNamesAreNamed) {
+  RecordingPlan plan;
+  std::string error;
+  EXPECT_FALSE(MakeRecordingPlan(
+      TwelveConfig(), Request("accel_bias=0.5mg scale_q=3ppm bias_w=1mg"), &plan, &error));
+  EXPECT_NE(error.find("scale_q"), std::string::npos) << error;
+  EXPECT_NE(error.find("bias_w"), std::string::npos) << error;
+  EXPECT_FALSE(MakeRecordingPlan(TwelveConfig(), Request("accel_bias=0.5ppm"), &plan, &error));
+  EXPECT_NE(error.find("unit"), std::string::npos) << error;
+}
+
+TEST(Plan, ImpossibleWithinMaxTimeSaysWhatIsAchievable) {
+  PlanRequest request = Request("accel_bias=0.02mg accel_scale=10ppm");
+  request.max_time_seconds = 300.0;
+  RecordingPlan plan;
+  std::string error;
+  EXPECT_FALSE(MakeRecordingPlan(TwelveConfig(), request, &plan, &error));
+  EXPECT_NE(error.find("cannot be met within --max_time 300"), std::string::npos) << error;
+  EXPECT_NE(error.find("achievable within it"), std::string::npos) << error;
+  EXPECT_NE(error.find("bias_x"), std::string::npos) << error;
+  EXPECT_NE(error.find("meeting them takes"), std::string::npos) << error;
+}
+
+// Simulated session of the given up directions, held `hold` seconds each.
+SimulatedSession SimulateUps(const std::vector<Eigen::Vector3d>& ups, double hold, uint64_t seed) {
+  Config config = TwelveConfig();
+  for (const Eigen::Vector3d& u : ups) config.simulation.planned_poses.push_back({u, hold});
+  config.simulation.initial_still_seconds = 0.0;
+  SimulatedSession session;
+  std::string error;
+  EXPECT_TRUE(Simulate(config.simulation, seed, &session, &error)) << error;
+  return session;
+}
+
+TEST(Check, SixFacesNameTheNonOrthogonalityAndTheProposedPosesDetermineIt) {
+  std::vector<Eigen::Vector3d> faces;
+  ASSERT_TRUE(CandidateDirections("faces", 0, &faces));
+  const Config config = TwelveConfig();
+  CoverageReport report;
+  std::string error;
+  ASSERT_TRUE(
+      CheckRecording(SimulateUps(faces, 10.0, 5).log, config, PlanRequest(), &report, &error))
+      << error;
+  EXPECT_EQ(report.positions, 6);
+  ASSERT_EQ(report.undetermined.size(), 3u) << CoverageReportText(report);
+  for (const char* name : {"u_xy", "u_xz", "u_yz"}) {
+    EXPECT_NE(std::find(report.undetermined.begin(), report.undetermined.end(), name),
+              report.undetermined.end())
+        << name;
+  }
+  ASSERT_FALSE(report.proposed.empty());
+  std::vector<Eigen::Vector3d> extended = faces;
+  for (const PlannedPose& p : report.proposed) {
+    // A between-axes pose: two axes off level, none straight up.
+    int tilted = 0;
+    for (int a = 0; a < 3; ++a) tilted += std::fabs(p.up(a)) > 0.3 ? 1 : 0;
+    EXPECT_GE(tilted, 2) << p.instruction;
+    extended.push_back(p.up);
+  }
+  EXPECT_TRUE(report.undetermined_with_proposed.empty()) << CoverageReportText(report);
+  // Record them too (in simulation): now everything is determined.
+  CoverageReport again;
+  ASSERT_TRUE(
+      CheckRecording(SimulateUps(extended, 10.0, 6).log, config, PlanRequest(), &again, &error))
+      << error;
+  EXPECT_TRUE(again.undetermined.empty()) << CoverageReportText(again);
+  std::printf("%s\n", CoverageReportText(report).c_str());
+}
+
+TEST(PlanCli, BadInputExitsNonZeroAndWritesNothing) {
+  const testing_util::ScratchDir dir;
+  const std::string out = dir / "plan.json";
+  const std::string config = SourceDir() + "/configs/twelve_position.yaml";
+  auto plan = [&](const std::string& target, const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"plan",     "--config", config,
+                                     "--output", out,        "--accel_noise_density",
+                                     "0.002",    "--target", target};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return testing_util::RunCli(args, dir);
+  };
+  testing_util::CliResult r = plan("accel_bias=0.5mg gyro_bias=1dph", {});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("gyro_bias"), std::string::npos) << r.err;
+  r = plan("accel_bias=0.01mg accel_scale=5ppm", {"--max_time", "300"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("achievable"), std::string::npos) << r.err;
+  EXPECT_FALSE(testing_util::FileExists(out)) << "no partial output";
+  r = plan("accel_bias=0.1mg accel_misalignment=0.05mrad", {});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(testing_util::FileExists(out));
+  // simulate --plan follows it, and check finds nothing undetermined.
+  r = testing_util::RunCli(
+      {"simulate", "--config", config, "--plan", out, "--output-dir", dir / "sim", "--seed", "3"},
+      dir);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  r = testing_util::RunCli({"check", "--config", config, "--input", dir / "sim/raw.csv"}, dir);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("UNDETERMINED"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("u_xy"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace gravcal
