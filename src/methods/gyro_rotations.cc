@@ -179,6 +179,13 @@ bool PrepareGyroRotations(const ImuLog& log, const std::vector<StaticInterval>& 
   std::vector<StaticInterval> poses;
   if (!CorePoses(log, intervals, options.edge_seconds, name, &poses, error)) return false;
   prep->positions = PositionsFromIntervals(poses);
+  if (options.pose_variance > 0.0) {
+    // s^2 I in specific force is M^-1 s^2 M^-T in raw units.
+    const Eigen::Matrix3d inverse = accel.matrix().inverse();
+    for (Position& p : prep->positions) {
+      p.raw_mean_cov += options.pose_variance * inverse * inverse.transpose();
+    }
+  }
   prep->segments = CutRotations(log, poses, options.max_rotation_seconds, warnings);
   if (static_cast<int>(prep->segments.size()) < MinRotations(options.parameterization)) {
     std::ostringstream s;

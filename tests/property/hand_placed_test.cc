@@ -1,0 +1,127 @@
+// Issue 14: honest standard deviations on hand-placed sessions. The
+// simulator adds what hand placement adds to the textbook white noise
+// (configs/hand_placed.yaml: bias instability, bias random walks, tremor and
+// a per-pose specific-force disturbance the samples of a pose cannot show,
+// sized so the white-noise fit's residuals are 4-5 times the noise level as
+// on the real recordings), and every estimated parameter's error / reported
+// sigma must have rms in [0.8, 1.25] over at least 100 seeds, for
+// twelve_position, ten_position and the gyroscope between poses, with the
+// uncertainty keys of configs/hand_placed.yaml (pose_noise, pose_variance and
+// its prior). The same sessions with the white-noise sigmas (pose_noise
+// white, pose_variance false) are printed for contrast, not asserted.
+//
+// Seeds: 1..kHonestySeeds unless GRAVCAL_PROPERTY_SEEDS says otherwise (the
+// large_seed run: 400 other seeds).
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+
+#include "property/method_case.h"
+#include "property/pipeline_case.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace testing_util {
+namespace {
+
+constexpr int kHonestySeeds = 100;
+
+// The keys of configs/hand_placed.yaml that describe hand placement and the
+// pipeline's answer to it: every sim_* key but the scheme and hold, and the
+// uncertainty keys. `white` replaces the latter by the white-noise ones.
+std::vector<std::pair<std::string, std::string>> HandPlacedKeys(bool white) {
+  std::vector<std::pair<std::string, std::string>> keys;
+  const YAML::Node root = YAML::LoadFile(SourceDir() + "/configs/hand_placed.yaml");
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    const bool sim = key.rfind("sim_", 0) == 0 && key != "sim_scheme" && key != "sim_hold";
+    const bool uncertainty = key.rfind("pose_", 0) == 0;
+    if (sim || (uncertainty && !white)) keys.emplace_back(key, entry.second.as<std::string>());
+  }
+  if (white) {
+    keys.emplace_back("pose_noise", "white");
+    keys.emplace_back("pose_variance", "false");
+  }
+  return keys;
+}
+
+std::vector<MethodCase> HandPlacedCases(bool white) {
+  const auto keys = HandPlacedKeys(white);
+  std::vector<MethodCase> cases;
+  auto with = [&](std::vector<std::pair<std::string, std::string>> extra) {
+    extra.insert(extra.begin(), keys.begin(), keys.end());
+    return extra;
+  };
+  cases.push_back(PipelineCase("hand_placed/twelve_position",
+                               ShippedConfig("hand_placed.yaml", with({{"gyro_model", "none"}}))));
+  {
+    // Ten poses; checked as in method_property_test.cc: step 4's covariance
+    // parameters and the diagonal of K.
+    MethodCase m = PipelineCase("hand_placed/ten_position",
+                                ShippedConfig("ten_position.yaml", with({{"sim_hold", "6"}})));
+    m.extract = TenPositionErrors;
+    cases.push_back(m);
+  }
+  {
+    MethodCase m =
+        PipelineCase("hand_placed/gyro_between_poses", ShippedConfig("hand_placed.yaml", with({})));
+    m.extract = AccelAndGyroErrors;
+    cases.push_back(m);
+  }
+  return cases;
+}
+
+// Runs a case over the seeds; false seeds are test failures.
+SigmaCheck RunCase(const MethodCase& method, int first, int seeds, double* seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  SigmaCheck check, known;
+  const std::vector<SeedOutcome> failed =
+      RunMethodCase(method, first, seeds, PropertyThreads(), &check, &known);
+  *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const SeedOutcome& f : failed) {
+    ADD_FAILURE() << method.name << " seed " << f.seed << ": " << f.message;
+  }
+  return check;
+}
+
+class HandPlaced : public ::testing::TestWithParam<int> {};
+
+TEST_P(HandPlaced, ErrorOverSigmaRmsIsNearOne) {
+  int first = 1, seeds = kHonestySeeds;
+  if (std::getenv("GRAVCAL_PROPERTY_SEEDS") != nullptr) PropertySeeds(&first, &seeds);
+  ASSERT_GE(seeds, 2);
+  const MethodCase honest = HandPlacedCases(false)[GetParam()];
+  const MethodCase white = HandPlacedCases(true)[GetParam()];
+  double honest_seconds = 0.0, white_seconds = 0.0;
+  const SigmaCheck check = RunCase(honest, first, seeds, &honest_seconds);
+  const SigmaCheck contrast = RunCase(white, first, seeds, &white_seconds);
+  std::printf(
+      "%s: seeds %d..%d, %.1f s\nwith configs/hand_placed.yaml's uncertainty keys:\n%s"
+      "white-noise sigmas on the same sessions (%.1f s):\n%s",
+      honest.name.c_str(), first, first + seeds - 1, honest_seconds, check.Table().c_str(),
+      white_seconds, contrast.Table().c_str());
+  ASSERT_FALSE(check.Names().empty());
+  for (const std::string& name : check.Names()) {
+    EXPECT_GT(check.Rms(name), 0.8) << honest.name << " " << name;
+    EXPECT_LT(check.Rms(name), 1.25) << honest.name << " " << name;
+  }
+}
+
+std::string CaseName(const ::testing::TestParamInfo<int>& info) {
+  std::string name = HandPlacedCases(false)[info.param].name;
+  for (char& c : name) {
+    if (!isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, HandPlaced,
+                         ::testing::Range(0, static_cast<int>(HandPlacedCases(false).size())),
+                         CaseName);
+
+}  // namespace
+}  // namespace testing_util
+}  // namespace gravcal
