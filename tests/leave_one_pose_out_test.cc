@@ -12,8 +12,9 @@
 // (already inflated) covariance, sigma_k the pose's own noise (pose_noise),
 // s^2 the per-pose variance the fit estimated and f its Student-t inflation
 // (estimation/variance_component.h; 1 without pose_variance). The rms over
-// the poses of residual / sqrt(var_k) must lie in [0.7, 1.4], and the full
-// fit must not carry the chi-square warning.
+// the poses of residual / sqrt(var_k) must lie in [0.7, 1.4] (where the fit
+// has two or more residual degrees of freedom), and the full fit must not
+// carry the chi-square warning.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -115,10 +116,16 @@ TEST(LeaveOnePoseOut, RealRecordingsPredictWithinTheirSigmas) {
     std::printf("%s: %zu poses, chi2/dof %.2f, pose variance: %s\n  left-out z:%s\n  rms %.3f\n",
                 r.config, positions.size(), c.refinement.chi2 / std::max(c.refinement.dof, 1),
                 c.accel.pose_variance.message.c_str(), zs.c_str(), rms);
-    EXPECT_GE(used, static_cast<int>(positions.size()) - 1) << r.config;
+    EXPECT_FALSE(HasChiSquareWarning(c)) << r.config;
+    // A pose whose axis no other pose shows (the only -x pose, say) leaves
+    // the others without a fit: it is skipped, at most a third of them.
+    EXPECT_GE(3 * used, 2 * static_cast<int>(positions.size())) << r.config;
+    // With one residual degree of freedom (the MPU-6050: ten poses, nine
+    // parameters) every left-out prediction is the same single residual, a
+    // single chi-square(1) draw: the band would test nothing.
+    if (c.refinement.dof < 2) continue;
     EXPECT_GT(rms, 0.7) << r.config;
     EXPECT_LT(rms, 1.4) << r.config;
-    EXPECT_FALSE(HasChiSquareWarning(c)) << r.config;
   }
 }
 

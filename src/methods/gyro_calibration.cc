@@ -398,6 +398,7 @@ bool AddGyroscopeCalibration(const ImuLog& log, const std::vector<StaticInterval
   // gravity direction too.
   GyroCalibrationOptions with_poses = options;
   if (c.accel.pose_variance.absorbed) with_poses.pose_variance = c.accel.pose_variance.variance;
+  with_poses.estimate_static_variance = c.accel.pose_variance.estimated;
   if (!CalibrateGyroscope(log, intervals, c.accel.model, accel_covariance, c.gravity, with_poses,
                           &g)) {
     for (const std::string& w : g.warnings) c.warnings.push_back(w);

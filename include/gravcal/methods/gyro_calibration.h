@@ -78,6 +78,12 @@ struct GyroCalibrationOptions {
   // sets it to the accelerometer's absorbed per-pose variance
   // (pose_variance); 0 = white noise only.
   double pose_variance = 0.0;
+  // Estimate the scatter of the static poses' mean rates beyond their white
+  // noise (bias instability, random walk) by REML and add it to every static
+  // pose's covariance (estimation/variance_component.h).
+  // AddGyroscopeCalibration turns it on with the accelerometer's
+  // pose_variance.
+  bool estimate_static_variance = false;
 
   // Stopping rules of the Ceres solve.
   SolverTolerances solver = {100, 1e-12, 1e-12, 1e-10};
