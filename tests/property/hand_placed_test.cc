@@ -69,17 +69,27 @@ std::vector<MethodCase> HandPlacedCases(bool white) {
     MethodCase m =
         PipelineCase("hand_placed/gyro_between_poses", ShippedConfig("hand_placed.yaml", with({})));
     m.extract = AccelAndGyroErrors;
+    // Known failure, measured 2026-11-23 (seeds 1-100): the gyroscope bias
+    // has rms error/sigma 1.56-1.72 (white sigmas 1.86-2.03) although the
+    // static poses' scatter is estimated (gyro_rotations.cc). The bias
+    // instability (3e-5 rad/s) and random walk (2e-6 rad/s/sqrt(s)) move
+    // the bias by about 2e-5 rad/s over the whole session, common to every
+    // pose: one session cannot tell that from the bias itself. Only a noise
+    // model (`gravcal noise`, the Allan variance at the session length)
+    // can size it; `calibrate --noise` does not yet add it to the gyroscope.
+    m.known_failures = {"gyro.bias_x", "gyro.bias_y", "gyro.bias_z"};
     cases.push_back(m);
   }
   return cases;
 }
 
 // Runs a case over the seeds; false seeds are test failures.
-SigmaCheck RunCase(const MethodCase& method, int first, int seeds, double* seconds) {
+SigmaCheck RunCase(const MethodCase& method, int first, int seeds, double* seconds,
+                   SigmaCheck* known) {
   const auto start = std::chrono::steady_clock::now();
-  SigmaCheck check, known;
+  SigmaCheck check;
   const std::vector<SeedOutcome> failed =
-      RunMethodCase(method, first, seeds, PropertyThreads(), &check, &known);
+      RunMethodCase(method, first, seeds, PropertyThreads(), &check, known);
   *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (const SeedOutcome& f : failed) {
     ADD_FAILURE() << method.name << " seed " << f.seed << ": " << f.message;
@@ -96,13 +106,18 @@ TEST_P(HandPlaced, ErrorOverSigmaRmsIsNearOne) {
   const MethodCase honest = HandPlacedCases(false)[GetParam()];
   const MethodCase white = HandPlacedCases(true)[GetParam()];
   double honest_seconds = 0.0, white_seconds = 0.0;
-  const SigmaCheck check = RunCase(honest, first, seeds, &honest_seconds);
-  const SigmaCheck contrast = RunCase(white, first, seeds, &white_seconds);
+  SigmaCheck known, known_white;
+  const SigmaCheck check = RunCase(honest, first, seeds, &honest_seconds, &known);
+  const SigmaCheck contrast = RunCase(white, first, seeds, &white_seconds, &known_white);
   std::printf(
       "%s: seeds %d..%d, %.1f s\nwith configs/hand_placed.yaml's uncertainty keys:\n%s"
       "white-noise sigmas on the same sessions (%.1f s):\n%s",
       honest.name.c_str(), first, first + seeds - 1, honest_seconds, check.Table().c_str(),
       white_seconds, contrast.Table().c_str());
+  if (!honest.known_failures.empty()) {
+    std::printf("known failures (not asserted):\n%swith white sigmas:\n%s", known.Table().c_str(),
+                known_white.Table().c_str());
+  }
   ASSERT_FALSE(check.Names().empty());
   for (const std::string& name : check.Names()) {
     EXPECT_GT(check.Rms(name), 0.8) << honest.name << " " << name;
