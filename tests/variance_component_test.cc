@@ -118,11 +118,19 @@ TEST(VarianceComponent, NoExcessGivesTheBoundaryMostOfTheTime) {
 // beta as the white fit (MakeDraw's, truth 0) and the covariance
 // f (1 + s^2) (J^T J)^-1, f the Student inflation (1 for `plain`). Returns the
 // rms of beta_j / sigma_j over every parameter and seed.
-double RmsZ(int n, int p, double s2, const internal::VariancePrior& prior, bool inflate) {
+// A prior with dof > 0 is drawn per seed as an estimate of s2 from that many
+// degrees of freedom (s2 chi2_dof / dof), which is what its dof claim.
+double RmsZ(int n, int p, double s2, const internal::VariancePrior& given, bool inflate) {
   double sum = 0.0;
   int count = 0;
+  std::mt19937 rng(77);
   for (int seed = 0; seed < 2000; ++seed) {
     const Draw d = MakeDraw(n, p, s2, 1.0, 1.0, 20000 + seed);
+    internal::VariancePrior prior = given;
+    if (prior.dof > 0.0) {
+      std::chi_squared_distribution<double> chi2(prior.dof);
+      prior.variance = s2 * chi2(rng) / prior.dof;
+    }
     VarianceComponent vc;
     EXPECT_TRUE(internal::EstimateVarianceComponent(d.residuals, d.sigmas, d.jacobian, &vc, prior));
     const double f = inflate ? internal::StudentInflation(vc, 1.0, nullptr) : 1.0;
@@ -149,7 +157,9 @@ TEST(VarianceComponent, StudentInflationMakesErrorOverSigmaUnitVariance) {
 }
 
 // Ten residuals and nine parameters (m = 1, as ten_position): the
-// likelihood alone cannot size s^2; a prior at the true s0^2 on 4 dof can.
+// likelihood alone cannot size s^2; a prior that is itself an estimate on 4
+// dof can, and the inflation then counts 1 + 4 dof. (A prior exactly at the
+// truth is worth more than its dof: rms 0.81 here, conservative.)
 TEST(VarianceComponent, PriorSizesTheExcessWithOneDegreeOfFreedom) {
   internal::VariancePrior prior;
   prior.variance = 25.0;
