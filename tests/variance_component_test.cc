@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <Eigen/QR>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,8 @@ struct Draw {
   Eigen::MatrixXd jacobian;
   // Residual sum of squares of the unweighted fit (equal sigmas only).
   double rss = 0.0;
+  // The white-weighted estimate (the truth is 0).
+  Eigen::VectorXd beta;
 };
 
 // n residuals of a p-parameter weighted least-squares fit; sigma_k drawn in
@@ -42,6 +45,7 @@ Draw MakeDraw(int n, int p, double s2, double sigma_low, double sigma_high, int 
   const Eigen::MatrixXd jw = w.asDiagonal() * draw.jacobian;
   const Eigen::VectorXd beta = jw.colPivHouseholderQr().solve(w.asDiagonal() * y);
   draw.residuals = y - draw.jacobian * beta;
+  draw.beta = beta;
   draw.rss = draw.residuals.squaredNorm();
   return draw;
 }
@@ -107,6 +111,68 @@ TEST(VarianceComponent, NoExcessGivesTheBoundaryMostOfTheTime) {
   // With no excess, d l_R / d s^2 at 0 is negative about half the time (more
   // with few dof): a positive s^2 for every seed would be a biased estimator.
   EXPECT_GT(boundary, 80);
+}
+
+// error / sigma of the fitted parameters when s^2 is estimated and added to
+// every variance. With equal sigmas (1) the refit with 1 + s^2 gives the same
+// beta as the white fit (MakeDraw's, truth 0) and the covariance
+// f (1 + s^2) (J^T J)^-1, f the Student inflation (1 for `plain`). Returns the
+// rms of beta_j / sigma_j over every parameter and seed.
+// A prior with dof > 0 is drawn per seed as an estimate of s2 from that many
+// degrees of freedom (s2 chi2_dof / dof), which is what its dof claim.
+double RmsZ(int n, int p, double s2, const internal::VariancePrior& given, bool inflate) {
+  double sum = 0.0;
+  int count = 0;
+  std::mt19937 rng(77);
+  for (int seed = 0; seed < 2000; ++seed) {
+    const Draw d = MakeDraw(n, p, s2, 1.0, 1.0, 20000 + seed);
+    internal::VariancePrior prior = given;
+    if (prior.dof > 0.0) {
+      std::chi_squared_distribution<double> chi2(prior.dof);
+      prior.variance = s2 * chi2(rng) / prior.dof;
+    }
+    VarianceComponent vc;
+    EXPECT_TRUE(internal::EstimateVarianceComponent(d.residuals, d.sigmas, d.jacobian, &vc, prior));
+    const double f = inflate ? internal::StudentInflation(vc, 1.0, nullptr) : 1.0;
+    const Eigen::MatrixXd cov =
+        f * (1.0 + vc.variance) * (d.jacobian.transpose() * d.jacobian).inverse();
+    for (int j = 0; j < p; ++j) {
+      sum += d.beta(j) * d.beta(j) / cov(j, j);
+      ++count;
+    }
+  }
+  return std::sqrt(sum / count);
+}
+
+// Twelve residuals and eight parameters (m = 4), the excess 25 times the
+// white variance: error / sigma is Student t with about 4 dof, rms sqrt(2)
+// = 1.41 with the estimated s^2 alone; the inflation nu / (nu - 2) brings it
+// to 1 (2000 seeds x 8 parameters, correlated within a seed: +-0.05).
+TEST(VarianceComponent, StudentInflationMakesErrorOverSigmaUnitVariance) {
+  const double plain = RmsZ(12, 8, 25.0, internal::VariancePrior(), false);
+  const double inflated = RmsZ(12, 8, 25.0, internal::VariancePrior(), true);
+  std::printf("m = 4: rms error/sigma %.3f without, %.3f with the inflation\n", plain, inflated);
+  EXPECT_GT(plain, 1.25);
+  EXPECT_NEAR(inflated, 1.0, 0.1);
+}
+
+// Ten residuals and nine parameters (m = 1, as ten_position): the
+// likelihood alone cannot size s^2; a prior that is itself an estimate on 4
+// dof can, and the inflation then counts 1 + 4 dof. (A prior exactly at the
+// truth is worth more than its dof: rms 0.81 here, conservative.)
+TEST(VarianceComponent, PriorSizesTheExcessWithOneDegreeOfFreedom) {
+  internal::VariancePrior prior;
+  prior.variance = 25.0;
+  prior.dof = 4.0;
+  const double inflated = RmsZ(10, 9, 25.0, prior, true);
+  std::printf("m = 1 with a prior on 4 dof: rms error/sigma %.3f\n", inflated);
+  EXPECT_NEAR(inflated, 1.0, 0.15);
+  internal::VariancePrior bad;
+  bad.dof = 2.0;
+  VarianceComponent vc;
+  const Draw d = MakeDraw(10, 9, 1.0, 1.0, 1.0, 1);
+  EXPECT_FALSE(internal::EstimateVarianceComponent(d.residuals, d.sigmas, d.jacobian, &vc, bad))
+      << "a prior with dof but no variance must be refused";
 }
 
 TEST(VarianceComponent, RejectsNoDegreesOfFreedom) {

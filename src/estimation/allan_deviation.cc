@@ -144,6 +144,147 @@ std::string Seconds(double tau) {
   return s.str();
 }
 
+// The points a fit uses: tau >= min_tau and a positive deviation, with
+// their taus and Allan variances.
+struct FitPoints {
+  std::vector<size_t> used;
+  std::vector<double> tau;
+  std::vector<double> avar;
+};
+
+FitPoints SelectFitPoints(const AllanDeviation& curve, double min_tau) {
+  FitPoints p;
+  for (size_t i = 0; i < curve.points.size(); ++i) {
+    if (curve.points[i].tau >= min_tau * (1.0 - 1e-9) && curve.points[i].adev > 0.0) {
+      p.used.push_back(i);
+    }
+  }
+  for (size_t i : p.used) {
+    p.tau.push_back(curve.points[i].tau);
+    p.avar.push_back(curve.points[i].adev * curve.points[i].adev);
+  }
+  return p;
+}
+
+// Step 1: the non-negative fit, its weights and each point's edf from the
+// model, iterated. Returns the coefficients; *model gets the fitted Allan
+// variance at the points and *curve its confidence intervals by the
+// dominating term's edf.
+Coefficients FitAndWeigh(const FitPoints& p, double confidence, AllanDeviation* curve,
+                         std::vector<double>* model) {
+  const size_t n = p.used.size();
+  std::vector<AllanNoiseType> types(curve->points.size(), AllanNoiseType::kWhiteNoise);
+  Coefficients c{0.0, 0.0, 0.0, 0.0};
+  std::vector<double> sd(n);
+  *model = p.avar;
+  for (int iteration = 0; iteration < 6; ++iteration) {
+    for (size_t k = 0; k < n; ++k) {
+      sd[k] = (*model)[k] * std::sqrt(2.0 / curve->points[p.used[k]].edf);
+    }
+    c = NonNegativeFit(p.tau, p.avar, sd);
+    for (size_t k = 0; k < n; ++k) (*model)[k] = std::max(ModelVariance(c, p.tau[k]), 1e-300);
+    for (size_t i = 0; i < curve->points.size(); ++i) {
+      types[i] = TypeOf(DominantTerm(c, curve->points[i].tau));
+    }
+    SetAllanConfidence(types, confidence, curve);
+  }
+  return c;
+}
+
+// The point where term j is read (bias instability at its largest share,
+// the flat minimum; quantisation at the shortest tau; the slopes where the
+// predicted relative uncertainty is smallest), among those where it
+// dominates; -1 when it dominates nowhere, with term->reason saying so.
+// Sets the term's tau range.
+int ChooseReadingPoint(int j, const Coefficients& c, const FitPoints& p,
+                       const std::vector<double>& model, const AllanDeviation& curve,
+                       double dominance, NoiseTerm* term) {
+  double best_share = 0.0, best_tau = 0.0;
+  int chosen = -1;
+  double chosen_score = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < p.used.size(); ++k) {
+    const double share = c[j] * Shape(j, p.tau[k]) / model[k];
+    if (share > best_share) {
+      best_share = share;
+      best_tau = p.tau[k];
+    }
+    if (share < dominance) continue;
+    term->tau_min = std::isnan(term->tau_min) ? p.tau[k] : std::min(term->tau_min, p.tau[k]);
+    term->tau_max = std::isnan(term->tau_max) ? p.tau[k] : std::max(term->tau_max, p.tau[k]);
+    const double edf = curve.points[p.used[k]].edf;
+    const double score = j == 2 ? -share : j == 0 ? p.tau[k] : std::sqrt(2.0 / edf) / share;
+    if (score < chosen_score) {
+      chosen_score = score;
+      chosen = static_cast<int>(k);
+    }
+  }
+  if (chosen < 0) {
+    const char* names[kTerms] = {"quantisation (tau^-1)", "white noise (tau^-1/2)",
+                                 "bias instability (flat part)", "random walk (tau^+1/2)"};
+    term->reason = std::string(names[j]) +
+                   (c[j] > 0.0 ? " never dominates the curve: at most " +
+                                     std::to_string(static_cast<int>(100.0 * best_share)) +
+                                     " % of the Allan variance, at tau " + Seconds(best_tau)
+                               : " is not in the fitted curve (tau " + Seconds(p.tau.front()) +
+                                     " to " + Seconds(p.tau.back()) + ")");
+  }
+  return chosen;
+}
+
+// Step 2: each dominating term read at one point, the others subtracted;
+// twice, the second time with the first readings' values and variances.
+// Only terms that dominate somewhere are subtracted: a term the fit gives a
+// small share everywhere is not determined by the curve (quantisation and
+// white noise, both falling, trade against each other), and subtracting it
+// would bias the reading.
+void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<double>& model,
+               double dominance, NoiseFit* fit) {
+  const size_t n = p.used.size();
+  Coefficients value{0.0, 0.0, 0.0, 0.0};
+  for (int j = 0; j < kTerms; ++j) {
+    for (size_t k = 0; k < n; ++k) {
+      if (c[j] * Shape(j, p.tau[k]) >= dominance * model[k]) value[j] = c[j];
+    }
+  }
+  Coefficients variance{0.0, 0.0, 0.0, 0.0};
+  for (int pass = 0; pass < 2; ++pass) {
+    Coefficients next{0.0, 0.0, 0.0, 0.0};
+    Coefficients next_variance{0.0, 0.0, 0.0, 0.0};
+    for (int j = 0; j < kTerms; ++j) {
+      NoiseTerm* term = TermOf(j, &fit->model);
+      *term = NoiseTerm();
+      const int chosen = ChooseReadingPoint(j, c, p, model, fit->curve, dominance, term);
+      if (chosen < 0) continue;
+      const size_t k = static_cast<size_t>(chosen);
+      const double g = Shape(j, p.tau[k]);
+      double rest = 0.0, rest_variance = 0.0;
+      for (int o = 0; o < kTerms; ++o) {
+        if (o == j) continue;
+        const double go = Shape(o, p.tau[k]);
+        rest += value[o] * go;
+        rest_variance += variance[o] * go * go;
+      }
+      const double edf = fit->curve.points[p.used[k]].edf;
+      const double coefficient = (p.avar[k] - rest) / g;
+      const double coefficient_variance =
+          (2.0 / edf * model[k] * model[k] + rest_variance) / (g * g);
+      term->tau = p.tau[k];
+      if (!(coefficient > 0.0)) {
+        term->reason = "the reading at tau " + Seconds(p.tau[k]) +
+                       " leaves nothing once the other terms are subtracted";
+        next[j] = 0.0;
+        continue;
+      }
+      next[j] = coefficient;
+      next_variance[j] = coefficient_variance;
+      term->value = std::sqrt(coefficient);
+      term->std = std::sqrt(coefficient_variance) / (2.0 * term->value);
+    }
+    value = next;
+    variance = next_variance;
+  }
+}
+
 }  // namespace
 }  // namespace internal
 
@@ -363,9 +504,7 @@ void SetAllanConfidence(const std::vector<AllanNoiseType>& types, double confide
 }
 
 bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, NoiseFit* fit) {
-  using internal::Coefficients;
   using internal::kTerms;
-  using internal::Shape;
   std::string error;
   if (!options.IsValid(&error)) {
     fit->message = error;
@@ -374,128 +513,19 @@ bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, 
   fit->curve = curve;
   fit->model = AxisNoiseModel();
   const double min_tau = options.min_tau_samples / curve.rate_hz;
-  std::vector<size_t> used;
-  for (size_t i = 0; i < curve.points.size(); ++i) {
-    if (curve.points[i].tau >= min_tau * (1.0 - 1e-9) && curve.points[i].adev > 0.0) {
-      used.push_back(i);
-    }
-  }
-  if (used.empty()) {
+  const internal::FitPoints points = internal::SelectFitPoints(curve, min_tau);
+  if (points.used.empty()) {
     fit->message = "no Allan deviation point at tau >= " + internal::Seconds(min_tau);
     return false;
   }
-  const size_t n = used.size();
-  std::vector<double> tau(n), avar(n), sd(n);
-  for (size_t k = 0; k < n; ++k) {
-    tau[k] = curve.points[used[k]].tau;
-    avar[k] = curve.points[used[k]].adev * curve.points[used[k]].adev;
-  }
-
-  // 1. The non-negative fit, its weights and each point's edf from the
-  // model, iterated.
-  std::vector<AllanNoiseType> types(curve.points.size(), AllanNoiseType::kWhiteNoise);
-  Coefficients c{0.0, 0.0, 0.0, 0.0};
-  std::vector<double> model(n);
-  for (size_t k = 0; k < n; ++k) model[k] = avar[k];
-  for (int iteration = 0; iteration < 6; ++iteration) {
-    for (size_t k = 0; k < n; ++k) {
-      sd[k] = model[k] * std::sqrt(2.0 / fit->curve.points[used[k]].edf);
-    }
-    c = internal::NonNegativeFit(tau, avar, sd);
-    for (size_t k = 0; k < n; ++k) {
-      model[k] = std::max(internal::ModelVariance(c, tau[k]), 1e-300);
-    }
-    for (size_t i = 0; i < curve.points.size(); ++i) {
-      types[i] = internal::TypeOf(internal::DominantTerm(c, curve.points[i].tau));
-    }
-    SetAllanConfidence(types, curve.confidence, &fit->curve);
-  }
-
-  // 2. Each dominating term read at one point, the others subtracted; twice,
-  // the second time with the first readings' values and variances.
-  // Only terms that dominate somewhere are subtracted: a term the fit gives
-  // a small share everywhere is not determined by the curve (quantisation
-  // and white noise, both falling, trade against each other), and
-  // subtracting it would bias the reading.
-  Coefficients value{0.0, 0.0, 0.0, 0.0};
-  for (int j = 0; j < kTerms; ++j) {
-    for (size_t k = 0; k < n; ++k) {
-      if (c[j] * Shape(j, tau[k]) >= options.dominance * model[k]) value[j] = c[j];
-    }
-  }
-  Coefficients variance{0.0, 0.0, 0.0, 0.0};
-  for (int pass = 0; pass < 2; ++pass) {
-    Coefficients next{0.0, 0.0, 0.0, 0.0};
-    Coefficients next_variance{0.0, 0.0, 0.0, 0.0};
-    for (int j = 0; j < kTerms; ++j) {
-      NoiseTerm* term = internal::TermOf(j, &fit->model);
-      *term = NoiseTerm();
-      double best_share = 0.0, best_tau = 0.0;
-      int chosen = -1;
-      double chosen_score = std::numeric_limits<double>::infinity();
-      for (size_t k = 0; k < n; ++k) {
-        const double share = c[j] * Shape(j, tau[k]) / model[k];
-        if (share > best_share) {
-          best_share = share;
-          best_tau = tau[k];
-        }
-        if (share < options.dominance) continue;
-        term->tau_min = std::isnan(term->tau_min) ? tau[k] : std::min(term->tau_min, tau[k]);
-        term->tau_max = std::isnan(term->tau_max) ? tau[k] : std::max(term->tau_max, tau[k]);
-        // Bias instability at its largest share (the flat minimum),
-        // quantisation at the shortest tau, the slopes where the predicted
-        // relative uncertainty is smallest.
-        const double edf = fit->curve.points[used[k]].edf;
-        const double score = j == 2 ? -share : j == 0 ? tau[k] : std::sqrt(2.0 / edf) / share;
-        if (score < chosen_score) {
-          chosen_score = score;
-          chosen = static_cast<int>(k);
-        }
-      }
-      if (chosen < 0) {
-        const char* names[kTerms] = {"quantisation (tau^-1)", "white noise (tau^-1/2)",
-                                     "bias instability (flat part)", "random walk (tau^+1/2)"};
-        term->reason =
-            std::string(names[j]) +
-            (c[j] > 0.0 ? " never dominates the curve: at most " +
-                              std::to_string(static_cast<int>(100.0 * best_share)) +
-                              " % of the Allan variance, at tau " + internal::Seconds(best_tau)
-                        : " is not in the fitted curve (tau " + internal::Seconds(tau.front()) +
-                              " to " + internal::Seconds(tau.back()) + ")");
-        continue;
-      }
-      const size_t k = static_cast<size_t>(chosen);
-      const double g = Shape(j, tau[k]);
-      double rest = 0.0, rest_variance = 0.0;
-      for (int o = 0; o < kTerms; ++o) {
-        if (o == j) continue;
-        const double go = Shape(o, tau[k]);
-        rest += value[o] * go;
-        rest_variance += variance[o] * go * go;
-      }
-      const double edf = fit->curve.points[used[k]].edf;
-      const double coefficient = (avar[k] - rest) / g;
-      const double coefficient_variance =
-          (2.0 / edf * model[k] * model[k] + rest_variance) / (g * g);
-      term->tau = tau[k];
-      if (!(coefficient > 0.0)) {
-        term->reason = "the reading at tau " + internal::Seconds(tau[k]) +
-                       " leaves nothing once the other terms are subtracted";
-        next[j] = 0.0;
-        continue;
-      }
-      next[j] = coefficient;
-      next_variance[j] = coefficient_variance;
-      term->value = std::sqrt(coefficient);
-      term->std = std::sqrt(coefficient_variance) / (2.0 * term->value);
-    }
-    value = next;
-    variance = next_variance;
-  }
+  std::vector<double> model;
+  const internal::Coefficients c =
+      internal::FitAndWeigh(points, curve.confidence, &fit->curve, &model);
+  internal::ReadTerms(c, points, model, options.dominance, fit);
 
   std::ostringstream s;
-  s << "fitted on " << n << " taus from " << internal::Seconds(tau.front()) << " to "
-    << internal::Seconds(tau.back()) << ":";
+  s << "fitted on " << points.used.size() << " taus from " << internal::Seconds(points.tau.front())
+    << " to " << internal::Seconds(points.tau.back()) << ":";
   for (int j = 0; j < kTerms; ++j) {
     const NoiseTerm& term = *internal::TermOf(j, &fit->model);
     s << " " << ToString(internal::TypeOf(j)) << "="

@@ -39,6 +39,12 @@ bool RefinementOptions::IsValid(std::string* error) const {
     *error = "extra_variance >= 0, max_pose_disturbance > 0, 0 < structure_test_level < 1";
     return false;
   }
+  if (!(pose_disturbance_prior_dof >= 0.0) || !std::isfinite(pose_disturbance_prior_dof) ||
+      !(pose_disturbance_prior >= 0.0) || !std::isfinite(pose_disturbance_prior) ||
+      (pose_disturbance_prior_dof > 0.0 && !(pose_disturbance_prior > 0.0))) {
+    *error = "pose_disturbance_prior_dof >= 0 and, when it is positive, pose_disturbance_prior > 0";
+    return false;
+  }
   return solver.IsValid(error);
 }
 

@@ -28,6 +28,32 @@
 //
 // evaluated at the estimate (also at the boundary s^2 = 0, where it says how
 // large an excess the data could have shown).
+//
+// A prior. With m = 1-3 (ten poses and nine parameters leave one) the
+// likelihood alone says little about s^2. What a pose of a given kind of
+// placement scatters by (a hand on a table, a fixture) can be stated as a
+// scaled inverse chi-square prior with nu0 degrees of freedom at s0^2,
+//
+//   -2 log p(s^2) = nu0 log s^2 + nu0 s0^2 / s^2   (+ const),
+//
+// added to -2 l_R, so that the estimate is a compromise between s0^2 (weight
+// nu0) and what the m residual directions show (about (nu0 s0^2 + sum f_i^2)
+// / (nu0 + m) when the white part is small), and its information grows by
+// nu0 / (2 s^4). nu0 = 0 (the default) is no prior: REML alone.
+//
+// An estimated s^2 makes every standard deviation itself an estimate, and
+// error / sigma then follows a Student t rather than N(0, 1): with few
+// residual degrees of freedom (three for twelve poses and nine parameters)
+// its variance nu / (nu - 2) is far above 1. The total variance per residual
+// direction, dbar + s^2 (dbar the mean of the d_i), rests on
+//
+//   nu = 2 (dbar + s^2)^2 / var(s^2)      (Satterthwaite)
+//
+// degrees of freedom: nu -> m when s^2 dominates, nu -> infinity when the
+// white part does. StudentInflation gives nu / (nu - 2), the factor that
+// makes the variance of error / sigma one, with nu held at kMinEffectiveDof
+// or above (at most a factor 3): below three degrees of freedom no factor
+// makes the variance finite, and a warning says so instead.
 #ifndef GRAVCAL_SRC_ESTIMATION_VARIANCE_COMPONENT_H_
 #define GRAVCAL_SRC_ESTIMATION_VARIANCE_COMPONENT_H_
 
@@ -42,8 +68,23 @@ namespace internal {
 // unwhitened (n x p; columns of any scale, rank decided after scaling each to
 // unit norm). Returns false (result->message says why) when n - rank(J) < 1
 // or an input is not finite or a sigma is not positive.
+struct VariancePrior {
+  // s0^2 and nu0 (above); dof = 0 is no prior.
+  double variance = 0.0;
+  double dof = 0.0;
+};
+
 bool EstimateVarianceComponent(const Eigen::VectorXd& residuals, const Eigen::VectorXd& sigmas,
-                               const Eigen::MatrixXd& jacobian, VarianceComponent* result);
+                               const Eigen::MatrixXd& jacobian, VarianceComponent* result,
+                               const VariancePrior& prior = VariancePrior());
+
+constexpr double kMinEffectiveDof = 3.0;
+
+// nu / (nu - 2) for an estimated component (1 when s^2 = 0 or not
+// estimated), nu from Satterthwaite as above with dbar =
+// mean_white_variance; *effective_dof receives nu (infinity for none).
+double StudentInflation(const VarianceComponent& component, double mean_white_variance,
+                        double* effective_dof);
 
 }  // namespace internal
 }  // namespace gravcal

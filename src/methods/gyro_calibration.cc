@@ -38,6 +38,9 @@ bool GyroCalibrationOptions::IsValid(std::string* error) const {
     return fail("gyro max_matrix_std, max_g_sensitivity_std: must be positive");
   }
   if (!(max_rotation_seconds > 0.0)) return fail("gyro max_rotation_seconds: must be positive");
+  if (!(pose_variance >= 0.0) || !std::isfinite(pose_variance)) {
+    return fail("gyro pose_variance: must be zero or positive");
+  }
   if (!(edge_seconds >= 0.0 && std::isfinite(edge_seconds))) {
     return fail("gyro edge_seconds: must be zero or positive");
   }
@@ -391,7 +394,12 @@ bool AddGyroscopeCalibration(const ImuLog& log, const std::vector<StaticInterval
   GyroCalibrationResult g;
   const Eigen::MatrixXd accel_covariance =
       c.refinement.covariance_available ? c.refinement.covariance : Eigen::MatrixXd();
-  if (!CalibrateGyroscope(log, intervals, c.accel.model, accel_covariance, c.gravity, options,
+  // The per-pose variance the accelerometer step absorbed moves every pose's
+  // gravity direction too.
+  GyroCalibrationOptions with_poses = options;
+  if (c.accel.pose_variance.absorbed) with_poses.pose_variance = c.accel.pose_variance.variance;
+  with_poses.estimate_static_variance = c.accel.pose_variance.estimated;
+  if (!CalibrateGyroscope(log, intervals, c.accel.model, accel_covariance, c.gravity, with_poses,
                           &g)) {
     for (const std::string& w : g.warnings) c.warnings.push_back(w);
     return fail(g.message);

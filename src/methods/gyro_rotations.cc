@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "estimation/variance_component.h"
 #include "methods/direction_noise.h"
 #include "methods/gyro_initial_matrix.h"
 
@@ -154,6 +155,33 @@ void NormaliseData(const ImuLog& log, const std::vector<StaticInterval>& poses,
   }
 }
 
+// The scatter of the static poses' mean rates beyond their white noise
+// (bias instability, bias random walk, unmodelled Earth rate): one variance
+// s^2 common to every axis and pose, estimated by REML from the pose means
+// around their common value b (+ G f_k when G is estimated), whose
+// parameters are the columns of J; added to every static pose's covariance.
+// Not a warning: hand-placed poses show it as a matter of course.
+void AddStaticPoseVariance(const GyroCalibrationOptions& options, GyroPrepared* prep) {
+  const int n = static_cast<int>(prep->static_gyro.size());
+  const int p = options.g_sensitivity ? 12 : 3;
+  if (3 * n <= p) return;
+  Eigen::VectorXd r(3 * n), sigmas(3 * n);
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(3 * n, p);
+  for (int k = 0; k < n; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      r(3 * k + i) = prep->static_gyro[k](i);
+      sigmas(3 * k + i) = std::sqrt(std::max(prep->static_gyro_cov[k](i, i), 1e-300));
+      jacobian(3 * k + i, i) = 1.0;
+      for (int j = 0; j < 3 && options.g_sensitivity; ++j) {
+        jacobian(3 * k + i, 3 + 3 * i + j) = prep->static_force[k](j);
+      }
+    }
+  }
+  VarianceComponent vc;
+  if (!EstimateVarianceComponent(r, sigmas, jacobian, &vc) || vc.at_boundary) return;
+  for (Eigen::Matrix3d& c : prep->static_gyro_cov) c += vc.variance * Eigen::Matrix3d::Identity();
+}
+
 }  // namespace
 
 bool PrepareGyroRotations(const ImuLog& log, const std::vector<StaticInterval>& intervals,
@@ -179,6 +207,13 @@ bool PrepareGyroRotations(const ImuLog& log, const std::vector<StaticInterval>& 
   std::vector<StaticInterval> poses;
   if (!CorePoses(log, intervals, options.edge_seconds, name, &poses, error)) return false;
   prep->positions = PositionsFromIntervals(poses);
+  if (options.pose_variance > 0.0) {
+    // s^2 I in specific force is M^-1 s^2 M^-T in raw units.
+    const Eigen::Matrix3d inverse = accel.matrix().inverse();
+    for (Position& p : prep->positions) {
+      p.raw_mean_cov += options.pose_variance * inverse * inverse.transpose();
+    }
+  }
   prep->segments = CutRotations(log, poses, options.max_rotation_seconds, warnings);
   if (static_cast<int>(prep->segments.size()) < MinRotations(options.parameterization)) {
     std::ostringstream s;
@@ -206,6 +241,7 @@ bool PrepareGyroRotations(const ImuLog& log, const std::vector<StaticInterval>& 
   *m0 = initial;
   prep->scale = std::cbrt(std::fabs(initial.determinant()));
   NormaliseData(log, poses, accel, forces, prep);
+  if (options.estimate_static_variance) AddStaticPoseVariance(options, prep);
   return true;
 }
 

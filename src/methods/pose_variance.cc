@@ -30,7 +30,10 @@ bool EstimateFromFit(const std::vector<Position>& placed, const RefinementOption
   for (size_t i = 0; i < columns.size(); ++i) jacobian.col(i) = all.col(columns[i]);
   const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(fit.residuals_after.data(), n);
   const Eigen::VectorXd sigmas = Eigen::Map<const Eigen::VectorXd>(fit.sigmas.data(), n);
-  return EstimateVarianceComponent(r, sigmas, jacobian, vc);
+  VariancePrior prior;
+  prior.variance = options.pose_disturbance_prior * options.pose_disturbance_prior;
+  prior.dof = options.pose_disturbance_prior_dof;
+  return EstimateVarianceComponent(r, sigmas, jacobian, vc, prior);
 }
 
 // The F test of the scale model against scale_misalignment (see the
@@ -107,15 +110,34 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
     *pose_variance = vc;
     return;
   }
+  // s^2 is estimated: error / sigma is Student-t like (variance_component.h).
+  double white_variance = 0.0;
+  for (double sigma : refinement->sigmas) white_variance += sigma * sigma;
+  white_variance /= std::max<size_t>(refinement->sigmas.size(), 1);
+  double effective_dof = INFINITY;
+  const double inflation = StudentInflation(vc, white_variance, &effective_dof);
+  if (absorbed.covariance_available) absorbed.covariance *= inflation;
   absorbed.solve_seconds += refinement->solve_seconds;
   absorbed.iterations += refinement->iterations;
   *refinement = absorbed;
   vc.absorbed = true;
-  vc.message += std::string("; added to every pose's variance") +
-                (tested || options.parameterization != AccelParameterization::kScale
-                     ? ""
-                     : " (too few poses to test whether non-orthogonality explains it)");
+  std::ostringstream t;
+  t.precision(3);
+  t << "; added to every pose's variance, covariance x " << inflation << " (Student t, "
+    << effective_dof << " effective dof)";
+  vc.message += t.str() + (tested || options.parameterization != AccelParameterization::kScale
+                               ? ""
+                               : " (too few poses to test whether non-orthogonality explains it)");
   *pose_variance = vc;
+  if (effective_dof < kMinEffectiveDof) {
+    std::ostringstream w;
+    w.precision(3);
+    w << "the pose-to-pose scatter rests on " << effective_dof
+      << " effective degrees of freedom (fewer than " << kMinEffectiveDof
+      << "): the standard deviations are themselves uncertain by a large factor; more poses "
+         "would tell";
+    refinement->warnings.push_back(w.str());
+  }
   const double s = std::sqrt(vc.variance);
   if (s > options.max_pose_disturbance) {
     std::ostringstream w;

@@ -3,7 +3,10 @@
 // flex, correlated noise): one extra variance s^2 per accelerometer pose,
 // estimated by REML from the magnitude residuals of the white-noise fit
 // (estimation/variance_component.h), then added to every sigma_k^2 and the
-// fit repeated, so every standard deviation carries it.
+// fit repeated, so every standard deviation carries it, multiplied by the
+// Student-t factor nu / (nu - 2) of an estimated variance; with
+// pose_disturbance_prior_dof > 0 the estimate leans on the prior s0
+// (estimation/variance_component.h). ten_position's step 4 uses it too.
 //
 // A variance component must not hide a missing model term. Before absorbing
 // the excess, the next richer parameterisation (scale -> scale_misalignment)

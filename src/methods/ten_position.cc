@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "gravcal/estimation/refinement.h"
+#include "methods/pose_variance.h"
 #include "methods/static_positions.h"
 #include "util/units.h"
 
@@ -62,6 +63,10 @@ bool FitZeroBias(const std::vector<Position>& positions, double nominal_scale,
     return false;
   }
   c->solver_name = "ceres_levenberg_marquardt (step 4) + normal equations (step 5)";
+  // What the samples of a pose cannot show (pose_variance), as in
+  // twelve_position: every standard deviation below carries it.
+  internal::AccountForPoseVariance(positions, initial, c->gravity, step4, &c->refinement,
+                                   &c->accel.pose_variance);
   for (const std::string& w : c->refinement.warnings) c->warnings.push_back("step 4: " + w);
   if (!c->refinement.converged) {
     c->not_converged = true;

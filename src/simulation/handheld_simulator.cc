@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "gravcal/estimation/strapdown.h"
+#include "simulation/sensor_noise.h"
 #include "util/units.h"
 
 namespace gravcal {
@@ -125,67 +126,49 @@ double TurnAngle(double rate_rad, double seconds, double unit) {
   return unit * std::max(1.0, std::round(rate_rad * seconds / unit));
 }
 
-}  // namespace
+// The motion session's random stream. One normal distribution serves every
+// draw (it caches every other value, so sharing it is part of what makes a
+// seed's session what it is).
+struct MotionStream {
+  explicit MotionStream(uint64_t seed) : rng(seed) {}
+  std::mt19937_64 rng;
+  std::normal_distribution<double> n01{0.0, 1.0};
+  std::uniform_real_distribution<double> u01{0.0, 1.0};
+  Vec3 Normal3() { return Vec3(n01(rng), n01(rng), n01(rng)); }
+};
 
-bool MotionOptions::IsValid(std::string* error) const {
-  auto check = [&](const char* key, double v, bool ok) {
-    if (ok && std::isfinite(v)) return true;
-    *error = std::string("key '") + key + "': out of range";
-    return false;
-  };
-  return check("hh_initial_still", initial_still_seconds, initial_still_seconds >= 0.0) &&
-         check("hh_final_still", final_still_seconds, final_still_seconds >= 0.0) &&
-         check("hh_seconds_per_axis", seconds_per_axis, seconds_per_axis >= 2.0 * kRamp + 0.5) &&
-         check("hh_rate", rate_dps, rate_dps > 0.0 && rate_dps <= 2000.0) &&
-         check("hh_rate_variation", rate_variation,
-               rate_variation >= 0.0 && rate_variation <= 2.0) &&
-         check("hh_axis_wobble", axis_wobble_deg,
-               axis_wobble_deg >= 0.0 && axis_wobble_deg <= 30.0) &&
-         check("hh_sway", sway, sway >= 0.0 && sway <= 1.0) &&
-         check("hh_sway_hz", sway_hz, sway_hz > 0.05 && sway_hz <= 5.0) &&
-         check("hh_tremor", tremor, tremor >= 0.0 && tremor <= 10.0) &&
-         check("hh_angular_tremor", angular_tremor,
-               angular_tremor >= 0.0 && angular_tremor <= 1.0) &&
-         check("hh_lever_arm", lever_arm, lever_arm >= 0.0 && lever_arm <= 1.0) &&
-         check("hh_rounds", rounds, rounds >= 1 && rounds <= 100);
-}
-
-bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion, uint64_t seed,
-                    MotionSession* session, std::string* error) {
-  if (!sensor.IsValid(error) || !motion.IsValid(error)) return false;
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-  MotionSession out;
-  SimulatedSession& s = out.sensor;
-  s.seed = seed;
-  s.gravity = sensor.gravity;
-  // Truth sensors, as in simulator.cc: scale in SI per raw unit.
+// The truth sensors, as in simulator.cc: scale in SI per raw unit.
+void DrawMotionTruth(const SimulatorOptions& sensor, uint64_t seed, MotionStream* stream,
+                     SimulatedSession* s) {
   const double accel_scale = sensor.raw_counts ? kStandardGravity / sensor.accel_counts_per_g : 1.0;
   const double gyro_scale = sensor.raw_counts ? kDegToRad / sensor.gyro_counts_per_dps : 1.0;
-  s.accel_units_per_si = 1.0 / accel_scale;
-  s.gyro_units_per_si = 1.0 / gyro_scale;
-  s.accel_truth =
-      AccelModel::Random(AccelParameterization::kAffine, accel_scale, sensor.accel_scale_std,
-                         sensor.accel_misalignment_std, sensor.accel_bias_std / accel_scale, &rng);
-  s.gyro_truth = GyroModel::Random(gyro_scale, sensor.gyro_scale_std, sensor.gyro_misalignment_std,
-                                   sensor.gyro_bias_std / gyro_scale, &rng);
-  const Eigen::Matrix3d accel_inverse = s.accel_truth.matrix().inverse();
-  const Eigen::Matrix3d gyro_inverse = s.gyro_truth.matrix.inverse();
+  s->seed = seed;
+  s->gravity = sensor.gravity;
+  s->accel_units_per_si = 1.0 / accel_scale;
+  s->gyro_units_per_si = 1.0 / gyro_scale;
+  s->accel_truth = AccelModel::Random(AccelParameterization::kAffine, accel_scale,
+                                      sensor.accel_scale_std, sensor.accel_misalignment_std,
+                                      sensor.accel_bias_std / accel_scale, &stream->rng);
+  s->gyro_truth = GyroModel::Random(gyro_scale, sensor.gyro_scale_std, sensor.gyro_misalignment_std,
+                                    sensor.gyro_bias_std / gyro_scale, &stream->rng);
+}
 
-  // Phases.
+// The phases of the profile from t = initial_still_seconds, with the
+// starting attitude and the rate table's segments; returns the session's
+// length in seconds.
+double PlanPhases(const SimulatorOptions& sensor, const MotionOptions& motion, MotionStream* stream,
+                  Trajectory* traj, Quat* start, MotionSession* out) {
   const MotionProfile profile = motion.profile;
-  const bool hand = profile == MotionProfile::kHandheld || profile == MotionProfile::kVertical;
   const double rate = motion.rate_dps * kDegToRad;
   const double turn_seconds = motion.seconds_per_axis;
-  Trajectory traj;
   double t = motion.initial_still_seconds;
-  Quat start = Quat::Identity();
+  *start = Quat::Identity();
   if (profile != MotionProfile::kRateTable) {
-    const double heading = 2.0 * M_PI * u01(rng);
+    const double heading = 2.0 * M_PI * stream->u01(stream->rng);
     const double tilt = profile == MotionProfile::kTurntable ? 0.0 : 2.0 * kDegToRad;
-    start = RotationVectorToQuaternion(Vec3(0, 0, heading)) *
-            RotationVectorToQuaternion(Vec3(tilt * n01(rng), tilt * n01(rng), 0.0));
+    *start = RotationVectorToQuaternion(Vec3(0, 0, heading)) *
+             RotationVectorToQuaternion(
+                 Vec3(tilt * stream->n01(stream->rng), tilt * stream->n01(stream->rng), 0.0));
   }
   auto add_turn = [&](const Vec3& axis, double seconds, bool irregular) {
     Phase p;
@@ -197,13 +180,13 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
       p.variation = motion.rate_variation;
       for (Sine& sine : p.irregular) {
         sine.amplitude = 1.0 / std::sqrt(1.5);
-        sine.hz = 0.1 + 0.4 * u01(rng);
-        sine.phase = 2.0 * M_PI * u01(rng);
+        sine.hz = 0.1 + 0.4 * stream->u01(stream->rng);
+        sine.phase = 2.0 * M_PI * stream->u01(stream->rng);
       }
     }
-    traj.phases_.push_back(p);
+    traj->phases_.push_back(p);
     t = p.t1;
-    return &traj.phases_.back();
+    return &traj->phases_.back();
   };
   if (profile == MotionProfile::kHandheld || profile == MotionProfile::kTurntable) {
     const bool irregular = profile == MotionProfile::kHandheld;
@@ -228,7 +211,7 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
     // Rate table: x up, y up, z up; +rate then -rate about the up axis.
     // Each constant-rate part is a segment; between axes the unit is
     // re-mounted (a 90-degree turn).
-    start = RotationVectorToQuaternion(Vec3(0, -0.5 * M_PI, 0));  // x up
+    *start = RotationVectorToQuaternion(Vec3(0, -0.5 * M_PI, 0));  // x up
     for (int axis = 0; axis < 3; ++axis) {
       for (double sign : {1.0, -1.0}) {
         Phase* p = add_turn(Vec3::Unit(axis), turn_seconds + 2.0 * kRamp, false);
@@ -237,7 +220,7 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
         seg.begin = static_cast<size_t>(std::ceil((p->t0 + kRamp) * sensor.sample_rate + 1e-9));
         seg.end = static_cast<size_t>(std::floor((p->t1 - kRamp) * sensor.sample_rate - 1e-9));
         seg.rate = sign * rate * Vec3::Unit(axis);
-        out.segments.push_back(seg);
+        out->segments.push_back(seg);
         t += kPause;
       }
       // The +rate and -rate turns cancel, so axis a is up again. The turn R
@@ -249,54 +232,39 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
       t += kPause;
     }
   }
-  t += motion.final_still_seconds;
-  const double total_seconds = t;
-  if (hand) {
-    const double wobble_rad = motion.axis_wobble_deg * kDegToRad;
-    traj.wobble_ = RandomSines(wobble_rad, 0.2, 1.0, &rng);
-    traj.angular_tremor_ = RandomSines(motion.angular_tremor, 8.0, 12.0, &rng);
-    traj.sway_ = RandomSines(motion.sway, 0.05, motion.sway_hz, &rng);
-    // Tremor displacement whose acceleration has the given rms.
-    traj.tremor_ = RandomSines(motion.tremor, 8.0, 12.0, &rng);
-    for (Sine& sine : traj.tremor_) {
-      const double w = 2.0 * M_PI * sine.hz;
-      sine.amplitude /= w * w;
-    }
-  }
-  Vec3 lever_direction;
-  for (int i = 0; i < 3; ++i) lever_direction(i) = n01(rng);
-  const Vec3 lever = motion.lever_arm * lever_direction.normalized();
-  out.lever_arm = lever;
+  return t + motion.final_still_seconds;
+}
 
-  const double rate_hz = sensor.sample_rate;
-  const double samples = std::floor(total_seconds * rate_hz) + 1.0;
-  if (!(samples <= kMaxSamples)) {
-    *error = "the motion session is too long (" + std::to_string(samples) + " samples)";
-    return false;
+// The hand's wobble, angular tremor, sway and tremor (handheld and
+// vertical profiles).
+void AddHandMotion(const MotionOptions& motion, std::mt19937_64* rng, Trajectory* traj) {
+  const double wobble_rad = motion.axis_wobble_deg * kDegToRad;
+  traj->wobble_ = RandomSines(wobble_rad, 0.2, 1.0, rng);
+  traj->angular_tremor_ = RandomSines(motion.angular_tremor, 8.0, 12.0, rng);
+  traj->sway_ = RandomSines(motion.sway, 0.05, motion.sway_hz, rng);
+  // Tremor displacement whose acceleration has the given rms.
+  traj->tremor_ = RandomSines(motion.tremor, 8.0, 12.0, rng);
+  for (Sine& sine : traj->tremor_) {
+    const double w = 2.0 * M_PI * sine.hz;
+    sine.amplitude /= w * w;
   }
-  const size_t count = static_cast<size_t>(samples);
-  const double dt = 1.0 / rate_hz;
+}
+
+// Samples 0..count-1: the truth attitude integrated from the rate (Simpson
+// substeps plus the coning term), the position, velocity and acceleration of
+// the hand and the lever arm, and the raw outputs.
+void WriteMotionSamples(const SimulatorOptions& sensor, const MotionOptions& motion,
+                        const Trajectory& traj, const Quat& start, const Vec3& lever, bool hand,
+                        size_t count, uint64_t seed, MotionStream* stream, MotionSession* out) {
+  SimulatedSession& s = out->sensor;
+  const Eigen::Matrix3d accel_inverse = s.accel_truth.matrix().inverse();
+  const Eigen::Matrix3d gyro_inverse = s.gyro_truth.matrix.inverse();
+  const double dt = 1.0 / sensor.sample_rate;
   const double h = dt / kSubsteps;
-  ImuLog& log = s.log;
-  log.source = std::string("simulated ") + ToString(profile) + " seed " + std::to_string(seed);
-  log.t.resize(count);
-  log.accel.resize(count);
-  log.gyro.resize(count);
-  log.temperature.resize(count);
-  out.attitude.resize(count);
-  out.position.resize(count);
-  out.velocity.resize(count);
-
-  const double accel_noise = sensor.accel_noise * s.accel_units_per_si;
-  const double gyro_noise = sensor.gyro_noise * s.gyro_units_per_si;
-  const double accel_walk = sensor.accel_bias_random_walk * std::sqrt(dt) * s.accel_units_per_si;
-  const double gyro_walk = sensor.gyro_bias_random_walk * std::sqrt(dt) * s.gyro_units_per_si;
-  Vec3 accel_drift = Vec3::Zero();
-  Vec3 gyro_drift = Vec3::Zero();
-  auto normal3 = [&]() { return Vec3(n01(rng), n01(rng), n01(rng)); };
   const Vec3 up_g(0.0, 0.0, sensor.gravity);
   Quat q = start;
   const Vec3 lever_start = start * lever;
+  internal::SensorNoise noise(sensor, s.accel_units_per_si, s.gyro_units_per_si, seed);
   for (size_t i = 0; i < count; ++i) {
     const double ti = static_cast<double>(i) * dt;
     if (i > 0) {
@@ -334,30 +302,78 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
     const Vec3 f = c.transpose() * (a + up_g);
     Vec3 raw_a = accel_inverse * f + s.accel_truth.bias;
     Vec3 raw_g = gyro_inverse * w + s.gyro_truth.bias;
-    if (accel_noise > 0.0) raw_a += accel_noise * normal3();
-    if (gyro_noise > 0.0) raw_g += gyro_noise * normal3();
-    if (accel_walk > 0.0) {
-      raw_a += accel_drift;
-      accel_drift += accel_walk * normal3();
-    }
-    if (gyro_walk > 0.0) {
-      raw_g += gyro_drift;
-      gyro_drift += gyro_walk * normal3();
-    }
-    if (sensor.raw_counts) {
-      raw_a = raw_a.array().round();
-      raw_g = raw_g.array().round();
-    }
-    log.t[i] = ti;
-    log.accel[i] = raw_a;
-    log.gyro[i] = raw_g;
-    log.temperature[i] =
+    noise.Add([stream] { return stream->Normal3(); }, &raw_a, &raw_g);
+    s.log.t[i] = ti;
+    s.log.accel[i] = raw_a;
+    s.log.gyro[i] = raw_g;
+    s.log.temperature[i] =
         sensor.temperature_end + (sensor.temperature_start - sensor.temperature_end) *
                                      std::exp(-ti / sensor.temperature_tau);
-    out.attitude[i] = q;
-    out.position[i] = p;
-    out.velocity[i] = v;
+    out->attitude[i] = q;
+    out->position[i] = p;
+    out->velocity[i] = v;
   }
+}
+
+}  // namespace
+
+bool MotionOptions::IsValid(std::string* error) const {
+  auto check = [&](const char* key, double v, bool ok) {
+    if (ok && std::isfinite(v)) return true;
+    *error = std::string("key '") + key + "': out of range";
+    return false;
+  };
+  return check("hh_initial_still", initial_still_seconds, initial_still_seconds >= 0.0) &&
+         check("hh_final_still", final_still_seconds, final_still_seconds >= 0.0) &&
+         check("hh_seconds_per_axis", seconds_per_axis, seconds_per_axis >= 2.0 * kRamp + 0.5) &&
+         check("hh_rate", rate_dps, rate_dps > 0.0 && rate_dps <= 2000.0) &&
+         check("hh_rate_variation", rate_variation,
+               rate_variation >= 0.0 && rate_variation <= 2.0) &&
+         check("hh_axis_wobble", axis_wobble_deg,
+               axis_wobble_deg >= 0.0 && axis_wobble_deg <= 30.0) &&
+         check("hh_sway", sway, sway >= 0.0 && sway <= 1.0) &&
+         check("hh_sway_hz", sway_hz, sway_hz > 0.05 && sway_hz <= 5.0) &&
+         check("hh_tremor", tremor, tremor >= 0.0 && tremor <= 10.0) &&
+         check("hh_angular_tremor", angular_tremor,
+               angular_tremor >= 0.0 && angular_tremor <= 1.0) &&
+         check("hh_lever_arm", lever_arm, lever_arm >= 0.0 && lever_arm <= 1.0) &&
+         check("hh_rounds", rounds, rounds >= 1 && rounds <= 100);
+}
+
+bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion, uint64_t seed,
+                    MotionSession* session, std::string* error) {
+  if (!sensor.IsValid(error) || !motion.IsValid(error)) return false;
+  MotionStream stream(seed);
+  MotionSession out;
+  DrawMotionTruth(sensor, seed, &stream, &out.sensor);
+  Trajectory traj;
+  Quat start;
+  const double total_seconds = PlanPhases(sensor, motion, &stream, &traj, &start, &out);
+  const bool hand =
+      motion.profile == MotionProfile::kHandheld || motion.profile == MotionProfile::kVertical;
+  if (hand) AddHandMotion(motion, &stream.rng, &traj);
+  Vec3 lever_direction;
+  for (int i = 0; i < 3; ++i) lever_direction(i) = stream.n01(stream.rng);
+  const Vec3 lever = motion.lever_arm * lever_direction.normalized();
+  out.lever_arm = lever;
+
+  const double samples = std::floor(total_seconds * sensor.sample_rate) + 1.0;
+  if (!(samples <= kMaxSamples)) {
+    *error = "the motion session is too long (" + std::to_string(samples) + " samples)";
+    return false;
+  }
+  const size_t count = static_cast<size_t>(samples);
+  ImuLog& log = out.sensor.log;
+  log.source =
+      std::string("simulated ") + ToString(motion.profile) + " seed " + std::to_string(seed);
+  log.t.resize(count);
+  log.accel.resize(count);
+  log.gyro.resize(count);
+  log.temperature.resize(count);
+  out.attitude.resize(count);
+  out.position.resize(count);
+  out.velocity.resize(count);
+  WriteMotionSamples(sensor, motion, traj, start, lever, hand, count, seed, &stream, &out);
   *session = std::move(out);
   return true;
 }

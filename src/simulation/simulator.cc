@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "gravcal/core/gravity.h"
+#include "simulation/sensor_noise.h"
 
 namespace gravcal {
 namespace {
@@ -189,12 +190,258 @@ void DrawEffects(const SimulatorOptions& o, uint64_t seed, SimulatedSession* s) 
   e.gyro_bias_drift = draw3(o.gyro_bias_drift_std);
 }
 
+// The session's main random stream. One normal distribution serves every
+// draw from it: the distribution caches every other value, so sharing it is
+// part of what makes a seed's session what it is.
+struct MainStream {
+  explicit MainStream(uint64_t seed) : rng(seed) {}
+  std::mt19937_64 rng;
+  std::normal_distribution<double> n01{0.0, 1.0};
+  Eigen::Vector3d Normal3() { return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)); }
+};
+
+// The truth sensors, from the session's main stream `rng`, and the effect
+// truths from a stream of their own. False when the random truth is singular.
+bool DrawTruth(const SimulatorOptions& options, uint64_t seed, std::mt19937_64* rng,
+               SimulatedSession* s, std::string* error) {
+  // AccelModel maps raw to SI, so its scale is SI per raw unit.
+  const double accel_scale =
+      options.raw_counts ? kStandardGravity / options.accel_counts_per_g : 1.0;
+  const double gyro_scale = options.raw_counts ? (kPi / 180.0) / options.gyro_counts_per_dps : 1.0;
+  s->seed = seed;
+  s->gravity = options.gravity;
+  s->accel_units_per_si = 1.0 / accel_scale;
+  s->gyro_units_per_si = 1.0 / gyro_scale;
+  s->accel_truth =
+      AccelModel::Random(AccelParameterization::kAffine, accel_scale, options.accel_scale_std,
+                         options.accel_misalignment_std, options.accel_bias_std / accel_scale, rng);
+  s->gyro_truth =
+      GyroModel::Random(gyro_scale, options.gyro_scale_std, options.gyro_misalignment_std,
+                        options.gyro_bias_std / gyro_scale, rng);
+  DrawEffects(options, seed, s);
+  if (s->accel_truth.upper.diagonal().minCoeff() <= 0.0 ||
+      !s->accel_truth.matrix().inverse().allFinite() || s->gyro_truth.matrix.determinant() <= 0.0 ||
+      !s->gyro_truth.matrix.inverse().allFinite()) {
+    if (error) {
+      *error =
+          "the random truth sensor is singular or reflected: reduce accel_scale_std, "
+          "gyro_scale_std or the misalignment standard deviations";
+    }
+    return false;
+  }
+  return true;
+}
+
+// Placed attitudes: an arbitrary heading (about navigation z) times the
+// nominal pose times a small placement error (about body axes).
+std::vector<Eigen::Quaterniond> PlaceAttitudes(const SimulatorOptions& options,
+                                               const std::vector<Eigen::Quaterniond>& nominal,
+                                               MainStream* stream) {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double placement_rad = options.placement_error_deg * kPi / 180.0;
+  std::vector<Eigen::Quaterniond> attitudes(nominal.size());
+  for (size_t k = 0; k < nominal.size(); ++k) {
+    const double heading = 2.0 * kPi * u01(stream->rng);
+    const Eigen::Vector3d tilt = stream->Normal3();
+    attitudes[k] = (AxisAngle(heading, Eigen::Vector3d::UnitZ()) * nominal[k] *
+                    FromRotationVector(placement_rad * tilt))
+                       .normalized();
+  }
+  return attitudes;
+}
+
+// The timeline: samples of the first still period, of each later hold and
+// of each rotation (with its hand profile when rotation_profile is hand).
+struct Timeline {
+  long first_still = 0;
+  // Samples of pose k's hold (k >= 1; the first pose's is first_still).
+  std::vector<long> hold;
+  bool hand = false;
+  std::vector<HandProfile> profiles;
+  std::vector<long> rotation;
+  size_t total = 0;
+};
+
+// The hand profiles draw from a stream of their own (G with the other
+// effects in DrawEffects), so switching them on leaves every other number of
+// a seed unchanged. False when the session is too long.
+bool PlanTimeline(const SimulatorOptions& options, uint64_t seed,
+                  const std::vector<double>& hold_seconds, Timeline* plan, std::string* error) {
+  const double rate = options.sample_rate;
+  const size_t pose_count = hold_seconds.size();
+  plan->first_still = SampleCount(options.initial_still_seconds + hold_seconds[0], rate);
+  plan->hold.resize(pose_count);
+  for (size_t k = 0; k < pose_count; ++k) plan->hold[k] = SampleCount(hold_seconds[k], rate);
+  plan->hand = options.rotation_profile == "hand";
+  std::mt19937_64 extra_rng(seed ^ 0xc2b2ae3d27d4eb4fULL);
+  plan->profiles.assign(pose_count > 0 ? pose_count - 1 : 0, HandProfile());
+  plan->rotation.assign(plan->profiles.size(), SampleCount(options.rotation_seconds, rate));
+  for (size_t k = 0; k < plan->profiles.size() && plan->hand; ++k) {
+    plan->profiles[k] = HandProfile::Random(options, &extra_rng);
+    plan->rotation[k] = std::max(1L, SampleCount(plan->profiles[k].seconds, rate));
+  }
+  plan->total = static_cast<size_t>(plan->first_still);
+  for (size_t k = 1; k < pose_count; ++k) plan->total += static_cast<size_t>(plan->hold[k]);
+  for (long r : plan->rotation) plan->total += static_cast<size_t>(r);
+  if (static_cast<double>(plan->total) > kMaxSamples) {
+    if (error) *error = "the session is too long (" + std::to_string(plan->total) + " samples)";
+    return false;
+  }
+  return true;
+}
+
+// Per-pose specific-force disturbances (SimulatorOptions::pose_disturbance),
+// from a stream of their own.
+std::vector<Eigen::Vector3d> DrawPoseDisturbances(const SimulatorOptions& options, uint64_t seed,
+                                                  size_t pose_count) {
+  std::mt19937_64 rng(seed ^ 0x510e527fade682d1ULL);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::vector<Eigen::Vector3d> disturbance(pose_count, Eigen::Vector3d::Zero());
+  for (Eigen::Vector3d& d : disturbance) {
+    if (options.pose_disturbance > 0.0) {
+      const double x = n01(rng);
+      const double y = n01(rng);
+      const double z = n01(rng);
+      d = options.pose_disturbance * Eigen::Vector3d(x, y, z);
+    }
+  }
+  return disturbance;
+}
+
+// Turns the true specific force and body rate into raw samples of the log:
+// the truth sensors, the effects, then the sensor noise (sensor_noise.h),
+// whose white and random-walk draws come from the session's main stream.
+class SampleWriter {
+ public:
+  SampleWriter(const SimulatorOptions& options, uint64_t seed, SimulatedSession* s,
+               MainStream* stream)
+      : o_(options),
+        s_(*s),
+        stream_(*stream),
+        accel_effects_(
+            options.accel_quadratic_std > 0.0 || options.accel_temperature_bias_std > 0.0 ||
+            options.accel_temperature_scale_std > 0.0 || options.accel_bias_drift_std > 0.0),
+        gyro_effects_(options.gyro_g_sensitivity_std > 0.0 ||
+                      options.gyro_temperature_bias_std > 0.0 || options.gyro_bias_drift_std > 0.0),
+        upper_inverse_(s->accel_truth.upper.inverse()),
+        accel_inverse_(s->accel_truth.matrix().inverse()),
+        gyro_inverse_(s->gyro_truth.matrix.inverse()),
+        dt_(1.0 / options.sample_rate),
+        noise_(options, s->accel_units_per_si, s->gyro_units_per_si, seed) {}
+
+  double dt() const { return dt_; }
+  Eigen::Vector3d Normal3() { return stream_.Normal3(); }
+
+  // Writes sample i from the true specific force and body rate.
+  void Emit(size_t i, const Eigen::Vector3d& force, const Eigen::Vector3d& body_rate) {
+    const double t = static_cast<double>(i) * dt_;
+    const double temperature = o_.temperature_end + (o_.temperature_start - o_.temperature_end) *
+                                                        std::exp(-t / o_.temperature_tau);
+    Eigen::Vector3d v = Accelerometer(force, temperature, t);
+    Eigen::Vector3d u = Gyroscope(force, body_rate, temperature, t);
+    noise_.Add([this] { return stream_.Normal3(); }, &v, &u);
+    s_.log.t[i] = t;
+    s_.log.accel[i] = v;
+    s_.log.gyro[i] = u;
+    s_.log.temperature[i] = temperature;
+  }
+
+ private:
+  // The effect terms only when switched on, so that sessions without them
+  // stay bit-identical.
+  Eigen::Vector3d Accelerometer(const Eigen::Vector3d& force, double temperature, double t) const {
+    if (!accel_effects_) return accel_inverse_ * force + s_.accel_truth.bias;
+    const Eigen::Vector3d sensed =
+        ApplyAccelEffects(s_.effects, s_.accel_truth.rotation.transpose() * force, temperature, t);
+    return upper_inverse_ * sensed + s_.accel_truth.bias;
+  }
+  Eigen::Vector3d Gyroscope(const Eigen::Vector3d& force, const Eigen::Vector3d& body_rate,
+                            double temperature, double t) const {
+    if (!gyro_effects_) return gyro_inverse_ * body_rate + s_.gyro_truth.bias;
+    const double dT = temperature - s_.effects.reference_temperature;
+    return gyro_inverse_ *
+               (body_rate + s_.gyro_g_sensitivity * force + s_.effects.gyro_temperature_bias * dT +
+                s_.effects.gyro_bias_drift * t) +
+           s_.gyro_truth.bias;
+  }
+
+  const SimulatorOptions& o_;
+  SimulatedSession& s_;
+  MainStream& stream_;
+  const bool accel_effects_;
+  const bool gyro_effects_;
+  const Eigen::Matrix3d upper_inverse_;
+  const Eigen::Matrix3d accel_inverse_;
+  const Eigen::Matrix3d gyro_inverse_;
+  const double dt_;
+  internal::SensorNoise noise_;
+};
+
+// Earth rotation in the navigation frame (East-North-Up), zero when off.
+Eigen::Vector3d EarthRateNav(const SimulatorOptions& options) {
+  if (!std::isfinite(options.latitude_deg)) return Eigen::Vector3d::Zero();
+  const double lat = options.latitude_deg * kPi / 180.0;
+  return kEarthRate * Eigen::Vector3d(0.0, std::cos(lat), std::sin(lat));
+}
+
+// One still period of `count` samples from sample *i: the pose's specific
+// force plus, when set, tremor (a first-order low-pass of white noise,
+// stationary rms options.tremor per axis, started in its stationary
+// distribution).
+void WriteStill(const SimulatorOptions& options, const Eigen::Vector3d& force,
+                const Eigen::Vector3d& rate, size_t count, SampleWriter* writer, size_t* i) {
+  const double tremor_pole = std::exp(-2.0 * kPi * kTremorCornerHz * writer->dt());
+  const double tremor_drive = options.tremor * std::sqrt(1.0 - tremor_pole * tremor_pole);
+  Eigen::Vector3d tremor = Eigen::Vector3d::Zero();
+  if (options.tremor > 0.0) tremor = options.tremor * writer->Normal3();
+  const size_t end = *i + count;
+  for (; *i < end; ++*i) {
+    if (options.tremor > 0.0) {
+      writer->Emit(*i, force + tremor, rate);
+      tremor = tremor_pole * tremor + tremor_drive * writer->Normal3();
+    } else {
+      writer->Emit(*i, force, rate);
+    }
+  }
+}
+
+// The rotation from pose `from` to pose `to` over `count` samples from
+// sample *i. Smooth: along the shortest great circle,
+// q(t) = q0 exp(s(x) log(q0^-1 q1)), x = (t - t0) / T, whose body rate is
+// w_b = axis * angle * s'(x) / T. Hand (`profile` set): q(x) = q0
+// exp(s(tau(x)) angle axis) exp(beta(x) v), whose body rate is
+// R(exp(beta v))^T axis angle s'(tau) tau'(x) / T + v beta'(x) / T.
+void WriteRotation(const Eigen::Quaterniond& from, const Eigen::Quaterniond& to,
+                   const HandProfile* profile, long count, const Eigen::Vector3d& gravity_nav,
+                   const Eigen::Vector3d& earth_rate_nav, SampleWriter* writer, size_t* i) {
+  Eigen::Quaterniond delta = from.conjugate() * to;
+  if (delta.w() < 0.0) delta.coeffs() *= -1.0;
+  const Eigen::AngleAxisd step(delta);
+  const double duration = static_cast<double>(count) * writer->dt();
+  for (long j = 0; j < count; ++j, ++*i) {
+    const double x = static_cast<double>(j) / static_cast<double>(count);
+    if (profile == nullptr) {
+      const Eigen::Quaterniond q = from * AxisAngle(SmoothStep(x) * step.angle(), step.axis());
+      writer->Emit(*i, q.conjugate() * gravity_nav,
+                   step.axis() * (step.angle() * SmoothStepRate(x) / duration) +
+                       q.conjugate() * earth_rate_nav);
+      continue;
+    }
+    const HandProfile& p = *profile;
+    const double tau = p.Warp(x);
+    const Eigen::Quaterniond wobble = AxisAngle(p.Wobble(x), p.wobble_axis);
+    const Eigen::Quaterniond q =
+        from * AxisAngle(SmoothStep(tau) * step.angle(), step.axis()) * wobble;
+    const Eigen::Vector3d main_rate =
+        step.axis() * (step.angle() * SmoothStepRate(tau) * p.WarpRate(x) / duration);
+    writer->Emit(*i, q.conjugate() * gravity_nav,
+                 wobble.conjugate() * main_rate + p.wobble_axis * (p.WobbleRate(x) / duration) +
+                     q.conjugate() * earth_rate_nav);
+  }
+}
+
 bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSession* session,
                   std::string* error) {
-  auto fail = [&](const std::string& what) {
-    if (error) *error = what;
-    return false;
-  };
   if (!options.IsValid(error)) return false;
   std::vector<Eigen::Quaterniond> nominal;
   std::vector<int> nominal_up;
@@ -209,204 +456,39 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   }
   const size_t pose_count = nominal.size();
 
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-
-  // Truth sensors. AccelModel maps raw to SI, so its scale is SI per raw unit.
-  const double accel_scale =
-      options.raw_counts ? kStandardGravity / options.accel_counts_per_g : 1.0;
-  const double gyro_scale = options.raw_counts ? (kPi / 180.0) / options.gyro_counts_per_dps : 1.0;
+  MainStream stream(seed);
   SimulatedSession s;
-  s.seed = seed;
-  s.gravity = options.gravity;
-  s.accel_units_per_si = 1.0 / accel_scale;
-  s.gyro_units_per_si = 1.0 / gyro_scale;
-  s.accel_truth = AccelModel::Random(AccelParameterization::kAffine, accel_scale,
-                                     options.accel_scale_std, options.accel_misalignment_std,
-                                     options.accel_bias_std / accel_scale, &rng);
-  s.gyro_truth =
-      GyroModel::Random(gyro_scale, options.gyro_scale_std, options.gyro_misalignment_std,
-                        options.gyro_bias_std / gyro_scale, &rng);
-  DrawEffects(options, seed, &s);
-  const bool accel_effects =
-      options.accel_quadratic_std > 0.0 || options.accel_temperature_bias_std > 0.0 ||
-      options.accel_temperature_scale_std > 0.0 || options.accel_bias_drift_std > 0.0;
-  const bool gyro_effects = options.gyro_g_sensitivity_std > 0.0 ||
-                            options.gyro_temperature_bias_std > 0.0 ||
-                            options.gyro_bias_drift_std > 0.0;
-  const Eigen::Matrix3d upper_inverse = s.accel_truth.upper.inverse();
-  const Eigen::Matrix3d accel_inverse = s.accel_truth.matrix().inverse();
-  const Eigen::Matrix3d gyro_inverse = s.gyro_truth.matrix.inverse();
-  if (s.accel_truth.upper.diagonal().minCoeff() <= 0.0 || !accel_inverse.allFinite() ||
-      s.gyro_truth.matrix.determinant() <= 0.0 || !gyro_inverse.allFinite()) {
-    return fail(
-        "the random truth sensor is singular or reflected: reduce accel_scale_std, "
-        "gyro_scale_std or the misalignment standard deviations");
-  }
-
-  // Placed attitudes: an arbitrary heading (about navigation z) times the
-  // nominal pose times a small placement error (about body axes).
-  const double placement_rad = options.placement_error_deg * kPi / 180.0;
-  std::vector<Eigen::Quaterniond> attitudes(pose_count);
-  for (size_t k = 0; k < pose_count; ++k) {
-    const double heading = 2.0 * kPi * u01(rng);
-    const Eigen::Vector3d tilt(n01(rng), n01(rng), n01(rng));
-    attitudes[k] = (AxisAngle(heading, Eigen::Vector3d::UnitZ()) * nominal[k] *
-                    FromRotationVector(placement_rad * tilt))
-                       .normalized();
-  }
-
-  const double rate = options.sample_rate;
-  const double dt = 1.0 / rate;
-  std::vector<long> hold(pose_count);
-  for (size_t k = 0; k < pose_count; ++k) hold[k] = SampleCount(hold_seconds[k], rate);
-  const long first_still = SampleCount(options.initial_still_seconds + hold_seconds[0], rate);
-  const bool hand = options.rotation_profile == "hand";
-  // The hand profiles draw from a stream of their own (G with the other
-  // effects in DrawEffects), so switching them on leaves every other number
-  // of a seed unchanged.
-  std::mt19937_64 extra_rng(seed ^ 0xc2b2ae3d27d4eb4fULL);
-  std::vector<HandProfile> profiles(pose_count > 0 ? pose_count - 1 : 0);
-  std::vector<long> rotation(profiles.size(), SampleCount(options.rotation_seconds, rate));
-  for (size_t k = 0; k < profiles.size() && hand; ++k) {
-    profiles[k] = HandProfile::Random(options, &extra_rng);
-    rotation[k] = std::max(1L, SampleCount(profiles[k].seconds, rate));
-  }
-  size_t total = static_cast<size_t>(first_still);
-  for (size_t k = 1; k < pose_count; ++k) total += static_cast<size_t>(hold[k]);
-  for (long r : rotation) total += static_cast<size_t>(r);
-  if (static_cast<double>(total) > kMaxSamples) {
-    return fail("the session is too long (" + std::to_string(total) + " samples)");
-  }
+  if (!DrawTruth(options, seed, &stream.rng, &s, error)) return false;
+  const std::vector<Eigen::Quaterniond> attitudes = PlaceAttitudes(options, nominal, &stream);
+  Timeline plan;
+  if (!PlanTimeline(options, seed, hold_seconds, &plan, error)) return false;
 
   ImuLog& log = s.log;
   log.source = "simulated " + (options.planned_poses.empty() ? options.scheme : "plan") + " seed " +
                std::to_string(seed);
-  log.t.resize(total);
-  log.accel.resize(total);
-  log.gyro.resize(total);
-  log.temperature.resize(total);
+  log.t.resize(plan.total);
+  log.accel.resize(plan.total);
+  log.gyro.resize(plan.total);
+  log.temperature.resize(plan.total);
 
   const Eigen::Vector3d gravity_nav(0.0, 0.0, options.gravity);
-  // Earth rotation in the navigation frame (East-North-Up), when on.
-  Eigen::Vector3d earth_rate_nav = Eigen::Vector3d::Zero();
-  if (std::isfinite(options.latitude_deg)) {
-    const double lat = options.latitude_deg * kPi / 180.0;
-    earth_rate_nav = kEarthRate * Eigen::Vector3d(0.0, std::cos(lat), std::sin(lat));
-  }
-  const double accel_noise = options.accel_noise * s.accel_units_per_si;
-  const double gyro_noise = options.gyro_noise * s.gyro_units_per_si;
-  const double accel_walk = options.accel_bias_random_walk * std::sqrt(dt) * s.accel_units_per_si;
-  const double gyro_walk = options.gyro_bias_random_walk * std::sqrt(dt) * s.gyro_units_per_si;
-  // Tremor: first-order low-pass of white noise, stationary rms options.tremor
-  // per axis, started in its stationary distribution at each still period.
-  const double tremor_pole = std::exp(-2.0 * kPi * kTremorCornerHz * dt);
-  const double tremor_drive = options.tremor * std::sqrt(1.0 - tremor_pole * tremor_pole);
-  Eigen::Vector3d accel_bias_drift = Eigen::Vector3d::Zero();
-  Eigen::Vector3d gyro_bias_drift = Eigen::Vector3d::Zero();
-  Eigen::Vector3d tremor = Eigen::Vector3d::Zero();
-  auto normal3 = [&]() { return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)); };
-
-  // Writes sample i from the true specific force and body rate.
-  auto emit = [&](size_t i, const Eigen::Vector3d& force, const Eigen::Vector3d& body_rate) {
-    const double t = static_cast<double>(i) * dt;
-    const double temperature =
-        options.temperature_end + (options.temperature_start - options.temperature_end) *
-                                      std::exp(-t / options.temperature_tau);
-    // The effect terms only when switched on, so that sessions without them
-    // stay bit-identical.
-    Eigen::Vector3d v;
-    if (accel_effects) {
-      const Eigen::Vector3d sensed =
-          ApplyAccelEffects(s.effects, s.accel_truth.rotation.transpose() * force, temperature, t);
-      v = upper_inverse * sensed + s.accel_truth.bias;
-    } else {
-      v = accel_inverse * force + s.accel_truth.bias;
-    }
-    Eigen::Vector3d u;
-    if (gyro_effects) {
-      const double dT = temperature - s.effects.reference_temperature;
-      u = gyro_inverse * (body_rate + s.gyro_g_sensitivity * force +
-                          s.effects.gyro_temperature_bias * dT + s.effects.gyro_bias_drift * t) +
-          s.gyro_truth.bias;
-    } else {
-      u = gyro_inverse * body_rate + s.gyro_truth.bias;
-    }
-    if (accel_noise > 0.0) v += accel_noise * normal3();
-    if (gyro_noise > 0.0) u += gyro_noise * normal3();
-    if (accel_walk > 0.0) {
-      v += accel_bias_drift;
-      accel_bias_drift += accel_walk * normal3();
-    }
-    if (gyro_walk > 0.0) {
-      u += gyro_bias_drift;
-      gyro_bias_drift += gyro_walk * normal3();
-    }
-    if (options.raw_counts) {
-      v = v.array().round();
-      u = u.array().round();
-    }
-    log.t[i] = t;
-    log.accel[i] = v;
-    log.gyro[i] = u;
-    log.temperature[i] = temperature;
-  };
-
+  const Eigen::Vector3d earth_rate_nav = EarthRateNav(options);
+  const std::vector<Eigen::Vector3d> disturbance = DrawPoseDisturbances(options, seed, pose_count);
+  SampleWriter writer(options, seed, &s, &stream);
   s.poses.resize(pose_count);
   size_t i = 0;
   for (size_t k = 0; k < pose_count; ++k) {
-    // Still period.
-    const size_t still = static_cast<size_t>(k == 0 ? first_still : hold[k]);
     SimulatedPose& pose = s.poses[k];
+    const size_t still = static_cast<size_t>(k == 0 ? plan.first_still : plan.hold[k]);
     pose.begin = i;
     pose.end = i + still;
     pose.attitude = attitudes[k];
     pose.nominal_up = nominal_up[k];
-    const Eigen::Vector3d force = attitudes[k].conjugate() * gravity_nav;
-    const Eigen::Vector3d still_rate = attitudes[k].conjugate() * earth_rate_nav;
-    if (options.tremor > 0.0) tremor = options.tremor * normal3();
-    for (; i < pose.end; ++i) {
-      if (options.tremor > 0.0) {
-        emit(i, force + tremor, still_rate);
-        tremor = tremor_pole * tremor + tremor_drive * normal3();
-      } else {
-        emit(i, force, still_rate);
-      }
-    }
+    WriteStill(options, attitudes[k].conjugate() * gravity_nav + disturbance[k],
+               attitudes[k].conjugate() * earth_rate_nav, still, &writer, &i);
     if (k + 1 == pose_count) break;
-
-    // Rotation to the next pose along the shortest great circle:
-    // q(t) = q0 exp(s(x) log(q0^-1 q1)), x = (t - t0) / T, whose body rate is
-    // w_b = axis * angle * s'(x) / T.
-    Eigen::Quaterniond delta = attitudes[k].conjugate() * attitudes[k + 1];
-    if (delta.w() < 0.0) delta.coeffs() *= -1.0;
-    const Eigen::AngleAxisd step(delta);
-    const double duration = static_cast<double>(rotation[k]) * dt;
-    for (long j = 0; j < rotation[k]; ++j, ++i) {
-      const double x = static_cast<double>(j) / static_cast<double>(rotation[k]);
-      if (!hand) {
-        const Eigen::Quaterniond q =
-            attitudes[k] * AxisAngle(SmoothStep(x) * step.angle(), step.axis());
-        emit(i, q.conjugate() * gravity_nav,
-             step.axis() * (step.angle() * SmoothStepRate(x) / duration) +
-                 q.conjugate() * earth_rate_nav);
-        continue;
-      }
-      // Hand: q(x) = q0 exp(s(tau(x)) angle axis) exp(beta(x) v), whose
-      // body rate is R(exp(beta v))^T axis angle s'(tau) tau'(x) / T +
-      // v beta'(x) / T.
-      const HandProfile& p = profiles[k];
-      const double tau = p.Warp(x);
-      const Eigen::Quaterniond wobble = AxisAngle(p.Wobble(x), p.wobble_axis);
-      const Eigen::Quaterniond q =
-          attitudes[k] * AxisAngle(SmoothStep(tau) * step.angle(), step.axis()) * wobble;
-      const Eigen::Vector3d main_rate =
-          step.axis() * (step.angle() * SmoothStepRate(tau) * p.WarpRate(x) / duration);
-      emit(i, q.conjugate() * gravity_nav,
-           wobble.conjugate() * main_rate + p.wobble_axis * (p.WobbleRate(x) / duration) +
-               q.conjugate() * earth_rate_nav);
-    }
+    WriteRotation(attitudes[k], attitudes[k + 1], plan.hand ? &plan.profiles[k] : nullptr,
+                  plan.rotation[k], gravity_nav, earth_rate_nav, &writer, &i);
   }
 
   *session = std::move(s);
@@ -421,121 +503,176 @@ nlohmann::json ToJson(const Eigen::Matrix3d& m) {
   return rows;
 }
 
+// The field checks of SimulatorOptions::IsValid: each returns true when the
+// field is fine, else sets the error ("SimulatorOptions.<field> = <value>:
+// <requirement>") and returns false.
+class FieldCheck {
+ public:
+  FieldCheck(double sample_rate, std::string* error) : sample_rate_(sample_rate), error_(error) {}
+
+  bool Fail(const char* field, double value, const std::string& requirement) const {
+    if (error_) {
+      std::ostringstream msg;
+      msg << "SimulatorOptions." << field << " = " << value << ": " << requirement;
+      *error_ = msg.str();
+    }
+    return false;
+  }
+  bool Positive(const char* field, double value) const {
+    return std::isfinite(value) && value > 0.0 ? true : Fail(field, value, "must be positive");
+  }
+  bool NonNegative(const char* field, double value) const {
+    return std::isfinite(value) && value >= 0.0 ? true
+                                                : Fail(field, value, "must be zero or positive");
+  }
+  bool AtMost(const char* field, double value, double limit) const {
+    if (!NonNegative(field, value)) return false;
+    std::ostringstream requirement;
+    requirement << "must be at most " << limit;
+    return value <= limit ? true : Fail(field, value, requirement.str());
+  }
+  bool Finite(const char* field, double value) const {
+    return std::isfinite(value) ? true : Fail(field, value, "must be finite");
+  }
+  // One sample period, with slack for decimal durations such as 0.01 s.
+  bool OneSample(const char* field, double value) const {
+    if (!std::isfinite(value) || value * sample_rate_ < 1.0 - 1e-9) {
+      return Fail(field, value, "must be at least one sample period (1 / sample_rate)");
+    }
+    return true;
+  }
+  void Say(const std::string& text) const {
+    if (error_) *error_ = text;
+  }
+
+ private:
+  double sample_rate_;
+  std::string* error_;
+};
+
+// Scheme, rates, durations and units.
+bool CheckTiming(const SimulatorOptions& o, const FieldCheck& c, long* pose_count) {
+  SchemeKind kind;
+  std::string scheme_error;
+  if (!ParseScheme(o.scheme, &kind, pose_count, &scheme_error)) {
+    c.Say("SimulatorOptions.scheme: " + scheme_error);
+    return false;
+  }
+  if (!c.Positive("sample_rate", o.sample_rate) || !c.OneSample("hold_seconds", o.hold_seconds)) {
+    return false;
+  }
+  for (const PlannedHold& p : o.planned_poses) {
+    if (!c.OneSample("planned_poses.hold_seconds", p.hold_seconds)) return false;
+    if (!(p.up.allFinite() && p.up.norm() > 0.5)) {
+      c.Say("SimulatorOptions.planned_poses: every up must be a unit vector");
+      return false;
+    }
+  }
+  if (!o.planned_poses.empty()) *pose_count = static_cast<long>(o.planned_poses.size());
+  return c.NonNegative("initial_still_seconds", o.initial_still_seconds) &&
+         c.OneSample("rotation_seconds", o.rotation_seconds) && c.Positive("gravity", o.gravity) &&
+         c.Positive("accel_counts_per_g", o.accel_counts_per_g) &&
+         c.Positive("gyro_counts_per_dps", o.gyro_counts_per_dps);
+}
+
+// Noise: white, random walks, bias instability.
+bool CheckNoise(const SimulatorOptions& o, const FieldCheck& c) {
+  if (!c.NonNegative("accel_noise", o.accel_noise) ||
+      !c.NonNegative("accel_bias_random_walk", o.accel_bias_random_walk) ||
+      !c.NonNegative("gyro_noise", o.gyro_noise) ||
+      !c.NonNegative("gyro_bias_random_walk", o.gyro_bias_random_walk) ||
+      !c.NonNegative("accel_bias_instability", o.accel_bias_instability) ||
+      !c.NonNegative("gyro_bias_instability", o.gyro_bias_instability)) {
+    return false;
+  }
+  if ((o.accel_bias_instability > 0.0 || o.gyro_bias_instability > 0.0) &&
+      !(o.bias_instability_tau_low >= 10.0 / o.sample_rate)) {
+    return c.Fail("bias_instability_tau_low", o.bias_instability_tau_low,
+                  "must be at least 10 sample periods");
+  }
+  if (!(o.bias_instability_tau_high > o.bias_instability_tau_low) ||
+      !std::isfinite(o.bias_instability_tau_high)) {
+    return c.Fail("bias_instability_tau_high", o.bias_instability_tau_high,
+                  "must be finite and above bias_instability_tau_low");
+  }
+  return true;
+}
+
+// The spreads of the random truth sensor.
+bool CheckTruthSpreads(const SimulatorOptions& o, const FieldCheck& c) {
+  return c.NonNegative("accel_bias_std", o.accel_bias_std) &&
+         c.AtMost("accel_scale_std", o.accel_scale_std, kMaxScaleStd) &&
+         c.AtMost("accel_misalignment_std", o.accel_misalignment_std, kMaxMisalignmentStd) &&
+         c.NonNegative("gyro_bias_std", o.gyro_bias_std) &&
+         c.AtMost("gyro_scale_std", o.gyro_scale_std, kMaxScaleStd) &&
+         c.AtMost("gyro_misalignment_std", o.gyro_misalignment_std, kMaxMisalignmentStd);
+}
+
+// Placement, rotations between poses, tremor and per-pose disturbances.
+bool CheckPlacement(const SimulatorOptions& o, const FieldCheck& c) {
+  if (!c.NonNegative("placement_error_deg", o.placement_error_deg)) return false;
+  if (o.rotation_profile != "smooth" && o.rotation_profile != "hand") {
+    c.Say("SimulatorOptions.rotation_profile: '" + o.rotation_profile +
+          "' is not one of smooth, hand");
+    return false;
+  }
+  if (!c.OneSample("hand_min_seconds", o.hand_min_seconds)) return false;
+  if (!(o.hand_max_seconds >= o.hand_min_seconds) || !std::isfinite(o.hand_max_seconds)) {
+    return c.Fail("hand_max_seconds", o.hand_max_seconds, "must be at least hand_min_seconds");
+  }
+  return c.NonNegative("hand_wobble_deg", o.hand_wobble_deg) &&
+         c.NonNegative("gyro_g_sensitivity_std", o.gyro_g_sensitivity_std) &&
+         c.NonNegative("tremor", o.tremor) && c.NonNegative("pose_disturbance", o.pose_disturbance);
+}
+
+// Temperature, Earth rate, fixture attitudes and the effect terms.
+bool CheckEnvironmentAndEffects(const SimulatorOptions& o, const FieldCheck& c) {
+  if (!c.Finite("temperature_start", o.temperature_start) ||
+      !c.Finite("temperature_end", o.temperature_end) ||
+      !c.Positive("temperature_tau", o.temperature_tau)) {
+    return false;
+  }
+  if (!std::isnan(o.latitude_deg) && !(std::fabs(o.latitude_deg) <= 90.0)) {
+    return c.Fail("latitude_deg", o.latitude_deg, "must be NaN (off) or within -90..90");
+  }
+  return c.NonNegative("fixture_attitude_noise_deg", o.fixture_attitude_noise_deg) &&
+         c.NonNegative("accel_quadratic_std", o.accel_quadratic_std) &&
+         c.NonNegative("accel_temperature_bias_std", o.accel_temperature_bias_std) &&
+         c.AtMost("accel_temperature_scale_std", o.accel_temperature_scale_std, 0.01) &&
+         c.NonNegative("accel_bias_drift_std", o.accel_bias_drift_std) &&
+         c.NonNegative("gyro_temperature_bias_std", o.gyro_temperature_bias_std) &&
+         c.NonNegative("gyro_bias_drift_std", o.gyro_bias_drift_std) &&
+         c.Finite("effect_reference_temperature", o.effect_reference_temperature);
+}
+
+// The session's length against kMaxSamples.
+bool CheckLength(const SimulatorOptions& o, long pose_count, const FieldCheck& c) {
+  double hold_total = o.hold_seconds * static_cast<double>(pose_count);
+  if (!o.planned_poses.empty()) {
+    hold_total = 0.0;
+    for (const PlannedHold& p : o.planned_poses) hold_total += p.hold_seconds;
+  }
+  const double samples =
+      (o.initial_still_seconds + hold_total +
+       static_cast<double>(pose_count - 1) *
+           (o.rotation_profile == "hand" ? o.hand_max_seconds : o.rotation_seconds)) *
+      o.sample_rate;
+  if (samples <= kMaxSamples) return true;
+  std::ostringstream msg;
+  msg << "SimulatorOptions: the session would have " << samples << " samples (limit " << kMaxSamples
+      << "); shorten hold_seconds, rotation_seconds or sample_rate";
+  c.Say(msg.str());
+  return false;
+}
+
 }  // namespace
 
 bool SimulatorOptions::IsValid(std::string* error) const {
-  auto fail = [&](const char* field, double value, const std::string& requirement) {
-    if (error) {
-      std::ostringstream msg;
-      msg << "SimulatorOptions." << field << " = " << value << ": " << requirement;
-      *error = msg.str();
-    }
-    return false;
-  };
-  auto positive = [&](const char* field, double value) {
-    return std::isfinite(value) && value > 0.0 ? true : fail(field, value, "must be positive");
-  };
-  auto non_negative = [&](const char* field, double value) {
-    return std::isfinite(value) && value >= 0.0 ? true
-                                                : fail(field, value, "must be zero or positive");
-  };
-  auto at_most = [&](const char* field, double value, double limit) {
-    if (!non_negative(field, value)) return false;
-    std::ostringstream requirement;
-    requirement << "must be at most " << limit;
-    return value <= limit ? true : fail(field, value, requirement.str());
-  };
-  auto finite = [&](const char* field, double value) {
-    return std::isfinite(value) ? true : fail(field, value, "must be finite");
-  };
-  // One sample period, with slack for decimal durations such as 0.01 s.
-  auto one_sample = [&](const char* field, double value) {
-    if (!std::isfinite(value) || value * sample_rate < 1.0 - 1e-9) {
-      return fail(field, value, "must be at least one sample period (1 / sample_rate)");
-    }
-    return true;
-  };
-
-  SchemeKind kind;
+  const FieldCheck check(sample_rate, error);
   long pose_count = 0;
-  std::string scheme_error;
-  if (!ParseScheme(scheme, &kind, &pose_count, &scheme_error)) {
-    if (error) *error = "SimulatorOptions.scheme: " + scheme_error;
-    return false;
-  }
-  if (!positive("sample_rate", sample_rate)) return false;
-  if (!one_sample("hold_seconds", hold_seconds)) return false;
-  double planned_seconds = 0.0;
-  for (const PlannedHold& p : planned_poses) {
-    if (!one_sample("planned_poses.hold_seconds", p.hold_seconds)) return false;
-    if (!(p.up.allFinite() && p.up.norm() > 0.5)) {
-      if (error) *error = "SimulatorOptions.planned_poses: every up must be a unit vector";
-      return false;
-    }
-    planned_seconds += p.hold_seconds;
-  }
-  if (!planned_poses.empty()) pose_count = static_cast<long>(planned_poses.size());
-  if (!non_negative("initial_still_seconds", initial_still_seconds)) return false;
-  if (!one_sample("rotation_seconds", rotation_seconds)) return false;
-  if (!positive("gravity", gravity)) return false;
-  if (!positive("accel_counts_per_g", accel_counts_per_g)) return false;
-  if (!positive("gyro_counts_per_dps", gyro_counts_per_dps)) return false;
-  if (!non_negative("accel_noise", accel_noise)) return false;
-  if (!non_negative("accel_bias_random_walk", accel_bias_random_walk)) return false;
-  if (!non_negative("gyro_noise", gyro_noise)) return false;
-  if (!non_negative("gyro_bias_random_walk", gyro_bias_random_walk)) return false;
-  if (!non_negative("accel_bias_std", accel_bias_std)) return false;
-  if (!at_most("accel_scale_std", accel_scale_std, kMaxScaleStd)) return false;
-  if (!at_most("accel_misalignment_std", accel_misalignment_std, kMaxMisalignmentStd)) {
-    return false;
-  }
-  if (!non_negative("gyro_bias_std", gyro_bias_std)) return false;
-  if (!at_most("gyro_scale_std", gyro_scale_std, kMaxScaleStd)) return false;
-  if (!at_most("gyro_misalignment_std", gyro_misalignment_std, kMaxMisalignmentStd)) return false;
-  if (!non_negative("placement_error_deg", placement_error_deg)) return false;
-  if (rotation_profile != "smooth" && rotation_profile != "hand") {
-    if (error) {
-      *error = "SimulatorOptions.rotation_profile: '" + rotation_profile +
-               "' is not one of smooth, hand";
-    }
-    return false;
-  }
-  if (!one_sample("hand_min_seconds", hand_min_seconds)) return false;
-  if (!(hand_max_seconds >= hand_min_seconds) || !std::isfinite(hand_max_seconds)) {
-    return fail("hand_max_seconds", hand_max_seconds, "must be at least hand_min_seconds");
-  }
-  if (!non_negative("hand_wobble_deg", hand_wobble_deg)) return false;
-  if (!non_negative("gyro_g_sensitivity_std", gyro_g_sensitivity_std)) return false;
-  if (!non_negative("tremor", tremor)) return false;
-  if (!finite("temperature_start", temperature_start)) return false;
-  if (!finite("temperature_end", temperature_end)) return false;
-  if (!positive("temperature_tau", temperature_tau)) return false;
-  if (!std::isnan(latitude_deg) && !(std::fabs(latitude_deg) <= 90.0)) {
-    return fail("latitude_deg", latitude_deg, "must be NaN (off) or within -90..90");
-  }
-  if (!non_negative("fixture_attitude_noise_deg", fixture_attitude_noise_deg)) return false;
-  if (!non_negative("accel_quadratic_std", accel_quadratic_std)) return false;
-  if (!non_negative("accel_temperature_bias_std", accel_temperature_bias_std)) return false;
-  if (!at_most("accel_temperature_scale_std", accel_temperature_scale_std, 0.01)) return false;
-  if (!non_negative("accel_bias_drift_std", accel_bias_drift_std)) return false;
-  if (!non_negative("gyro_temperature_bias_std", gyro_temperature_bias_std)) return false;
-  if (!non_negative("gyro_bias_drift_std", gyro_bias_drift_std)) return false;
-  if (!finite("effect_reference_temperature", effect_reference_temperature)) return false;
-
-  const double samples =
-      (initial_still_seconds +
-       (planned_poses.empty() ? hold_seconds * static_cast<double>(pose_count) : planned_seconds) +
-       static_cast<double>(pose_count - 1) *
-           (rotation_profile == "hand" ? hand_max_seconds : rotation_seconds)) *
-      sample_rate;
-  if (!(samples <= kMaxSamples)) {
-    std::ostringstream msg;
-    msg << "SimulatorOptions: the session would have " << samples << " samples (limit "
-        << kMaxSamples << "); shorten hold_seconds, rotation_seconds or sample_rate";
-    if (error) *error = msg.str();
-    return false;
-  }
-  return true;
+  return CheckTiming(*this, check, &pose_count) && CheckNoise(*this, check) &&
+         CheckTruthSpreads(*this, check) && CheckPlacement(*this, check) &&
+         CheckEnvironmentAndEffects(*this, check) && CheckLength(*this, pose_count, check);
 }
 
 bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
@@ -658,6 +795,11 @@ std::string TruthToJson(const SimulatedSession& session, const SimulatorOptions&
                     {"gyro_misalignment_std", o.gyro_misalignment_std},
                     {"placement_error_deg", o.placement_error_deg},
                     {"tremor", o.tremor},
+                    {"pose_disturbance", o.pose_disturbance},
+                    {"accel_bias_instability", o.accel_bias_instability},
+                    {"gyro_bias_instability", o.gyro_bias_instability},
+                    {"bias_instability_tau_low", o.bias_instability_tau_low},
+                    {"bias_instability_tau_high", o.bias_instability_tau_high},
                     {"rotation_profile", o.rotation_profile},
                     {"hand_min_seconds", o.hand_min_seconds},
                     {"hand_max_seconds", o.hand_max_seconds},

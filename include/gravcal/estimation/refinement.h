@@ -59,6 +59,11 @@ struct RefinementOptions {
   bool estimate_pose_variance = false;
   double max_pose_disturbance = 0.01;
   double structure_test_level = 1e-3;
+  // A prior on that variance (estimation/variance_component.h): the typical
+  // pose-to-pose scatter s0 of the placement, m/s^2, on pose_disturbance_dof
+  // degrees of freedom (0 = none, REML alone).
+  double pose_disturbance_prior = 0.0;
+  double pose_disturbance_prior_dof = 0.0;
   // Stopping rules of the solve (max_iterations 100, tolerances 1e-14, 1e-14,
   // 1e-12).
   SolverTolerances solver;

@@ -72,6 +72,18 @@ struct GyroCalibrationOptions {
   double edge_seconds = 0.5;
   // A gap between two static poses longer than this is not used, s.
   double max_rotation_seconds = 60.0;
+  // (m/s^2)^2 per axis added to the covariance of every pose's mean
+  // specific force: what the samples of a pose cannot show, which moves the
+  // gravity direction each pose gives the rotations. AddGyroscopeCalibration
+  // sets it to the accelerometer's absorbed per-pose variance
+  // (pose_variance); 0 = white noise only.
+  double pose_variance = 0.0;
+  // Estimate the scatter of the static poses' mean rates beyond their white
+  // noise (bias instability, random walk) by REML and add it to every static
+  // pose's covariance (estimation/variance_component.h).
+  // AddGyroscopeCalibration turns it on with the accelerometer's
+  // pose_variance.
+  bool estimate_static_variance = false;
 
   // Stopping rules of the Ceres solve.
   SolverTolerances solver = {100, 1e-12, 1e-12, 1e-10};

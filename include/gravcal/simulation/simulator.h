@@ -4,8 +4,10 @@
 // pose is a nominal orientation from the scheme, disturbed by a random
 // placement (tilt and heading) error. The true specific force in the body
 // frame is f = C_bn^T (0, 0, g) (the unit reads +g on the axis that points up)
-// plus, while static, hand tremor if set; the raw accelerometer is
-//   v = M^-1 f + b + n_a,     n_a white, plus a bias random walk,
+// plus, while static, hand tremor and a per-pose disturbance if set; the raw
+// accelerometer is
+//   v = M^-1 f + b + n_a,     n_a white, plus a bias random walk and bias
+// instability if set,
 // and the raw gyroscope u = M_g^-1 (w + G f) + b_g + n_g, with w the true
 // body rate (exactly consistent with the attitude trajectory) and G the
 // g-sensitivity (zero by default). Raw outputs are either
@@ -76,11 +78,26 @@ struct SimulatorOptions {
   double gyro_scale_std = 0.02;
   double gyro_misalignment_std = 0.005;  // rad
 
+  // Bias instability (flicker, simulation/noise_process.h) of each axis:
+  // B in m/s^2 (accelerometer) and rad/s (gyroscope), the Allan deviation
+  // flat at 0.664 B over [bias_instability_tau_low, bias_instability_tau_high]
+  // seconds. From a stream of its own; 0 = off.
+  double accel_bias_instability = 0.0;
+  double gyro_bias_instability = 0.0;
+  double bias_instability_tau_low = 1.0;
+  double bias_instability_tau_high = 100.0;
+
   // Placement error of each pose, degrees (standard deviation per axis).
   double placement_error_deg = 2.0;
   // Hand tremor while "static": specific force disturbance, m/s^2 rms. 0 = a
   // table.
   double tremor = 0.0;
+  // What the samples of a pose cannot show (placement settling, mount flex):
+  // a specific-force offset N(0, pose_disturbance^2) per body axis, m/s^2,
+  // constant over each still period, drawn per pose from a stream of its
+  // own. It enters every pose's mean and the gravity direction the poses
+  // show, exactly as a pose-to-pose variance component. 0 = off.
+  double pose_disturbance = 0.0;
 
   // Rotations between poses: "smooth" (minimum-jerk about one fixed axis,
   // rotation_seconds each) or "hand" (hand-like: each lasts a random

@@ -123,6 +123,11 @@ ConfigSection SolverSection() {
                          "warn when the per-pose scatter s exceeds this, m/s^2"),
           GRAVCAL_DOUBLE("structure_test_level", calibration.refinement.structure_test_level,
                          "significance at which non-orthogonality, not noise, owns the excess"),
+          GRAVCAL_DOUBLE("pose_disturbance_prior", calibration.refinement.pose_disturbance_prior,
+                         "pose_variance: typical per-pose scatter of the placement, m/s^2"),
+          GRAVCAL_DOUBLE("pose_disturbance_prior_dof",
+                         calibration.refinement.pose_disturbance_prior_dof,
+                         "pose_variance: weight of that prior in degrees of freedom (0 = none)"),
       }};
 }
 

@@ -1,0 +1,42 @@
+#include "simulation/sensor_noise.h"
+
+#include <cmath>
+
+namespace gravcal {
+namespace internal {
+
+BiasInstability::BiasInstability(double bias_instability, double tau_low, double tau_high,
+                                 double rate_hz, uint64_t seed, uint64_t stream) {
+  if (!(bias_instability > 0.0)) return;
+  NoiseProcessOptions options;
+  options.rate_hz = rate_hz;
+  options.bias_instability = bias_instability;
+  options.bias_tau_low = tau_low;
+  options.bias_tau_high = tau_high;
+  for (uint64_t axis = 0; axis < 3; ++axis) {
+    axes_.push_back(std::make_unique<NoiseProcess>(
+        options, seed ^ (stream * 0x9fb21c651e98df25ULL) ^ (axis * 0xd6e8feb86659fd93ULL)));
+  }
+}
+
+Eigen::Vector3d BiasInstability::Next() {
+  if (axes_.empty()) return Eigen::Vector3d::Zero();
+  return Eigen::Vector3d(axes_[0]->Next(), axes_[1]->Next(), axes_[2]->Next());
+}
+
+SensorNoise::SensorNoise(const SimulatorOptions& o, double accel_units_per_si,
+                         double gyro_units_per_si, uint64_t seed)
+    : accel_units_per_si_(accel_units_per_si),
+      gyro_units_per_si_(gyro_units_per_si),
+      raw_counts_(o.raw_counts),
+      accel_noise_(o.accel_noise * accel_units_per_si),
+      gyro_noise_(o.gyro_noise * gyro_units_per_si),
+      accel_walk_(o.accel_bias_random_walk * std::sqrt(1.0 / o.sample_rate) * accel_units_per_si),
+      gyro_walk_(o.gyro_bias_random_walk * std::sqrt(1.0 / o.sample_rate) * gyro_units_per_si),
+      accel_instability_(o.accel_bias_instability, o.bias_instability_tau_low,
+                         o.bias_instability_tau_high, o.sample_rate, seed, 1),
+      gyro_instability_(o.gyro_bias_instability, o.bias_instability_tau_low,
+                        o.bias_instability_tau_high, o.sample_rate, seed, 2) {}
+
+}  // namespace internal
+}  // namespace gravcal

@@ -1,0 +1,87 @@
+// Private: the noise both simulators (simulator.cc, handheld_simulator.cc)
+// add to a simulated sensor's raw output, in raw units:
+//   white noise        N(0, accel_noise^2), N(0, gyro_noise^2) per sample;
+//   bias random walk   the drift before the sample, then a step
+//                      N(0, walk^2 dt);
+//   bias instability   per axis a NoiseProcess (gravcal/simulation/
+//                      noise_process.h) with only its bias instability
+//                      term, from a stream of its own, so that switching it
+//                      on changes no other number of a session;
+// then quantisation to counts when the output is in counts. The white and
+// random-walk draws come from the caller's stream (`normal3`, three N(0, 1)),
+// in the order the simulators have always drawn them.
+#ifndef GRAVCAL_SRC_SIMULATION_SENSOR_NOISE_H_
+#define GRAVCAL_SRC_SIMULATION_SENSOR_NOISE_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "gravcal/simulation/noise_process.h"
+#include "gravcal/simulation/simulator.h"
+
+namespace gravcal {
+namespace internal {
+
+// Three axes of bias instability B (sensor units) flat over [tau_low,
+// tau_high] seconds at rate_hz; B = 0 gives zero forever. `stream` tells the
+// accelerometer's from the gyroscope's processes of the same seed.
+class BiasInstability {
+ public:
+  BiasInstability(double bias_instability, double tau_low, double tau_high, double rate_hz,
+                  uint64_t seed, uint64_t stream);
+
+  bool on() const { return !axes_.empty(); }
+  // The next sample of the three axes (zero when off).
+  Eigen::Vector3d Next();
+
+ private:
+  std::vector<std::unique_ptr<NoiseProcess>> axes_;
+};
+
+class SensorNoise {
+ public:
+  // Raw units per m/s^2 and per rad/s.
+  SensorNoise(const SimulatorOptions& options, double accel_units_per_si, double gyro_units_per_si,
+              uint64_t seed);
+
+  // Adds the noise of one sample to the raw accelerometer v and gyroscope u.
+  template <typename Normal3>
+  void Add(Normal3&& normal3, Eigen::Vector3d* v, Eigen::Vector3d* u) {
+    if (accel_noise_ > 0.0) *v += accel_noise_ * normal3();
+    if (gyro_noise_ > 0.0) *u += gyro_noise_ * normal3();
+    if (accel_walk_ > 0.0) {
+      *v += accel_drift_;
+      accel_drift_ += accel_walk_ * normal3();
+    }
+    if (gyro_walk_ > 0.0) {
+      *u += gyro_drift_;
+      gyro_drift_ += gyro_walk_ * normal3();
+    }
+    if (accel_instability_.on()) *v += accel_units_per_si_ * accel_instability_.Next();
+    if (gyro_instability_.on()) *u += gyro_units_per_si_ * gyro_instability_.Next();
+    if (raw_counts_) {
+      *v = v->array().round();
+      *u = u->array().round();
+    }
+  }
+
+ private:
+  double accel_units_per_si_;
+  double gyro_units_per_si_;
+  bool raw_counts_;
+  double accel_noise_;
+  double gyro_noise_;
+  double accel_walk_;
+  double gyro_walk_;
+  BiasInstability accel_instability_;
+  BiasInstability gyro_instability_;
+  Eigen::Vector3d accel_drift_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_drift_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace internal
+}  // namespace gravcal
+
+#endif  // GRAVCAL_SRC_SIMULATION_SENSOR_NOISE_H_
