@@ -28,7 +28,9 @@
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/config.h"
+#include "gravcal/workflows/pipeline.h"
 #include "test_util.h"
+#include "util/cancellation.h"
 
 namespace gravcal {
 namespace {
@@ -149,18 +151,20 @@ TEST_F(BatchFaultsTest, OutputDiskFullStopsTheBatchAndResumesWhenThereIsSpace) {
   const CliResult full = RunBatch(out);
   EXPECT_EQ(full.exit_code, 1) << full.err;
   EXPECT_NE(full.err.find("No space left on device"), std::string::npos) << full.err;
-  EXPECT_NE(full.err.find("run again"), std::string::npos) << full.err;
+  EXPECT_NE(full.err.find("again to resume"), std::string::npos) << full.err;
   ExpectIntactFolder(out);
+  const auto states = testing_util::JsonFiles(out + "/batch_state");
   const auto written = testing_util::JsonFiles(out);
 
   std::filesystem::remove(filler);
   ExpectResumesToCleanResult(out);
-  // What the full disk let through was kept, not recomputed.
+  // A unit whose state was stored is kept, not recomputed (a result whose
+  // state file did not fit is computed again).
+  const auto states_after = testing_util::JsonFiles(out + "/batch_state");
   const auto after = testing_util::JsonFiles(out);
-  for (const auto& [name, id] : written) {
-    if (name == "summary.json") continue;
-    ASSERT_TRUE(after.count(name)) << name;
-    EXPECT_TRUE(after.at(name) == id) << name << " was rewritten";
+  for (const auto& [name, id] : states) {
+    EXPECT_TRUE(states_after.at(name) == id) << name << " state was rewritten";
+    if (written.count(name)) EXPECT_TRUE(after.at(name) == written.at(name)) << name;
   }
 }
 
@@ -344,6 +348,26 @@ TEST_F(BatchFaultsTest, SigtermFinishesTheUnitInFlightAndLeavesAResumableState) 
     if (name == "summary.json") continue;
     EXPECT_TRUE(after.at(name) == id) << name << " was rewritten";
   }
+}
+
+// A unit over its time limit is asked to stop: the solver aborts at its
+// next iteration (an iteration callback on every solve of the library)
+// instead of running on for nothing.
+TEST_F(BatchFaultsTest, TheSolverStopsWhenTheUnitIsCancelled) {
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(ConfigPath(), &config, &error)) << error;
+  PipelineInput input;
+  input.source = UnitPath(0);
+  ASSERT_TRUE(ReadImuLog(UnitPath(0), config.input, &input.log, &error)) << error;
+  Calibration calibration;
+  ASSERT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
+  std::atomic<bool> cancel{true};
+  internal::ScopedCancelFlag scope(&cancel);
+  Calibration cancelled;
+  EXPECT_FALSE(RunCalibration(config, input, &cancelled));
+  EXPECT_NE(cancelled.refinement.termination.find("USER_FAILURE"), std::string::npos)
+      << cancelled.refinement.termination << ": " << cancelled.message;
 }
 
 }  // namespace
