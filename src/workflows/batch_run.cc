@@ -89,6 +89,20 @@ namespace {
 
 using State = BatchRun::State;
 
+// Runs `work`; an exception it throws fails the unit: "<what_failed>: <why>".
+template <typename Work>
+void FailOnException(const std::string& what_failed, BatchResult* r, Work&& work) {
+  try {
+    work();
+  } catch (const std::exception& e) {
+    r->status = BatchStatus::kFailed;
+    r->message = what_failed + ": " + e.what();
+  } catch (...) {
+    r->status = BatchStatus::kFailed;
+    r->message = what_failed;
+  }
+}
+
 // The loop of one worker thread. `state` is shared: a worker abandoned with
 // its unit may come back after the run has returned, and then must touch
 // only `state`'s own members (never units, options or results).
@@ -119,28 +133,15 @@ void Worker(std::shared_ptr<State> state, size_t worker) {
       if (slot.abandoned) return true;
       return state->options.skip && state->options.skip(i, u, hash);
     };
-    try {
+    FailOnException(unit.id + ": internal error", &r, [&] {
       ScopedCancelFlag cancel(&slot.cancel);
       RunUnit(unit, *base, skip, &r);
-    } catch (const std::exception& e) {
-      r.status = BatchStatus::kFailed;
-      r.message = unit.id + ": internal error: " + e.what();
-    } catch (...) {
-      r.status = BatchStatus::kFailed;
-      r.message = unit.id + ": internal error";
-    }
+    });
     std::lock_guard<std::mutex> callback(slot.callback);
     if (slot.abandoned) return;  // Its result was given up; this thread is no longer counted.
     if (state->options.on_result) {
-      try {
-        state->options.on_result(i, r);
-      } catch (const std::exception& e) {
-        r.status = BatchStatus::kFailed;
-        r.message = unit.id + ": the result could not be stored: " + e.what();
-      } catch (...) {
-        r.status = BatchStatus::kFailed;
-        r.message = unit.id + ": the result could not be stored";
-      }
+      FailOnException(unit.id + ": the result could not be stored", &r,
+                      [&] { state->options.on_result(i, r); });
     }
     if (!state->options.keep_calibrations) r.calibration = Calibration();
     std::lock_guard<std::mutex> lock(state->mutex);
@@ -172,57 +173,43 @@ BatchRun::BatchRun(const std::vector<BatchUnit>& units, const Config& base,
 
 BatchRun::~BatchRun() = default;
 
-void BatchRun::Run(int threads) {
-  State& s = *state_;
-  const BatchOptions& options = s.options;
-  const size_t n = s.slots.size();
-  std::unique_lock<std::mutex> lock(s.mutex);
-  const size_t workers = std::min(n, static_cast<size_t>(std::max(threads, 1)));
-  for (size_t w = 0; w < workers; ++w) StartWorker(state_);
-  bool stopping = false;
-  Clock::time_point stop_time;
-  while (s.active > 0) {
-    s.changed.wait_for(lock, std::chrono::milliseconds(20));
-    const Clock::time_point now = Clock::now();
-    if (!stopping && s.StopRequested()) {
-      stopping = true;
-      stop_time = now;
-    }
-    for (size_t i = 0; i < n; ++i) {
-      Slot& slot = s.slots[i];
-      if (!slot.started || slot.finished) continue;
-      const double running = Seconds(slot.start, now);
-      const bool timed_out =
-          options.unit_timeout_seconds > 0.0 && running > options.unit_timeout_seconds;
-      const bool given_up = stopping && Seconds(stop_time, now) > options.stop_grace_seconds;
-      if (!timed_out && !given_up) continue;
-      // The worker may be in a callback for this unit: then try again later.
-      std::unique_lock<std::mutex> callback(slot.callback, std::try_to_lock);
-      if (!callback.owns_lock()) continue;
-      slot.abandoned = true;
-      slot.cancel = true;
-      callback.unlock();
-      slot.finished = true;
-      BatchResult& r = (*s.results)[i];
-      r = BatchResult();
-      r.unit = s.units[i].id;
-      r.status = BatchStatus::kFailed;
-      r.timings.total_seconds = running;
-      if (timed_out) {
-        r.timed_out = true;
-        r.message = r.unit + ": timed out after " + SecondsText(options.unit_timeout_seconds) +
-                    " s (unit_timeout); abandoned, the batch went on";
-      } else {
-        r.not_run = true;
-        r.message = r.unit + ": abandoned in flight: the batch was stopped";
-      }
-      s.thread_abandoned[slot.worker] = 1;
-      --s.active;
-      s.CountDone(r);
-      if (s.next < n && !s.StopRequested()) StartWorker(state_);
-    }
+namespace {
+
+// Gives up unit i, whose worker is late (State::mutex held): its result
+// says why, a fresh worker takes the place of the late one. False when its
+// worker is inside a callback for it (try again later).
+bool Abandon(const std::shared_ptr<State>& state, size_t i, bool timed_out, double running) {
+  State& s = *state;
+  Slot& slot = s.slots[i];
+  std::unique_lock<std::mutex> callback(slot.callback, std::try_to_lock);
+  if (!callback.owns_lock()) return false;
+  slot.abandoned = true;
+  slot.cancel = true;
+  callback.unlock();
+  slot.finished = true;
+  BatchResult& r = (*s.results)[i];
+  r = BatchResult();
+  r.unit = s.units[i].id;
+  r.status = BatchStatus::kFailed;
+  r.timings.total_seconds = running;
+  if (timed_out) {
+    r.timed_out = true;
+    r.message = r.unit + ": timed out after " + SecondsText(s.options.unit_timeout_seconds) +
+                " s (unit_timeout); abandoned, the batch went on";
+  } else {
+    r.not_run = true;
+    r.message = r.unit + ": abandoned in flight: the batch was stopped";
   }
-  for (size_t i = 0; i < n; ++i) {
+  s.thread_abandoned[slot.worker] = 1;
+  --s.active;
+  s.CountDone(r);
+  if (s.next < s.slots.size() && !s.StopRequested()) StartWorker(state);
+  return true;
+}
+
+// The units no worker started (State::mutex held).
+void MarkNotStarted(State& s) {
+  for (size_t i = 0; i < s.slots.size(); ++i) {
     if (s.slots[i].started) continue;
     BatchResult& r = (*s.results)[i];
     r.unit = s.units[i].id;
@@ -230,6 +217,37 @@ void BatchRun::Run(int threads) {
     r.not_run = true;
     r.message = r.unit + ": not run: the batch was stopped before it started";
   }
+}
+
+}  // namespace
+
+void BatchRun::Run(int threads) {
+  State& s = *state_;
+  const BatchOptions& options = s.options;
+  std::unique_lock<std::mutex> lock(s.mutex);
+  const size_t workers = std::min(s.slots.size(), static_cast<size_t>(std::max(threads, 1)));
+  for (size_t w = 0; w < workers; ++w) StartWorker(state_);
+  bool stopping = false;
+  Clock::time_point stop_time;
+  // The watchdog: wakes when a unit finishes, and every 20 ms.
+  while (s.active > 0) {
+    s.changed.wait_for(lock, std::chrono::milliseconds(20));
+    const Clock::time_point now = Clock::now();
+    if (!stopping && s.StopRequested()) {
+      stopping = true;
+      stop_time = now;
+    }
+    const bool grace_over = stopping && Seconds(stop_time, now) > options.stop_grace_seconds;
+    for (size_t i = 0; i < s.slots.size(); ++i) {
+      const Slot& slot = s.slots[i];
+      if (!slot.started || slot.finished) continue;
+      const double running = Seconds(slot.start, now);
+      const bool timed_out =
+          options.unit_timeout_seconds > 0.0 && running > options.unit_timeout_seconds;
+      if (timed_out || grace_over) Abandon(state_, i, timed_out, running);
+    }
+  }
+  MarkNotStarted(s);
   std::vector<std::thread> threads_left = std::move(s.threads);
   const std::vector<char> abandoned = s.thread_abandoned;
   lock.unlock();
