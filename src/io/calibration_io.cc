@@ -223,7 +223,9 @@ bool ReadCalibrationJson(const std::string& path, LoadedCalibration* calibration
   json j;
   try {
     j = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error, and out_of_range for a number beyond double (found by
+    // fuzz/fuzz_calibration_json: "1e999999" aborted gravcal apply).
     *error = path + ": not valid JSON (" + e.what() + ")";
     return false;
   }
