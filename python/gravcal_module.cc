@@ -585,7 +585,7 @@ PYBIND11_MODULE(_gravcal, m) {
 
   py::class_<PyCalibration>(m, "Calibration")
       .def_property_readonly("json", &PyCalibration::Json)
-      .def_property_readonly("has_gyro", [](const PyCalibration& c) { return c.Models().has_gyro; })
+      .def_property_readonly("has_gyro", [](const PyCalibration& c) { return c.Models().corrector.has_gyro; })
       .def_static("from_file", &CalibrationFromFile)
       .def_static("from_text",
                   [](const std::string& text, const std::string& name) {

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "batch_test_util.h"
 #include "cli_runner.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/log_reader.h"
@@ -38,70 +39,17 @@ namespace {
 
 using nlohmann::json;
 
-std::string Slurp(const std::string& path) {
-  std::string text;
-  std::string error;
-  ReadFileBytes(path, &text, &error);
-  return text;
-}
-
-// The calibration JSON without the solver's wall-clock time, the only field
-// that differs between two runs of the same calibration.
-json WithoutTime(const std::string& text) {
-  json j = json::parse(text);
-  j["solver"].erase("time_s");
-  return j;
-}
-
-// summary.csv without the time columns.
-std::string WithoutTimes(const std::string& csv) {
-  std::vector<SummaryRow> rows;
-  std::string error;
-  EXPECT_TRUE(ParseSummaryCsv(csv, "summary.csv", &rows, &error)) << error;
-  for (SummaryRow& row : rows) {
-    for (const char* c : {"read_s", "detect_s", "solve_s", "total_s"}) row.values.erase(c);
-  }
-  return SummaryToCsv(rows);
-}
+using testing_util::CountNames;
+using testing_util::FileId;
+using testing_util::JsonFiles;
+using testing_util::Slurp;
+using testing_util::WithoutTime;
+using testing_util::WithoutTimes;
 
 struct Process {
   int exit_code = -1;
   std::string err;
 };
-
-struct FileId {
-  ino_t inode = 0;
-  int64_t mtime_ns = 0;
-  bool operator==(const FileId& o) const { return inode == o.inode && mtime_ns == o.mtime_ns; }
-};
-
-// Finished files (*.json, no temporaries) in a folder, with inode and mtime.
-std::map<std::string, FileId> JsonFiles(const std::string& folder) {
-  std::map<std::string, FileId> files;
-  DIR* dir = opendir(folder.c_str());
-  if (dir == nullptr) return files;
-  while (const dirent* e = readdir(dir)) {
-    const std::string name = e->d_name;
-    if (name.size() < 5 || name.compare(name.size() - 5, 5, ".json") != 0) continue;
-    struct stat st;
-    if (stat((folder + "/" + name).c_str(), &st) != 0) continue;
-    files[name] = {st.st_ino,
-                   static_cast<int64_t>(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec};
-  }
-  closedir(dir);
-  return files;
-}
-
-// Names in a folder that contain `part`.
-size_t CountNames(const std::string& folder, const std::string& part) {
-  size_t n = 0;
-  DIR* dir = opendir(folder.c_str());
-  if (dir == nullptr) return 0;
-  while (const dirent* e = readdir(dir))
-    n += std::string(e->d_name).find(part) != std::string::npos;
-  closedir(dir);
-  return n;
-}
 
 // Twelve units: nine good ones (one with its own gravity, one with a planted
 // accelerometer bias), a corrupt file, a missing file and a session with
@@ -267,7 +215,7 @@ TEST_F(BatchTest, ExceptionsInCallbacksFailOnlyThatUnit) {
   ASSERT_TRUE(CalibrateBatch(units, base_, options, &results, &error)) << error;
   EXPECT_EQ(results[0].status, BatchStatus::kOk);
   EXPECT_EQ(results[1].status, BatchStatus::kFailed);
-  EXPECT_EQ(results[1].message, "u01: internal error: disk full");
+  EXPECT_EQ(results[1].message, "u01: the result could not be stored: disk full");
   EXPECT_EQ(results[2].status, BatchStatus::kOk);
   EXPECT_TRUE(results[0].calibration.positions.empty());
   options.threads = -1;

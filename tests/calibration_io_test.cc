@@ -157,5 +157,24 @@ INSTANTIATE_TEST_SUITE_P(EveryMethod, CalibrationRoundTrip, ::testing::ValuesIn(
                            return info.param.name;
                          });
 
+// Found by fuzz/fuzz_calibration_json (kept in fuzz/regressions/): a number
+// beyond double made nlohmann throw out_of_range, which nothing caught, so
+// `gravcal apply` aborted. Now it is an error naming the file.
+TEST(CalibrationJsonReader, ANumberBeyondDoubleIsAnErrorNotACrash) {
+  testing_util::ScratchDir dir;
+  const std::string path =
+      dir.Write("huge.json", "{\"accel\": {\"bias\": [4.01e5685773387834, 0, 0]}}");
+  LoadedCalibration loaded;
+  std::string error;
+  EXPECT_FALSE(ReadCalibrationJson(path, &loaded, &error));
+  EXPECT_NE(error.find(path + ": not valid JSON"), std::string::npos) << error;
+  EXPECT_NE(error.find("number overflow"), std::string::npos) << error;
+  const std::string regression =
+      testing_util::SourceDir() + "/fuzz/regressions/calibration_json/number_overflow.json";
+  error.clear();
+  EXPECT_FALSE(ReadCalibrationJson(regression, &loaded, &error));
+  EXPECT_FALSE(error.empty());
+}
+
 }  // namespace
 }  // namespace gravcal

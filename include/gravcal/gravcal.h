@@ -71,6 +71,7 @@
 // workflows
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/batch_manifest.h"
+#include "gravcal/workflows/batch_scheduler_shard.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/discovery.h"
 #include "gravcal/workflows/discovery_report.h"

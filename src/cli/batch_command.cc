@@ -15,11 +15,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <system_error>
@@ -29,6 +32,7 @@
 #include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/batch_manifest.h"
+#include "gravcal/workflows/batch_scheduler_shard.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/report.h"
 
@@ -41,6 +45,11 @@ using Json = nlohmann::json;
 const char kStateFolder[] = "batch_state";
 // Failed units listed by name on stderr; summary.json lists all.
 constexpr size_t kFailuresShown = 10;
+
+bool SetError(std::string* error, const std::string& message) {
+  *error = message;
+  return false;
+}
 
 // mkdir -p.
 bool MakeFolders(const std::string& path, std::string* error) {
@@ -190,142 +199,306 @@ int ExitCode(const FleetStatistics& s) {
   return 0;
 }
 
-}  // namespace
+// Set by SIGTERM / SIGINT (once: the second one kills as usual) or by a
+// result that cannot be stored; BatchOptions::stop.
+std::atomic<bool> g_stop{false};
+volatile std::sig_atomic_t g_stop_signal = 0;
+static_assert(std::atomic<bool>::is_always_lock_free, "g_stop is set in a signal handler");
 
-int RunBatch(const CommandArgs& args) {
-  if (args.output_dir.empty()) return Fail("batch needs --output-dir <folder>");
+void OnStopSignal(int signal) {
+  g_stop_signal = signal;
+  g_stop.store(true);
+}
+
+// Installs OnStopSignal for SIGTERM and SIGINT for the object's lifetime.
+class StopSignals {
+ public:
+  StopSignals() {
+    g_stop = false;
+    g_stop_signal = 0;
+    struct sigaction action = {};
+    action.sa_handler = OnStopSignal;
+    action.sa_flags = SA_RESETHAND;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGTERM, &action, &old_term_);
+    sigaction(SIGINT, &action, &old_int_);
+  }
+  ~StopSignals() {
+    sigaction(SIGTERM, &old_term_, nullptr);
+    sigaction(SIGINT, &old_int_, nullptr);
+  }
+
+ private:
+  struct sigaction old_term_ = {};
+  struct sigaction old_int_ = {};
+};
+
+// The options of a batch, checked.
+struct BatchSettings {
+  FleetOptions fleet;
+  BatchOptions batch;
+  Shard shard;
+  // Where --shard auto found K/N; empty for K/N or no shard.
+  std::string shard_source;
+};
+
+bool ReadBatchSettings(const CommandArgs& args, BatchSettings* s, std::string* error) {
+  if (args.output_dir.empty()) return SetError(error, "batch needs --output-dir <folder>");
   const bool by_topic = !args.topics.empty();
   if (by_topic && (args.topics != "all" || args.input.empty())) {
-    return Fail("--topics takes 'all', with --input <bag or MCAP file>");
+    return SetError(error, "--topics takes 'all', with --input <bag or MCAP file>");
   }
   if (by_topic ? !args.manifest.empty() || !args.input_dir.empty()
                : args.manifest.empty() == args.input_dir.empty()) {
-    return Fail(
-        "batch needs either --manifest <units.csv>, --input-dir <folder> or --input "
-        "<bag> --topics all");
+    return SetError(error,
+                    "batch needs either --manifest <units.csv>, --input-dir <folder> or --input "
+                    "<bag> --topics all");
   }
-  std::string error;
-  if (!args.config.IsValid(&error)) return Fail(error);
-  FleetOptions fleet_options;
-  fleet_options.outlier_sigmas = args.outlier_sigmas;
-  fleet_options.min_units = args.outlier_min_units;
-  if (!fleet_options.IsValid(&error)) return Fail(error);
-  BatchOptions options;
-  options.threads = args.threads;
-  options.keep_calibrations = false;
-  if (!options.IsValid(&error)) return Fail(error);
-  Shard shard;
-  if (!args.shard.empty() && !ParseShard(args.shard, &shard, &error)) return Fail(error);
+  if (!args.config.IsValid(error)) return false;
+  s->fleet.outlier_sigmas = args.outlier_sigmas;
+  s->fleet.min_units = args.outlier_min_units;
+  if (!s->fleet.IsValid(error)) return false;
+  s->batch.threads = args.threads;
+  s->batch.keep_calibrations = false;
+  s->batch.unit_timeout_seconds = args.unit_timeout;
+  s->batch.stop = &g_stop;
+  if (!s->batch.IsValid(error)) return false;
+  if (IsSchedulerShard(args.shard)) {
+    return ShardFromScheduler(args.shard, ProcessEnvironment(), &s->shard, &s->shard_source, error);
+  }
+  return args.shard.empty() || ParseShard(args.shard, &s->shard, error);
+}
 
-  std::vector<BatchUnit> fleet;
-  const bool listed = by_topic ? UnitsFromTopics(args.input, &fleet, &error)
-                      : args.manifest.empty()
-                          ? UnitsFromDirectory(args.input_dir, args.pattern, &fleet, &error)
-                          : ReadBatchManifest(args.manifest, args.config, &fleet, &error);
-  if (!listed) return Fail(error);
+// The fleet's units of this shard, with their positions in the fleet.
+struct ShardUnits {
   FleetInfo info;
-  {
-    std::vector<std::string> ids;
-    for (const BatchUnit& u : fleet) ids.push_back(u.id);
-    info.fleet = FleetHash(ids);
-  }
-  info.config = ConfigHash(args.config);
-  info.units_in_fleet = fleet.size();
-  info.shard_index = shard.index;
-  info.shard_count = shard.count;
-  const std::vector<size_t> positions = ShardPositions(fleet.size(), shard);
   std::vector<BatchUnit> units;
-  units.reserve(positions.size());
-  for (size_t p : positions) units.push_back(std::move(fleet[p]));
+  std::vector<size_t> positions;
+};
 
-  const std::string& out = args.output_dir;
-  const std::string state_folder = out + "/" + kStateFolder;
-  if (!MakeFolders(state_folder, &error)) return Fail(error);
-  RemoveStaleTemporaries(out);
-  RemoveStaleTemporaries(state_folder);
+bool ListShardUnits(const CommandArgs& args, const Shard& shard, ShardUnits* out,
+                    std::string* error) {
+  std::vector<BatchUnit> fleet;
+  const bool listed = !args.topics.empty() ? UnitsFromTopics(args.input, &fleet, error)
+                      : args.manifest.empty()
+                          ? UnitsFromDirectory(args.input_dir, args.pattern, &fleet, error)
+                          : ReadBatchManifest(args.manifest, args.config, &fleet, error);
+  if (!listed) return false;
+  std::vector<std::string> ids;
+  for (const BatchUnit& u : fleet) ids.push_back(u.id);
+  out->info.fleet = FleetHash(ids);
+  out->info.config = ConfigHash(args.config);
+  out->info.units_in_fleet = fleet.size();
+  out->info.shard_index = shard.index;
+  out->info.shard_count = shard.count;
+  out->positions = ShardPositions(fleet.size(), shard);
+  for (size_t p : out->positions) out->units.push_back(std::move(fleet[p]));
+  return true;
+}
 
-  std::vector<SummaryRow> rows(units.size());
-  std::vector<char> have_row(units.size(), 0);
-  options.skip = [&](size_t i, const BatchUnit& unit, const std::string& hash) {
-    SummaryRow row;
-    if (!ReadState(state_folder + "/" + unit.id + ".json", hash, positions[i], &row)) return false;
-    if (row.status == BatchStatus::kOk && !FileExists(out + "/" + unit.id + ".json")) return false;
-    rows[i] = std::move(row);
-    have_row[i] = 1;
+// The batch's files: the state of each unit (resume), its calibration JSON,
+// and its summary row. A result that cannot be stored (disk full, folder
+// unwritable) stops the batch: the units after it would fail the same way.
+class BatchStore {
+ public:
+  BatchStore(const CommandArgs& args, const ShardUnits& shard)
+      : args_(args),
+        shard_(shard),
+        out_(args.output_dir),
+        state_folder_(out_ + "/" + kStateFolder),
+        rows_(shard.units.size()),
+        have_row_(shard.units.size(), 0) {}
+
+  bool Prepare(std::string* error) {
+    if (!MakeFolders(state_folder_, error)) return false;
+    RemoveStaleTemporaries(out_);
+    RemoveStaleTemporaries(state_folder_);
     return true;
-  };
-  options.on_result = [&](size_t i, const BatchResult& r) {
+  }
+
+  bool Skip(size_t i, const BatchUnit& unit, const std::string& hash) {
+    SummaryRow row;
+    if (!ReadState(state_folder_ + "/" + unit.id + ".json", hash, shard_.positions[i], &row)) {
+      return false;
+    }
+    if (row.status == BatchStatus::kOk && !FileExists(out_ + "/" + unit.id + ".json")) {
+      return false;
+    }
+    rows_[i] = std::move(row);
+    have_row_[i] = 1;
+    return true;
+  }
+
+  void Store(size_t i, const BatchResult& r) {
     if (r.skipped) return;
-    const std::string result_path = out + "/" + r.unit + ".json";
     std::string why;
+    if (!WriteResult(i, r, &why)) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (write_error_.empty()) write_error_ = why;
+      }
+      g_stop = true;
+      throw std::runtime_error(why);
+    }
+  }
+
+  // Every unit's row: from its state or this run's result.
+  const std::vector<SummaryRow>& Rows(const std::vector<BatchResult>& results) {
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      if (!have_row_[i]) rows_[i] = MakeSummaryRow(shard_.positions[i], results[i]);
+    }
+    return rows_;
+  }
+
+  // The first result that could not be stored ("" when none).
+  std::string write_error() const { return write_error_; }
+  const std::string& out() const { return out_; }
+
+ private:
+  bool WriteResult(size_t i, const BatchResult& r, std::string* why) {
+    const std::string result_path = out_ + "/" + r.unit + ".json";
     if (r.status == BatchStatus::kOk) {
       Config config;
-      if (!EffectiveConfig(units[i], args.config, &config, &why) ||
-          !WriteCalibrationJson(r.calibration, config.output_covariance, result_path, &why)) {
-        throw std::runtime_error(why);
+      if (!EffectiveConfig(shard_.units[i], args_.config, &config, why) ||
+          !WriteCalibrationJson(r.calibration, config.output_covariance, result_path, why)) {
+        return false;
       }
     } else if (unlink(result_path.c_str()) != 0 && errno != ENOENT) {
-      throw std::runtime_error(result_path + ": cannot remove the stale result: " +
-                               std::generic_category().message(errno));
+      *why = result_path +
+             ": cannot remove the stale result: " + std::generic_category().message(errno);
+      return false;
     }
-    SummaryRow row = MakeSummaryRow(positions[i], r);
+    SummaryRow row = MakeSummaryRow(shard_.positions[i], r);
     if (!r.content_hash.empty()) {
       const Json state = {{"unit", r.unit},
                           {"content_hash", r.content_hash},
                           {"gravcal_version", GravcalVersion()},
                           {"row", RowToJson(row)}};
-      if (!WriteFileAtomically(state_folder + "/" + r.unit + ".json", state.dump(2) + "\n", &why)) {
-        throw std::runtime_error(why);
+      if (!WriteFileAtomically(state_folder_ + "/" + r.unit + ".json", state.dump(2) + "\n", why)) {
+        return false;
       }
     }
-    rows[i] = std::move(row);
-    have_row[i] = 1;
+    rows_[i] = std::move(row);
+    have_row_[i] = 1;
+    return true;
+  }
+
+  const CommandArgs& args_;
+  const ShardUnits& shard_;
+  const std::string out_;
+  const std::string state_folder_;
+  std::vector<SummaryRow> rows_;
+  std::vector<char> have_row_;
+  std::mutex mutex_;
+  std::string write_error_;
+};
+
+// What happened to the units of this run, beyond the fleet statistics.
+struct RunCounts {
+  size_t skipped = 0;
+  size_t timed_out = 0;
+  size_t not_run = 0;
+  BatchTimings sum;
+};
+
+RunCounts CountRun(const std::vector<BatchResult>& results) {
+  RunCounts c;
+  for (const BatchResult& r : results) {
+    if (r.skipped) ++c.skipped;
+    if (r.timed_out) ++c.timed_out;
+    if (r.not_run) ++c.not_run;
+    if (r.skipped || r.not_run) continue;
+    c.sum.read_seconds += r.timings.read_seconds;
+    c.sum.detect_seconds += r.timings.detect_seconds;
+    c.sum.solve_seconds += r.timings.solve_seconds;
+  }
+  return c;
+}
+
+// Why the batch stopped early ("" when it did not).
+std::string StopReason(const BatchStore& store) {
+  if (g_stop_signal != 0)
+    return std::string("stopped by ") + (g_stop_signal == SIGINT ? "SIGINT" : "SIGTERM");
+  if (!store.write_error().empty()) return "stopped: cannot store a result: " + store.write_error();
+  return "";
+}
+
+void PrintBatchLine(const BatchSettings& s, const ShardUnits& shard, const FleetStatistics& st,
+                    const RunCounts& c, double elapsed, const std::string& stop,
+                    const std::string& out) {
+  const size_t computed = shard.units.size() - c.skipped - c.not_run;
+  const double busy = c.sum.read_seconds + c.sum.detect_seconds + c.sum.solve_seconds;
+  auto percent = [busy](double x) { return busy > 0 ? 100 * x / busy : 0.0; };
+  const std::string from = s.shard_source.empty() ? "" : " from " + s.shard_source;
+  std::fprintf(
+      stderr,
+      "gravcal: batch: %zu units (shard %d/%d%s of a fleet of %zu): %zu ok, %zu failed, %zu not "
+      "converged, %zu outliers; skipped %zu (stored results up to date); %zu timed out; %.1f "
+      "units/s computed; time in read %.0f %%, detect %.0f %%, solve %.0f %%; wrote "
+      "%s/summary.csv and summary.json\n",
+      shard.units.size(), s.shard.index, s.shard.count, from.c_str(),
+      static_cast<size_t>(shard.info.units_in_fleet), st.ok, st.failed, st.not_converged,
+      st.outliers.size(), c.skipped, c.timed_out, elapsed > 0 ? computed / elapsed : 0.0,
+      percent(c.sum.read_seconds), percent(c.sum.detect_seconds), percent(c.sum.solve_seconds),
+      out.c_str());
+  if (!stop.empty()) {
+    std::fprintf(stderr,
+                 "gravcal: batch %s: %zu units not run (summary.csv says which); every result "
+                 "written is complete: run the same command again to resume\n",
+                 stop.c_str(), c.not_run);
+  }
+}
+
+}  // namespace
+
+int RunBatch(const CommandArgs& args) {
+  BatchSettings settings;
+  std::string error;
+  if (!ReadBatchSettings(args, &settings, &error)) return Fail(error);
+  ShardUnits shard;
+  if (!ListShardUnits(args, settings.shard, &shard, &error)) return Fail(error);
+  BatchStore store(args, shard);
+  if (!store.Prepare(&error)) return Fail(error);
+
+  StopSignals signals;
+  BatchOptions& options = settings.batch;
+  options.skip = [&store](size_t i, const BatchUnit& unit, const std::string& hash) {
+    return store.Skip(i, unit, hash);
   };
+  options.on_result = [&store](size_t i, const BatchResult& r) { store.Store(i, r); };
   ProgressDisplay display;
   options.progress = [&display](const BatchProgress& p) { display.Update(p); };
 
   const auto start = std::chrono::steady_clock::now();
   std::vector<BatchResult> results;
-  if (!CalibrateBatch(units, args.config, options, &results, &error)) return Fail(error);
+  if (!CalibrateBatch(shard.units, args.config, options, &results, &error)) return Fail(error);
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  size_t skipped = 0;
-  BatchTimings sum;
-  for (size_t i = 0; i < units.size(); ++i) {
-    // A unit whose result could not be stored has no row yet.
-    if (!have_row[i]) rows[i] = MakeSummaryRow(positions[i], results[i]);
-    if (results[i].skipped) {
-      ++skipped;
-      continue;
-    }
-    sum.read_seconds += results[i].timings.read_seconds;
-    sum.detect_seconds += results[i].timings.detect_seconds;
-    sum.solve_seconds += results[i].timings.solve_seconds;
-  }
+  const std::string stop = StopReason(store);
+  const RunCounts counts = CountRun(results);
   FleetStatistics statistics;
-  if (!WriteSummary(out, rows, info, fleet_options, &statistics, &error)) return Fail(error);
+  if (!WriteSummary(store.out(), store.Rows(results), shard.info, settings.fleet, &statistics,
+                    &error)) {
+    return Fail(error + (stop.empty() ? "" : " (batch " + stop + ")") +
+                "; the unit results written are complete: run again to resume");
+  }
   ReportFleet(statistics);
-  const size_t computed = units.size() - skipped;
   if (!args.report.empty()) {
-    const BatchThroughput throughput = {elapsed,          computed,           skipped,
-                                        sum.read_seconds, sum.detect_seconds, sum.solve_seconds};
-    if (!WriteFileAtomically(args.report, FleetToHtml(statistics, rows, throughput), &error)) {
+    const size_t computed = shard.units.size() - counts.skipped - counts.not_run;
+    const BatchThroughput throughput = {elapsed,
+                                        computed,
+                                        counts.skipped,
+                                        counts.sum.read_seconds,
+                                        counts.sum.detect_seconds,
+                                        counts.sum.solve_seconds};
+    if (!WriteFileAtomically(args.report, FleetToHtml(statistics, store.Rows(results), throughput),
+                             &error)) {
       return Fail(error);
     }
   }
-  const double busy = sum.read_seconds + sum.detect_seconds + sum.solve_seconds;
-  std::fprintf(
-      stderr,
-      "gravcal: batch: %zu units (shard %d/%d of a fleet of %zu): %zu ok, %zu failed, %zu not "
-      "converged, %zu outliers; skipped %zu (stored results up to date); %.1f units/s "
-      "computed; time in read %.0f %%, detect %.0f %%, solve %.0f %%; wrote %s/summary.csv "
-      "and summary.json\n",
-      units.size(), shard.index, shard.count, fleet.size(), statistics.ok, statistics.failed,
-      statistics.not_converged, statistics.outliers.size(), skipped,
-      elapsed > 0 ? computed / elapsed : 0.0, busy > 0 ? 100 * sum.read_seconds / busy : 0.0,
-      busy > 0 ? 100 * sum.detect_seconds / busy : 0.0,
-      busy > 0 ? 100 * sum.solve_seconds / busy : 0.0, out.c_str());
+  PrintBatchLine(settings, shard, statistics, counts, elapsed, stop, store.out());
+  if (!stop.empty()) return Fail("batch " + stop);
   return ExitCode(statistics);
 }
 

@@ -40,7 +40,10 @@ struct CommandArgs {
   std::string input_dir;
   std::string pattern = "*.csv";
   int threads = 0;
+  // K/N, auto or auto/N (batch_scheduler_shard.h).
   std::string shard;
+  // batch: seconds one unit may take; 0 = no limit.
+  double unit_timeout = 0.0;
   double outlier_sigmas = 5.0;
   int outlier_min_units = 5;
   // plan and check: the request from --target, --pose_set, ... (not the

@@ -28,7 +28,12 @@ DEFINE_string(manifest, "", "batch: CSV with columns unit, path and optional con
 DEFINE_string(input_dir, "", "batch: every file matching --pattern in this folder is a unit");
 DEFINE_string(pattern, "*.csv", "batch: file name pattern for --input-dir");
 DEFINE_int32(threads, 0, "batch: worker threads, 0 = one per core");
-DEFINE_string(shard, "", "batch: K/N, calibrate only units i with i mod N = K - 1");
+DEFINE_string(shard, "",
+              "batch: K/N, calibrate only units i with i mod N = K - 1; auto or auto/N: K and N "
+              "from the scheduler's job array (Slurm, Kubernetes, AWS Batch)");
+DEFINE_double(unit_timeout, 0.0,
+              "batch: seconds one unit may take; a unit over it fails with a message and the "
+              "batch goes on (0 = no limit)");
 DEFINE_double(outlier_sigmas, gravcal::FleetOptions().outlier_sigmas,
               "batch: outlier threshold, robust standard deviations from the fleet median");
 DEFINE_int32(outlier_min_units, gravcal::FleetOptions().min_units,
@@ -82,6 +87,8 @@ struct CommandInfo {
   int (*run)(const gravcal::cli::CommandArgs&);
   // Takes arguments that are not flags (merge-summaries: the shard folders).
   bool positional = false;
+  // Reads the config: takes config keys as flags (--gravity 9.81).
+  bool config_keys = true;
 };
 
 const std::vector<CommandInfo>& Commands() {
@@ -122,14 +129,15 @@ const std::vector<CommandInfo>& Commands() {
        "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
        "statistics)",
        {"manifest", "input_dir", "pattern", "config", "output_dir", "threads", "shard",
-        "outlier_sigmas", "outlier_min_units", "input", "topics", "report"},
+        "outlier_sigmas", "outlier_min_units", "input", "topics", "report", "unit_timeout"},
        gravcal::cli::RunBatch},
       {"merge-summaries",
        "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
        "shard1/ shard2/ ...",
        {"output_dir", "outlier_sigmas", "outlier_min_units"},
        gravcal::cli::RunMergeSummaries,
-       true},
+       true,
+       false},
       {"discover",
        "find the effects the model misses: discovery.json and an HTML report",
        {"input", "config", "output", "report"},
@@ -216,6 +224,159 @@ void PrintHelp(const std::string& command) {
   std::printf("unknown command '%s'\n", command.c_str());
 }
 
+// The command line split: config keys (--key value) become overrides, the
+// gflags flags are copied as "--name=value" for gflags, the rest is
+// positional.
+struct SplitArguments {
+  std::vector<std::pair<std::string, std::string>> overrides;
+  std::vector<std::string> flags;
+  std::vector<std::string> positional;
+  bool help = false;
+};
+
+// "--output-dir" -> "output_dir".
+std::string FlagName(std::string name) {
+  for (char& ch : name) {
+    if (ch == '-') ch = '_';
+  }
+  return name;
+}
+
+std::string DashedName(std::string name) {
+  for (char& ch : name) {
+    if (ch == '_') ch = '-';
+  }
+  return name;
+}
+
+bool SplitCommandLine(int argc, char** argv, const CommandInfo& command, SplitArguments* split,
+                      std::string* error) {
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      split->help = true;
+      return true;
+    }
+    if (arg.rfind("--", 0) != 0) {
+      if (!command.positional) {
+        *error = "unexpected argument '" + arg + "'";
+        return false;
+      }
+      split->positional.push_back(arg);
+      continue;
+    }
+    std::string name = arg.substr(2);
+    std::string value;
+    const size_t eq = name.find('=');
+    const bool has_value = eq != std::string::npos;
+    if (has_value) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    }
+    name = FlagName(name);
+    // Every flag here, config key or gflags flag, takes a value.
+    if (!has_value) {
+      if (i + 1 >= argc) {
+        *error = "flag --" + DashedName(name) + " needs a value";
+        return false;
+      }
+      value = argv[++i];
+    }
+    if (gravcal::IsConfigKey(name)) {
+      split->overrides.emplace_back(name, value);
+    } else {
+      split->flags.push_back("--" + name + "=" + value);
+    }
+  }
+  return true;
+}
+
+// Every flag must be one of gravcal's and one that `command` uses: a flag the
+// command ignores (calibrate --report) is an error, not silently dropped.
+bool CheckFlagsOfCommand(const CommandInfo& command, const SplitArguments& split,
+                         std::string* error) {
+  const std::string listed = std::string("('gravcal ") + command.name + " --help' lists its flags)";
+  for (const std::string& flag : split.flags) {
+    const std::string name = flag.substr(2, flag.find('=') - 2);
+    gflags::CommandLineFlagInfo info;
+    if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info) ||
+        info.filename.find("cli/main.cc") == std::string::npos) {
+      *error = "unknown flag --" + DashedName(name) + " " + listed;
+      return false;
+    }
+    bool used = false;
+    for (const char* f : command.flags) used = used || name == f;
+    if (!used) {
+      *error = "flag --" + DashedName(name) + " is not used by '" + command.name + "' " + listed;
+      return false;
+    }
+  }
+  if (!command.config_keys && !split.overrides.empty()) {
+    *error = "config key --" + DashedName(split.overrides.front().first) + " is not used by '" +
+             command.name + "' " + listed;
+    return false;
+  }
+  return true;
+}
+
+// --config, then the config keys given as flags on top of it.
+bool LoadCommandConfig(const SplitArguments& split, gravcal::Config* config, std::string* error) {
+  if (!FLAGS_config.empty() && !gravcal::LoadConfigFile(FLAGS_config, config, error)) return false;
+  for (const auto& [key, value] : split.overrides) {
+    if (!gravcal::SetConfigValue(key, value, config, error)) {
+      *error = "command line: " + *error;
+      return false;
+    }
+  }
+  return true;
+}
+
+// The parsed gflags values, copied into the command's arguments.
+void CopyFlags(gravcal::cli::CommandArgs* args) {
+  args->config_path = FLAGS_config;
+  args->input = FLAGS_input;
+  args->output = FLAGS_output;
+  args->output_dir = FLAGS_output_dir;
+  args->calibration = FLAGS_calibration;
+  args->seed = FLAGS_seed;
+  args->manifest = FLAGS_manifest;
+  args->input_dir = FLAGS_input_dir;
+  args->pattern = FLAGS_pattern;
+  args->threads = FLAGS_threads;
+  args->shard = FLAGS_shard;
+  args->unit_timeout = FLAGS_unit_timeout;
+  args->outlier_sigmas = FLAGS_outlier_sigmas;
+  args->outlier_min_units = FLAGS_outlier_min_units;
+  args->attitudes = FLAGS_attitudes;
+  args->segments = FLAGS_segments;
+  args->history = FLAGS_history;
+  args->report = FLAGS_report;
+  args->kalibr = FLAGS_kalibr;
+  args->handheld = FLAGS_handheld;
+  args->noise = FLAGS_noise;
+  args->topics = FLAGS_topics;
+  args->to = FLAGS_to;
+  args->plan = FLAGS_plan;
+  args->plan_request.targets = FLAGS_target;
+  args->plan_request.pose_set = FLAGS_pose_set;
+  args->plan_request.free_candidates = FLAGS_candidates;
+  args->plan_request.max_time_seconds = FLAGS_max_time;
+  args->plan_request.overhead_seconds = FLAGS_overhead;
+  args->plan_request.min_hold_seconds = FLAGS_min_hold;
+  args->plan_request.max_hold_seconds = FLAGS_max_hold;
+  args->plan_request.accel_noise_density = FLAGS_accel_noise_density;
+  args->plan_request.accel_bias_instability = FLAGS_accel_bias_instability;
+  args->plan_request.accel_random_walk = FLAGS_accel_random_walk;
+  args->plan_request.pose_disturbance = FLAGS_pose_disturbance;
+}
+
+const CommandInfo* FindCommand(const std::string& name) {
+  for (const CommandInfo& c : Commands()) {
+    if (name == c.name) return &c;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -232,114 +393,26 @@ int main(int argc, char** argv) {
     PrintHelp(argc > 2 ? argv[2] : "");
     return 0;
   }
-  const CommandInfo* info = nullptr;
-  for (const CommandInfo& c : Commands()) {
-    if (command == c.name) info = &c;
-  }
+  const CommandInfo* info = FindCommand(command);
   if (info == nullptr) return Fail("unknown command '" + command + "' (gravcal help lists them)");
 
-  // Split argv: config keys become overrides, the rest goes to gflags.
-  std::vector<std::pair<std::string, std::string>> overrides;
-  std::vector<char*> rest = {argv[0]};
-  std::vector<std::string> storage;
-  storage.reserve(argc);
-  std::vector<std::string> positional;
-  for (int i = 2; i < argc; ++i) {
-    std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      PrintHelp(command);
-      return 0;
-    }
-    if (arg.rfind("--", 0) != 0) {
-      if (!info->positional) return Fail("unexpected argument '" + arg + "'");
-      positional.push_back(arg);
-      continue;
-    }
-    std::string name = arg.substr(2);
-    std::string value;
-    bool has_value = false;
-    const size_t eq = name.find('=');
-    if (eq != std::string::npos) {
-      value = name.substr(eq + 1);
-      name = name.substr(0, eq);
-      has_value = true;
-    }
-    for (char& ch : name) {
-      if (ch == '-') ch = '_';
-    }
-    if (gravcal::IsConfigKey(name)) {
-      if (!has_value) {
-        if (i + 1 >= argc) return Fail("flag --" + name + " needs a value");
-        value = argv[++i];
-      }
-      overrides.emplace_back(name, value);
-      continue;
-    }
-    // Every gflags flag here takes a value.
-    if (!has_value) {
-      if (i + 1 >= argc) return Fail("flag --" + name + " needs a value");
-      value = argv[++i];
-    }
-    storage.push_back("--" + name + "=" + value);
-    rest.push_back(storage.back().data());
+  SplitArguments split;
+  std::string error;
+  if (!SplitCommandLine(argc, argv, *info, &split, &error)) return Fail(error);
+  if (split.help) {
+    PrintHelp(command);
+    return 0;
   }
-  int rest_argc = static_cast<int>(rest.size());
-  char** rest_argv = rest.data();
-  for (int i = 1; i < rest_argc; ++i) {
-    std::string name = rest_argv[i] + 2;
-    name = name.substr(0, name.find('='));
-    gflags::CommandLineFlagInfo info;
-    if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info) ||
-        info.filename.find("cli/main.cc") == std::string::npos) {
-      return Fail("unknown flag --" + name + " ('gravcal " + command + " --help' lists the flags)");
-    }
-  }
-  gflags::ParseCommandLineNonHelpFlags(&rest_argc, &rest_argv, false);
+  if (!CheckFlagsOfCommand(*info, split, &error)) return Fail(error);
+  std::vector<char*> gflags_argv = {argv[0]};
+  for (std::string& f : split.flags) gflags_argv.push_back(f.data());
+  int gflags_argc = static_cast<int>(gflags_argv.size());
+  char** gflags_args = gflags_argv.data();
+  gflags::ParseCommandLineNonHelpFlags(&gflags_argc, &gflags_args, false);
 
   gravcal::cli::CommandArgs args;
-  std::string error;
-  args.config_path = FLAGS_config;
-  if (!FLAGS_config.empty() && !gravcal::LoadConfigFile(FLAGS_config, &args.config, &error)) {
-    return Fail(error);
-  }
-  for (const auto& [key, value] : overrides) {
-    if (!gravcal::SetConfigValue(key, value, &args.config, &error))
-      return Fail("command line: " + error);
-  }
-  args.input = FLAGS_input;
-  args.output = FLAGS_output;
-  args.output_dir = FLAGS_output_dir;
-  args.calibration = FLAGS_calibration;
-  args.seed = FLAGS_seed;
-  args.manifest = FLAGS_manifest;
-  args.input_dir = FLAGS_input_dir;
-  args.pattern = FLAGS_pattern;
-  args.threads = FLAGS_threads;
-  args.shard = FLAGS_shard;
-  args.outlier_sigmas = FLAGS_outlier_sigmas;
-  args.outlier_min_units = FLAGS_outlier_min_units;
-  args.positional = positional;
-  args.attitudes = FLAGS_attitudes;
-  args.segments = FLAGS_segments;
-  args.history = FLAGS_history;
-  args.report = FLAGS_report;
-  args.kalibr = FLAGS_kalibr;
-  args.handheld = FLAGS_handheld;
-  args.noise = FLAGS_noise;
-  args.topics = FLAGS_topics;
-  args.to = FLAGS_to;
-  args.plan = FLAGS_plan;
-  args.plan_request.targets = FLAGS_target;
-  args.plan_request.pose_set = FLAGS_pose_set;
-  args.plan_request.free_candidates = FLAGS_candidates;
-  args.plan_request.max_time_seconds = FLAGS_max_time;
-  args.plan_request.overhead_seconds = FLAGS_overhead;
-  args.plan_request.min_hold_seconds = FLAGS_min_hold;
-  args.plan_request.max_hold_seconds = FLAGS_max_hold;
-  args.plan_request.accel_noise_density = FLAGS_accel_noise_density;
-  args.plan_request.accel_bias_instability = FLAGS_accel_bias_instability;
-  args.plan_request.accel_random_walk = FLAGS_accel_random_walk;
-  args.plan_request.pose_disturbance = FLAGS_pose_disturbance;
-
+  if (!LoadCommandConfig(split, &args.config, &error)) return Fail(error);
+  CopyFlags(&args);
+  args.positional = split.positional;
   return info->run(args);
 }

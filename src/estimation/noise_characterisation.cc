@@ -6,6 +6,8 @@
 #include <sstream>
 #include <vector>
 
+#include "util/source_prefix.h"
+
 namespace gravcal {
 namespace internal {
 namespace {
@@ -64,7 +66,7 @@ bool ChooseStillRange(const ImuLog& log, const NoiseOptions& options, size_t* be
   if (options.find_still) {
     StaticDetection detection;
     if (!DetectStaticIntervals(log, options.detector, &detection)) {
-      *message = log.source + ": " + detection.message;
+      *message = internal::PrefixSource(log.source, detection.message);
       return false;
     }
     if (detection.intervals.empty()) {

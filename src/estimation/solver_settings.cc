@@ -1,5 +1,7 @@
 #include "estimation/solver_settings.h"
 
+#include "util/cancellation.h"
+
 namespace gravcal {
 
 bool SolverTolerances::IsValid(std::string* error) const {
@@ -17,6 +19,18 @@ bool SolverTolerances::IsValid(std::string* error) const {
 }
 
 namespace internal {
+namespace {
+
+// Aborts the solve when the work on this thread was cancelled (a batch unit
+// over its time limit, util/cancellation.h).
+class CancellationCallback : public ceres::IterationCallback {
+ public:
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return CancelRequested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+};
+
+}  // namespace
 
 ceres::Solver::Options SolverOptions(const SolverTolerances& tolerances,
                                      ceres::LinearSolverType linear_solver) {
@@ -29,6 +43,8 @@ ceres::Solver::Options SolverOptions(const SolverTolerances& tolerances,
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
   options.num_threads = 1;
+  static CancellationCallback cancellation;
+  options.callbacks.push_back(&cancellation);
   return options;
 }
 

@@ -444,7 +444,9 @@ bool CalibrationFromJson(const std::string& text, const std::string& name,
   json j;
   try {
     j = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error, and out_of_range for a number beyond double (found by
+    // fuzz/fuzz_calibration_json: "1e999999" aborted gravcal apply).
     *error = name + ": not valid JSON (" + e.what() + ")";
     return false;
   }

@@ -4,6 +4,7 @@
 #define GRAVCAL_SRC_IO_FILE_TEXT_H_
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -22,6 +23,19 @@ class FileText {
   std::unique_ptr<char[]> data_;
   size_t size_ = 0;
 };
+
+// Memory the system can still give (MemAvailable of /proc/meminfo, else
+// the free physical pages); 0 when unknown.
+uint64_t AvailableMemoryBytes();
+
+// A log of `file_bytes` parsed in memory needs the text and the samples
+// (8 doubles a row): about kLogMemoryPerFileByte times its size for raw
+// counts (rows of ~40 bytes). False with a message saying how large the file
+// is, what it needs and what to do, when that exceeds `available_bytes`
+// (0 = unknown: no check).
+constexpr double kLogMemoryPerFileByte = 2.7;
+bool CheckLogFitsInMemory(const std::string& path, uint64_t file_bytes, uint64_t available_bytes,
+                          std::string* error);
 
 }  // namespace internal
 }  // namespace gravcal

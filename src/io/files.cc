@@ -30,6 +30,43 @@ std::string ErrnoMessage(int errnum) { return std::generic_category().message(er
 
 namespace internal {
 
+uint64_t AvailableMemoryBytes() {
+  if (FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    unsigned long long kib = 0;
+    bool found = false;
+    while (!found && std::fgets(line, sizeof(line), f) != nullptr) {
+      found = std::sscanf(line, "MemAvailable: %llu kB", &kib) == 1;
+    }
+    std::fclose(f);
+    if (found) return static_cast<uint64_t>(kib) * 1024;
+  }
+  const long pages = sysconf(_SC_AVPHYS_PAGES);
+  const long page_size = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page_size > 0 ? static_cast<uint64_t>(pages) * page_size : 0;
+}
+
+namespace {
+
+std::string Gigabytes(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.2f GB", bytes / 1e9);
+  return text;
+}
+
+}  // namespace
+
+bool CheckLogFitsInMemory(const std::string& path, uint64_t file_bytes, uint64_t available_bytes,
+                          std::string* error) {
+  const double needed = kLogMemoryPerFileByte * static_cast<double>(file_bytes);
+  if (available_bytes == 0 || needed <= static_cast<double>(available_bytes)) return true;
+  return SetError(error, path + ": the log is " + Gigabytes(static_cast<double>(file_bytes)) +
+                             " and reading it needs about " + Gigabytes(needed) + " of memory; " +
+                             Gigabytes(static_cast<double>(available_bytes)) +
+                             " is available. Split it into shorter sessions (each calibration "
+                             "needs only its own poses) or run on a machine with more memory");
+}
+
 bool FileText::Read(const std::string& path, std::string* error) {
   const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return SetError(error, path + ": cannot open: " + ErrnoMessage(errno));

@@ -1,5 +1,7 @@
 #include "gravcal/io/log_reader.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -18,6 +20,7 @@
 #include "io/file_text.h"
 #include "io/formats/file_format.h"
 #include "io/formats/message_log.h"
+#include "util/cancellation.h"
 
 namespace gravcal {
 namespace {
@@ -27,6 +30,11 @@ using internal::FileText;
 // The contract's column names, in the order of the slots a row fills.
 enum Slot : int { kT = 0, kAx, kAy, kAz, kGx, kGy, kGz, kTemp, kNumSlots };
 constexpr const char* kSlotNames[kNumSlots] = {"t", "ax", "ay", "az", "gx", "gy", "gz", "temp"};
+
+// Longer lines and more columns are not a log: refused before they cost
+// memory or time.
+constexpr size_t kMaxLineBytes = size_t{1} << 16;
+constexpr size_t kMaxColumns = 4096;
 
 // Two times agree when they differ by at most this, relative.
 constexpr double kTimeTolerance = 1e-9;
@@ -51,25 +59,48 @@ std::string FormatDouble(double x) {
   return std::string(buffer, result.ptr);
 }
 
-// A cell as it appears in a message: quoted, bounded, printable.
-std::string Quote(std::string_view cell) {
-  constexpr size_t kMaxChars = 40;
-  std::string out = "'";
-  for (size_t i = 0; i < cell.size() && i < kMaxChars; ++i) {
-    const unsigned char c = static_cast<unsigned char>(cell[i]);
-    out += (c < 0x20 || c == 0x7f) ? '?' : static_cast<char>(c);
+// Bytes of the file as they appear in a message: at most `max_chars` of
+// them, control bytes and bytes that are not UTF-8 written as \xNN, so a
+// binary or garbled file never sends raw bytes to the terminal.
+std::string Printable(std::string_view text, size_t max_chars) {
+  static const char kHex[] = "0123456789abcdef";
+  std::string out;
+  size_t i = 0;
+  for (; i < text.size() && i < max_chars; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    // A valid UTF-8 sequence passes whole.
+    size_t length = c >= 0xC2 && c <= 0xDF   ? 2
+                    : c >= 0xE0 && c <= 0xEF ? 3
+                    : c >= 0xF0 && c <= 0xF4 ? 4
+                                             : 1;
+    for (size_t k = 1; k < length; ++k) {
+      if (i + k >= text.size() || (static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80)
+        length = 1;
+    }
+    if (length > 1) {
+      out.append(text.data() + i, length);
+      i += length - 1;
+    } else if (c < 0x20 || c >= 0x7f) {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
   }
-  if (cell.size() > kMaxChars) out += "...";
-  out += "'";
+  if (i < text.size()) out += "...";
   return out;
 }
+
+// A cell as it appears in a message: quoted, bounded, printable.
+std::string Quote(std::string_view cell) { return "'" + Printable(cell, 40) + "'"; }
 
 std::string JoinNames(const std::vector<std::string>& names) {
   constexpr size_t kMaxNames = 32;
   std::string out;
   for (size_t i = 0; i < names.size() && i < kMaxNames; ++i) {
     if (i > 0) out += ", ";
-    out += names[i].empty() ? std::string("''") : names[i];
+    out += names[i].empty() ? std::string("''") : Printable(names[i], 40);
   }
   if (names.size() > kMaxNames) out += ", ...";
   if (names.empty()) out = "nothing";
@@ -173,7 +204,17 @@ class Parser {
       const char* s = p;
       p = newline != nullptr ? newline + 1 : end;
       ++line;
+      if ((line & 0xffff) == 0 && internal::CancelRequested()) {
+        return SetError(error, Where(name_, line) + "reading was cancelled (time limit)");
+      }
       if (line <= skip_lines) continue;
+      if (static_cast<size_t>(line_end - s) > kMaxLineBytes) {
+        return SetError(error, Where(name_, line) + "the line is " + std::to_string(line_end - s) +
+                                   " bytes long; a log line has at "
+                                   "most " +
+                                   std::to_string(kMaxLineBytes) +
+                                   " (is this a text log? are the line ends newlines?)");
+      }
       if (line_end > s && line_end[-1] == '\r') --line_end;
       while (s < line_end && IsBlank(*s)) ++s;
       if (s == line_end || *s == '#') continue;  // Blank or comment.
@@ -216,12 +257,18 @@ class Parser {
       }
       for (CsvCell& cell : cells) names.push_back(std::move(cell.text));
     }
+    if (names.size() > kMaxColumns) {
+      return SetError(error, Where(name_, line) +
+                                 (columns_.empty() ? "the header has " : "columns lists ") +
+                                 std::to_string(names.size()) + " columns; a log has at most " +
+                                 std::to_string(kMaxColumns));
+    }
     const std::string listing = std::string(source) + ": " + JoinNames(names);
     const std::string where = Where(name_, line);
 
     slot_of_field_.assign(names.size(), -1);
     field_label_.assign(names.size(), std::string());
-    for (size_t i = 0; i < names.size(); ++i) field_label_[i] = "'" + names[i] + "'";
+    for (size_t i = 0; i < names.size(); ++i) field_label_[i] = Quote(names[i]);
     for (int slot = 0; slot < kNumSlots; ++slot) {
       has_[slot] = false;
       if (IsGyroFile() && slot != kT && slot != kGx && slot != kGy && slot != kGz) continue;
@@ -557,6 +604,12 @@ bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog
       if (!options.IsValid(&why)) return SetError(error, path + ": invalid options: " + why);
       return recording->Open(path, error) &&
              internal::ReadMessageLog(recording.get(), path, options, log, error);
+    }
+    struct stat st;
+    if (stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+        !internal::CheckLogFitsInMemory(path, static_cast<uint64_t>(st.st_size),
+                                        internal::AvailableMemoryBytes(), error)) {
+      return false;
     }
     FileText text;
     if (!text.Read(path, error)) return false;

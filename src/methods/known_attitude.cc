@@ -16,6 +16,7 @@
 #include "estimation/solver_settings.h"
 #include "gravcal/core/gravity.h"
 #include "methods/static_positions.h"
+#include "util/source_prefix.h"
 #include "util/statistics.h"
 #include "util/units.h"
 
@@ -420,7 +421,7 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::vector<FixtureAttitude
                          r.pitch_std_deg * internal::kDegToRad});
   }
   const bool ok = CalibrateFromKnownAttitudes(positions, attitudes, options, &c);
-  if (!ok && !log.source.empty()) c.message = log.source + ": " + c.message;
+  if (!ok) c.message = internal::PrefixSource(log.source, c.message);
   return ok;
 }
 

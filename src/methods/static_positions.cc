@@ -4,6 +4,7 @@
 
 #include "core/calibration_gravity.h"
 #include "gravcal/estimation/refinement.h"
+#include "util/source_prefix.h"
 #include "util/statistics.h"
 
 namespace gravcal {
@@ -14,7 +15,7 @@ bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector
   if (!log.Validate(message)) return false;
   StaticDetection detection;
   if (!DetectStaticIntervals(log, detector, &detection)) {
-    *message = log.source + ": " + detection.message;
+    *message = internal::PrefixSource(log.source, detection.message);
     return false;
   }
   *intervals = detection.intervals;

@@ -11,6 +11,7 @@
 #include "gravcal/estimation/housing_rotation.h"
 #include "methods/pose_variance.h"
 #include "methods/static_positions.h"
+#include "util/source_prefix.h"
 #include "util/statistics.h"
 #include "util/units.h"
 
@@ -218,7 +219,7 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
   }
   const bool ok = CalibrateFromPositions(positions, options, calibration);
   for (const std::string& n : notes) calibration->warnings.push_back(n);
-  if (!ok && !log.source.empty()) calibration->message = log.source + ": " + calibration->message;
+  if (!ok) calibration->message = internal::PrefixSource(log.source, calibration->message);
   return ok;
 }
 

@@ -1,8 +1,10 @@
 #include "gravcal/workflows/batch.h"
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <chrono>
-#include <exception>
-#include <mutex>
+#include <functional>
 #include <thread>
 
 #include "gravcal/io/calibration_io.h"
@@ -10,7 +12,7 @@
 #include "gravcal/io/recording.h"
 #include "gravcal/workflows/pipeline.h"
 #include "util/content_hash.h"
-#include "util/thread_pool.h"
+#include "workflows/batch_run.h"
 
 #ifndef GRAVCAL_VERSION
 #error "GRAVCAL_VERSION must be defined by the build (CMakeLists.txt)"
@@ -19,7 +21,6 @@
 namespace gravcal {
 
 using internal::ContentHash;
-using internal::ParallelFor;
 
 namespace {
 
@@ -42,9 +43,33 @@ std::string LogBytes(const ImuLog& log) {
   return bytes;
 }
 
-// Reads, hashes and parses one unit, then calibrates it (unless skipped).
-void RunUnit(size_t index, const BatchUnit& unit, const Config& base, const BatchOptions& options,
-             BatchResult* r) {
+bool SameFileState(const struct stat& a, const struct stat& b) {
+  return a.st_ino == b.st_ino && a.st_dev == b.st_dev && a.st_size == b.st_size &&
+         a.st_mtim.tv_sec == b.st_mtim.tv_sec && a.st_mtim.tv_nsec == b.st_mtim.tv_nsec;
+}
+
+// ReadFileBytes, refusing a regular file that changed while it was read
+// (truncated, rewritten, or of another size than the bytes read): the
+// bytes would be a mix, and their hash would mark a wrong result as current.
+bool ReadUnitFile(const std::string& path, std::string* bytes, std::string* error) {
+  struct stat before, after;
+  const bool regular = stat(path.c_str(), &before) == 0 && S_ISREG(before.st_mode);
+  if (!ReadFileBytes(path, bytes, error)) return false;
+  if (regular && (stat(path.c_str(), &after) != 0 || !SameFileState(before, after) ||
+                  static_cast<off_t>(bytes->size()) != before.st_size)) {
+    *error = path +
+             ": the file changed while it was read (truncated or rewritten?); the unit "
+             "is tried again on the next run";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+namespace internal {
+
+void RunUnit(const BatchUnit& unit, const Config& base, const SkipFunction& skip, BatchResult* r) {
   const Clock::time_point start = Clock::now();
   r->unit = unit.id;
   // Ends the unit before calibration: all of its time was reading.
@@ -60,17 +85,17 @@ void RunUnit(size_t index, const BatchUnit& unit, const Config& base, const Batc
   std::string attitudes_bytes;
   if (unit.path.empty()) {
     log_bytes = LogBytes(unit.log);
-  } else if (!ReadFileBytes(unit.path, &log_bytes, &error)) {
+  } else if (!ReadUnitFile(unit.path, &log_bytes, &error)) {
     return stop(error);
   }
   if ((!config.input.gyro_path.empty() &&
-       !ReadFileBytes(config.input.gyro_path, &gyro_bytes, &error)) ||
+       !ReadUnitFile(config.input.gyro_path, &gyro_bytes, &error)) ||
       (!unit.attitudes_path.empty() &&
-       !ReadFileBytes(unit.attitudes_path, &attitudes_bytes, &error))) {
+       !ReadUnitFile(unit.attitudes_path, &attitudes_bytes, &error))) {
     return stop(error);
   }
   r->content_hash = UnitContentHash(log_bytes, gyro_bytes, attitudes_bytes, config);
-  if (options.skip && options.skip(index, unit, r->content_hash)) {
+  if (skip && skip(unit, r->content_hash)) {
     r->skipped = true;
     return stop("skipped: the stored result has this content hash");
   }
@@ -103,7 +128,7 @@ void RunUnit(size_t index, const BatchUnit& unit, const Config& base, const Batc
   r->timings.total_seconds = Seconds(start, end);
 }
 
-}  // namespace
+}  // namespace internal
 
 const char* GravcalVersion() { return GRAVCAL_VERSION; }
 
@@ -131,6 +156,10 @@ bool BatchOptions::IsValid(std::string* error) const {
     *error = "threads: must be >= 0 (0 = one per core), is " + std::to_string(threads);
     return false;
   }
+  if (!(unit_timeout_seconds >= 0.0) || !(stop_grace_seconds >= 0.0)) {
+    *error = "unit_timeout_seconds and stop_grace_seconds: must be >= 0 (0 = no time limit)";
+    return false;
+  }
   return true;
 }
 
@@ -152,39 +181,8 @@ bool CalibrateBatch(const std::vector<BatchUnit>& units, const Config& base,
   int threads = options.threads;
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   results->assign(units.size(), BatchResult());
-  std::mutex progress_mutex;
-  BatchProgress progress;
-  progress.total = units.size();
-  const Clock::time_point start = Clock::now();
-  ParallelFor(units.size(), threads, [&](size_t i) {
-    BatchResult& r = (*results)[i];
-    try {
-      RunUnit(i, units[i], base, options, &r);
-      if (options.on_result) options.on_result(i, r);
-    } catch (const std::exception& e) {
-      r.status = BatchStatus::kFailed;
-      r.message = units[i].id + ": internal error: " + e.what();
-    } catch (...) {
-      r.status = BatchStatus::kFailed;
-      r.message = units[i].id + ": internal error";
-    }
-    if (!options.keep_calibrations) r.calibration = Calibration();
-    std::lock_guard<std::mutex> lock(progress_mutex);
-    ++progress.done;
-    if (r.skipped) {
-      ++progress.skipped;
-    } else if (r.status != BatchStatus::kOk) {
-      ++progress.failed;
-    }
-    progress.elapsed_seconds = Seconds(start, Clock::now());
-    if (options.progress) {
-      try {
-        options.progress(progress);
-      } catch (...) {
-        // A progress display must not stop the batch.
-      }
-    }
-  });
+  internal::BatchRun run(units, base, options, results);
+  run.Run(threads);
   return true;
 }
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "methods/static_positions.h"
+#include "util/source_prefix.h"
 #include "workflows/discovery_candidates.h"
 #include "workflows/discovery_context.h"
 #include "workflows/discovery_cross_validation.h"
@@ -261,7 +262,7 @@ bool DiscoverEffects(const ImuLog& log, const CalibrationOptions& calibration,
   result->source = log.source;
   const bool ok = DiscoverFromObservations(ObservationsFromIntervals(intervals, log.has_gyro()),
                                            calibration, baseline_effects, options, result);
-  if (!ok && !log.source.empty()) result->message = log.source + ": " + result->message;
+  if (!ok) result->message = internal::PrefixSource(log.source, result->message);
   return ok;
 }
 

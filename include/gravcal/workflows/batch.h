@@ -17,6 +17,7 @@
 #ifndef GRAVCAL_WORKFLOWS_BATCH_H_
 #define GRAVCAL_WORKFLOWS_BATCH_H_
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -78,6 +79,12 @@ struct BatchResult {
   std::string message = "not run";
   // Empty when the input could not be read.
   std::string content_hash;
+  // Over BatchOptions::unit_timeout_seconds: the unit was abandoned
+  // (status kFailed, message says so).
+  bool timed_out = false;
+  // Not started, or abandoned in flight, because BatchOptions::stop was set
+  // (status kFailed, message says so).
+  bool not_run = false;
   Calibration calibration;
   BatchTimings timings;
 };
@@ -103,11 +110,24 @@ struct BatchOptions {
   std::function<bool(size_t index, const BatchUnit& unit, const std::string& content_hash)> skip;
   // Called once per unit as soon as it is finished (also for skipped
   // units), concurrently from worker threads: must be thread-safe. An
-  // exception it throws fails that unit, not the batch.
+  // exception it throws fails that unit ("<unit>: the result could not be
+  // stored: <what>"), not the batch.
   std::function<void(size_t index, const BatchResult& result)> on_result;
   // Called after each unit, one call at a time (serialised), from the
   // worker that finished it.
   std::function<void(const BatchProgress& progress)> progress;
+  // Seconds one unit may take (reading, detection, solve); 0 = no limit. A
+  // unit over it fails with a message and the batch goes on: its worker is
+  // asked to stop (the solver and the log reader check between iterations
+  // and lines) and is abandoned, not killed; its late result is dropped and
+  // no callback is called for it after that. A fresh worker takes its
+  // place.
+  double unit_timeout_seconds = 0.0;
+  // When it becomes true (e.g. set by a SIGTERM handler), no further unit is
+  // started; units in flight may finish for up to stop_grace_seconds, then
+  // are abandoned. Units not run get BatchResult::not_run. Not owned.
+  const std::atomic<bool>* stop = nullptr;
+  double stop_grace_seconds = 30.0;
 
   bool IsValid(std::string* error) const;
 };

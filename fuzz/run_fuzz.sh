@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Runs the fuzz targets of a GRAVCAL_FUZZ build.
+#   fuzz/run_fuzz.sh <build dir> <target|all> <seconds per target>
+# Each target first runs its regression inputs (fuzz/regressions/<target>/,
+# inputs that once crashed or broke an invariant, kept after the fix), then
+# fuzzes for the given time from the seed corpus (fuzz/corpus/<target>/ and
+# the test data named in fuzz/CMakeLists.txt), with a working corpus in
+# <build dir>/fuzz/work/<target>. New crashes land in
+# <build dir>/fuzz/crashes/<target>/ and fail the run.
+set -euo pipefail
+build=$1
+which=$2
+seconds=$3
+here="$(cd "$(dirname "$0")" && pwd)"
+# all: every fuzz_<name> executable the build made.
+if [ "$which" = all ]; then
+  targets=$(cd "$build/fuzz" && ls fuzz_* | sed -n 's/^fuzz_\([a-z0-9_]*\)$/\1/p')
+else
+  targets=$which
+fi
+status=0
+for t in $targets; do
+  exe="$build/fuzz/fuzz_$t"
+  work="$build/fuzz/work/$t"
+  crashes="$build/fuzz/crashes/$t"
+  mkdir -p "$work" "$crashes"
+  if [ -d "$here/regressions/$t" ] && [ -n "$(ls -A "$here/regressions/$t")" ]; then
+    "$exe" -runs=0 "$here/regressions/$t"/* >/dev/null 2>&1 || {
+      echo "fuzz: $t fails on a regression input"
+      status=1
+    }
+  fi
+  start=$SECONDS
+  if ! "$exe" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+    -artifact_prefix="$crashes/" -print_final_stats=1 "$work" "$build/fuzz/seeds/$t" \
+    >"$build/fuzz/$t.log" 2>&1; then
+    echo "fuzz: $t FOUND A PROBLEM (see $build/fuzz/$t.log, input in $crashes)"
+    tail -30 "$build/fuzz/$t.log"
+    status=1
+  fi
+  runs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$build/fuzz/$t.log" | awk '{print $2}')
+  echo "fuzz: $t ran $((SECONDS - start)) s, ${runs:-?} inputs"
+done
+exit $status
