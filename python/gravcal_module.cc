@@ -305,8 +305,10 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
 }
 
 
-// RunCalibration, as `gravcal calibrate` runs it.
-PyCalibration Run(const Config& config, const PipelineInput& input) {
+// RunCalibration, as `gravcal calibrate` runs it; `provenance` names the
+// log file when there is one (LogProvenance).
+PyCalibration Run(const Config& config, const PipelineInput& input,
+                  const CalibrationProvenance* provenance = nullptr) {
   Calibration c;
   bool ok;
   {
@@ -314,6 +316,7 @@ PyCalibration Run(const Config& config, const PipelineInput& input) {
     ok = RunCalibration(config, input, &c);
   }
   Check(ok, c.message);
+  if (provenance != nullptr) c.provenance = *provenance;
   return PyCalibration::FromResult(std::move(c), config.output_covariance, input.source);
 }
 
@@ -347,7 +350,9 @@ PyCalibration CalibrateFile(const Config& config, const std::string& path,
     ok = ReadImuLog(path, config.input, &input.log, &error);
   }
   Check(ok, error);
-  return Run(config, input);
+  CalibrationProvenance provenance;
+  Check(LogProvenance(path, &provenance, &error), error);
+  return Run(config, input, &provenance);
 }
 
 // `gravcal simulate`: the truth (truth.json text), the raw log, the

@@ -32,16 +32,16 @@ class CliFlagsTest : public ::testing::Test {
   testing_util::ScratchDir scratch_;
 };
 
-// calibrate --report used to exit 0 and write no report: --report belongs to
-// discover.
+// calibrate --kalibr used to exit 0 and write nothing: --kalibr belongs to
+// noise. (The example, calibrate --report, is a calibrate flag now.)
 TEST_F(CliFlagsTest, AFlagTheCommandDoesNotUseIsAnErrorNamingBoth) {
   const std::string raw = Simulated();
   const std::string out = scratch_ / "out.json";
-  const std::string report = scratch_ / "x.html";
+  const std::string report = scratch_ / "imu.yaml";
   CliResult r = Run("calibrate --input " + raw + " --config " + Config() + " --output " + out +
-                    " --report " + report);
+                    " --kalibr " + report);
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("--report"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--kalibr"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("'calibrate'"), std::string::npos) << r.err;
   EXPECT_FALSE(testing_util::FileExists(out));
   EXPECT_FALSE(testing_util::FileExists(report));

@@ -51,6 +51,8 @@ nlohmann::json StripTimes(const nlohmann::json& j) {
       const std::string& k = it.key();
       if (k.size() >= 6 && k.compare(k.size() - 6, 6, "time_s") == 0) continue;
       if (k.find("_seconds") != std::string::npos || k == "message") continue;
+      // The input file's name and content hash: a different file by design.
+      if (k == "provenance") continue;
       out[k] = StripTimes(it.value());
     }
     return out;

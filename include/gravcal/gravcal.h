@@ -50,8 +50,8 @@
 #include "gravcal/io/imu_stream.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
-#include "gravcal/io/recording.h"
 #include "gravcal/io/plan_io.h"
+#include "gravcal/io/recording.h"
 
 // simulation
 #include "gravcal/simulation/handheld_simulator.h"

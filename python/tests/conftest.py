@@ -41,6 +41,17 @@ def strip_times(x):
     return x
 
 
+def without_log_file(d):
+    """The calibration dict without the log file's name and hash (a log made
+    from arrays has none; everything else must agree)."""
+    d = dict(d)
+    provenance = dict(d.get("provenance", {}))
+    provenance.pop("log_file", None)
+    provenance.pop("log_hash", None)
+    d["provenance"] = provenance
+    return d
+
+
 def read_json(path):
     with open(path) as f:
         return json.load(f)
