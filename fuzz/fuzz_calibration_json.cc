@@ -17,8 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   gravcal::fuzz::RequireOutcome(ok, error);
   if (ok) {
     const gravcal::AccelModel& accel = calibration.corrector.accel;
-    Require(accel.bias.allFinite() && accel.upper.allFinite(),
-            "non-finite accelerometer model");
+    Require(accel.bias.allFinite() && accel.upper.allFinite(), "non-finite accelerometer model");
   }
   return 0;
 }
