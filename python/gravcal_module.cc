@@ -304,7 +304,6 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
   return py::make_tuple(a_out, gyro.is_none() ? py::object(py::none()) : py::object(w_out));
 }
 
-
 // RunCalibration, as `gravcal calibrate` runs it; `provenance` names the
 // log file when there is one (LogProvenance).
 PyCalibration Run(const Config& config, const PipelineInput& input,
@@ -590,7 +589,8 @@ PYBIND11_MODULE(_gravcal, m) {
 
   py::class_<PyCalibration>(m, "Calibration")
       .def_property_readonly("json", &PyCalibration::Json)
-      .def_property_readonly("has_gyro", [](const PyCalibration& c) { return c.Models().corrector.has_gyro; })
+      .def_property_readonly("has_gyro",
+                             [](const PyCalibration& c) { return c.Models().corrector.has_gyro; })
       .def_static("from_file", &CalibrationFromFile)
       .def_static("from_text",
                   [](const std::string& text, const std::string& name) {
