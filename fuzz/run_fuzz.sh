@@ -11,7 +11,7 @@
 # inputs that once crashed or broke an invariant, kept after the fix), then
 # fuzzes for the given time from the seed corpus (fuzz/corpus/<target>/ and
 # the test data named in fuzz/CMakeLists.txt), with a working corpus in
-# <build dir>/fuzz/work/<target>. New crashes land in
+# <build dir>/fuzz/corpus_run/<target>. New crashes land in
 # <build dir>/fuzz/crashes/<target>/ and fail the run.
 set -euo pipefail
 build=$1
@@ -27,7 +27,7 @@ fi
 status=0
 for t in $targets; do
   exe="$build/fuzz/fuzz_$t"
-  work="$build/fuzz/work/$t"
+  work="$build/fuzz/corpus_run/$t"
   crashes="$build/fuzz/crashes/$t"
   mkdir -p "$work" "$crashes"
   if [ -d "$here/regressions/$t" ] && [ -n "$(ls -A "$here/regressions/$t")" ]; then

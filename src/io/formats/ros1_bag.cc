@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "io/formats/byte_cursor.h"
 #include "io/formats/message_recording.h"
 
 #ifdef GRAVCAL_HAVE_ROSBAG
@@ -17,6 +18,7 @@
 #include <rosbag/view.h>
 
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <fstream>
 #include <map>
@@ -69,16 +71,14 @@ bool RecordsFitInFile(const std::string& path, std::string* what) {
       *what = "cannot read the record at byte " + std::to_string(pos);
       return false;
     }
-    for (uint64_t f = 0; f < header_len;) {
-      const auto* b = reinterpret_cast<const unsigned char*>(header.data() + f);
-      const uint64_t field_len = f + 4 > header_len ? header_len + 1
-                                                    : (uint64_t{b[0]} | uint64_t{b[1]} << 8 |
-                                                       uint64_t{b[2]} << 16 | uint64_t{b[3]} << 24);
-      if (f + 4 + field_len > header_len || header.find('=', f + 4) >= f + 4 + field_len) {
+    ByteCursor fields(reinterpret_cast<const uint8_t*>(header.data()), header.size());
+    while (fields.ok() && fields.remaining() > 0) {
+      const uint32_t field_len = fields.U32();
+      const uint8_t* field = fields.Bytes(field_len);
+      if (field == nullptr || std::memchr(field, '=', field_len) == nullptr) {
         *what = "the record at byte " + std::to_string(pos) + " has a damaged header field";
         return false;
       }
-      f += 4 + field_len;
     }
     pos += 8 + uint64_t{header_len} + data_len;
   }
