@@ -247,6 +247,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   ceres::Solve(SolverOptions(options), &problem, &summary);
   SensorFitSummary& fit = result->accel_fit;
   fit.fitted = true;
+  fit.information = "position magnitudes";
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
   fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {
@@ -373,6 +374,7 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   ceres::Solve(SolverOptions(options), &problem, &summary);
   SensorFitSummary& fit = result->gyro_fit;
   fit.fitted = true;
+  fit.information = "static mean rates";
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
   fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {

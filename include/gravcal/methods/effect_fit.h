@@ -102,6 +102,10 @@ struct SensorFitSummary {
   // Only computed with the covariance.
   std::vector<double> leverage;
   int iterations = 0;
+  // Which information the fit used, in plain words for the reports (for
+  // example "position magnitudes" or "position magnitudes + within-pose
+  // trends"); empty when the sensor was not fitted.
+  std::string information;
 };
 
 struct EffectFitResult {
