@@ -7,6 +7,7 @@
 // anything that can take long) and turns a false return into gravcal.Error
 // with the library's one-line message. The Pythonic surface (keyword
 // arguments, pandas, attribute access) is python/gravcal/__init__.py.
+#include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -320,10 +321,9 @@ PyCalibration Run(const Config& config, const PipelineInput& input,
 }
 
 // On a log in memory: the log itself when there is no side input, else a
-// copy with the side files.
+// copy with the side files. RunCalibration checks the config first.
 PyCalibration Calibrate(const Config& config, const LogHandle& log, const std::string& attitudes,
                         const std::string& segments, const std::string& noise) {
-  CheckConfig(config);
   if (attitudes.empty() && segments.empty() && noise.empty()) return Run(config, *log);
   PipelineInput input = *log;
   input.attitudes_path = attitudes;
@@ -354,35 +354,24 @@ PyCalibration CalibrateFile(const Config& config, const std::string& path,
   return Run(config, input, &provenance);
 }
 
-// `gravcal simulate`: the truth (truth.json text), the raw log, the
-// fixture's attitudes (attitudes.csv text) and, for sim_motion rate_table,
-// the segments (segments.csv text, else empty).
-py::tuple SimulateSession(const Config& config, uint64_t seed) {
-  CheckConfig(config);
-  SimulatedSession session;
-  std::vector<RateTableSegment> segments;
+// `gravcal simulate` (workflows/simulation_workflow.h): the truth
+// (truth.json text), the raw log, the fixture's attitudes (attitudes.csv
+// text) and, for sim_motion rate_table, the segments (segments.csv text,
+// else empty).
+py::tuple SimulateSession(const Config& config, uint64_t seed, const std::string& plan) {
+  SimulationRequest request;
+  request.plan_path = plan;
+  request.seed = seed;
+  SimulationFiles files;
   std::string error;
   bool ok;
   {
     py::gil_scoped_release release;
-    if (!config.sim_motion.empty()) {
-      MotionOptions motion = config.motion;
-      FromString(config.sim_motion, &motion.profile);
-      MotionSession moving;
-      ok = SimulateMotion(config.simulation, motion, seed, &moving, &error);
-      segments = moving.segments;
-      session = std::move(moving.sensor);
-    } else {
-      ok = Simulate(config.simulation, seed, &session, &error);
-    }
+    ok = SimulateFromConfig(config, request, &files, &error);
   }
   Check(ok, error);
-  const std::string fixture = FixtureAttitudesToCsv(
-      SimulatedFixtureAttitudes(session, config.simulation.fixture_attitude_noise_deg, seed));
-  const std::string segments_csv =
-      segments.empty() ? "" : RateTableSegmentsToCsv(segments, session.log);
-  const std::string truth = TruthToJson(session, config.simulation);
-  return py::make_tuple(truth, WrapLog(std::move(session.log)), fixture, segments_csv);
+  return py::make_tuple(files.truth_json, WrapLog(std::move(files.session.log)),
+                        files.attitudes_csv, files.segments_csv);
 }
 
 // ---------------------------------------------------------------------------
@@ -471,23 +460,18 @@ std::vector<BatchUnit> UnitsFromFolder(const std::string& folder, const std::str
 // ---------------------------------------------------------------------------
 // Noise and discovery: the JSON text of noise.json and discovery.json.
 
+// `gravcal noise` (workflows/noise_workflow.h).
 std::string Noise(const Config& config, const LogHandle& input) {
-  const ImuLog& log = input->log;
-  // The same options `gravcal noise` builds from the config.
-  NoiseOptions options = config.noise;
-  options.accel_scale = config.calibration.nominal_scale;
-  options.gyro_scale = config.handheld.gyro_nominal_scale;
-  options.detector = config.calibration.detector;
+  NoiseOptions options;
   std::string error;
-  Check(config.input.IsValid(&error), "input: " + error);
-  Check(options.IsValid(&error), error);
+  Check(NoiseOptionsFromConfig(config, &options, &error), error);
   ImuNoise noise;
   bool ok;
   {
     py::gil_scoped_release release;
-    ok = CharacteriseNoise(log, options, &noise);
+    ok = CharacteriseLogNoise(input->log, options, &noise, &error);
   }
-  Check(ok, noise.message);
+  Check(ok, error);
   return NoiseToJson(noise);
 }
 
@@ -502,6 +486,112 @@ py::tuple Discover(const Config& config, const LogHandle& input) {
   }
   Check(ok, result.message);
   return py::make_tuple(DiscoveryToJson(result), DiscoveryToHtml(result));
+}
+
+// ---------------------------------------------------------------------------
+// Plan, check and export (workflows/plan.h, io/calibration_export.h).
+
+// The noise model of a request: noise.json at `path`, else the text of one
+// (a dict from gravcal.noise, as JSON); false when neither is given.
+bool ReadNoise(const std::string& path, const std::string& text, ImuNoise* noise) {
+  std::string error;
+  if (!path.empty()) {
+    Check(ReadNoiseJson(path, noise, &error), error);
+  } else if (!text.empty()) {
+    Check(NoiseFromJson(text, "noise", noise, &error), error);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// `gravcal plan`: plan.json's text.
+std::string Plan(const Config& config, PlanRequest request, const std::string& noise_path,
+                 const std::string& noise_text) {
+  ImuNoise noise;
+  if (ReadNoise(noise_path, noise_text, &noise)) request.noise_model = &noise.model;
+  RecordingPlan plan;
+  std::string error;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = MakeRecordingPlan(config, request, &plan, &error);
+  }
+  Check(ok, error);
+  return PlanToJson(plan);
+}
+
+py::list PosesList(const std::vector<PlannedPose>& poses) {
+  py::list list;
+  for (const PlannedPose& p : poses) {
+    py::dict d;
+    d["up"] = std::vector<double>(p.up.data(), p.up.data() + 3);
+    d["hold_s"] = p.hold_seconds;
+    d["instruction"] = p.instruction;
+    list.append(d);
+  }
+  return list;
+}
+
+// `gravcal check`: the report's fields, and "text", what the CLI prints.
+py::dict CheckSession(const Config& config, const LogHandle& log, PlanRequest request,
+                      const std::string& noise_path, const std::string& noise_text) {
+  ImuNoise noise;
+  if (ReadNoise(noise_path, noise_text, &noise)) request.noise_model = &noise.model;
+  std::string error;
+  Check(config.input.IsValid(&error), "input: " + error);
+  CoverageReport report;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = CheckRecording(log->log, config, request, &report, &error);
+  }
+  Check(ok, error);
+  py::dict d;
+  d["parameters"] = report.parameter_names;
+  d["positions"] = report.positions;
+  d["nominal_scale"] = report.nominal_scale;
+  d["predicted_std"] = report.predicted_std;
+  d["predicted_std_scale_free"] = report.predicted_std_scale_free;
+  d["targets_scale_free"] = report.targets_scale_free;
+  d["targeted"] = report.targeted;
+  d["undetermined"] = report.undetermined;
+  d["short_of_target"] = report.short_of_target;
+  d["proposed"] = PosesList(report.proposed);
+  d["predicted_std_with_proposed"] = report.predicted_std_with_proposed;
+  d["undetermined_with_proposed"] = report.undetermined_with_proposed;
+  d["message"] = report.message;
+  d["text"] = CoverageReportText(report);
+  return d;
+}
+
+// `gravcal export`: the files' names and texts, what the target drops, the
+// truncation's residuals.
+py::dict Export(const PyCalibration& c, const std::string& to, const std::string& name,
+                const std::string& noise_path, const std::string& noise_text) {
+  ExportOptions options;
+  Check(FromString(to, &options.target),
+        "to: expected one of " + ExportTargetNames() + ", not '" + to + "'");
+  ImuNoise noise;
+  if (ReadNoise(noise_path, noise_text, &noise)) options.noise = &noise.model;
+  options.calibration_name = name.empty() ? c.name : name;
+  ExportResult result;
+  std::string error;
+  Check(ExportCalibration(c.Models(), options, &result, &error), error);
+  py::list files;
+  for (const ExportedFile& f : result.files) {
+    py::dict file;
+    file["name"] = f.name;
+    file["text"] = f.text;
+    files.append(file);
+  }
+  py::dict d;
+  d["files"] = files;
+  d["dropped"] = result.dropped;
+  d["full_rms"] = result.full_rms;
+  d["truncated_rms"] = result.truncated_rms;
+  d["message"] = result.message;
+  return d;
 }
 
 // CPU seconds of the calling thread (the library is single-threaded here:
@@ -603,7 +693,7 @@ PYBIND11_MODULE(_gravcal, m) {
         py::arg("segments"), py::arg("noise"));
   m.def("calibrate_file", &CalibrateFile, py::arg("config"), py::arg("path"), py::arg("attitudes"),
         py::arg("segments"), py::arg("noise"));
-  m.def("simulate", &SimulateSession, py::arg("config"), py::arg("seed"));
+  m.def("simulate", &SimulateSession, py::arg("config"), py::arg("seed"), py::arg("plan"));
 
   py::class_<BatchUnit>(m, "BatchUnit").def_readonly("id", &BatchUnit::id);
   py::class_<PyBatchResult>(m, "BatchResult")
@@ -640,6 +730,32 @@ PYBIND11_MODULE(_gravcal, m) {
   m.def("batch", &Batch, py::arg("units"), py::arg("config"), py::arg("threads"));
   m.def("noise", &Noise, py::arg("config"), py::arg("log"));
   m.def("discover", &Discover, py::arg("config"), py::arg("log"));
+  m.def("write_file", [](const std::string& path, const std::string& text) {
+    std::string error;
+    Check(WriteFileAtomically(path, text, &error), error);
+  });
+
+  py::class_<PlanRequest>(m, "PlanRequest", "The request of gravcal plan and gravcal check.")
+      .def(py::init<>())
+      .def_readwrite("targets", &PlanRequest::targets)
+      .def_readwrite("pose_set", &PlanRequest::pose_set)
+      .def_readwrite("free_candidates", &PlanRequest::free_candidates)
+      .def_readwrite("max_time_seconds", &PlanRequest::max_time_seconds)
+      .def_readwrite("overhead_seconds", &PlanRequest::overhead_seconds)
+      .def_readwrite("min_hold_seconds", &PlanRequest::min_hold_seconds)
+      .def_readwrite("max_hold_seconds", &PlanRequest::max_hold_seconds)
+      .def_readwrite("max_poses", &PlanRequest::max_poses)
+      .def_readwrite("accel_noise_density", &PlanRequest::accel_noise_density)
+      .def_readwrite("accel_bias_instability", &PlanRequest::accel_bias_instability)
+      .def_readwrite("accel_random_walk", &PlanRequest::accel_random_walk)
+      .def_readwrite("pose_disturbance", &PlanRequest::pose_disturbance)
+      .def_readwrite("extra_poses", &PlanRequest::extra_poses);
+  m.def("plan", &Plan, py::arg("config"), py::arg("request"), py::arg("noise_path"),
+        py::arg("noise_text"));
+  m.def("check", &CheckSession, py::arg("config"), py::arg("log"), py::arg("request"),
+        py::arg("noise_path"), py::arg("noise_text"));
+  m.def("export", &Export, py::arg("calibration"), py::arg("to"), py::arg("name"),
+        py::arg("noise_path"), py::arg("noise_text"));
   m.def("_time_calibrate", &TimeCalibrate, py::arg("config"), py::arg("log"), py::arg("path"),
         py::arg("repeats"));
 }

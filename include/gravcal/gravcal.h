@@ -77,8 +77,10 @@
 #include "gravcal/workflows/discovery_report.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/method_registry.h"
+#include "gravcal/workflows/noise_workflow.h"
 #include "gravcal/workflows/pipeline.h"
 #include "gravcal/workflows/plan.h"
 #include "gravcal/workflows/rate_table_segments.h"
 #include "gravcal/workflows/report.h"
+#include "gravcal/workflows/simulation_workflow.h"
 #endif  // GRAVCAL_GRAVCAL_H_

@@ -29,7 +29,8 @@ __version__ = _gravcal.__version__
 
 __all__ = [
     "Error", "Log", "Calibration", "BatchResult", "Config", "config", "read_log", "log",
-    "calibrate", "simulate", "batch", "noise", "discover", "config_keys", "__version__",
+    "calibrate", "simulate", "batch", "noise", "discover", "plan", "check", "export",
+    "config_keys", "__version__",
 ]
 
 Config = _gravcal.Config
@@ -342,13 +343,14 @@ def calibrate(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None
     return Calibration(_gravcal.calibrate(cfg, _as_log(log, cfg, t, accel, gyro, temp), *side))
 
 
-def simulate(config=None, seed=1, *, return_files=False, **keys):
+def simulate(config=None, seed=1, *, plan=None, return_files=False, **keys):
     """Simulates a session exactly as ``gravcal simulate --seed`` does.
-    Returns ``(truth, log)``: truth.json as a dict and the raw log. With
-    ``return_files=True`` also a dict with the text of attitudes.csv and,
-    for ``sim_motion: rate_table``, segments.csv."""
-    truth, data, attitudes, segments = _gravcal.simulate(_config(config, **keys),
-                                                         int(seed))
+    Returns ``(truth, log)``: truth.json as a dict and the raw log. ``plan``
+    is a plan.json path (``gravcal simulate --plan``): its poses replace
+    ``sim_scheme``. With ``return_files=True`` also a dict with the text of
+    attitudes.csv and, for ``sim_motion: rate_table``, segments.csv."""
+    truth, data, attitudes, segments = _gravcal.simulate(
+        _config(config, **keys), int(seed), "" if plan is None else _os.fspath(plan))
     if return_files:
         files = {"attitudes.csv": attitudes}
         if segments:
@@ -421,6 +423,99 @@ def discover(log=None, *, config=None, report=None, t=None, accel=None, gyro=Non
     cfg = _config(config, **keys)
     text, html = _gravcal.discover(cfg, _as_log(log, cfg, t, accel, gyro, temp))
     if report is not None:
-        with open(_os.fspath(report), "w", encoding="utf-8") as f:
-            f.write(html)
+        _gravcal.write_file(_os.fspath(report), html)
     return _json.loads(text)
+
+
+# The request of plan and check: the CLI's flag names, and the
+# PlanRequest field each sets (workflows/plan.h; defaults are the library's).
+_PLAN_FLAGS = {
+    "target": "targets", "pose_set": "pose_set", "candidates": "free_candidates",
+    "max_time": "max_time_seconds", "overhead": "overhead_seconds",
+    "min_hold": "min_hold_seconds", "max_hold": "max_hold_seconds", "max_poses": "max_poses",
+    "accel_noise_density": "accel_noise_density",
+    "accel_bias_instability": "accel_bias_instability",
+    "accel_random_walk": "accel_random_walk", "pose_disturbance": "pose_disturbance",
+    "extra_poses": "extra_poses",
+}
+
+
+def _split_request(keys):
+    """(PlanRequest, the remaining config keys) from keyword arguments."""
+    request = _gravcal.PlanRequest()
+    rest = {}
+    for key, value in keys.items():
+        if key in _PLAN_FLAGS:
+            if value is not None:
+                setattr(request, _PLAN_FLAGS[key], value)
+        else:
+            rest[key] = value
+    return request, rest
+
+
+def _noise_source(noise):
+    """(path, JSON text) of a noise model given as a noise.json path or a
+    dict from :func:`noise`; ("", "") for None."""
+    if noise is None:
+        return "", ""
+    if isinstance(noise, dict):
+        return "", _json.dumps(noise)
+    if isinstance(noise, (str, bytes, _os.PathLike)):
+        return _os.fsdecode(noise), ""
+    raise Error("noise: expected a noise.json path or a dict from gravcal.noise, got %s"
+                % type(noise).__name__)
+
+
+def plan(config=None, *, noise=None, output=None, **keys):
+    """A recording plan, as ``gravcal plan`` writes plan.json: a dict.
+
+    The request takes the CLI's flag names as keywords: ``target``
+    ("accel_bias=0.5mg accel_scale=50ppm"), ``pose_set``, ``candidates``,
+    ``max_time``, ``overhead``, ``min_hold``, ``max_hold``, and the
+    datasheet noise ``accel_noise_density``, ``accel_bias_instability``,
+    ``accel_random_walk``, ``pose_disturbance`` (or ``noise``: a noise.json
+    path or the dict :func:`noise` returns); also ``max_poses``. Other
+    keywords are config keys. ``output`` writes plan.json there (the CLI's
+    file, byte for byte); ``simulate(plan=...)`` reads it."""
+    request, rest = _split_request(keys)
+    text = _gravcal.plan(_config(config, **rest), request, *_noise_source(noise))
+    if output is not None:
+        _gravcal.write_file(_os.fspath(output), text)
+    return _json.loads(text)
+
+
+def check(log=None, *, config=None, noise=None, t=None, accel=None, gyro=None, temp=None,
+          **keys):
+    """What a recorded session determines, as ``gravcal check`` reports it:
+    a dict with ``parameters``, ``predicted_std`` (calibration JSON units;
+    inf = undetermined), ``undetermined``, ``short_of_target``, ``proposed``
+    (extra poses: ``up``, ``hold_s``, ``instruction``), ``message`` and
+    ``text`` (what ``gravcal check`` prints). The request keywords are
+    :func:`plan`'s (``target``, ``pose_set``, ``accel_noise_density``...);
+    ``extra_poses`` sets how many poses are proposed when all is
+    determined."""
+    request, rest = _split_request(keys)
+    cfg = _config(config, **rest)
+    return _gravcal.check(cfg, _as_log(log, cfg, t, accel, gyro, temp), request,
+                          *_noise_source(noise))
+
+
+def export(calibration, to, *, noise=None, name=None):
+    """A calibration for another tool, as ``gravcal export --to`` writes
+    it: ``to`` is kalibr, openvins, ros, px4, ardupilot or c;
+    ``calibration`` a :class:`Calibration` or a calibration JSON path;
+    ``noise`` (kalibr, openvins, ros) a noise.json path or the dict of
+    :func:`noise`; ``name`` the calibration's name in the file's comment
+    (default: its path, as the CLI writes it). Returns a dict: ``files``
+    (a list of ``{"name", "text"}``: one file with name "" for a
+    single-file target, gravcal_correct.h and .c for c), ``dropped`` (what
+    the target cannot hold, one line each), ``full_rms`` and
+    ``truncated_rms`` (m/s^2 over the recorded positions) and
+    ``message``."""
+    if isinstance(calibration, (str, bytes, _os.PathLike)):
+        calibration = Calibration.from_json(calibration)
+    if not isinstance(calibration, Calibration):
+        raise Error("calibration: expected a gravcal.Calibration or a calibration JSON path, "
+                    "got %s" % type(calibration).__name__)
+    return _gravcal.export(calibration._core, str(to), "" if name is None else str(name),
+                           *_noise_source(noise))

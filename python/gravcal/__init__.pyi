@@ -89,10 +89,11 @@ def calibrate(log: LogLike = ..., *, config: ConfigLike = ..., t: Optional[Array
               segments: Optional[PathLike] = ..., noise: Optional[PathLike] = ...,
               **keys: Any) -> Calibration: ...
 @overload
-def simulate(config: ConfigLike = ..., seed: int = ..., **keys: Any) -> Tuple[Dict[str, Any], Log]: ...
+def simulate(config: ConfigLike = ..., seed: int = ..., *, plan: Optional[PathLike] = ...,
+             **keys: Any) -> Tuple[Dict[str, Any], Log]: ...
 @overload
-def simulate(config: ConfigLike = ..., seed: int = ..., *, return_files: bool,
-             **keys: Any) -> Tuple[Dict[str, Any], Log, Dict[str, str]]: ...
+def simulate(config: ConfigLike = ..., seed: int = ..., *, plan: Optional[PathLike] = ...,
+             return_files: bool, **keys: Any) -> Tuple[Dict[str, Any], Log, Dict[str, str]]: ...
 def batch(units: Union[PathLike, Sequence[Union[PathLike, Log, Mapping[str, Any]]]],
           config: ConfigLike = ..., threads: int = ..., *, pattern: str = ...,
           **keys: Any) -> List[BatchResult]: ...
@@ -103,3 +104,25 @@ def discover(log: LogLike = ..., *, config: ConfigLike = ..., report: Optional[P
              t: Optional[ArrayLike] = ..., accel: Optional[ArrayLike] = ...,
              gyro: Optional[ArrayLike] = ..., temp: Optional[ArrayLike] = ...,
              **keys: Any) -> Dict[str, Any]: ...
+
+NoiseLike = Union[None, PathLike, Mapping[str, Any]]
+
+def plan(config: ConfigLike = ..., *, noise: NoiseLike = ..., output: Optional[PathLike] = ...,
+         target: Optional[str] = ..., pose_set: Optional[str] = ...,
+         candidates: Optional[int] = ..., max_time: Optional[float] = ...,
+         overhead: Optional[float] = ..., min_hold: Optional[float] = ...,
+         max_hold: Optional[float] = ..., max_poses: Optional[int] = ...,
+         accel_noise_density: Optional[float] = ...,
+         accel_bias_instability: Optional[float] = ...,
+         accel_random_walk: Optional[float] = ..., pose_disturbance: Optional[float] = ...,
+         **keys: Any) -> Dict[str, Any]: ...
+def check(log: LogLike = ..., *, config: ConfigLike = ..., noise: NoiseLike = ...,
+          t: Optional[ArrayLike] = ..., accel: Optional[ArrayLike] = ...,
+          gyro: Optional[ArrayLike] = ..., temp: Optional[ArrayLike] = ...,
+          target: Optional[str] = ..., pose_set: Optional[str] = ...,
+          candidates: Optional[int] = ..., accel_noise_density: Optional[float] = ...,
+          accel_bias_instability: Optional[float] = ...,
+          accel_random_walk: Optional[float] = ..., pose_disturbance: Optional[float] = ...,
+          extra_poses: Optional[int] = ..., **keys: Any) -> Dict[str, Any]: ...
+def export(calibration: Union[Calibration, PathLike], to: str, *, noise: NoiseLike = ...,
+           name: Optional[str] = ...) -> Dict[str, Any]: ...

@@ -19,11 +19,14 @@ def config_path(name):
     return os.path.join(SOURCE_DIR, "configs", name)
 
 
-def run_cli(*args, ok=True):
-    """Runs `gravcal args...`; returns (exit code, the one-line error or '')."""
+def run_cli(*args, ok=True, stdout=False):
+    """Runs `gravcal args...`; returns (exit code, the one-line error or '')
+    (and what it printed on stdout, with stdout=True)."""
     p = subprocess.run([CLI] + [str(a) for a in args], capture_output=True, text=True)
     if ok and p.returncode != 0:
         raise AssertionError("gravcal %s failed: %s" % (" ".join(map(str, args)), p.stderr))
+    if stdout:
+        return p.stdout
     error = ""
     for line in p.stderr.splitlines():
         if line.startswith("gravcal: error: "):

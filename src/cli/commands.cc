@@ -14,8 +14,8 @@
 #include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/pipeline.h"
-#include "gravcal/workflows/rate_table_segments.h"
 #include "gravcal/workflows/report.h"
+#include "gravcal/workflows/simulation_workflow.h"
 
 namespace gravcal {
 namespace cli {
@@ -157,32 +157,12 @@ int RunCalibrate(const CommandArgs& args) {
 int RunSimulate(const CommandArgs& args) {
   if (args.output_dir.empty()) return Fail("simulate needs --output-dir <folder>");
   std::string error;
-  if (!CheckConfig(args.config, &error)) return Fail(error);
-  SimulatedSession session;
-  SimulatorOptions sim = args.config.simulation;
-  // Issue 15: a plan's poses, in order, each its own hold, no extra still
-  // period before the first.
-  if (!args.plan.empty()) {
-    std::vector<PlannedPose> poses;
-    if (!ReadPlanPoses(args.plan, &poses, &error)) return Fail(error);
-    sim.planned_poses.clear();
-    for (const PlannedPose& p : poses) sim.planned_poses.push_back({p.up, p.hold_seconds});
-    sim.initial_still_seconds = 0.0;
-  }
-  // The rate table's constant-rate segments (motion profile rate_table).
-  std::vector<RateTableSegment> segments;
-  if (!args.config.sim_motion.empty()) {
-    MotionOptions motion = args.config.motion;
-    FromString(args.config.sim_motion, &motion.profile);
-    MotionSession moving;
-    if (!SimulateMotion(sim, motion, args.seed, &moving, &error)) {
-      return Fail(error);
-    }
-    segments = moving.segments;
-    session = std::move(moving.sensor);
-  } else if (!Simulate(sim, args.seed, &session, &error)) {
-    return Fail(error);
-  }
+  SimulationRequest request;
+  request.plan_path = args.plan;
+  request.seed = args.seed;
+  SimulationFiles files;
+  if (!SimulateFromConfig(args.config, request, &files, &error)) return Fail(error);
+  const SimulatedSession& session = files.session;
   mkdir(args.output_dir.c_str(), 0755);
   struct stat st;
   if (stat(args.output_dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
@@ -192,27 +172,24 @@ int RunSimulate(const CommandArgs& args) {
   const std::string truth = args.output_dir + "/truth.json";
   const std::string attitudes = args.output_dir + "/attitudes.csv";
   if (!WriteImuLogCsv(session.log, raw, &error)) return Fail(error);
-  if (!WriteFileAtomically(truth, TruthToJson(session, sim), &error)) {
+  if (!WriteFileAtomically(truth, files.truth_json, &error)) {
     std::remove(raw.c_str());
     return Fail(error);
   }
-  // What a fixture (or an inclinometer) would say about each pose.
-  const std::string fixture = FixtureAttitudesToCsv(
-      SimulatedFixtureAttitudes(session, sim.fixture_attitude_noise_deg, args.seed));
-  if (!WriteFileAtomically(attitudes, fixture, &error)) {
+  if (!WriteFileAtomically(attitudes, files.attitudes_csv, &error)) {
     std::remove(raw.c_str());
     std::remove(truth.c_str());
     return Fail(error);
   }
   const std::string segments_path = args.output_dir + "/segments.csv";
-  if (!segments.empty() &&
-      !WriteFileAtomically(segments_path, RateTableSegmentsToCsv(segments, session.log), &error)) {
+  const bool segments = !files.segments_csv.empty();
+  if (segments && !WriteFileAtomically(segments_path, files.segments_csv, &error)) {
     for (const std::string& f : {raw, truth, attitudes}) std::remove(f.c_str());
     return Fail(error);
   }
   std::fprintf(stderr, "gravcal: wrote %s (%zu samples), %s and %s%s%s\n", raw.c_str(),
-               session.log.size(), truth.c_str(), attitudes.c_str(),
-               segments.empty() ? "" : " and ", segments.empty() ? "" : segments_path.c_str());
+               session.log.size(), truth.c_str(), attitudes.c_str(), segments ? " and " : "",
+               segments ? segments_path.c_str() : "");
   return 0;
 }
 

@@ -1,47 +1,18 @@
 // gravcal noise: the noise model of a still log (issue 14): noise.json, and
 // optionally Kalibr's imu.yaml and the handheld filter's hk_* keys.
-#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "cli/commands.h"
-#include "gravcal/core/gravity.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
+#include "gravcal/workflows/noise_workflow.h"
 #include "gravcal/workflows/report.h"
 
 namespace gravcal {
 namespace cli {
 namespace {
-
-// The options from the config: the noise section, the raw units of
-// nominal_scale and gyro_nominal_scale, and the detector section.
-NoiseOptions NoiseOptionsOf(const Config& config) {
-  NoiseOptions options = config.noise;
-  options.accel_scale = config.calibration.nominal_scale;
-  options.gyro_scale = config.handheld.gyro_nominal_scale;
-  options.detector = config.calibration.detector;
-  return options;
-}
-
-// |mean accelerometer| over the still interval in m/s^2 must be near
-// gravity: otherwise nominal_scale is not m/s^2 per raw unit and every
-// accelerometer number would be in the wrong unit.
-bool CheckAccelUnit(const ImuLog& log, const ImuNoise& noise, double scale, std::string* error) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  const ImuNoiseModel& m = noise.model;
-  for (size_t i = m.still_begin; i < m.still_end; ++i) mean += log.accel[i];
-  const double g = scale * mean.norm() / static_cast<double>(m.still_end - m.still_begin);
-  if (std::abs(g / kStandardGravity - 1.0) <= 0.1) return true;
-  char text[256];
-  std::snprintf(text, sizeof(text),
-                "%s: |mean accelerometer| over the still interval is %.4g m/s^2 with "
-                "nominal_scale %.6g, not about 9.8: set nominal_scale to m/s^2 per raw unit",
-                log.source.c_str(), g, scale);
-  *error = text;
-  return false;
-}
 
 std::string TermText(const NoiseTerm& term, const std::string& unit) {
   if (!term.visible()) return "not shown";
@@ -65,14 +36,12 @@ int RunNoise(const CommandArgs& args) {
   if (args.input.empty()) return Fail("noise needs --input <still log>");
   if (args.output.empty()) return Fail("noise needs --output <noise.json>");
   std::string error;
-  const NoiseOptions options = NoiseOptionsOf(args.config);
-  if (!args.config.input.IsValid(&error)) return Fail("input: " + error);
-  if (!options.IsValid(&error)) return Fail(error);
+  NoiseOptions options;
+  if (!NoiseOptionsFromConfig(args.config, &options, &error)) return Fail(error);
   ImuLog log;
   if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
   ImuNoise noise;
-  if (!CharacteriseNoise(log, options, &noise)) return Fail(noise.message);
-  if (!CheckAccelUnit(log, noise, options.accel_scale, &error)) return Fail(error);
+  if (!CharacteriseLogNoise(log, options, &noise, &error)) return Fail(error);
   // Every text first, then the files, so that a failure leaves none.
   std::string kalibr;
   if (!args.kalibr.empty() && !NoiseToKalibrYaml(noise.model, &kalibr, &error)) {

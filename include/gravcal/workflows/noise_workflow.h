@@ -1,0 +1,34 @@
+// gravcal/workflows/noise_workflow.h: the noise model of a still log with
+// the options a configuration gives, as `gravcal noise` computes it. The
+// command-line tool and the Python package both call these two functions.
+//
+// The config's noise section supplies the Allan and fit settings; the raw
+// units come from nominal_scale (accelerometer, m/s^2 per raw unit) and
+// gyro_nominal_scale (gyroscope, rad/s per raw unit), and the still
+// interval from the calibration's static detector section.
+#ifndef GRAVCAL_WORKFLOWS_NOISE_WORKFLOW_H_
+#define GRAVCAL_WORKFLOWS_NOISE_WORKFLOW_H_
+
+#include <string>
+
+#include "gravcal/core/imu_log.h"
+#include "gravcal/estimation/noise_characterisation.h"
+#include "gravcal/workflows/config.h"
+
+namespace gravcal {
+
+// The options of `config`. False with a one-line *error when its reader
+// options ("input: ...") or the noise options are invalid.
+bool NoiseOptionsFromConfig(const Config& config, NoiseOptions* options, std::string* error);
+
+// CharacteriseNoise, then a check of the accelerometer's unit: over the
+// still interval |mean accelerometer| * accel_scale must be within 10 % of
+// standard gravity, else nominal_scale is not m/s^2 per raw unit and every
+// accelerometer number would be in the wrong unit. False with a one-line
+// *error (naming log.source) on either failure.
+bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise* noise,
+                          std::string* error);
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_WORKFLOWS_NOISE_WORKFLOW_H_

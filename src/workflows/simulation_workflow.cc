@@ -1,0 +1,45 @@
+#include "gravcal/workflows/simulation_workflow.h"
+
+#include <utility>
+
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/io/plan_io.h"
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulated_attitudes.h"
+#include "gravcal/workflows/rate_table_segments.h"
+
+namespace gravcal {
+
+bool SimulateFromConfig(const Config& config, const SimulationRequest& request,
+                        SimulationFiles* files, std::string* error) {
+  if (!config.IsValid(error)) return false;
+  SimulatorOptions& sim = files->options;
+  sim = config.simulation;
+  if (!request.plan_path.empty()) {
+    std::vector<PlannedPose> poses;
+    if (!ReadPlanPoses(request.plan_path, &poses, error)) return false;
+    sim.planned_poses.clear();
+    for (const PlannedPose& p : poses) sim.planned_poses.push_back({p.up, p.hold_seconds});
+    sim.initial_still_seconds = 0.0;
+  }
+  files->segments.clear();
+  if (!config.sim_motion.empty()) {
+    MotionOptions motion = config.motion;
+    FromString(config.sim_motion, &motion.profile);
+    MotionSession moving;
+    if (!SimulateMotion(sim, motion, request.seed, &moving, error)) return false;
+    files->segments = std::move(moving.segments);
+    files->session = std::move(moving.sensor);
+  } else if (!Simulate(sim, request.seed, &files->session, error)) {
+    return false;
+  }
+  files->truth_json = TruthToJson(files->session, sim);
+  files->attitudes_csv = FixtureAttitudesToCsv(
+      SimulatedFixtureAttitudes(files->session, sim.fixture_attitude_noise_deg, request.seed));
+  files->segments_csv = files->segments.empty()
+                            ? std::string()
+                            : RateTableSegmentsToCsv(files->segments, files->session.log);
+  return true;
+}
+
+}  // namespace gravcal
