@@ -212,12 +212,14 @@ struct PyCalibration {
     return c;
   }
 
-  static PyCalibration FromResult(Calibration&& result, bool include_covariance,
-                                  const std::string& name) {
-    PyCalibration c;
-    c.result = std::make_shared<const Calibration>(std::move(result));
-    c.include_covariance = include_covariance;
-    c.name = name;
+  // Held as made: results are handed to Python without a copy or a move.
+  static std::unique_ptr<PyCalibration> FromResult(std::shared_ptr<const Calibration> result,
+                                                   bool include_covariance,
+                                                   const std::string& name) {
+    auto c = std::make_unique<PyCalibration>();
+    c->result = std::move(result);
+    c->include_covariance = include_covariance;
+    c->name = name;
     return c;
   }
 
@@ -305,25 +307,26 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
   return py::make_tuple(a_out, gyro.is_none() ? py::object(py::none()) : py::object(w_out));
 }
 
-// RunCalibration, as `gravcal calibrate` runs it; `provenance` names the
-// log file when there is one (LogProvenance).
-PyCalibration Run(const Config& config, const PipelineInput& input,
-                  const CalibrationProvenance* provenance = nullptr) {
-  Calibration c;
+// RunCalibration, as `gravcal calibrate` runs it, into the result Python
+// will hold; `provenance` names the log file when there is one.
+std::unique_ptr<PyCalibration> Run(const Config& config, const PipelineInput& input,
+                                   const CalibrationProvenance* provenance = nullptr) {
+  auto c = std::make_shared<Calibration>();
   bool ok;
   {
     py::gil_scoped_release release;
-    ok = RunCalibration(config, input, &c);
+    ok = RunCalibration(config, input, c.get());
   }
-  Check(ok, c.message);
-  if (provenance != nullptr) c.provenance = *provenance;
+  Check(ok, c->message);
+  if (provenance != nullptr) c->provenance = *provenance;
   return PyCalibration::FromResult(std::move(c), config.output_covariance, input.source);
 }
 
 // On a log in memory: the log itself when there is no side input, else a
 // copy with the side files. RunCalibration checks the config first.
-PyCalibration Calibrate(const Config& config, const LogHandle& log, const std::string& attitudes,
-                        const std::string& segments, const std::string& noise) {
+std::unique_ptr<PyCalibration> Calibrate(const Config& config, const LogHandle& log,
+                                         const std::string& attitudes, const std::string& segments,
+                                         const std::string& noise) {
   if (attitudes.empty() && segments.empty() && noise.empty()) return Run(config, *log);
   PipelineInput input = *log;
   input.attitudes_path = attitudes;
@@ -332,25 +335,28 @@ PyCalibration Calibrate(const Config& config, const LogHandle& log, const std::s
   return Run(config, input);
 }
 
-// On a log file, read straight into the pipeline's input.
-PyCalibration CalibrateFile(const Config& config, const std::string& path,
-                            const std::string& attitudes, const std::string& segments,
-                            const std::string& noise) {
+// On a log file, read straight into the pipeline's input, with the file's
+// provenance, as `gravcal calibrate --input` does (the config checked
+// first, so that its errors come before the file's).
+std::unique_ptr<PyCalibration> CalibrateFile(const Config& config, const std::string& path,
+                                             const std::string& attitudes,
+                                             const std::string& segments,
+                                             const std::string& noise) {
   CheckConfig(config);
   PipelineInput input;
   input.source = path;
   input.attitudes_path = attitudes;
   input.segments_path = segments;
   input.noise_path = noise;
+  CalibrationProvenance provenance;
   std::string error;
   bool ok;
   {
     py::gil_scoped_release release;
-    ok = ReadImuLog(path, config.input, &input.log, &error);
+    ok = ReadImuLog(path, config.input, &input.log, &error) &&
+         LogProvenance(path, &provenance, &error);
   }
   Check(ok, error);
-  CalibrationProvenance provenance;
-  Check(LogProvenance(path, &provenance, &error), error);
   return Run(config, input, &provenance);
 }
 
@@ -422,8 +428,9 @@ std::vector<PyBatchResult> Batch(const std::vector<BatchUnit>& units, const Conf
     Config config;
     if (r.status == BatchStatus::kOk && EffectiveConfig(units[i], base, &config, &error)) {
       // The unit's <unit>.json as `gravcal batch` writes it.
-      p.calibration = py::cast(PyCalibration::FromResult(std::move(results[i].calibration),
-                                                         config.output_covariance, r.unit));
+      p.calibration = py::cast(PyCalibration::FromResult(
+          std::make_shared<const Calibration>(std::move(results[i].calibration)),
+          config.output_covariance, r.unit));
     }
   }
   return out;
@@ -603,9 +610,10 @@ double ThreadCpuSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// For benchmarks/python_overhead.py: CPU seconds per call of the C++ user's
-// code, `repeats` calls: ReadImuLog + RunCalibration on `path` (as `gravcal
-// calibrate`), or, with an empty path, RunCalibration on the log in memory.
+// For benchmarks/python_overhead.py: CPU seconds per call of a C++ user's
+// code doing what the Python call does, `repeats` calls: on `path`,
+// ReadImuLog, LogProvenance and RunCalibration (as `gravcal calibrate`);
+// with an empty path, RunCalibration on the log in memory.
 double TimeCalibrate(const Config& config, const LogHandle& log, const std::string& path,
                      int repeats) {
   py::gil_scoped_release release;
@@ -618,8 +626,12 @@ double TimeCalibrate(const Config& config, const LogHandle& log, const std::stri
     }
     PipelineInput input;
     input.source = path;
+    CalibrationProvenance provenance;
     std::string error;
-    if (ReadImuLog(path, config.input, &input.log, &error)) RunCalibration(config, input, &c);
+    if (ReadImuLog(path, config.input, &input.log, &error) &&
+        LogProvenance(path, &provenance, &error) && RunCalibration(config, input, &c)) {
+      c.provenance = provenance;
+    }
   }
   return (ThreadCpuSeconds() - start) / std::max(repeats, 1);
 }

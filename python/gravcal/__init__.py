@@ -333,10 +333,18 @@ def calibrate(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None
     ``gravity=9.81744``) apply on top. ``attitudes``, ``segments`` and
     ``noise`` are the side files of the methods that need them. Returns a
     :class:`Calibration`; raises :class:`Error` with the CLI's message."""
-    cfg = _config(config, **keys)
-    side = ["" if p is None else _os.fspath(p) for p in (attitudes, segments, noise)]
-    if isinstance(log, (str, bytes, _os.PathLike)):
-        if any(x is not None for x in (t, accel, gyro, temp)):
+    # Exact type checks first: in a loop of calls on logs or paths with a
+    # Config, each call stays a handful of cheap tests.
+    cfg = config if type(config) is Config and not keys else _config(config, **keys)
+    if attitudes is None and segments is None and noise is None:
+        side = ("", "", "")
+    else:
+        side = tuple("" if p is None else _os.fspath(p) for p in (attitudes, segments, noise))
+    arrays = t is not None or accel is not None or gyro is not None or temp is not None
+    if type(log) is Log and not arrays:
+        return Calibration(_gravcal.calibrate(cfg, log, *side))
+    if type(log) is str or isinstance(log, (bytes, _os.PathLike)):
+        if arrays:
             raise Error("give either a log (Log, path or DataFrame) or arrays t/accel, not both")
         # Read straight into the pipeline, as gravcal calibrate --input does.
         return Calibration(_gravcal.calibrate_file(cfg, _os.fsdecode(log), *side))
