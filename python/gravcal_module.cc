@@ -546,7 +546,6 @@ py::dict CheckSession(const Config& config, const LogHandle& log, PlanRequest re
   ImuNoise noise;
   if (ReadNoise(noise_path, noise_text, &noise)) request.noise_model = &noise.model;
   std::string error;
-  Check(config.input.IsValid(&error), "input: " + error);
   CoverageReport report;
   bool ok;
   {

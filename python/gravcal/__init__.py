@@ -28,8 +28,8 @@ from ._gravcal import Error, Log
 __version__ = _gravcal.__version__
 
 __all__ = [
-    "Error", "Log", "Calibration", "BatchResult", "Config", "config", "read_log", "log",
-    "calibrate", "simulate", "batch", "noise", "discover", "plan", "check", "export",
+    "Error", "Log", "Calibration", "Result", "BatchResult", "Config", "config", "read_log",
+    "log", "calibrate", "simulate", "batch", "noise", "discover", "plan", "check", "export",
     "config_keys", "__version__",
 ]
 
@@ -253,6 +253,44 @@ class _Section:
         return "<gravcal section: %s>" % ", ".join(self._dict())
 
 
+class Result(dict):
+    """A result of noise, discover, plan, check, export or simulate's truth:
+    the JSON object the CLI writes, as a dict (so ``==``, ``json.dump`` and
+    ``result["key"]`` work as on ``json.load`` of the CLI's file) whose keys
+    also read as attributes: ``noise.accel.x.white_noise.value``,
+    ``plan.poses``; lists of numbers read as attributes are NumPy arrays
+    (null = NaN), as in :class:`Calibration`."""
+
+    __slots__ = ()
+
+    def __getattr__(self, name):
+        try:
+            value = self[name]
+        except KeyError:
+            raise AttributeError("no key '%s' (keys: %s)" % (name, ", ".join(self))) from None
+        return value if isinstance(value, dict) else _convert(value)
+
+    def __dir__(self):
+        return list(self)
+
+    def to_dict(self):
+        """Plain dicts and lists (a copy)."""
+        return _plain(self)
+
+
+def _plain(value):
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _result(text):
+    """JSON text as a :class:`Result` (every object in it one too)."""
+    return _json.loads(text, object_hook=Result)
+
+
 class Calibration(_Section):
     """A calibration result: the calibration JSON of ``gravcal calibrate``.
 
@@ -363,8 +401,8 @@ def simulate(config=None, seed=1, *, plan=None, return_files=False, **keys):
         files = {"attitudes.csv": attitudes}
         if segments:
             files["segments.csv"] = segments
-        return _json.loads(truth), data, files
-    return _json.loads(truth), data
+        return _result(truth), data, files
+    return _result(truth), data
 
 
 def _unit_spec(i, unit):
@@ -421,7 +459,7 @@ def noise(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None, **
     """The noise model of a still log (Allan deviation), as ``gravcal noise``
     writes noise.json: a dict."""
     cfg = _config(config, **keys)
-    return _json.loads(_gravcal.noise(cfg, _as_log(log, cfg, t, accel, gyro, temp)))
+    return _result(_gravcal.noise(cfg, _as_log(log, cfg, t, accel, gyro, temp)))
 
 
 def discover(log=None, *, config=None, report=None, t=None, accel=None, gyro=None, temp=None,
@@ -432,7 +470,7 @@ def discover(log=None, *, config=None, report=None, t=None, accel=None, gyro=Non
     text, html = _gravcal.discover(cfg, _as_log(log, cfg, t, accel, gyro, temp))
     if report is not None:
         _gravcal.write_file(_os.fspath(report), html)
-    return _json.loads(text)
+    return _result(text)
 
 
 # The request of plan and check: the CLI's flag names, and the
@@ -489,7 +527,7 @@ def plan(config=None, *, noise=None, output=None, **keys):
     text = _gravcal.plan(_config(config, **rest), request, *_noise_source(noise))
     if output is not None:
         _gravcal.write_file(_os.fspath(output), text)
-    return _json.loads(text)
+    return _result(text)
 
 
 def check(log=None, *, config=None, noise=None, t=None, accel=None, gyro=None, temp=None,
@@ -504,8 +542,8 @@ def check(log=None, *, config=None, noise=None, t=None, accel=None, gyro=None, t
     determined."""
     request, rest = _split_request(keys)
     cfg = _config(config, **rest)
-    return _gravcal.check(cfg, _as_log(log, cfg, t, accel, gyro, temp), request,
-                          *_noise_source(noise))
+    return Result(_gravcal.check(cfg, _as_log(log, cfg, t, accel, gyro, temp), request,
+                                 *_noise_source(noise)))
 
 
 def export(calibration, to, *, noise=None, name=None):
@@ -525,5 +563,7 @@ def export(calibration, to, *, noise=None, name=None):
     if not isinstance(calibration, Calibration):
         raise Error("calibration: expected a gravcal.Calibration or a calibration JSON path, "
                     "got %s" % type(calibration).__name__)
-    return _gravcal.export(calibration._core, str(to), "" if name is None else str(name),
-                           *_noise_source(noise))
+    result = _gravcal.export(calibration._core, str(to), "" if name is None else str(name),
+                             *_noise_source(noise))
+    result["files"] = [Result(f) for f in result["files"]]
+    return Result(result)

@@ -125,3 +125,16 @@ def test_export_errors_are_the_cli_messages(cli_calibration):
     assert str(e.value) == error
     with pytest.raises(gravcal.Error, match=r"^to: expected one of kalibr, .*, not 'matlab'$"):
         gravcal.export(str(cli_calibration), "matlab")
+
+
+def test_results_read_as_attributes_and_stay_dicts(cli_plan, still_noise):
+    plan = gravcal.plan(TWELVE, target=TARGET, pose_set="faces+45",
+                        accel_noise_density=float(DENSITY))
+    assert isinstance(plan, dict) and isinstance(plan, gravcal.Result)
+    assert plan.poses[0]["up"] == plan["poses"][0]["up"]
+    assert plan.predicted_std.bias_x == plan["predicted_std"]["bias_x"]
+    assert type(plan.to_dict()) is dict and plan.to_dict() == read_json(cli_plan)
+    noise = gravcal.noise(still_noise.parent / "raw.csv")
+    assert noise.accel.x.white_noise.value == noise["accel"]["x"]["white_noise"]["value"]
+    with pytest.raises(AttributeError, match="no key 'nonsense'"):
+        noise.nonsense
