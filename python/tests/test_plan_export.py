@@ -9,20 +9,25 @@ from conftest import config_path, read_json, run_cli, strip_times
 TWELVE = config_path("twelve_position.yaml")
 TARGET = "accel_bias=0.5mg accel_scale=100ppm"
 DENSITY = "0.002"
+# Every other request flag, away from its default, so that a keyword mapped
+# to the wrong field shows.
+PLAN_KEYWORDS = {"overhead": 7.0, "min_hold": 4.0, "max_hold": 500.0, "max_time": 1000.0,
+                 "accel_bias_instability": 1e-4, "pose_disturbance": 1e-4}
+PLAN_FLAGS = [x for k, v in PLAN_KEYWORDS.items() for x in ("--" + k, repr(v))]
 
 
 @pytest.fixture(scope="module")
 def cli_plan(tmp_path_factory):
     out = tmp_path_factory.mktemp("plan") / "plan.json"
     run_cli("plan", "--config", TWELVE, "--target", TARGET, "--accel_noise_density", DENSITY,
-            "--pose_set", "faces+45", "--output", out)
+            "--pose_set", "faces+45", *PLAN_FLAGS, "--output", out)
     return out
 
 
 def test_plan_equals_cli(cli_plan, tmp_path):
     out = tmp_path / "py_plan.json"
     result = gravcal.plan(TWELVE, target=TARGET, accel_noise_density=float(DENSITY),
-                          pose_set="faces+45", output=out)
+                          pose_set="faces+45", output=out, **PLAN_KEYWORDS)
     assert out.read_bytes() == cli_plan.read_bytes()
     assert result == read_json(cli_plan)
     assert result["poses"] and result["meets_targets"]
@@ -106,7 +111,9 @@ def test_export_equals_cli(target, si_calibration, still_noise, tmp_path):
         args += ["--output", tmp_path / "out"]
     run_cli(*args)
     result = gravcal.export(si_calibration, target, noise=still_noise)
-    assert result["files"]
+    names = [f["name"] or "out" for f in result["files"]]
+    written = [p.name for p in tmp_path.iterdir()] if target == "c" else ["out"]
+    assert sorted(names) == sorted(written)
     for f in result["files"]:
         path = tmp_path / (f["name"] or "out")
         assert f["text"] == path.read_text(), target
@@ -129,7 +136,7 @@ def test_export_errors_are_the_cli_messages(cli_calibration):
 
 def test_results_read_as_attributes_and_stay_dicts(cli_plan, still_noise):
     plan = gravcal.plan(TWELVE, target=TARGET, pose_set="faces+45",
-                        accel_noise_density=float(DENSITY))
+                        accel_noise_density=float(DENSITY), **PLAN_KEYWORDS)
     assert isinstance(plan, dict) and isinstance(plan, gravcal.Result)
     assert plan.poses[0]["up"] == plan["poses"][0]["up"]
     assert plan.predicted_std.bias_x == plan["predicted_std"]["bias_x"]
