@@ -377,8 +377,9 @@ TEST(Discovery, GyroscopeExcessDoesNotMaskAccelerometerEffect) {
       if (Info(a[i].effect).sensor != EffectSensor::kAccelerometer || !a[i].tried) continue;
       same = b[i].tried && !a[i].information.empty();
       if (!same || a[i].information != b[i].information) continue;
-      same = a[i].significant == b[i].significant && a[i].p_value == b[i].p_value &&
-             a[i].delta_bic == b[i].delta_bic && a[i].cv_gap.accel_sigma == b[i].cv_gap.accel_sigma;
+      same = a[i].significant == b[i].significant && a[i].reason == b[i].reason &&
+             a[i].p_value == b[i].p_value && a[i].delta_bic == b[i].delta_bic &&
+             a[i].cv_gap.accel_sigma == b[i].cv_gap.accel_sigma;
     }
     same_scores += same ? 1 : 0;
     std::printf("seed %d: %s | without gyroscope: %s\n", seed, with_gyro.verdict.c_str(),
