@@ -342,9 +342,18 @@ TEST_F(CliTest, DiscoverNamesHiddenEffectAndCalibrateFitsIt) {
   }
   EXPECT_LT(step["cv_gap_after"].get<double>(), 0.5 * step["cv_gap_before"].get<double>());
   EXPECT_FALSE(step["where"]["summary"].get<std::string>().empty());
+  // Issue 21: which information each decision used, and a verdict per sensor.
+  EXPECT_FALSE(step["information"].get<std::string>().empty());
+  ASSERT_EQ(j["sensors"].size(), 2u);
+  EXPECT_EQ(j["sensors"][0]["sensor"], "accelerometer");
+  EXPECT_EQ(j["sensors"][0]["information"], step["information"]);
+  EXPECT_NE(r.err.find("(from the " + step["information"].get<std::string>() + ")"),
+            std::string::npos)
+      << r.err;
   EXPECT_NE(j["verdict"].get<std::string>().find("accel_temperature_bias"), std::string::npos);
   const std::string html = Slurp(html_path);
   EXPECT_NE(html.find("<svg"), std::string::npos);
+  EXPECT_NE(html.find("information used"), std::string::npos);
   EXPECT_EQ(html.find("src="), std::string::npos);
   EXPECT_EQ(html.find("href="), std::string::npos);
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <random>
 
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
@@ -292,6 +293,108 @@ TEST(Discovery, ReportsTemperatureVersusTimeAmbiguityInMonotonicWarmUp) {
   EXPECT_GE(reported, testing_util::RequiredSuccesses(seeds, 0.92)) << reported << " of " << seeds;
 }
 
+// Issue 21: each sensor's evidence stands on its own. Fourteen poses with
+// the scale baseline, as on the repeat recordings of the AHRS unit of
+// ../shared/data/real/ahrs_static_poses: the accelerometer hides a
+// non-orthogonality (1.5 mrad per angle: chi2 33 to 4000 on 8 dof over the
+// seeds, at the noise with it), while every pose's gyroscope mean carries
+// an offset of 30 sigma per axis that no catalogue effect explains (the
+// AHRS's gyroscope output has its own processing). The accelerometer effect
+// is named; the gyroscope is reported as unexplained; and every
+// accelerometer candidate is scored exactly as on the same positions
+// without the gyroscope (before issue 21 the gyroscope's candidates shared
+// the accelerometer's test family and BIC n, so they differed).
+void AddPoseOffsetsToGyro(double sigmas, uint64_t seed, SimulatedSession* session,
+                          const SimulatorOptions& sim) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> z(0.0, 1.0);
+  const double per_sample = sim.gyro_noise * session->gyro_units_per_si;
+  for (const SimulatedPose& p : session->poses) {
+    const double sigma_of_mean = per_sample / std::sqrt(static_cast<double>(p.end - p.begin));
+    const Eigen::Vector3d offset(z(rng), z(rng), z(rng));
+    for (size_t i = p.begin; i < p.end; ++i) {
+      session->log.gyro[i] += (sigmas * sigma_of_mean * offset).array().round().matrix();
+    }
+  }
+}
+
+// The same static positions as if the log had no gyroscope column.
+std::vector<StaticObservation> WithoutGyroscope(std::vector<StaticObservation> observations) {
+  for (StaticObservation& o : observations) o.has_gyro = false;
+  return observations;
+}
+
+TEST(Discovery, GyroscopeExcessDoesNotMaskAccelerometerEffect) {
+  SimulatorOptions sim;
+  sim.scheme = "random:14";
+  sim.hold_seconds = 10.0;
+  sim.accel_misalignment_std = 1.5e-3;
+  CalibrationOptions calibration;
+  calibration.refinement.parameterization = AccelParameterization::kScale;
+  const int seeds = 10;
+  int named = 0, gyro_unexplained = 0, same_scores = 0;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    SimulatedSession session;
+    std::string error;
+    ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
+    AddPoseOffsetsToGyro(30.0, seed, &session, sim);
+    calibration.gravity.gravity = session.gravity;
+    DiscoveryResult with_gyro, without_gyro;
+    ASSERT_TRUE(DiscoverEffects(session.log, calibration, {}, DiscoveryOptions(), &with_gyro))
+        << with_gyro.message;
+    ASSERT_TRUE(DiscoverFromObservations(WithoutGyroscope(with_gyro.observations), calibration, {},
+                                         DiscoveryOptions(), &without_gyro))
+        << without_gyro.message;
+    const std::vector<Effect> found = with_gyro.named();
+    const bool has = Contains(found, Effect::kAccelMisalignment) ||
+                     (!with_gyro.steps.empty() &&
+                      Contains(with_gyro.steps.front().ambiguous_with, Effect::kAccelMisalignment));
+    named += has ? 1 : 0;
+    ASSERT_EQ(with_gyro.sensors.size(), 2u);
+    const SensorVerdict& gyro = with_gyro.sensors[1];
+    EXPECT_EQ(gyro.sensor, EffectSensor::kGyroscope);
+    EXPECT_EQ(gyro.information, with_gyro.final_model.fit.gyro_fit.information);
+    EXPECT_FALSE(gyro.information.empty());
+    EXPECT_EQ(with_gyro.sensors[0].information, with_gyro.final_model.fit.accel_fit.information);
+    EXPECT_GT(gyro.excess, 10.0);
+    if (gyro.unexplained &&
+        gyro.verdict.find("gyroscope static means exceed their noise by") != std::string::npos &&
+        gyro.verdict.find("no catalogue effect explains it") != std::string::npos &&
+        with_gyro.verdict.find("no catalogue effect explains it") != std::string::npos) {
+      ++gyro_unexplained;
+    }
+    // The accelerometer's first round, scored with and without the
+    // gyroscope: the same p-values, BIC and cross-validation (as long as
+    // the accelerometer's fit uses no gyroscope information, which its
+    // `information` would say).
+    const std::vector<CandidateScore>& a =
+        with_gyro.steps.empty() ? with_gyro.final_candidates : with_gyro.steps.front().candidates;
+    const std::vector<CandidateScore>& b = without_gyro.steps.empty()
+                                               ? without_gyro.final_candidates
+                                               : without_gyro.steps.front().candidates;
+    bool same = !a.empty() && a.size() == b.size();
+    for (size_t i = 0; same && i < a.size(); ++i) {
+      if (Info(a[i].effect).sensor != EffectSensor::kAccelerometer || !a[i].tried) continue;
+      same = b[i].tried && !a[i].information.empty();
+      if (!same || a[i].information != b[i].information) continue;
+      same = a[i].significant == b[i].significant && a[i].reason == b[i].reason &&
+             a[i].p_value == b[i].p_value && a[i].delta_bic == b[i].delta_bic &&
+             a[i].cv_gap.accel_sigma == b[i].cv_gap.accel_sigma;
+    }
+    same_scores += same ? 1 : 0;
+    std::printf("seed %d: %s | without gyroscope: %s\n", seed, with_gyro.verdict.c_str(),
+                without_gyro.verdict.c_str());
+  }
+  // Measured on seeds 1001-1060 (the same session through `gravcal
+  // simulate` and `discover`): named first in 60 of 60 (lower 99.9 % bound
+  // 0.89), the gyroscope reported unexplained in every seed. The scores are
+  // identical by construction: any difference is a coupling between the
+  // sensors.
+  EXPECT_GE(named, testing_util::RequiredSuccesses(seeds, 0.89)) << named << " of " << seeds;
+  EXPECT_EQ(gyro_unexplained, seeds);
+  EXPECT_EQ(same_scores, seeds);
+}
+
 }  // namespace
 }  // namespace gravcal
 
@@ -306,6 +409,10 @@ namespace {
 struct RealCase {
   const char* config;
   const char* file;
+  // What the full session names: nothing (no false alarm), except on the
+  // Ferraris session, whose accelerometer's chi2 falls from 164 on 7 dof to
+  // 6.9 on 4 with a bias drift (discover.md, "Measured").
+  std::vector<Effect> named;
 };
 
 class DiscoveryRealData : public ::testing::TestWithParam<RealCase> {};
@@ -324,6 +431,7 @@ TEST_P(DiscoveryRealData, RunsAndIsStableWhenOnePositionIsLeftOut) {
   EXPECT_FALSE(full.verdict.empty());
   std::printf("%s: %s\n", rc.config, full.verdict.c_str());
   const std::vector<Effect> named = full.named();
+  EXPECT_EQ(EffectNames(named), EffectNames(rc.named)) << full.verdict;
   int same = 0, runs = 0;
   for (size_t leave = 0; leave < full.observations.size(); ++leave) {
     std::vector<StaticObservation> subset = full.observations;
@@ -350,11 +458,62 @@ TEST_P(DiscoveryRealData, RunsAndIsStableWhenOnePositionIsLeftOut) {
   EXPECT_GE(same, 0.8 * runs) << same << " of " << runs;
 }
 
+// Issue 21 on the first AHRS recording (nine poses, scale baseline): its
+// gyroscope's static means sit several times their noise from every static
+// model (the AHRS processes its gyroscope output), and no catalogue effect
+// explains that. The report says so for the gyroscope, names nothing, and
+// the accelerometer's own verdict is exactly the one the log gives without
+// its gyroscope column.
+TEST(DiscoveryRealAhrs, GyroscopeExcessIsReportedWithoutSilencingTheAccelerometer) {
+  const std::string dir = testing_util::RealDataDir();
+  if (dir.empty()) GTEST_SKIP() << "no ../shared/data/real";
+  Config config;
+  ImuLog log;
+  std::string error;
+  ASSERT_TRUE(testing_util::LoadRealSession(
+      "ahrs_static_poses.yaml", "ahrs_static_poses/imu_good1.txt", &config, &log, &error))
+      << error;
+  DiscoveryResult r;
+  ASSERT_TRUE(DiscoverEffects(log, config.calibration, config.effects, config.discovery, &r))
+      << r.message;
+  std::printf("%s\n", r.verdict.c_str());
+  EXPECT_TRUE(r.named().empty()) << r.verdict;
+  ASSERT_EQ(r.sensors.size(), 2u);
+  const SensorVerdict& accel = r.sensors[0];
+  const SensorVerdict& gyro = r.sensors[1];
+  EXPECT_EQ(accel.information, r.final_model.fit.accel_fit.information);
+  EXPECT_EQ(gyro.information, r.final_model.fit.gyro_fit.information);
+  EXPECT_FALSE(accel.information.empty());
+  EXPECT_FALSE(gyro.information.empty());
+  // Measured: 6.4 (chi2 983 on 24 dof).
+  EXPECT_GT(gyro.excess, 3.0);
+  EXPECT_TRUE(gyro.unexplained);
+  EXPECT_NE(gyro.verdict.find("gyroscope static means exceed their noise by"), std::string::npos)
+      << gyro.verdict;
+  EXPECT_NE(r.verdict.find("no catalogue effect explains it"), std::string::npos) << r.verdict;
+  // Nine poses leave the six-parameter scale model three residuals: no
+  // three-parameter accelerometer effect can be tested, and the verdict
+  // says so rather than calling the accelerometer's excess explained.
+  EXPECT_FALSE(accel.unexplained);
+  EXPECT_NE(accel.verdict.find("can be tested"), std::string::npos) << accel.verdict;
+  CalibrationOptions calibration = config.calibration;
+  calibration.nominal_up.clear();
+  DiscoveryResult without;
+  ASSERT_TRUE(DiscoverFromObservations(WithoutGyroscope(r.observations), calibration,
+                                       config.effects, config.discovery, &without))
+      << without.message;
+  ASSERT_EQ(without.sensors.size(), 1u);
+  EXPECT_EQ(without.sensors[0].verdict, accel.verdict);
+  EXPECT_EQ(without.sensors[0].excess, accel.excess);
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Recordings, DiscoveryRealData,
-    ::testing::Values(RealCase{"ferraris_nilspod.yaml", "ferraris_nilspod/session.csv"},
-                      RealCase{"mpu6050_ten_pose.yaml", "mpu6050_ten_pose/session.csv"},
-                      RealCase{"ahrs_static_poses.yaml", "ahrs_static_poses/imu_good1.txt"}),
+    ::testing::Values(RealCase{"ferraris_nilspod.yaml",
+                               "ferraris_nilspod/session.csv",
+                               {Effect::kAccelBiasDrift}},
+                      RealCase{"mpu6050_ten_pose.yaml", "mpu6050_ten_pose/session.csv", {}},
+                      RealCase{"ahrs_static_poses.yaml", "ahrs_static_poses/imu_good1.txt", {}}),
     [](const ::testing::TestParamInfo<RealCase>& info) {
       std::string name = info.param.config;
       return name.substr(0, name.find('.'));

@@ -32,8 +32,11 @@ int RunDiscover(const CommandArgs& args) {
   }
   for (size_t i = 0; i < result.steps.size(); ++i) {
     const DiscoveryStep& s = result.steps[i];
-    std::fprintf(stderr, "gravcal: step %zu: %s (p = %.3g, delta BIC %.1f)\n", i + 1,
-                 ToString(s.effect), s.p_value, s.delta_bic);
+    std::fprintf(stderr, "gravcal: step %zu: %s (p = %.3g, delta BIC %.1f; from the %s)\n", i + 1,
+                 ToString(s.effect), s.p_value, s.delta_bic, s.information.c_str());
+  }
+  for (const SensorVerdict& v : result.sensors) {
+    std::fprintf(stderr, "gravcal: %s (from the %s)\n", v.verdict.c_str(), v.information.c_str());
   }
   std::fprintf(stderr, "gravcal: %s; wrote %s%s%s\n", result.verdict.c_str(), args.output.c_str(),
                args.report.empty() ? "" : " and ", args.report.c_str());

@@ -76,10 +76,69 @@ bool StartingModel(const std::vector<StaticObservation>& observations,
   return true;
 }
 
-// The verdict line of the run and the warnings on what the final model
-// still leaves.
+// "gyroscope static means exceed their noise by 11.8 x".
+std::string ExcessPhrase(EffectSensor sensor, double excess) {
+  return std::string(sensor == EffectSensor::kAccelerometer ? "accelerometer |a| - g residuals"
+                                                            : "gyroscope static means") +
+         " exceed their noise by " + FormatNumber("%.3g", excess) + " x";
+}
+
+// The conclusion on one sensor, from its own final fit and the last round
+// of candidates (which none of its candidates passed).
+SensorVerdict JudgeSensor(EffectSensor sensor, bool stopped_by_limit, const DiscoveryResult& r) {
+  const bool accel = sensor == EffectSensor::kAccelerometer;
+  const SensorFitSummary& f = accel ? r.final_model.fit.accel_fit : r.final_model.fit.gyro_fit;
+  SensorVerdict v;
+  v.sensor = sensor;
+  v.information = f.information;
+  std::vector<const DiscoveryStep*> own;
+  for (const DiscoveryStep& s : r.steps) {
+    if (IsAccel(s.effect) != accel) continue;
+    v.named.push_back(s.effect);
+    own.push_back(&s);
+  }
+  v.excess = f.dof() > 0 ? std::sqrt(f.chi2 / f.dof()) : NAN;
+  v.p_value = accel ? r.final_where.accel_p : r.final_where.gyro_p;
+  int tried = 0;
+  for (const CandidateScore& c : r.final_candidates) {
+    tried += c.tried && IsAccel(c.effect) == accel ? 1 : 0;
+  }
+  const char* name = accel ? "accelerometer" : "gyroscope";
+  std::ostringstream line;
+  line << name << ": ";
+  if (v.named.empty()) {
+    line << "no significant missing effect";
+  } else {
+    line << "missing effect" << (v.named.size() > 1 ? "s" : "") << " found: ";
+    for (size_t i = 0; i < own.size(); ++i) {
+      line << (i ? ", " : "") << ToString(own[i]->effect);
+      if (!own[i]->ambiguous_with.empty()) {
+        line << " (or " << ToString(own[i]->ambiguous_with.front())
+             << ": this session cannot tell them apart)";
+      }
+    }
+  }
+  if (v.p_value < 1e-3 && std::isfinite(v.excess)) {
+    line << "; " << ExcessPhrase(sensor, v.excess);
+    if (stopped_by_limit) {
+      line << " (stopped at discovery_max_steps)";
+    } else if (tried == 0) {
+      line << "; no catalogue effect can be tested on it in this session (see the warnings)";
+    } else {
+      v.unexplained = true;
+      line << "; no catalogue effect explains it";
+    }
+  }
+  v.verdict = line.str();
+  return v;
+}
+
+// The verdict line of the run, each sensor's own verdict, and the warnings
+// on what the final model still leaves.
 void Verdict(const DiscoveryContext& ctx, bool stopped_by_limit, DiscoveryResult* result) {
   DiscoveryResult& r = *result;
+  r.sensors.push_back(JudgeSensor(EffectSensor::kAccelerometer, stopped_by_limit, r));
+  if (ctx.has_gyro) r.sensors.push_back(JudgeSensor(EffectSensor::kGyroscope, stopped_by_limit, r));
   std::ostringstream v;
   if (r.steps.empty()) {
     v << "no significant missing effect";
@@ -94,6 +153,10 @@ void Verdict(const DiscoveryContext& ctx, bool stopped_by_limit, DiscoveryResult
     }
     v << (stopped_by_limit ? "; stopped at discovery_max_steps"
                            : "; no further candidate is significant");
+  }
+  for (const SensorVerdict& s : r.sensors) {
+    if (!s.unexplained) continue;
+    v << "; " << ExcessPhrase(s.sensor, s.excess) << "; no catalogue effect explains it";
   }
   r.verdict = v.str();
   const double phi_a = r.final_model.fit.accel_fit.dof() > 0
@@ -112,7 +175,8 @@ void Verdict(const DiscoveryContext& ctx, bool stopped_by_limit, DiscoveryResult
         FormatNumber("%.3g",
                      std::sqrt(r.final_where.gyro_chi2 / std::max(1, r.final_where.gyro_dof))) +
         " times the noise the positions show: an effect outside the catalogue (earth rotation, "
-        "bias instability) or correlated noise");
+        "bias instability, an AHRS's own processing of its gyroscope) or correlated noise; the "
+        "accelerometer's tests do not depend on it");
   }
 }
 
@@ -212,8 +276,6 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
     return false;
   }
   const std::vector<Effect> candidates = internal::CandidateEffects(options);
-  const double log_n = std::log(static_cast<double>(r.baseline.fit.accel_fit.num_residuals +
-                                                    r.baseline.fit.gyro_fit.num_residuals));
   ModelAssessment current = r.baseline;
   Disagreement where = r.baseline_where;
   bool stopped_by_limit = false;
@@ -227,7 +289,7 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
     std::vector<EffectFitResult> fits;
     internal::TryCandidates(ctx, current, candidates, options, &untestable_warned, &r.warnings,
                             &scores, &fits);
-    internal::ScoreCandidates(ctx, current, fits, log_n, &scores);
+    internal::ScoreCandidates(ctx, current, fits, &scores);
     const int best = internal::ChooseCandidate(ctx, current, options, &scores);
     if (best < 0) {
       r.final_candidates = scores;

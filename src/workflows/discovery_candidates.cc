@@ -11,6 +11,10 @@ namespace gravcal {
 namespace internal {
 namespace {
 
+// Whether a fit leaves the sensor's data at the noise its positions show:
+// chi2 on dof degrees of freedom with p >= 0.01.
+bool FitsNoise(double chi2, int dof) { return dof >= 1 && ChiSquareUpperTail(chi2, dof) >= 0.01; }
+
 // Why an effect cannot be tried in this session, or "".
 std::string NotApplicable(const DiscoveryContext& ctx, const std::vector<Effect>& current, Effect e,
                           const DiscoveryOptions& options, int sensor_residuals,
@@ -103,6 +107,7 @@ void TryCandidate(const DiscoveryContext& ctx, const ModelAssessment& current, E
     return;
   }
   c->tried = true;
+  c->information = ext.information;
   c->dof = Info(e).num_parameters;
   c->delta_chi2 = now.chi2 - ext.chi2;
   c->gap = InSampleGap(extended_fit, ctx.has_gyro);
@@ -122,6 +127,17 @@ void TryCandidate(const DiscoveryContext& ctx, const ModelAssessment& current, E
   *fit = extended_fit;
 }
 
+// The significance level of one candidate test of a sensor: each sensor is
+// its own family, `significance` divided among that sensor's candidates
+// tried, so candidates of the other sensor (an AHRS gyroscope's, which
+// cannot explain its excess) do not raise the bar for this one's.
+double SensorAlpha(const std::vector<CandidateScore>& scores, bool accel,
+                   const DiscoveryOptions& options) {
+  int tried = 0;
+  for (const CandidateScore& c : scores) tried += c.tried && IsAccel(c.effect) == accel ? 1 : 0;
+  return options.significance / std::max(1, tried);
+}
+
 // When no candidate is significant on its own but some pass the likelihood
 // ratio and BIC and fail only the cross-validation, two effects may be
 // masking each other: each alone leaves the other's large residual, which
@@ -131,12 +147,13 @@ void TryCandidate(const DiscoveryContext& ctx, const ModelAssessment& current, E
 // on top of the other. The member of the best such pair (lowest
 // cross-validated gap) with the lower delta BIC alone is named; the index
 // of its score, or -1.
-int PairLookAhead(const DiscoveryContext& ctx, const ModelAssessment& current, double alpha,
+int PairLookAhead(const DiscoveryContext& ctx, const ModelAssessment& current,
                   const DiscoveryOptions& options, std::vector<CandidateScore>* scores) {
   std::vector<int> masked;
   for (size_t i = 0; i < scores->size(); ++i) {
     const CandidateScore& c = (*scores)[i];
-    if (c.tried && c.p_value < alpha && c.delta_bic < -options.min_bic_gain) {
+    if (c.tried && c.p_value < SensorAlpha(*scores, IsAccel(c.effect), options) &&
+        c.delta_bic < -options.min_bic_gain) {
       masked.push_back(static_cast<int>(i));
     }
   }
@@ -149,6 +166,7 @@ int PairLookAhead(const DiscoveryContext& ctx, const ModelAssessment& current, d
       CandidateScore& cb = (*scores)[masked[b]];
       const bool accel = IsAccel(ca.effect);
       if (IsAccel(cb.effect) != accel) continue;
+      const double alpha = SensorAlpha(*scores, accel, options);
       std::vector<Effect> pair = current.effects;
       pair.push_back(ca.effect);
       pair.push_back(cb.effect);
@@ -202,17 +220,24 @@ void TryCandidates(const DiscoveryContext& ctx, const ModelAssessment& current,
   }
 }
 
-// The noise scale: when the current model extended by all candidates of a
-// sensor at once fits that sensor's data to its own noise (chi2 test, p >=
-// 0.01), the per-position sigmas are right and each candidate is tested
-// against them (chi-square); otherwise the data show noise (or an effect)
-// beyond the catalogue, and each candidate's statistic is divided by the
-// dispersion phi = chi2 / dof its extended model leaves, and referred to
-// F(p, dof). (Dividing by each candidate's own phi alone would count the
-// other missing effects as noise: two effects hidden together could then
-// both go unnamed.)
+// The noise scale, per sensor and from that sensor's residuals only: a
+// candidate is tested against the positions' own sigmas (chi-square) when
+// they are right for it, that is when the current model extended by all
+// candidates of the sensor at once, or by this candidate alone, fits the
+// sensor's data to that noise (chi2 test, p >= 0.01). Otherwise the data
+// show noise (or an effect) beyond the catalogue, and the candidate's
+// statistic is divided by the dispersion phi = chi2 / dof its extended
+// model leaves, and referred to F(p, dof). (Dividing by each candidate's
+// own phi alone would count the other missing effects as noise: two
+// effects hidden together could then both go unnamed. And when every
+// candidate together leaves no degree of freedom, as on 14 hand-placed
+// poses with the scale baseline, the joint model cannot tell noise from
+// effect: a candidate that brings the sensor down to its noise is then
+// judged by that noise, not by its own leftover scatter.)
+// The BIC penalty is p ln(n) with n the sensor's own residual count, so an
+// accelerometer decision is the same with or without a gyroscope column.
 void ScoreCandidates(const DiscoveryContext& ctx, const ModelAssessment& current,
-                     const std::vector<EffectFitResult>& fits, double log_n,
+                     const std::vector<EffectFitResult>& fits,
                      std::vector<CandidateScore>* scores) {
   for (EffectSensor sensor : {EffectSensor::kAccelerometer, EffectSensor::kGyroscope}) {
     const bool accel = sensor == EffectSensor::kAccelerometer;
@@ -234,15 +259,17 @@ void ScoreCandidates(const DiscoveryContext& ctx, const ModelAssessment& current
         FitDiscoveryModel(ctx, *ctx.observations, all, current.fit, accel, !accel, true, &joint)) {
       if (count > 1) richest = &joint;
       const SensorFitSummary& f = accel ? richest->accel_fit : richest->gyro_fit;
-      const int dof = f.num_residuals - f.rank;
-      noise_fits = dof >= 1 && ChiSquareUpperTail(f.chi2, dof) >= 0.01;
+      noise_fits = FitsNoise(f.chi2, f.num_residuals - f.rank);
     }
+    const SensorFitSummary& now = accel ? current.fit.accel_fit : current.fit.gyro_fit;
+    const double log_n = std::log(static_cast<double>(std::max(1, now.num_residuals)));
     for (size_t i = 0; i < scores->size(); ++i) {
       CandidateScore& c = (*scores)[i];
       if (!c.tried || IsAccel(c.effect) != accel) continue;
       const SensorFitSummary& ext = accel ? fits[i].accel_fit : fits[i].gyro_fit;
       const int dof1 = ext.dof();
-      c.dispersion = noise_fits || dof1 <= 0 ? 1.0 : std::max(1.0, ext.chi2 / dof1);
+      const bool sigmas_right = noise_fits || FitsNoise(ext.chi2, dof1);
+      c.dispersion = sigmas_right || dof1 <= 0 ? 1.0 : std::max(1.0, ext.chi2 / dof1);
       if (!(c.delta_chi2 > 0.0)) {
         c.p_value = 1.0;
       } else if (c.dispersion > 1.0) {
@@ -258,14 +285,12 @@ void ScoreCandidates(const DiscoveryContext& ctx, const ModelAssessment& current
 int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,
                     const DiscoveryOptions& options, std::vector<CandidateScore>* scores_out) {
   std::vector<CandidateScore>& scores = *scores_out;
-  int tried = 0;
-  for (const CandidateScore& c : scores) tried += c.tried ? 1 : 0;
-  const double alpha = options.significance / std::max(1, tried);
   int best = -1;
   for (size_t i = 0; i < scores.size(); ++i) {
     CandidateScore& c = scores[i];
     if (!c.tried) continue;
     const bool accel = IsAccel(c.effect);
+    const double alpha = SensorAlpha(scores, accel, options);
     const double before = accel ? current.cv_gap.accel_sigma : current.cv_gap.gyro_sigma;
     const double after = accel ? c.cv_gap.accel_sigma : c.cv_gap.gyro_sigma;
     std::ostringstream why;
@@ -284,7 +309,7 @@ int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,
       best = static_cast<int>(i);
     }
   }
-  if (best < 0) best = PairLookAhead(ctx, current, alpha, options, &scores);
+  if (best < 0) best = PairLookAhead(ctx, current, options, &scores);
   return best;
 }
 

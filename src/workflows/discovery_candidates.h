@@ -22,14 +22,14 @@ void TryCandidates(const DiscoveryContext& ctx, const ModelAssessment& current,
                    std::vector<std::string>* warned, std::vector<std::string>* warnings,
                    std::vector<CandidateScore>* scores, std::vector<EffectFitResult>* fits);
 
-// The likelihood-ratio p-value and delta BIC of every candidate tried, with
-// log_n the log of the number of residuals (see discovery_candidates.cc for
-// the noise scale).
+// The likelihood-ratio p-value and delta BIC of every candidate tried, each
+// from its own sensor's residuals, noise level and residual count (see
+// discovery_candidates.cc for the noise scale).
 void ScoreCandidates(const DiscoveryContext& ctx, const ModelAssessment& current,
-                     const std::vector<EffectFitResult>& fits, double log_n,
-                     std::vector<CandidateScore>* scores);
+                     const std::vector<EffectFitResult>& fits, std::vector<CandidateScore>* scores);
 
-// Marks the significant candidates (with the reason of each that is not)
+// Marks the significant candidates (with the reason of each that is not;
+// each sensor's tests at `significance` divided among its own candidates)
 // and returns the index of the one to name, or -1; looks at pairs of
 // candidates masking each other when none is significant alone.
 int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,

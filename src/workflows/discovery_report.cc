@@ -24,6 +24,10 @@ json Matrix(const Eigen::Matrix3d& m) { return internal::JsonMatrix<json>(m); }
 
 bool IsAccel(Effect e) { return Info(e).sensor == EffectSensor::kAccelerometer; }
 
+const char* SensorName(EffectSensor s) {
+  return s == EffectSensor::kAccelerometer ? "accelerometer" : "gyroscope";
+}
+
 const char* GapUnit(Effect e) { return IsAccel(e) ? "m/s^2" : "raw gyro units"; }
 
 double Of(const Gap& g, bool accel) { return accel ? g.accel : g.gyro; }
@@ -119,6 +123,7 @@ json CandidatesJson(const std::vector<CandidateScore>& scores) {
     const bool accel = IsAccel(c.effect);
     json j = {{"effect", ToString(c.effect)}, {"tried", c.tried}, {"significant", c.significant}};
     if (c.tried) {
+      j["information"] = c.information;
       j["dof"] = c.dof;
       j["delta_chi2"] = Number(c.delta_chi2);
       j["dispersion"] = Number(c.dispersion);
@@ -147,11 +152,13 @@ json ModelJson(const ModelAssessment& m) {
                 {"upper", Matrix(f.accel.upper)},
                 {"chi2", f.accel_fit.chi2},
                 {"dof", f.accel_fit.dof()}};
+  j["accel"]["information"] = f.accel_fit.information;
   if (f.gyro_fit.fitted) {
     j["gyro"] = {{"bias", Vector(f.gyro.bias)},
                  {"bias_std", Vector(f.gyro_bias_std)},
                  {"chi2", f.gyro_fit.chi2},
-                 {"dof", f.gyro_fit.dof()}};
+                 {"dof", f.gyro_fit.dof()},
+                 {"information", f.gyro_fit.information}};
   }
   json params = json::object();
   for (const EffectEstimate& e : f.estimates) params[ToString(e.effect)] = ParametersJson(e);
@@ -215,6 +222,16 @@ std::string Bars(const std::string& title, const std::string& ylabel,
   return internal::RenderPlot(p);
 }
 
+// "accelerometer: <information>; gyroscope: <information>" of a fit.
+std::string BaselineInformation(const EffectFitResult& f) {
+  std::string out;
+  if (f.accel_fit.fitted) out = "accelerometer: " + f.accel_fit.information;
+  if (f.gyro_fit.fitted) {
+    out += (out.empty() ? "" : "; ") + ("gyroscope: " + f.gyro_fit.information);
+  }
+  return out;
+}
+
 std::string GapCells(const Gap& before, const Gap& after, bool accel) {
   std::ostringstream s;
   s << "<td>" << FormatNumber(Of(before, accel)) << " &rarr; " << FormatNumber(Of(after, accel))
@@ -251,13 +268,13 @@ std::string GroupsTable(const Disagreement& d) {
 
 std::string CandidatesTable(const std::vector<CandidateScore>& scores) {
   std::ostringstream s;
-  s << "<table><tr><th>candidate</th><th>p-value</th><th>delta BIC</th><th>CV gap after, "
-       "sigma</th><th>verdict</th></tr>";
+  s << "<table><tr><th>candidate</th><th>information used</th><th>p-value</th><th>delta "
+       "BIC</th><th>CV gap after, sigma</th><th>verdict</th></tr>";
   for (const CandidateScore& c : scores) {
     const bool accel = IsAccel(c.effect);
-    s << "<tr><td>" << ToString(c.effect) << "</td><td>" << FormatNumber(c.p_value, "%.3g")
-      << "</td><td>" << FormatNumber(c.delta_bic, "%.1f") << "</td><td>"
-      << FormatNumber(SigmaOf(c.cv_gap, accel), "%.3g") << "</td><td>"
+    s << "<tr><td>" << ToString(c.effect) << "</td><td>" << HtmlEscape(c.information) << "</td><td>"
+      << FormatNumber(c.p_value, "%.3g") << "</td><td>" << FormatNumber(c.delta_bic, "%.1f")
+      << "</td><td>" << FormatNumber(SigmaOf(c.cv_gap, accel), "%.3g") << "</td><td>"
       << (c.significant ? "significant" : HtmlEscape(c.reason)) << "</td></tr>";
   }
   s << "</table>";
@@ -324,6 +341,7 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
     json j = {{"effect", ToString(s.effect)},
               {"description", Info(s.effect).description},
               {"sensor", accel ? "accelerometer" : "gyroscope"},
+              {"information", s.information},
               {"parameters", ParametersJson(s.estimate)},
               {"p_value", Number(s.p_value)},
               {"delta_bic", Number(s.delta_bic)},
@@ -356,6 +374,17 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
   if (!r.final_candidates.empty()) final_model["candidates"] = CandidatesJson(r.final_candidates);
   out["final_model"] = final_model;
   out["verdict"] = r.verdict;
+  json sensors = json::array();
+  for (const SensorVerdict& v : r.sensors) {
+    sensors.push_back({{"sensor", SensorName(v.sensor)},
+                       {"information", v.information},
+                       {"named", EffectNames(v.named)},
+                       {"excess", Number(v.excess)},
+                       {"p_value", Number(v.p_value)},
+                       {"unexplained", v.unexplained},
+                       {"verdict", v.verdict}});
+  }
+  out["sensors"] = sensors;
   out["warnings"] = r.warnings;
   out["message"] = r.message;
   out["time_s"] = r.seconds;
@@ -380,10 +409,27 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
        "when its likelihood-ratio p-value is below the step's level, its delta BIC is negative "
        "and it lowers the CV gap.</p>\n";
 
-  h << "<h2>Models</h2><table><tr><th>step</th><th>model</th><th>effect</th><th>p-value</th>"
+  h << "<h2>Per sensor</h2><p>Each sensor is judged on its own evidence: its fits, tests, BIC "
+       "and cross-validation use only its own residuals and noise, so one sensor's "
+       "unexplained excess does not hide an effect of the other.</p>"
+    << "<table><tr><th>sensor</th><th>information used</th><th>named</th><th>final residual / "
+       "noise</th><th>verdict</th></tr>";
+  for (const SensorVerdict& v : r.sensors) {
+    std::string named;
+    for (Effect e : v.named) named += (named.empty() ? "" : ", ") + std::string(ToString(e));
+    h << "<tr><td>" << SensorName(v.sensor) << "</td><td>" << HtmlEscape(v.information)
+      << "</td><td>" << (named.empty() ? "none" : named) << "</td><td>"
+      << FormatNumber(v.excess, "%.3g") << " x</td><td" << (v.unexplained ? " class='warn'" : "")
+      << ">" << HtmlEscape(v.verdict) << "</td></tr>";
+  }
+  h << "</table>\n";
+
+  h << "<h2>Models</h2><table><tr><th>step</th><th>model</th><th>effect</th><th>information "
+       "used</th><th>p-value</th>"
     << "<th>delta BIC</th><th>gap</th><th>gap, sigma</th><th>CV gap</th><th>CV gap, sigma</th>"
     << "</tr>";
-  h << "<tr><td>baseline</td><td>" << HtmlEscape(ModelName(r.baseline)) << "</td><td></td><td></td>"
+  h << "<tr><td>baseline</td><td>" << HtmlEscape(ModelName(r.baseline)) << "</td><td></td><td>"
+    << HtmlEscape(BaselineInformation(r.baseline.fit)) << "</td><td></td>"
     << "<td></td><td>accel " << FormatNumber(r.baseline.gap.accel) << " m/s^2; gyro "
     << FormatNumber(r.baseline.gap.gyro) << "</td><td>"
     << FormatNumber(r.baseline.gap.accel_sigma, "%.3g") << "; "
@@ -395,9 +441,9 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
     const DiscoveryStep& s = r.steps[i];
     const bool accel = IsAccel(s.effect);
     h << "<tr><td>" << i + 1 << "</td><td>+ " << ToString(s.effect) << "</td><td>"
-      << HtmlEscape(Info(s.effect).description) << "</td><td>" << FormatNumber(s.p_value, "%.3g")
-      << "</td><td>" << FormatNumber(s.delta_bic, "%.1f") << "</td>"
-      << GapCells(s.gap_before, s.gap_after, accel)
+      << HtmlEscape(Info(s.effect).description) << "</td><td>" << HtmlEscape(s.information)
+      << "</td><td>" << FormatNumber(s.p_value, "%.3g") << "</td><td>"
+      << FormatNumber(s.delta_bic, "%.1f") << "</td>" << GapCells(s.gap_before, s.gap_after, accel)
       << GapCells(s.cv_gap_before, s.cv_gap_after, accel) << "</tr>";
   }
   h << "</table><p>Gaps of a step are for the sensor of its effect ("
@@ -424,7 +470,8 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
     const DiscoveryStep& s = r.steps[i];
     const bool accel = IsAccel(s.effect);
     h << "<h2>Step " << i + 1 << ": " << ToString(s.effect) << "</h2><p>"
-      << HtmlEscape(Info(s.effect).description)
+      << HtmlEscape(Info(s.effect).description) << ". Decided from the "
+      << HtmlEscape(SensorName(Info(s.effect).sensor)) << "'s " << HtmlEscape(s.information)
       << ". Where the model before this step disagreed: " << HtmlEscape(s.where.summary) << "</p>";
     h << "<table><tr><th>parameter</th><th>value</th><th>std</th><th>unit</th></tr>";
     for (size_t k = 0; k < s.estimate.names.size(); ++k) {

@@ -137,6 +137,7 @@ bool TakeStep(const DiscoveryContext& ctx, const DiscoveryOptions& options,
   s.p_value = chosen.p_value;
   s.delta_bic = chosen.delta_bic;
   s.dof = chosen.dof;
+  s.information = chosen.information;
   s.where = where;
   s.candidates = scores;
   s.gap_before = current->gap;

@@ -10,24 +10,38 @@
 //    grouped by dominant axis, specific-force level, time and temperature,
 //    each in units of the noise that position's own samples show.
 // 4. Try every candidate effect of the catalogue (model_effects.h): refit
-//    with it (Ceres) and score it by
+//    with it (Ceres) and score it from its own sensor's evidence alone:
 //    - a likelihood-ratio test on that sensor's chi2 with dof = the effect's
-//      parameter count, against the positions' own noise; when even the
-//      model with every candidate of the sensor leaves more than that noise
-//      (noise the samples do not show, e.g. hand tremor), the statistic is
-//      divided by phi = chi2 / dof of the extended model and referred to
-//      F(p, dof) instead;
-//    - delta BIC = (chi2_new - chi2_old) / phi + p ln(n);
+//      parameter count, against the positions' own noise; when neither the
+//      model with every candidate of the sensor nor the one with this
+//      candidate fits the sensor's data to that noise (noise the samples do
+//      not show, e.g. hand tremor), the statistic is divided by phi = chi2 /
+//      dof of the extended model and referred to F(p, dof) instead;
+//    - delta BIC = (chi2_new - chi2_old) / phi + p ln(n), n the sensor's
+//      own residual count;
 //    - leave-one-position-out cross-validation: every position predicted by
 //      a fit without it; the effect must lower the cross-validated gap.
-//    Significant = p below significance / (candidates tried), delta BIC
-//    below -min_bic_gain and a smaller cross-validated gap. The significant
-//    candidate with the lowest delta BIC is named; others of the same
-//    sensor within ambiguity_bic of it explain the data almost as well and
-//    are reported as ambiguous with advice on the recording that would
+//    Significant = p below significance / (candidates of its sensor tried),
+//    delta BIC below -min_bic_gain and a smaller cross-validated gap. The
+//    significant candidate with the lowest delta BIC is named; others of the
+//    same sensor within ambiguity_bic of it explain the data almost as well
+//    and are reported as ambiguous with advice on the recording that would
 //    separate them.
 // 5. Add it; the extended model is the new baseline; repeat until nothing
 //    is significant.
+// 6. Judge each sensor (SensorVerdict): the effects named for it, and, when
+//    its final model still leaves far more than its noise, that no catalogue
+//    effect explains the excess. No sensor's chi2, noise level, candidates
+//    or excess enters the other's decisions (the gyroscope's g-sensitivity
+//    takes the accelerometer's fitted specific force as its regressor,
+//    nothing more): an AHRS gyroscope whose static means sit 11 sigma from
+//    any static model does not hide an accelerometer effect, and the
+//    accelerometer's scores are the same with or without a gyroscope
+//    column.
+//
+// Each decision says which information of the session it used
+// (SensorFitSummary::information: "position magnitudes" for the
+// accelerometer, "static mean rates" for the gyroscope).
 //
 // The gap is the rms of measured minus simulated: |a| - g over positions for
 // the accelerometer (m/s^2), the gyroscope residual over positions and axes
@@ -163,6 +177,10 @@ struct CandidateScore {
   double delta_bic = NAN;
   Gap gap;
   Gap cv_gap;
+  // Which information of the session its fit and tests used
+  // (SensorFitSummary::information of its sensor), e.g. "position
+  // magnitudes".
+  std::string information;
 };
 
 struct DiscoveryStep {
@@ -171,6 +189,8 @@ struct DiscoveryStep {
   double p_value = NAN;
   double delta_bic = NAN;
   int dof = 0;
+  // Which information the decision used (its candidate's `information`).
+  std::string information;
   // Of the sensor the effect belongs to (and the other, unchanged).
   Gap gap_before;
   Gap gap_after;
@@ -201,6 +221,30 @@ struct Ambiguity {
   std::string advice;
 };
 
+// What the run concluded about one sensor, from that sensor's evidence
+// alone: its fits, tests, BIC and cross-validation never see the other
+// sensor's residuals, so a sensor whose excess no catalogue effect explains
+// (an AHRS gyroscope with its own processing) does not mask an effect of
+// the other.
+struct SensorVerdict {
+  EffectSensor sensor = EffectSensor::kAccelerometer;
+  // SensorFitSummary::information of the final model's fit of this sensor.
+  std::string information;
+  // The effects named for this sensor, in order.
+  std::vector<Effect> named;
+  // How far the final model is from this sensor's data: sqrt(chi2 / dof)
+  // (1 = at the noise the positions' samples show), and the chi-square
+  // p-value.
+  double excess = NAN;
+  double p_value = NAN;
+  // The final model still leaves more than the noise (p below 1e-3) and no
+  // catalogue effect of this sensor was significant in the last round.
+  bool unexplained = false;
+  // One line, e.g. "gyroscope static means exceed their noise by 11 x; no
+  // catalogue effect explains it".
+  std::string verdict;
+};
+
 struct DiscoveryResult {
   bool success = false;
   std::string source;
@@ -216,7 +260,10 @@ struct DiscoveryResult {
   // The scores of the last round, the one in which nothing was significant
   // (empty when stopped by max_steps).
   std::vector<CandidateScore> final_candidates;
-  // "no significant missing effect" when nothing was named.
+  // One per sensor the log has (accelerometer first).
+  std::vector<SensorVerdict> sensors;
+  // "no significant missing effect" when nothing was named; followed by the
+  // sensors' unexplained excess, if any.
   std::string verdict;
   std::vector<std::string> warnings;
   double seconds = 0.0;
