@@ -59,6 +59,16 @@ class KnownAttitudeTest : public ::testing::Test {
     return sim;
   }
 
+  // Simulates seed `seed` and writes its attitudes file; returns the path
+  // (empty, with *error, when the simulation fails).
+  std::string SimulateWithAttitudes(const SimulatorOptions& sim, int seed, SimulatedSession* s,
+                                    std::string* error) const {
+    if (!Simulate(sim, seed, s, error)) return "";
+    return Write("attitudes.csv",
+                 FixtureAttitudesToCsv(SimulatedFixtureAttitudes(*s, sim.fixture_attitude_noise_deg,
+                                                                 static_cast<uint64_t>(seed))));
+  }
+
   static CalibrationOptions Options() {
     CalibrationOptions options;
     options.gravity.gravity = 9.80665;
@@ -76,10 +86,8 @@ TEST_F(KnownAttitudeTest, AllTwelveParametersWithinTheirUncertainty) {
   for (int seed = 1; seed <= seeds; ++seed) {
     SimulatedSession s;
     std::string error;
-    ASSERT_TRUE(Simulate(sim, seed, &s, &error)) << error;
-    const std::string path = Write(
-        "attitudes.csv", FixtureAttitudesToCsv(SimulatedFixtureAttitudes(
-                             s, sim.fixture_attitude_noise_deg, static_cast<uint64_t>(seed))));
+    const std::string path = SimulateWithAttitudes(sim, seed, &s, &error);
+    ASSERT_FALSE(path.empty()) << error;
     Calibration c;
     ASSERT_TRUE(CalibrateKnownAttitude(s.log, path, Options(), &c)) << c.message;
     EXPECT_EQ(c.method, "known_attitude");
@@ -90,6 +98,7 @@ TEST_F(KnownAttitudeTest, AllTwelveParametersWithinTheirUncertainty) {
                           c.accel.bias_std);
     testing_util::AddEach(&check, "matrix", m - truth, c.accel.matrix_std);
   }
+  std::printf("known_attitude, seeds 1..%d:\n%s", seeds, check.Table().c_str());
   check.ExpectHonest("known_attitude");
 }
 
@@ -106,10 +115,8 @@ TEST_F(KnownAttitudeTest, PoseVarianceKeepsSigmasHonestUnderPoseDisturbances) {
   for (int seed = 1; seed <= seeds; ++seed) {
     SimulatedSession s;
     std::string error;
-    ASSERT_TRUE(Simulate(sim, seed, &s, &error)) << error;
-    const std::string path = Write(
-        "attitudes.csv", FixtureAttitudesToCsv(SimulatedFixtureAttitudes(
-                             s, sim.fixture_attitude_noise_deg, static_cast<uint64_t>(seed))));
+    const std::string path = SimulateWithAttitudes(sim, seed, &s, &error);
+    ASSERT_FALSE(path.empty()) << error;
     CalibrationOptions options = Options();
     Calibration w;
     ASSERT_TRUE(CalibrateKnownAttitude(s.log, path, options, &w)) << w.message;

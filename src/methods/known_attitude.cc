@@ -211,8 +211,8 @@ bool Whiten(const std::vector<Position>& positions, double extra, AttitudeFit* f
   const double s0 = fit->s0;
   fit->whitening.resize(n);
   for (int k = 0; k < n; ++k) {
-    const Eigen::Matrix3d cov = m0 * (s0 * s0 * positions[k].raw_mean_cov) * m0.transpose() +
-                                extra * Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d cov = m0 * (s0 * s0 * positions[k].raw_mean_cov) * m0.transpose();
+    cov.diagonal().array() += extra;
     const Eigen::LLT<Eigen::Matrix3d> llt(cov);
     if (llt.info() != Eigen::Success) {
       *error = "known_attitude: static position " + std::to_string(k) +
