@@ -184,3 +184,47 @@ TEST(VarianceComponent, RejectsNoDegreesOfFreedom) {
 
 }  // namespace
 }  // namespace gravcal
+
+namespace gravcal {
+namespace {
+
+// The whitened form with a diagonal shape is the diagonal form: residuals
+// r_k / sigma_k, Jacobian rows / sigma_k and shape diag(1 / sigma_k^2) give
+// the same s^2 and standard deviation. Rows the extra variance does not
+// enter (shape zero, as for priors) are not counted, and leave s^2 alone
+// when their residual is made huge.
+TEST(VarianceComponent, WhitenedFormAgreesAndIgnoresRowsOutsideTheShape) {
+  const Draw d = MakeDraw(30, 4, 2.0, 0.5, 1.5, 7);
+  VarianceComponent diagonal, whitened;
+  ASSERT_TRUE(internal::EstimateVarianceComponent(d.residuals, d.sigmas, d.jacobian, &diagonal));
+  const Eigen::VectorXd w = d.sigmas.cwiseInverse();
+  const Eigen::MatrixXd shape = w.array().square().matrix().asDiagonal();
+  ASSERT_TRUE(internal::EstimateWhitenedVarianceComponent(
+      w.asDiagonal() * d.residuals, w.asDiagonal() * d.jacobian, shape, &whitened));
+  EXPECT_GT(diagonal.variance, 0.0);
+  EXPECT_NEAR(whitened.variance, diagonal.variance, 1e-6 * diagonal.variance);
+  EXPECT_NEAR(whitened.variance_std, diagonal.variance_std, 1e-6 * diagonal.variance_std);
+  EXPECT_EQ(whitened.dof, diagonal.dof);
+
+  // Two more rows, each the only row of a parameter of its own (as a prior
+  // on an attitude): they leave no free direction, so any residual there
+  // changes nothing.
+  const int n = 32, p = 6;
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(n);
+  r.head(30) = w.asDiagonal() * d.residuals;
+  r(30) = 1e3;
+  r(31) = -1e3;
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(n, p);
+  j.topLeftCorner(30, 4) = w.asDiagonal() * d.jacobian;
+  j(30, 4) = 1.0;
+  j(31, 5) = 1.0;
+  Eigen::MatrixXd s = Eigen::MatrixXd::Zero(n, n);
+  s.topLeftCorner(30, 30) = shape;
+  VarianceComponent with_priors;
+  ASSERT_TRUE(internal::EstimateWhitenedVarianceComponent(r, j, s, &with_priors));
+  EXPECT_NEAR(with_priors.variance, diagonal.variance, 1e-6 * diagonal.variance);
+  EXPECT_EQ(with_priors.dof, diagonal.dof);
+}
+
+}  // namespace
+}  // namespace gravcal

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 namespace gravcal {
 namespace internal {
@@ -51,13 +52,12 @@ bool CheckInput(const Eigen::VectorXd& residuals, const Eigen::VectorXd& sigmas,
   return true;
 }
 
-// Projects the residuals onto the m = n - rank(J) directions the parameters
-// leave free (the rank of J with its columns scaled to unit norm, so the
-// parameters' units do not decide it). False when m < 1.
-bool Restrict(const Eigen::VectorXd& residuals, const Eigen::VectorXd& sigmas,
-              const Eigen::MatrixXd& jacobian, RestrictedProblem* problem,
-              VarianceComponent* result) {
-  const int n = static_cast<int>(residuals.size());
+// An orthonormal basis (n x m) of the m = n - rank(J) directions the
+// parameters leave free (the rank of J with its columns scaled to unit
+// norm, so the parameters' units do not decide it). False when m < 1.
+bool Complement(const Eigen::MatrixXd& jacobian, Eigen::MatrixXd* basis,
+                VarianceComponent* result) {
+  const int n = static_cast<int>(jacobian.rows());
   Eigen::MatrixXd scaled = jacobian;
   for (int j = 0; j < scaled.cols(); ++j) {
     const double norm = scaled.col(j).norm();
@@ -77,12 +77,53 @@ bool Restrict(const Eigen::VectorXd& residuals, const Eigen::VectorXd& sigmas,
   }
   Eigen::MatrixXd q = Eigen::MatrixXd::Identity(n, n);
   if (rank > 0) q = qr.householderQ() * Eigen::MatrixXd::Identity(n, n);
-  const Eigen::MatrixXd k = q.rightCols(m);
+  *basis = q.rightCols(m);
+  return true;
+}
+
+// Projects the residuals onto the free directions: d_i and f_i^2 of the
+// header. False when there are none.
+bool Restrict(const Eigen::VectorXd& residuals, const Eigen::VectorXd& sigmas,
+              const Eigen::MatrixXd& jacobian, RestrictedProblem* problem,
+              VarianceComponent* result) {
+  Eigen::MatrixXd k;
+  if (!Complement(jacobian, &k, result)) return false;
   const Eigen::VectorXd e = k.transpose() * residuals;
   const Eigen::MatrixXd a = k.transpose() * sigmas.array().square().matrix().asDiagonal() * k;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(a);
   problem->d = eigen.eigenvalues().cwiseMax(0.0);
   problem->f2 = (eigen.eigenvectors().transpose() * e).array().square().matrix();
+  return true;
+}
+
+// The whitened form (header): B = K^T D K = Q diag(lambda) Q^T, g = Q^T K^T r;
+// each direction with lambda_i > 0 is d_i = 1 / lambda_i, f_i^2 = g_i^2 /
+// lambda_i; those with lambda_i = 0 do not depend on s^2 and are left out
+// (result->dof counts the others).
+bool RestrictWhitened(const Eigen::VectorXd& residuals, const Eigen::MatrixXd& jacobian,
+                      const Eigen::MatrixXd& shape, RestrictedProblem* problem,
+                      VarianceComponent* result) {
+  Eigen::MatrixXd k;
+  if (!Complement(jacobian, &k, result)) return false;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(k.transpose() * shape * k);
+  const Eigen::VectorXd lambda = eigen.eigenvalues();
+  const Eigen::VectorXd g = eigen.eigenvectors().transpose() * (k.transpose() * residuals);
+  const double tolerance = 1e-10 * std::max(lambda.maxCoeff(), 0.0);
+  std::vector<int> kept;
+  for (int i = 0; i < lambda.size(); ++i) {
+    if (lambda(i) > tolerance && lambda(i) > 0.0) kept.push_back(i);
+  }
+  result->dof = static_cast<int>(kept.size());
+  if (kept.empty()) {
+    result->message = "no free direction of the residuals is moved by the extra variance";
+    return false;
+  }
+  problem->d.resize(kept.size());
+  problem->f2.resize(kept.size());
+  for (size_t j = 0; j < kept.size(); ++j) {
+    problem->d(j) = 1.0 / lambda(kept[j]);
+    problem->f2(j) = g(kept[j]) * g(kept[j]) / lambda(kept[j]);
+  }
   return true;
 }
 
@@ -132,17 +173,11 @@ double Minimise(const RestrictedProblem& r, const VariancePrior& prior) {
   return Objective(r, prior, t) < Objective(r, prior, 0.0) ? t : 0.0;
 }
 
-}  // namespace
-
-bool EstimateVarianceComponent(const Eigen::VectorXd& residuals, const Eigen::VectorXd& sigmas,
-                               const Eigen::MatrixXd& jacobian, VarianceComponent* result,
-                               const VariancePrior& prior) {
-  CHECK(result != nullptr);
-  *result = VarianceComponent();
-  if (!CheckInput(residuals, sigmas, jacobian, prior, result)) return false;
-  RestrictedProblem problem;
-  if (!Restrict(residuals, sigmas, jacobian, &problem, result)) return false;
-  const int m = result->dof;
+// The estimate from the restricted problem: s^2, its standard deviation and
+// the message (result->dof already set).
+void Estimate(const RestrictedProblem& problem, const VariancePrior& prior,
+              VarianceComponent* result) {
+  const int m = static_cast<int>(problem.d.size());
   const double t = Minimise(problem, prior);
   double information = 0.0;
   for (int i = 0; i < m; ++i) {
@@ -165,6 +200,38 @@ bool EstimateVarianceComponent(const Eigen::VectorXd& residuals, const Eigen::Ve
     s << ")";
   }
   result->message = s.str();
+}
+
+}  // namespace
+
+bool EstimateVarianceComponent(const Eigen::VectorXd& residuals, const Eigen::VectorXd& sigmas,
+                               const Eigen::MatrixXd& jacobian, VarianceComponent* result,
+                               const VariancePrior& prior) {
+  CHECK(result != nullptr);
+  *result = VarianceComponent();
+  if (!CheckInput(residuals, sigmas, jacobian, prior, result)) return false;
+  RestrictedProblem problem;
+  if (!Restrict(residuals, sigmas, jacobian, &problem, result)) return false;
+  Estimate(problem, prior, result);
+  return true;
+}
+
+bool EstimateWhitenedVarianceComponent(const Eigen::VectorXd& residuals,
+                                       const Eigen::MatrixXd& jacobian,
+                                       const Eigen::MatrixXd& shape, VarianceComponent* result,
+                                       const VariancePrior& prior, double* known_variance) {
+  CHECK(result != nullptr);
+  *result = VarianceComponent();
+  const int n = static_cast<int>(residuals.size());
+  if (!CheckInput(residuals, Eigen::VectorXd::Ones(n), jacobian, prior, result)) return false;
+  if (shape.rows() != n || shape.cols() != n || !shape.allFinite()) {
+    result->message = "the extra variance's shape must be finite and n x n";
+    return false;
+  }
+  RestrictedProblem problem;
+  if (!RestrictWhitened(residuals, jacobian, shape, &problem, result)) return false;
+  Estimate(problem, prior, result);
+  if (known_variance != nullptr) *known_variance = problem.d.mean();
   return true;
 }
 

@@ -78,6 +78,29 @@ bool EstimateVarianceComponent(const Eigen::VectorXd& residuals, const Eigen::Ve
                                const Eigen::MatrixXd& jacobian, VarianceComponent* result,
                                const VariancePrior& prior = VariancePrior());
 
+// The same for correlated residuals whose known (white) covariance is not
+// diagonal and an extra variance that enters only some of them with a
+// shape: with W the whitening of the known covariance (W Sigma W^T = I),
+// `residuals` = W r and `jacobian` = W J, and `shape` = W E W^T, E the
+// extra covariance per unit s^2 (zero rows for residuals it does not
+// enter, such as priors):
+//
+//   V = I + s^2 D,   D = shape.
+//
+// With B = K^T D K = Q diag(lambda) Q^T and g = Q^T K^T r, every free
+// direction with lambda_i > 0 is the diagonal problem above with d_i =
+// 1 / lambda_i and f_i^2 = g_i^2 / lambda_i (up to a constant); directions
+// with lambda_i = 0 do not depend on s^2. dof counts the others.
+// *known_variance (when not null) receives the mean of those d_i: the
+// known variance per direction in s^2's unit, the dbar of StudentInflation
+// (with priors among the residuals it includes what they allow, which the
+// white sensor noise alone would leave out).
+bool EstimateWhitenedVarianceComponent(const Eigen::VectorXd& residuals,
+                                       const Eigen::MatrixXd& jacobian,
+                                       const Eigen::MatrixXd& shape, VarianceComponent* result,
+                                       const VariancePrior& prior = VariancePrior(),
+                                       double* known_variance = nullptr);
+
 constexpr double kMinEffectiveDof = 3.0;
 
 // nu / (nu - 2) for an estimated component (1 when s^2 = 0 or not

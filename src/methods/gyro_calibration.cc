@@ -12,6 +12,7 @@
 #include "estimation/normalization.h"
 #include "estimation/solver_settings.h"
 #include "methods/direction_noise.h"
+#include "methods/gyro_bias_wander.h"
 #include "methods/gyro_covariance.h"
 #include "methods/gyro_observability.h"
 #include "methods/gyro_problem.h"
@@ -366,6 +367,7 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
   if (options.compute_covariance && r.converged) {
     internal::ComputeGyroCovariance(prep, layout, solve.built, solve.free, solve.weights, accel,
                                     accel_final, norm, accel_covariance, &solve.x, &r);
+    internal::AddSessionBiasWander(prep, options, &r);
   }
   if (layout.accel_bias >= 0) {
     internal::FillJointAccel(prep, accel, accel_final, magnitude_sigmas, gravity, &r);
@@ -378,6 +380,7 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
     return false;
   }
   r.message = internal::SuccessMessage(options, r, prep.positions.size());
+  if (r.bias_wander_std.norm() > 0.0) r.message += "; " + r.bias_wander_note;
   return true;
 }
 
@@ -419,6 +422,12 @@ bool AddGyroscopeCalibration(const ImuLog& log, const std::vector<StaticInterval
       out.extra_values.push_back(g.g_sensitivity(i / 3, i % 3));
       out.extra_std.push_back(g.g_sensitivity_std(i / 3, i % 3));
     }
+  }
+  for (int a = 0; a < 3 && g.bias_wander_std.norm() > 0.0; ++a) {
+    // What the bias's standard deviation includes for the session's wander.
+    out.extra_names.push_back(std::string("bias_wander_") + internal::kGyroAxisNames[a]);
+    out.extra_values.push_back(g.bias_wander_std(a));
+    out.extra_std.push_back(NAN);
   }
   for (const GyroRotationReport& r : g.rotations)
     out.rotation_residual_deg.push_back(r.residual_deg);

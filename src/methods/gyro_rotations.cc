@@ -180,6 +180,8 @@ void AddStaticPoseVariance(const GyroCalibrationOptions& options, GyroPrepared* 
   VarianceComponent vc;
   if (!EstimateVarianceComponent(r, sigmas, jacobian, &vc) || vc.at_boundary) return;
   for (Eigen::Matrix3d& c : prep->static_gyro_cov) c += vc.variance * Eigen::Matrix3d::Identity();
+  prep->static_variance = vc.variance;
+  prep->static_variance_dof = vc.dof;
 }
 
 }  // namespace
@@ -241,6 +243,7 @@ bool PrepareGyroRotations(const ImuLog& log, const std::vector<StaticInterval>& 
   *m0 = initial;
   prep->scale = std::cbrt(std::fabs(initial.determinant()));
   NormaliseData(log, poses, accel, forces, prep);
+  prep->session_seconds = log.t[poses.back().end - 1] - log.t[poses.front().begin];
   if (options.estimate_static_variance) AddStaticPoseVariance(options, prep);
   return true;
 }

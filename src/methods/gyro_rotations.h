@@ -47,6 +47,14 @@ struct GyroPrepared {
   std::vector<Position> normalized_positions;
   // Rotation data without weights (t, normalised gyro, force, raw means).
   std::vector<GyroRotationData> rotations;
+  // Seconds from the first static pose's first sample to the last pose's
+  // last sample: the span the bias wanders over (gyro_bias_wander.h).
+  double session_seconds = 0.0;
+  // The static poses' scatter s^2 beyond their white noise, normalised units
+  // squared per axis (estimate_static_variance; 0 when not estimated or
+  // at the boundary), and the residual dof it rests on.
+  double static_variance = 0.0;
+  int static_variance_dof = 0;
 };
 
 // Cuts the log into rotations and prepares the normalised data; *m0 gets the

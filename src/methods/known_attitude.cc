@@ -14,7 +14,9 @@
 
 #include "estimation/robust_loss.h"
 #include "estimation/solver_settings.h"
+#include "estimation/variance_component.h"
 #include "gravcal/core/gravity.h"
+#include "methods/pose_variance.h"
 #include "methods/static_positions.h"
 #include "util/source_prefix.h"
 #include "util/statistics.h"
@@ -156,6 +158,8 @@ struct AttitudeFit {
   double bias[3] = {0.0, 0.0, 0.0};
   double matrix[9] = {};
   std::vector<std::array<double, 2>> attitude;
+  // The linear initial M (normalised), which the whitening uses.
+  Eigen::Matrix3d initial_matrix = Eigen::Matrix3d::Identity();
   std::vector<Eigen::Matrix3d> whitening;
 };
 
@@ -192,10 +196,23 @@ bool InitialFit(const std::vector<Position>& positions, const std::vector<KnownA
     for (int col = 0; col < 3; ++col) fit->matrix[3 * r + col] = m0(r, col);
   }
   fit->attitude.resize(n);
+  for (int k = 0; k < n; ++k) fit->attitude[k] = {attitudes[k].roll, attitudes[k].pitch};
+  fit->initial_matrix = m0;
+  return true;
+}
+
+// The whitening of every position: W_k = L_k^-1, L_k L_k^T = M0 (s0^2 C_k)
+// M0^T + extra I, extra the per-pose variance of the specific force
+// ((m/s^2)^2, 0 = the samples' noise only). False with *error.
+bool Whiten(const std::vector<Position>& positions, double extra, AttitudeFit* fit,
+            std::string* error) {
+  const int n = static_cast<int>(positions.size());
+  const Eigen::Matrix3d& m0 = fit->initial_matrix;
+  const double s0 = fit->s0;
   fit->whitening.resize(n);
   for (int k = 0; k < n; ++k) {
-    fit->attitude[k] = {attitudes[k].roll, attitudes[k].pitch};
-    const Eigen::Matrix3d cov = m0 * (s0 * s0 * positions[k].raw_mean_cov) * m0.transpose();
+    Eigen::Matrix3d cov = m0 * (s0 * s0 * positions[k].raw_mean_cov) * m0.transpose();
+    cov.diagonal().array() += extra;
     const Eigen::LLT<Eigen::Matrix3d> llt(cov);
     if (llt.info() != Eigen::Success) {
       *error = "known_attitude: static position " + std::to_string(k) +
@@ -205,6 +222,24 @@ bool InitialFit(const std::vector<Position>& positions, const std::vector<KnownA
     fit->whitening[k] = llt.matrixL().solve(Eigen::Matrix3d::Identity());
   }
   return true;
+}
+
+// The Ceres problem at the fit's current values and whitening, solved.
+std::unique_ptr<ceres::Problem> Solve(const std::vector<Position>& positions,
+                                      const std::vector<KnownAttitude>& attitudes,
+                                      const RefinementOptions& ro, AttitudeFit* fit,
+                                      ceres::Solver::Summary* summary) {
+  auto problem = std::make_unique<ceres::Problem>();
+  for (size_t k = 0; k < positions.size(); ++k) {
+    problem->AddResidualBlock(GravityVectorResidual::Create(fit->s0 * positions[k].raw_mean,
+                                                            fit->whitening[k], fit->gravity),
+                              MakeLoss(ro.loss, ro.loss_scale), fit->bias, fit->matrix,
+                              fit->attitude[k].data());
+    problem->AddResidualBlock(AttitudePriorResidual::Create(attitudes[k]), nullptr,
+                              fit->attitude[k].data());
+  }
+  ceres::Solve(internal::SolverOptions(ro.solver, ceres::DENSE_QR), problem.get(), summary);
+  return problem;
 }
 
 // Whitened sum of squares (no loss) at the current parameters.
@@ -225,8 +260,9 @@ double Chi2(const std::vector<Position>& positions, const std::vector<KnownAttit
 
 // The covariance of (b, M) in raw units (scale_back per parameter) into
 // c->refinement and c->accel, and each attitude's standard deviations.
-void ComputeCovariance(ceres::Problem* problem, const double scale_back[12], AttitudeFit* fit,
-                       std::vector<Eigen::Vector2d>* attitude_std, Calibration* c) {
+void ComputeCovariance(ceres::Problem* problem, const double scale_back[12], double inflation,
+                       AttitudeFit* fit, std::vector<Eigen::Vector2d>* attitude_std,
+                       Calibration* c) {
   RefinementResult& f = c->refinement;
   double* bias = fit->bias;
   double* matrix = fit->matrix;
@@ -253,7 +289,7 @@ void ComputeCovariance(ceres::Problem* problem, const double scale_back[12], Att
       for (int j = 0; j < 9; ++j) cov(3 + i, 3 + j) = cmm[9 * i + j];
     }
     for (int i = 0; i < 12; ++i) {
-      for (int j = 0; j < 12; ++j) cov(i, j) *= scale_back[i] * scale_back[j];
+      for (int j = 0; j < 12; ++j) cov(i, j) *= inflation * scale_back[i] * scale_back[j];
     }
     f.covariance = cov;
     f.covariance_available = true;
@@ -264,13 +300,102 @@ void ComputeCovariance(ceres::Problem* problem, const double scale_back[12], Att
     for (int k = 0; k < n; ++k) {
       double ca[4];
       covariance.GetCovarianceBlock(attitude[k].data(), attitude[k].data(), ca);
-      (*attitude_std)[k] = Eigen::Vector2d(std::sqrt(ca[0]), std::sqrt(ca[3]));
+      (*attitude_std)[k] =
+          Eigen::Vector2d(std::sqrt(inflation * ca[0]), std::sqrt(inflation * ca[3]));
     }
   } else {
     c->warnings.push_back(
         "known_attitude: the covariance could not be computed (rank deficient); no standard "
         "deviations are reported");
   }
+}
+
+// The whitened residuals (sensor and prior, no loss) and their Jacobian
+// over (b, M, attitudes) at the solution, and the shape of a per-pose
+// specific-force variance s^2 I in them: W_k W_k^T on position k's sensor
+// rows, zero on the priors (estimation/variance_component.h).
+void WhitenedSystem(ceres::Problem* problem, AttitudeFit* fit, Eigen::VectorXd* residuals,
+                    Eigen::MatrixXd* jacobian, Eigen::MatrixXd* shape) {
+  const int n = static_cast<int>(fit->attitude.size());
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.apply_loss_function = false;
+  evaluate.parameter_blocks = {fit->bias, fit->matrix};
+  for (int k = 0; k < n; ++k) evaluate.parameter_blocks.push_back(fit->attitude[k].data());
+  double cost = 0.0;
+  std::vector<double> r;
+  ceres::CRSMatrix crs;
+  problem->Evaluate(evaluate, &cost, &r, nullptr, &crs);
+  *residuals = Eigen::Map<const Eigen::VectorXd>(r.data(), r.size());
+  *jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int i = crs.rows[row]; i < crs.rows[row + 1]; ++i) {
+      (*jacobian)(row, crs.cols[i]) = crs.values[i];
+    }
+  }
+  *shape = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_rows);
+  for (int k = 0; k < n; ++k) {
+    shape->block<3, 3>(5 * k, 5 * k) = fit->whitening[k] * fit->whitening[k].transpose();
+  }
+}
+
+// What the samples of each position cannot show (placement disturbances,
+// tremor, mount flex): one extra specific-force variance s^2 per position,
+// estimated by REML (with the prior of pose_disturbance_prior) from the
+// fit's residuals, added to every position's covariance and the fit
+// repeated; the covariance then carries the Student-t factor of an
+// estimated s^2 (*inflation), as in twelve_position (methods/pose_variance.h).
+// Replaces *problem and *summary by the re-weighted fit's when absorbed.
+void AccountForPoseVariance(const std::vector<Position>& positions,
+                            const std::vector<KnownAttitude>& attitudes,
+                            const RefinementOptions& ro, AttitudeFit* fit,
+                            std::unique_ptr<ceres::Problem>* problem,
+                            ceres::Solver::Summary* summary, double* inflation, Calibration* c) {
+  VarianceComponent& vc = c->accel.pose_variance;
+  vc = VarianceComponent();
+  *inflation = 1.0;
+  if (!ro.estimate_pose_variance) {
+    vc.message = "not estimated (pose_variance: false)";
+    return;
+  }
+  if (!summary->IsSolutionUsable()) {
+    vc.message = "not estimated: the fit did not converge";
+    return;
+  }
+  Eigen::VectorXd residuals;
+  Eigen::MatrixXd jacobian, shape;
+  WhitenedSystem(problem->get(), fit, &residuals, &jacobian, &shape);
+  internal::VariancePrior prior;
+  prior.variance = ro.pose_disturbance_prior * ro.pose_disturbance_prior;
+  prior.dof = ro.pose_disturbance_prior_dof;
+  VarianceComponent estimate;
+  double known = 0.0;
+  if (!internal::EstimateWhitenedVarianceComponent(residuals, jacobian, shape, &estimate, prior,
+                                                   &known)) {
+    vc.message = "not estimated: " + estimate.message;
+    return;
+  }
+  vc = estimate;
+  if (vc.at_boundary) return;
+  std::string error;
+  if (!Whiten(positions, vc.variance, fit, &error)) {
+    vc.message += "; not absorbed: " + error;
+    return;
+  }
+  ceres::Solver::Summary again;
+  std::unique_ptr<ceres::Problem> reweighted = Solve(positions, attitudes, ro, fit, &again);
+  *problem = std::move(reweighted);
+  *summary = again;
+  double effective_dof = INFINITY;
+  // The known variance per residual direction (sensor noise and the
+  // attitudes' uncertainty) beside s^2 (variance_component.h).
+  *inflation = internal::StudentInflation(vc, known, &effective_dof);
+  vc.absorbed = true;
+  std::ostringstream t;
+  t.precision(3);
+  t << "; added to every position's variance, covariance x " << *inflation << " (Student t, "
+    << effective_dof << " effective dof)";
+  vc.message += t.str();
+  internal::WarnPoseVariance(vc, effective_dof, ro, &c->warnings);
 }
 
 // Warnings on the fit's degrees of freedom and chi-square.
@@ -308,25 +433,23 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
   for (const Position& p : positions) mean_norm += p.raw_mean.norm();
   fit.s0 = g * n / mean_norm;
   const double s0 = fit.s0;
-  if (!InitialFit(positions, attitudes, &fit, &c.message)) return false;
-
-  ceres::Problem problem;
-  const RefinementOptions& ro = options.refinement;
-  for (int k = 0; k < n; ++k) {
-    problem.AddResidualBlock(
-        GravityVectorResidual::Create(s0 * positions[k].raw_mean, fit.whitening[k], g),
-        MakeLoss(ro.loss, ro.loss_scale), fit.bias, fit.matrix, fit.attitude[k].data());
-    problem.AddResidualBlock(AttitudePriorResidual::Create(attitudes[k]), nullptr,
-                             fit.attitude[k].data());
+  if (!InitialFit(positions, attitudes, &fit, &c.message) ||
+      !Whiten(positions, 0.0, &fit, &c.message)) {
+    return false;
   }
+
+  const RefinementOptions& ro = options.refinement;
   RefinementResult& f = c.refinement;
   f.initial_cost = 0.5 * Chi2(positions, attitudes, &fit);
-  const ceres::Solver::Options solver_options = internal::SolverOptions(ro.solver, ceres::DENSE_QR);
   ceres::Solver::Summary summary;
   const auto start = std::chrono::steady_clock::now();
-  ceres::Solve(solver_options, &problem, &summary);
+  std::unique_ptr<ceres::Problem> problem = Solve(positions, attitudes, ro, &fit, &summary);
+  int iterations = static_cast<int>(summary.iterations.size()) - 1;
+  double inflation = 1.0;
+  AccountForPoseVariance(positions, attitudes, ro, &fit, &problem, &summary, &inflation, &c);
+  if (c.accel.pose_variance.absorbed) iterations += static_cast<int>(summary.iterations.size()) - 1;
   f.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  f.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  f.iterations = iterations;
   f.termination = ceres::TerminationTypeToString(summary.termination_type);
   f.converged = summary.termination_type == ceres::CONVERGENCE;
   f.chi2 = Chi2(positions, attitudes, &fit);
@@ -351,7 +474,9 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
   f.model = c.accel.model;
 
   std::vector<Eigen::Vector2d> attitude_std(n, Eigen::Vector2d::Constant(NAN));
-  if (ro.compute_covariance) ComputeCovariance(&problem, scale_back, &fit, &attitude_std, &c);
+  if (ro.compute_covariance) {
+    ComputeCovariance(problem.get(), scale_back, inflation, &fit, &attitude_std, &c);
+  }
   WarnFit(f, &c);
 
   AccelModel nominal;

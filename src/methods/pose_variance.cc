@@ -129,6 +129,11 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
                                ? ""
                                : " (too few poses to test whether non-orthogonality explains it)");
   *pose_variance = vc;
+  WarnPoseVariance(vc, effective_dof, options, &refinement->warnings);
+}
+
+void WarnPoseVariance(const VarianceComponent& vc, double effective_dof,
+                      const RefinementOptions& options, std::vector<std::string>* warnings) {
   if (effective_dof < kMinEffectiveDof) {
     std::ostringstream w;
     w.precision(3);
@@ -136,7 +141,7 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
       << " effective degrees of freedom (fewer than " << kMinEffectiveDof
       << "): the standard deviations are themselves uncertain by a large factor; more poses "
          "would tell";
-    refinement->warnings.push_back(w.str());
+    warnings->push_back(w.str());
   }
   const double s = std::sqrt(vc.variance);
   if (s > options.max_pose_disturbance) {
@@ -147,7 +152,7 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
       << options.max_pose_disturbance
       << " m/s^2 for a sensor at rest: a pose was disturbed or the model misses an effect (run "
          "`gravcal discover`); the standard deviations include the scatter";
-    refinement->warnings.push_back(w.str());
+    warnings->push_back(w.str());
   }
 }
 

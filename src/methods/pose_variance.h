@@ -24,6 +24,7 @@
 #ifndef GRAVCAL_SRC_METHODS_POSE_VARIANCE_H_
 #define GRAVCAL_SRC_METHODS_POSE_VARIANCE_H_
 
+#include <string>
 #include <vector>
 
 #include "gravcal/core/position.h"
@@ -41,6 +42,12 @@ namespace internal {
 void AccountForPoseVariance(const std::vector<Position>& placed, const AccelModel& initial,
                             double gravity, const RefinementOptions& options,
                             RefinementResult* refinement, VarianceComponent* pose_variance);
+
+// The warnings on an absorbed s^2 (above): fewer than kMinEffectiveDof
+// effective degrees of freedom, and s above options.max_pose_disturbance.
+// known_attitude uses them too.
+void WarnPoseVariance(const VarianceComponent& vc, double effective_dof,
+                      const RefinementOptions& options, std::vector<std::string>* warnings);
 
 }  // namespace internal
 }  // namespace gravcal

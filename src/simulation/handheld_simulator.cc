@@ -134,7 +134,13 @@ struct MotionStream {
   std::mt19937_64 rng;
   std::normal_distribution<double> n01{0.0, 1.0};
   std::uniform_real_distribution<double> u01{0.0, 1.0};
-  Vec3 Normal3() { return Vec3(n01(rng), n01(rng), n01(rng)); }
+  // Sequenced in g++'s order, as simulator.cc's MainStream::Normal3.
+  Vec3 Normal3() {
+    const double z = n01(rng);
+    const double y = n01(rng);
+    const double x = n01(rng);
+    return Vec3(x, y, z);
+  }
 };
 
 // The truth sensors, as in simulator.cc: scale in SI per raw unit.

@@ -175,7 +175,12 @@ void DrawEffects(const SimulatorOptions& o, uint64_t seed, SimulatedSession* s) 
   std::mt19937_64 rng(seed ^ 0x6a09e667f3bcc909ULL);
   std::normal_distribution<double> n01(0.0, 1.0);
   auto draw3 = [&](double std) -> Eigen::Vector3d {
-    return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)) * std;
+    // Sequenced (z, y, x: the order g++ gave the unsequenced arguments), so a
+    // seed is the same session whatever the compiler.
+    const double z = n01(rng);
+    const double y = n01(rng);
+    const double x = n01(rng);
+    return Eigen::Vector3d(x, y, z) * std;
   };
   EffectParameters& e = s->effects;
   e.reference_temperature = o.effect_reference_temperature;
@@ -197,7 +202,15 @@ struct MainStream {
   explicit MainStream(uint64_t seed) : rng(seed) {}
   std::mt19937_64 rng;
   std::normal_distribution<double> n01{0.0, 1.0};
-  Eigen::Vector3d Normal3() { return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)); }
+  // Sequenced z, y, x: function arguments are evaluated in an unspecified
+  // order (g++ right to left, clang left to right), and a seed must be the
+  // same session whatever the compiler; z first is g++'s order.
+  Eigen::Vector3d Normal3() {
+    const double z = n01(rng);
+    const double y = n01(rng);
+    const double x = n01(rng);
+    return Eigen::Vector3d(x, y, z);
+  }
 };
 
 // The truth sensors, from the session's main stream `rng`, and the effect

@@ -44,7 +44,9 @@ bool RunTwelvePosition(const Config& config, const MethodData& data, Calibration
     ok = FitCalibrationEffects(*data.log, intervals, options, config.effects, calibration);
   }
   if (!ok || config.gyro.parameterization == GyroParameterization::kNone) return ok;
-  return AddGyroscopeCalibration(*data.log, intervals, config.gyro, calibration);
+  GyroCalibrationOptions gyro = config.gyro;
+  gyro.noise_model = data.noise;
+  return AddGyroscopeCalibration(*data.log, intervals, gyro, calibration);
 }
 
 bool RunTenPosition(const Config& config, const MethodData& data, Calibration* calibration) {
@@ -162,7 +164,8 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
       {"known_attitude",
        "fixture attitudes, --attitudes",
        {"gravity", "detector", "pose_noise"},
-       {"loss", "loss_scale", "covariance", "max_iterations"},
+       {"loss", "loss_scale", "covariance", "max_iterations", "pose_variance",
+        "max_pose_disturbance", "pose_disturbance_prior", "pose_disturbance_prior_dof"},
        MethodSideInput::kAttitudes,
        nullptr,
        RunKnownAttitude,

@@ -39,6 +39,7 @@
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/core/noise_model.h"
 #include "gravcal/core/types.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/refinement.h"
@@ -84,6 +85,13 @@ struct GyroCalibrationOptions {
   // AddGyroscopeCalibration turns it on with the accelerometer's
   // pose_variance.
   bool estimate_static_variance = false;
+  // The gyroscope's noise model (`calibrate --noise noise.json`), or null.
+  // The bias wanders over the session (bias instability, rate random walk)
+  // by an amount every static pose shares and no pose can show: with a
+  // model, B^2 + K^2 T / 3 (T the session's span) is added to the bias's
+  // covariance; without one, twice the static poses' REML scatter (when
+  // estimate_static_variance finds one; src/methods/gyro_bias_wander.h).
+  const ImuNoiseModel* noise_model = nullptr;
 
   // Stopping rules of the Ceres solve.
   SolverTolerances solver = {100, 1e-12, 1e-12, 1e-10};
@@ -131,6 +139,11 @@ struct GyroCalibrationResult : LeastSquaresSummary {
   // Per-sample gyroscope noise seen in the static intervals, raw units
   // (sqrt of the diagonal of the pooled covariance).
   Eigen::Vector3d gyro_noise = Eigen::Vector3d::Zero();
+  // The bias's wander over the session that every pose shares, per axis,
+  // raw units (included in bias_std and covariance; zero when none was
+  // accounted for), and a note saying from what it was sized.
+  Eigen::Vector3d bias_wander_std = Eigen::Vector3d::Zero();
+  std::string bias_wander_note;
   // The linear initial estimate of M_g.
   Eigen::Matrix3d initial_matrix = Eigen::Matrix3d::Identity();
   // joint: the refined accelerometer (model, covariance of its bias and free

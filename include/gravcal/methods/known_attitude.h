@@ -19,6 +19,16 @@
 // so the estimate is weighted by the sensor noise and the attitude
 // uncertainty together, and the covariance of (b, M) from ceres::Covariance
 // includes both. Heading does not enter (gravity is vertical).
+//
+// With options.refinement.estimate_pose_variance (config pose_variance), one
+// extra specific-force variance s^2 I per position (placement disturbances
+// the samples cannot show) is estimated by REML from the whitened residuals
+// of that fit, the attitude priors counted as the parameters' degrees of
+// freedom (estimation/variance_component.h, the whitened form; with the
+// prior pose_disturbance_prior on pose_disturbance_prior_dof), added to
+// every L_k L_k^T and the fit repeated; the covariance is then multiplied by
+// the Student-t factor nu / (nu - 2) of an estimated s^2, and
+// calibration->accel.pose_variance reports it (as twelve_position does).
 #ifndef GRAVCAL_METHODS_KNOWN_ATTITUDE_H_
 #define GRAVCAL_METHODS_KNOWN_ATTITUDE_H_
 
@@ -46,8 +56,8 @@ struct KnownAttitude {
 // solver's summary: iterations, chi2, dof), per-position attitude and
 // residuals. `options` supplies gravity (unless calibration->gravity_source is
 // already set, as CalibrateKnownAttitude leaves it), loss, loss_scale,
-// covariance and max_iterations. Returns false on fewer than 4 positions, invalid
-// attitudes, a singular initial fit or no convergence.
+// covariance, max_iterations and the pose-variance keys above. Returns false on fewer than 4
+// positions, invalid attitudes, a singular initial fit or no convergence.
 bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
                                  const std::vector<KnownAttitude>& attitudes,
                                  const CalibrationOptions& options, Calibration* calibration);
