@@ -12,6 +12,7 @@
 #include <memory>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "estimation/robust_loss.h"
 #include "estimation/solver_settings.h"
 #include "gravcal/core/gravity.h"
@@ -267,18 +268,21 @@ void ComputeCovariance(ceres::Problem* problem, const double scale_back[12], Att
       (*attitude_std)[k] = Eigen::Vector2d(std::sqrt(ca[0]), std::sqrt(ca[3]));
     }
   } else {
-    c->warnings.push_back(
-        "known_attitude: the covariance could not be computed (rank deficient); no standard "
-        "deviations are reported");
+    internal::AddWarning(WarningCode::kNoCovariance,
+                         "known_attitude: the covariance could not be computed (rank deficient); "
+                         "no standard deviations are reported",
+                         &c->warnings, &c->warning_codes);
   }
 }
 
 // Warnings on the fit's degrees of freedom and chi-square.
 void WarnFit(const RefinementResult& f, Calibration* c) {
   if (f.dof <= 0) {
-    c->warnings.push_back(
-        "known_attitude: as many equations as unknowns; the fit cannot show whether the attitudes "
-        "or the noise estimate are right: record more positions");
+    internal::AddWarning(WarningCode::kExactFit,
+                         "known_attitude: as many equations as unknowns; the fit cannot show "
+                         "whether the attitudes or the noise estimate are right: record more "
+                         "positions",
+                         &c->warnings, &c->warning_codes);
   } else if (ChiSquareUpperTail(f.chi2, f.dof) < 1e-3) {
     std::ostringstream s;
     s.precision(3);
@@ -287,7 +291,8 @@ void WarnFit(const RefinementResult& f, Calibration* c) {
       << f.chi2 << " on " << f.dof
       << " dof): an attitude is wrong or too confident, or a position was disturbed; the "
          "standard deviations are too small by about that factor";
-    c->warnings.push_back(s.str());
+    internal::AddWarning(WarningCode::kResidualsAboveNoise, s.str(), &c->warnings,
+                         &c->warning_codes);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "estimation/variance_component.h"
 #include "util/statistics.h"
 
@@ -99,7 +100,8 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
   if (ExcessIsStructured(placed, initial, gravity, options, *refinement, &tested, &structured)) {
     vc.message += "; not absorbed: a model term explains the excess";
     *pose_variance = vc;
-    refinement->warnings.push_back(structured);
+    AddWarning(WarningCode::kResidualsAboveNoise, structured, &refinement->warnings,
+               &refinement->warning_codes);
     return;
   }
   RefinementOptions again = options;
@@ -136,7 +138,8 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
       << " effective degrees of freedom (fewer than " << kMinEffectiveDof
       << "): the standard deviations are themselves uncertain by a large factor; more poses "
          "would tell";
-    refinement->warnings.push_back(w.str());
+    AddWarning(WarningCode::kPoseScatter, w.str(), &refinement->warnings,
+               &refinement->warning_codes);
   }
   const double s = std::sqrt(vc.variance);
   if (s > options.max_pose_disturbance) {
@@ -147,7 +150,8 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
       << options.max_pose_disturbance
       << " m/s^2 for a sensor at rest: a pose was disturbed or the model misses an effect (run "
          "`gravcal discover`); the standard deviations include the scatter";
-    refinement->warnings.push_back(w.str());
+    AddWarning(WarningCode::kPoseScatter, w.str(), &refinement->warnings,
+               &refinement->warning_codes);
   }
 }
 
