@@ -397,25 +397,35 @@ void NearlyStillStretches(const ImuLog& log, const float* accel_var, const float
   const std::vector<QuietRun> loose =
       FindQuietRuns(accel_var, gyro_var, num_windows, w, f * detection.accel_threshold,
                     f * detection.gyro_threshold);
+  std::vector<double> scratch;
   auto report = [&](size_t begin, size_t end) {
     if (end < begin + w || end - begin < min_count + 2 * settle) return;
-    // No window inside [begin, end) is quiet: the largest ratios say why.
-    double accel_ratio = 0.0, gyro_ratio = 0.0;
-    for (size_t k = begin; k + w <= end; ++k) {
-      accel_ratio = std::max(accel_ratio, accel_var[k] / detection.accel_threshold);
-      if (gyro_var) gyro_ratio = std::max(gyro_ratio, gyro_var[k] / detection.gyro_threshold);
+    // Not inside an interval merged across a gap.
+    for (const StaticInterval& s : detection.intervals) {
+      if (begin < s.end && s.begin < end) return;
     }
+    // No window inside [begin, end) is quiet: the typical (median) ratios
+    // of the variances to their thresholds say why (the ends of the
+    // stretch are the ends of motions).
+    std::vector<double> accel_ratio, gyro_ratio;
+    for (size_t k = begin; k + w <= end; ++k) {
+      accel_ratio.push_back(accel_var[k] / detection.accel_threshold);
+      if (gyro_var) gyro_ratio.push_back(gyro_var[k] / detection.gyro_threshold);
+    }
+    const double accel_median =
+        StridedQuantile(accel_ratio.data(), accel_ratio.size(), 0.5, &scratch);
+    const double gyro_median = StridedQuantile(gyro_ratio.data(), gyro_ratio.size(), 0.5, &scratch);
     const std::string seconds = Num(log.t[end - 1] - log.t[begin]);
-    if (accel_ratio > 1.0) {
+    if (accel_median > 1.0 || gyro_var == nullptr) {
       rejected->push_back(MakeRejected(log, begin, end, RejectionReason::kTooMuchMotion,
                                        "nearly still for " + seconds +
-                                           " s, but the accelerometer variance reached " +
-                                           Num(accel_ratio) + " times its threshold"));
+                                           " s, but the accelerometer variance was typically " +
+                                           Num(accel_median) + " times its threshold"));
     } else {
       rejected->push_back(MakeRejected(log, begin, end, RejectionReason::kRotating,
-                                       "the accelerometer was still for " + seconds +
-                                           " s, but the gyroscope variance reached " +
-                                           Num(gyro_ratio) + " times its threshold"));
+                                       "the accelerometer was nearly still for " + seconds +
+                                           " s, but the gyroscope variance was typically " +
+                                           Num(gyro_median) + " times its threshold"));
     }
   };
   size_t q = 0;

@@ -94,7 +94,7 @@ void SetEffectResiduals(const EffectFitResult& fit, Calibration* calibration) {
   for (size_t i = 0; i < c.warnings.size(); ++i) {
     const WarningCode code =
         i < c.warning_codes.size() ? c.warning_codes[i] : WarningCode::kUnclassified;
-    if (code != WarningCode::kResidualsAboveNoise) {
+    if (c.warnings[i].find("times the noise level (chi2") == std::string::npos) {
       internal::AddWarning(code, c.warnings[i], &kept, &kept_codes);
     }
   }

@@ -144,6 +144,13 @@ std::string RawPlot(const ImuLog& log, const std::vector<Eigen::Vector3d>& v, co
                     const std::vector<Span>& spans, const std::string& css) {
   Plot p;
   p.title = std::string(what) + " against time; shaded and numbered: the static intervals used";
+  for (const Span& s : spans) {
+    if (s.css_class == "rejected-stretch") {
+      p.title = std::string(what) +
+                " against time: the static intervals used (numbered) and the stretches rejected";
+      break;
+    }
+  }
   p.x.label = "time, s";
   // The time axis spans the log exactly (ticks inside it).
   if (!log.t.empty()) {
