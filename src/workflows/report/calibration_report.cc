@@ -111,16 +111,11 @@ std::vector<Span> PoseSpans(const Calibration& c) {
   return spans;
 }
 
-const char* ReasonWords(RejectionReason reason) {
-  switch (reason) {
-    case RejectionReason::kTooShort:
-      return "too short";
-    case RejectionReason::kTooMuchMotion:
-      return "too much motion";
-    case RejectionReason::kRotating:
-      return "rotating";
-  }
-  return "unknown";
+// "too short" for RejectionReason::kTooShort ("too_short").
+std::string ReasonWords(RejectionReason reason) {
+  std::string words = ToString(reason);
+  std::replace(words.begin(), words.end(), '_', ' ');
+  return words;
 }
 
 // The shading of the stretches the detector rejected, the reason in the
@@ -133,8 +128,8 @@ std::vector<Span> RejectedSpans(const StaticDetection& detection) {
     s.x1 = r.t_end;
     s.color = r.reason == RejectionReason::kTooShort ? "#ff7f0e" : "#d62728";
     s.css_class = "rejected-stretch";
-    s.legend = std::string("rejected: ") + ReasonWords(r.reason);
-    s.title = std::string("rejected, ") + ReasonWords(r.reason) + ": " + r.detail;
+    s.legend = "rejected: " + ReasonWords(r.reason);
+    s.title = "rejected, " + ReasonWords(r.reason) + ": " + r.detail;
     spans.push_back(s);
   }
   return spans;
