@@ -14,10 +14,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <random>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "cli_runner.h"
+#include "gravcal/detection/static_detector.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/pipeline.h"
@@ -202,6 +205,16 @@ void ExpectRoundTicks(const std::string& dom, size_t min_axes) {
   }
 }
 
+// Empty when `html` fetches nothing: no src= or href= attribute, no CSS
+// import or url(); otherwise the first such reference.
+std::string ExternalReference(const std::string& html) {
+  for (const char* needle : {"src=", "href=", "@import", "url("}) {
+    const size_t at = html.find(needle);
+    if (at != std::string::npos) return html.substr(at, 60);
+  }
+  return "";
+}
+
 std::string ScreenshotDir() {
   const std::string d =
       std::filesystem::path(GRAVCAL_CLI_PATH).parent_path().string() + "/report_screenshots";
@@ -213,11 +226,14 @@ std::string ScreenshotDir() {
 // full-page screenshot <build>/report_screenshots/<name>.png; returns the DOM.
 std::string OpenReport(const std::string& html, const std::string& name, const ScratchDir& dir,
                        size_t min_axes) {
+  EXPECT_EQ(ExternalReference(Slurp(html)), "") << "the report is not self-contained";
   const LoadedPage page = Load(html, dir);
   EXPECT_EQ(page.exit_code, 0) << Slurp(dir / "browser.log");
   EXPECT_TRUE(page.console.empty()) << "console: " << page.console[0];
   EXPECT_NE(page.dom.find("data-load-ms"), std::string::npos) << "the load event did not run";
   ExpectRoundTicks(page.dom, min_axes);
+  // Every warning has its explanation (report_warning_test.cc checks more).
+  EXPECT_EQ(Count(page.dom, "warning unexplained"), 0u);
   const int height =
       std::max(600, std::min(16000, std::atoi(Attribute(page.dom, "data-height").c_str())));
   std::vector<std::string> args = HeadlessFlags();
@@ -229,6 +245,10 @@ std::string OpenReport(const std::string& html, const std::string& name, const S
   EXPECT_TRUE(testing_util::FileExists(png));
   ::testing::Test::RecordProperty("screenshot", png);
   ::testing::Test::RecordProperty("load_ms", Attribute(page.dom, "data-load-ms"));
+  const size_t bytes = Slurp(html).size();
+  ::testing::Test::RecordProperty("bytes", std::to_string(bytes));
+  std::printf("report %s: %zu bytes, load %s ms\n", name.c_str(), bytes,
+              Attribute(page.dom, "data-load-ms").c_str());
   return page.dom;
 }
 
@@ -264,6 +284,9 @@ TEST(ReportBrowser, CheckersCatchPlantedMistakes) {
   EXPECT_NE(TickProblem(bad), "");
   bad.labels = {"0", "0.3", "0.6"};
   EXPECT_NE(TickProblem(bad), "");
+  EXPECT_NE(ExternalReference("<img src='https://example.org/a.png'>"), "");
+  EXPECT_NE(ExternalReference("<style>@import 'a.css';</style>"), "");
+  EXPECT_EQ(ExternalReference("<svg xmlns='http://www.w3.org/2000/svg'></svg>"), "");
   const AxisTicks good{"linear", {"-1", "-0.5", "0", "0.5", "1"}};
   EXPECT_EQ(TickProblem(good), "");
   EXPECT_EQ(TickProblem({"log", {"0.01", "0.1", "1", "10"}}), "");
@@ -304,6 +327,67 @@ TEST(ReportBrowser, CalibrationReport) {
   }
   EXPECT_NE(dom.find("+3 sigma"), std::string::npos);
   EXPECT_NE(dom.find("magnitude fit"), std::string::npos);
+  // The stretches the detector rejected (with the config's detector
+  // options, on the same log), shaded in each raw plot.
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(ConfigPath("twelve_position_gyro.yaml"), &config, &error)) << error;
+  ImuLog log;
+  ASSERT_TRUE(ReadImuLog(dir / "sim/raw.csv", config.input, &log, &error)) << error;
+  StaticDetection detection;
+  ASSERT_TRUE(DetectStaticIntervals(log, config.calibration.detector, &detection));
+  EXPECT_EQ(detection.intervals.size(), n);
+  EXPECT_EQ(Count(dom, "class=\"rejected-stretch\""), 2 * detection.rejected.size());
+}
+
+// A session with two disturbed poses: one held with tremor, one cut short.
+// The detector rejects both, and the report shades each stretch it rejected
+// (as many as the detector reports, in each raw plot) with its reason in the
+// legend, beside the numbered intervals it used.
+TEST(ReportBrowser, RejectedStretchesAreShadedWithTheirReason) {
+  SKIP_WITHOUT_BROWSER();
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(ConfigPath("twelve_position.yaml"), &config, &error)) << error;
+  SimulatedSession s;
+  ASSERT_TRUE(Simulate(config.simulation, 8, &s, &error)) << error;
+  StaticDetection clean;
+  ASSERT_TRUE(DetectStaticIntervals(s.log, config.calibration.detector, &clean));
+  ASSERT_GE(clean.intervals.size(), 12u);
+  // Tremor of about 20 times the noise floor's variance over pose 4.
+  ImuLog log = s.log;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> tremor(0.0, std::sqrt(19.0 * clean.accel_noise_floor / 3.0));
+  for (size_t i = clean.intervals[3].begin; i < clean.intervals[3].end; ++i) {
+    log.accel[i] += Eigen::Vector3d(tremor(rng), tremor(rng), tremor(rng));
+  }
+  // Pose 8 cut to 1.5 s by a jolt after its first 1.5 s.
+  const StaticInterval& cut = clean.intervals[7];
+  const size_t jolt = cut.begin + static_cast<size_t>(1.5 * config.simulation.sample_rate);
+  const double a = 30.0 * std::sqrt(clean.accel_noise_floor);
+  for (size_t i = jolt; i < cut.end; ++i) {
+    log.accel[i] += a * Eigen::Vector3d(std::sin(0.3 * i), std::cos(0.2 * i), 0.0);
+  }
+  StaticDetection detection;
+  ASSERT_TRUE(DetectStaticIntervals(log, config.calibration.detector, &detection));
+  std::set<RejectionReason> reasons;
+  for (const RejectedStretch& r : detection.rejected) reasons.insert(r.reason);
+  EXPECT_TRUE(reasons.count(RejectionReason::kTooMuchMotion)) << detection.message;
+  EXPECT_TRUE(reasons.count(RejectionReason::kTooShort)) << detection.message;
+  PipelineInput input;
+  input.log = log;
+  Calibration c;
+  ASSERT_TRUE(RunCalibration(config, input, &c)) << c.message;
+  ASSERT_EQ(c.positions.size(), detection.intervals.size());
+  ScratchDir dir;
+  const std::string html =
+      dir.Write("rejected.html", CalibrationToHtml(c, log, "two disturbed poses", detection));
+  const std::string dom = OpenReport(html, "calibration_rejected", dir, 8);
+  EXPECT_EQ(Count(dom, "class=\"static-interval\""), 2 * c.positions.size());
+  EXPECT_EQ(Count(dom, "class=\"rejected-stretch\""), 2 * detection.rejected.size());
+  EXPECT_NE(dom.find("rejected: too much motion"), std::string::npos);
+  EXPECT_NE(dom.find("rejected: too short"), std::string::npos);
+  EXPECT_NE(dom.find("accelerometer variance was typically"), std::string::npos);
 }
 
 // A failed calibration still gets its report, and it says "record again".
@@ -448,7 +532,9 @@ TEST(ReportBrowser, HourLongSessionStaysSmall) {
   ASSERT_GE(input.log.t.back() - input.log.t.front(), 3600.0);
   Calibration c;
   ASSERT_TRUE(RunCalibration(config, input, &c)) << c.message;
-  const std::string html = CalibrationToHtml(c, input.log, "one hour at 200 Hz");
+  StaticDetection detection;
+  ASSERT_TRUE(DetectStaticIntervals(input.log, config.calibration.detector, &detection));
+  const std::string html = CalibrationToHtml(c, input.log, "one hour at 200 Hz", detection);
   EXPECT_LT(html.size(), 2u << 20);
   ::testing::Test::RecordProperty("bytes", std::to_string(html.size()));
   SKIP_WITHOUT_BROWSER();

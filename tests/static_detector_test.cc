@@ -179,6 +179,70 @@ TEST(StaticDetector, RejectsShortStillSegments) {
   StaticDetection d;
   ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
   ExpectMatches(d, {truth[0], truth[1], truth[3], truth[5]}, 30, 30);
+  // The 1.5 s pose is reported as rejected, too short, and no rejected
+  // stretch overlaps an interval.
+  size_t short_pose = 0;
+  for (const RejectedStretch& r : d.rejected) {
+    EXPECT_LT(r.begin, r.end);
+    EXPECT_DOUBLE_EQ(r.t_begin, log.t[r.begin]);
+    EXPECT_DOUBLE_EQ(r.t_end, log.t[r.end - 1]);
+    for (const StaticInterval& s : d.intervals) EXPECT_TRUE(r.end <= s.begin || s.end <= r.begin);
+    if (r.begin < truth[2].end && truth[2].begin < r.end) {
+      ++short_pose;
+      EXPECT_EQ(r.reason, RejectionReason::kTooShort);
+      EXPECT_NE(r.detail.find("min_duration_seconds"), std::string::npos) << r.detail;
+    }
+  }
+  EXPECT_EQ(short_pose, 1u);
+  EXPECT_STREQ(ToString(RejectionReason::kTooShort), "too_short");
+}
+
+// A pose held with tremor (accelerometer variance a few times the
+// threshold) is rejected as too much motion; a pose rocked about the
+// vertical (the accelerometer still, the gyroscope's variance a few times
+// its threshold) as rotating. Neither changes the intervals of the others.
+TEST(StaticDetector, ReportsNearlyStillStretchesWithTheirReason) {
+  SyntheticOptions so;
+  std::vector<Truth> truth;
+  const ImuLog clean = MakeLog(SixPoses(6.0), so, &truth);
+  ImuLog log = clean;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> tremor(0.0, 0.02 * std::sqrt(19.0));
+  for (size_t i = truth[1].begin; i < truth[1].end; ++i) {
+    log.accel[i] += Eigen::Vector3d(tremor(rng), tremor(rng), tremor(rng));
+  }
+  for (size_t i = truth[4].begin; i < truth[4].end; ++i) {
+    // Pose 4 has x down: rocking about x leaves gravity where it is.
+    log.gyro[i].x() += 0.2 * std::sin(2.0 * M_PI * (log.t[i] - log.t[truth[4].begin]));
+  }
+  StaticDetection d, d_clean;
+  ASSERT_TRUE(DetectStaticIntervals(clean, StaticDetectorOptions(), &d_clean)) << d.message;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  ExpectMatches(d, {truth[0], truth[2], truth[3], truth[5]}, 30, 30);
+  EXPECT_TRUE(d_clean.rejected.empty()) << d_clean.rejected[0].detail;
+  ASSERT_EQ(d.rejected.size(), 2u) << d.message;
+  EXPECT_EQ(d.rejected[0].reason, RejectionReason::kTooMuchMotion) << d.rejected[0].detail;
+  EXPECT_EQ(d.rejected[1].reason, RejectionReason::kRotating) << d.rejected[1].detail;
+  for (int k : {0, 1}) {
+    const Truth& t = truth[k == 0 ? 1 : 4];
+    EXPECT_LT(d.rejected[k].begin, t.end);
+    EXPECT_GT(d.rejected[k].end, t.begin);
+    // The stretch is most of the pose.
+    EXPECT_GT(d.rejected[k].end - d.rejected[k].begin, (t.end - t.begin) / 2);
+  }
+  EXPECT_NE(d.message.find("2 stretches rejected"), std::string::npos) << d.message;
+  // Rejected stretches are reported only: a candidate_factor of 1 reports
+  // none of the nearly still ones and leaves the intervals as they are.
+  StaticDetectorOptions strict;
+  strict.candidate_factor = 1.0;
+  StaticDetection d_strict;
+  ASSERT_TRUE(DetectStaticIntervals(log, strict, &d_strict)) << d_strict.message;
+  EXPECT_TRUE(d_strict.rejected.empty());
+  ASSERT_EQ(d_strict.intervals.size(), d.intervals.size());
+  for (size_t i = 0; i < d.intervals.size(); ++i) {
+    EXPECT_EQ(d_strict.intervals[i].begin, d.intervals[i].begin);
+    EXPECT_EQ(d_strict.intervals[i].end, d.intervals[i].end);
+  }
 }
 
 TEST(StaticDetector, NoStillSegmentGivesNoInterval) {
@@ -295,6 +359,7 @@ TEST(StaticDetector, RejectsInvalidOptionsNamingTheField) {
       {"settle_seconds", [](StaticDetectorOptions* o) { o->settle_seconds = INFINITY; }},
       {"merge_angle_deg", [](StaticDetectorOptions* o) { o->merge_angle_deg = 200.0; }},
       {"merge_gap_windows", [](StaticDetectorOptions* o) { o->merge_gap_windows = -2.0; }},
+      {"candidate_factor", [](StaticDetectorOptions* o) { o->candidate_factor = 0.5; }},
   };
   for (const Case& c : cases) {
     StaticDetectorOptions options;

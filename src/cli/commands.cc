@@ -137,9 +137,17 @@ int RunCalibrate(const CommandArgs& args) {
   const bool ok = RunCalibration(args.config, input, &c);
   c.provenance = provenance;
   PrintWarnings(c);
-  // The report also for a failed calibration: it says why.
+  // The report also for a failed calibration: it says why. For a session of
+  // static poses it shows what the detector rejected too.
+  StaticDetection detection;
   if (!args.report.empty() &&
-      !WriteFileAtomically(args.report, CalibrationToHtml(c, input.log, args.input), &error)) {
+      !WriteFileAtomically(
+          args.report,
+          !c.positions.empty() &&
+                  DetectStaticIntervals(input.log, args.config.calibration.detector, &detection)
+              ? CalibrationToHtml(c, input.log, args.input, detection)
+              : CalibrationToHtml(c, input.log, args.input),
+          &error)) {
     return Fail(error);
   }
   // 2 only for a solver that ran and did not converge; 1 for the data.

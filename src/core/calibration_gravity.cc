@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "core/warnings.h"
+
 namespace gravcal {
 namespace internal {
 
@@ -13,9 +15,11 @@ bool ResolveCalibrationGravity(const GravityOptions& options, Calibration* calib
     return false;
   }
   if (c.gravity_source == "standard") {
-    c.warnings.push_back(
+    internal::AddWarning(
+        WarningCode::kStandardGravity,
         "using standard gravity 9.80665 m/s^2: local gravity differs by up to 0.3 %, which goes "
-        "into the scale factors; give gravity, or latitude and height");
+        "into the scale factors; give gravity, or latitude and height",
+        &c.warnings, &c.warning_codes);
   }
   return true;
 }

@@ -105,6 +105,30 @@ const EnumName<EffectRegressor> kEffectRegressors[] = {
     {EffectRegressor::kTime, "time"},
 };
 
+const EnumName<RejectionReason> kRejectionReasons[] = {
+    {RejectionReason::kTooShort, "too_short"},
+    {RejectionReason::kTooMuchMotion, "too_much_motion"},
+    {RejectionReason::kRotating, "rotating"},
+};
+
+const EnumName<WarningCode> kWarningCodes[] = {
+    {WarningCode::kUnclassified, "unclassified"},
+    {WarningCode::kStandardGravity, "standard_gravity"},
+    {WarningCode::kUndetermined, "undetermined"},
+    {WarningCode::kNoCovariance, "no_covariance"},
+    {WarningCode::kExactFit, "exact_fit"},
+    {WarningCode::kResidualsAboveNoise, "residuals_above_noise"},
+    {WarningCode::kPoseScatter, "pose_scatter"},
+    {WarningCode::kFewPoses, "few_poses"},
+    {WarningCode::kRotationSkipped, "rotation_skipped"},
+    {WarningCode::kMethodScope, "method_scope"},
+    {WarningCode::kParameterSource, "parameter_source"},
+    {WarningCode::kNotStillAtStart, "not_still_at_start"},
+    {WarningCode::kLogGap, "log_gap"},
+    {WarningCode::kNoiseModel, "noise_model"},
+    {WarningCode::kAlignment, "alignment"},
+};
+
 }  // namespace
 
 // Each enum's pair, from its table.
@@ -124,6 +148,8 @@ GRAVCAL_ENUM_STRINGS(BatchStatus, kBatchStatuses)
 GRAVCAL_ENUM_STRINGS(Effect, kEffects)
 GRAVCAL_ENUM_STRINGS(EffectSensor, kEffectSensors)
 GRAVCAL_ENUM_STRINGS(EffectRegressor, kEffectRegressors)
+GRAVCAL_ENUM_STRINGS(RejectionReason, kRejectionReasons)
+GRAVCAL_ENUM_STRINGS(WarningCode, kWarningCodes)
 
 #undef GRAVCAL_ENUM_STRINGS
 

@@ -175,6 +175,8 @@ bool StaticDetectorOptions::IsValid(std::string* error) const {
     return fail("merge_angle_deg must be in [0, 180] (got " + Num(merge_angle_deg) + ")");
   if (!(std::isfinite(merge_gap_windows) && merge_gap_windows >= 0.0))
     return fail("merge_gap_windows must be >= 0 (got " + Num(merge_gap_windows) + ")");
+  if (!(std::isfinite(candidate_factor) && candidate_factor >= 1.0))
+    return fail("candidate_factor must be at least 1 (got " + Num(candidate_factor) + ")");
   return true;
 }
 
@@ -313,22 +315,46 @@ std::vector<QuietRun> FindQuietRuns(const float* accel_var, const float* gyro_va
   return runs;
 }
 
+RejectedStretch MakeRejected(const ImuLog& log, size_t begin, size_t end, RejectionReason reason,
+                             const std::string& detail) {
+  RejectedStretch r;
+  r.begin = begin;
+  r.end = end;
+  r.t_begin = log.t[begin];
+  r.t_end = log.t[end - 1];
+  r.reason = reason;
+  r.detail = detail;
+  return r;
+}
+
 // Trim the settling time at each end, merge neighbours that are the same pose
 // across a short gap (when the merged interval still looks still as a whole,
 // so that a real pick-up-and-put-down is not averaged in), keep what has at
-// least min_count samples.
+// least min_count samples; the runs that are too short go to *rejected
+// (with the samples of the whole run, settling time included).
 std::vector<StaticInterval> TrimAndMerge(const ImuLog& log, const std::vector<QuietRun>& runs,
                                          size_t settle, size_t min_count, double max_gap,
                                          const StaticDetectorOptions& options,
-                                         const StaticDetection& detection, bool use_gyro) {
+                                         const StaticDetection& detection, bool use_gyro,
+                                         std::vector<RejectedStretch>* rejected) {
   std::vector<StaticInterval> pieces;
+  std::vector<QuietRun> piece_runs;
   for (const QuietRun& run : runs) {
-    if (run.end - run.begin <= 2 * settle) continue;
+    if (run.end - run.begin <= 2 * settle) {
+      rejected->push_back(
+          MakeRejected(log, run.begin, run.end, RejectionReason::kTooShort,
+                       "still for " + Num(log.t[run.end - 1] - log.t[run.begin]) +
+                           " s, no longer than the settling time trimmed from its two ends (2 x " +
+                           Num(options.settle_seconds) + " s)"));
+      continue;
+    }
     pieces.push_back(MakeInterval(log, run.begin + settle, run.end - settle));
+    piece_runs.push_back(run);
   }
   std::vector<StaticInterval> intervals;
   for (size_t i = 0; i < pieces.size(); ++i) {
     StaticInterval current = pieces[i];
+    const size_t first = i;
     while (i + 1 < pieces.size()) {
       const StaticInterval& next = pieces[i + 1];
       if (!(static_cast<double>(next.begin - current.end) < max_gap) ||
@@ -343,9 +369,75 @@ std::vector<StaticInterval> TrimAndMerge(const ImuLog& log, const std::vector<Qu
       current = merged;
       ++i;
     }
-    if (current.count() >= min_count) intervals.push_back(current);
+    if (current.count() >= min_count) {
+      intervals.push_back(current);
+    } else {
+      rejected->push_back(MakeRejected(
+          log, piece_runs[first].begin, piece_runs[i].end, RejectionReason::kTooShort,
+          "still for " + Num(current.t_end - current.t_begin) + " s after trimming " +
+              Num(options.settle_seconds) + " s at each end, shorter than min_duration_seconds (" +
+              Num(options.min_duration_seconds) + " s)"));
+    }
   }
   return intervals;
+}
+
+// The nearly still stretches that are not static: runs of windows whose
+// variances are below candidate_factor times the thresholds, less the quiet
+// runs inside them; what is left and at least min_count samples long once
+// trimmed goes to *rejected as too much motion (the accelerometer was above
+// its threshold somewhere) or rotating (only the gyroscope was). `quiet` are
+// the quiet runs, in time order.
+void NearlyStillStretches(const ImuLog& log, const float* accel_var, const float* gyro_var,
+                          size_t num_windows, size_t w, const std::vector<QuietRun>& quiet,
+                          size_t settle, size_t min_count, const StaticDetectorOptions& options,
+                          const StaticDetection& detection,
+                          std::vector<RejectedStretch>* rejected) {
+  const double f = options.candidate_factor;
+  const std::vector<QuietRun> loose =
+      FindQuietRuns(accel_var, gyro_var, num_windows, w, f * detection.accel_threshold,
+                    f * detection.gyro_threshold);
+  std::vector<double> scratch;
+  auto report = [&](size_t begin, size_t end) {
+    if (end < begin + w || end - begin < min_count + 2 * settle) return;
+    // Not inside an interval merged across a gap.
+    for (const StaticInterval& s : detection.intervals) {
+      if (begin < s.end && s.begin < end) return;
+    }
+    // No window inside [begin, end) is quiet: the typical (median) ratios
+    // of the variances to their thresholds say why (the ends of the
+    // stretch are the ends of motions).
+    std::vector<double> accel_ratio, gyro_ratio;
+    for (size_t k = begin; k + w <= end; ++k) {
+      accel_ratio.push_back(accel_var[k] / detection.accel_threshold);
+      if (gyro_var) gyro_ratio.push_back(gyro_var[k] / detection.gyro_threshold);
+    }
+    const double accel_median =
+        StridedQuantile(accel_ratio.data(), accel_ratio.size(), 0.5, &scratch);
+    const double gyro_median = StridedQuantile(gyro_ratio.data(), gyro_ratio.size(), 0.5, &scratch);
+    const std::string seconds = Num(log.t[end - 1] - log.t[begin]);
+    if (accel_median > 1.0 || gyro_var == nullptr) {
+      rejected->push_back(MakeRejected(log, begin, end, RejectionReason::kTooMuchMotion,
+                                       "nearly still for " + seconds +
+                                           " s, but the accelerometer variance was typically " +
+                                           Num(accel_median) + " times its threshold"));
+    } else {
+      rejected->push_back(MakeRejected(log, begin, end, RejectionReason::kRotating,
+                                       "the accelerometer was nearly still for " + seconds +
+                                           " s, but the gyroscope variance was typically " +
+                                           Num(gyro_median) + " times its threshold"));
+    }
+  };
+  size_t q = 0;
+  for (const QuietRun& run : loose) {
+    // A quiet run can reach into this loose run from the previous one.
+    size_t cursor = q > 0 ? std::max(run.begin, quiet[q - 1].end) : run.begin;
+    for (; q < quiet.size() && quiet[q].begin < run.end; ++q) {
+      if (quiet[q].begin > cursor) report(cursor, quiet[q].begin);
+      cursor = std::max(cursor, quiet[q].end);
+    }
+    if (run.end > cursor) report(cursor, run.end);
+  }
 }
 
 }  // namespace
@@ -397,10 +489,15 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
   const std::vector<QuietRun> runs =
       FindQuietRuns(accel_var.get(), gyro_var.get(), num_windows, w, detection->accel_threshold,
                     detection->gyro_threshold);
-  detection->intervals = TrimAndMerge(log, runs, to_samples(options.settle_seconds),
-                                      std::max<size_t>(1, to_samples(options.min_duration_seconds)),
-                                      options.merge_gap_windows * static_cast<double>(w), options,
-                                      *detection, use_gyro);
+  const size_t settle = to_samples(options.settle_seconds);
+  const size_t min_count = std::max<size_t>(1, to_samples(options.min_duration_seconds));
+  detection->intervals =
+      TrimAndMerge(log, runs, settle, min_count, options.merge_gap_windows * static_cast<double>(w),
+                   options, *detection, use_gyro, &detection->rejected);
+  NearlyStillStretches(log, accel_var.get(), gyro_var.get(), num_windows, w, runs, settle,
+                       min_count, options, *detection, &detection->rejected);
+  std::sort(detection->rejected.begin(), detection->rejected.end(),
+            [](const RejectedStretch& a, const RejectedStretch& b) { return a.begin < b.begin; });
 
   std::ostringstream msg;
   msg << name << ": " << detection->intervals.size() << " static interval"
@@ -408,6 +505,10 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
       << " samples, accel threshold " << Num(detection->accel_threshold);
   if (use_gyro) msg << ", gyro threshold " << Num(detection->gyro_threshold);
   msg << ")";
+  if (!detection->rejected.empty()) {
+    msg << "; " << detection->rejected.size() << " stretch"
+        << (detection->rejected.size() == 1 ? "" : "es") << " rejected";
+  }
   detection->message = msg.str();
   return true;
 }

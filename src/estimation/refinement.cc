@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "estimation/magnitude_fit.h"
 #include "estimation/normalization.h"
 #include "estimation/robust_loss.h"
@@ -234,7 +235,8 @@ int AnalyzeActiveObservability(const MagnitudeFitStart& fit, const AccelModel& r
       << " direction(s) of the model:";
     for (const std::string& d : result->observability.descriptions) s << " [" << d << "]";
     s << "; add positions with other axes up";
-    result->warnings.push_back(s.str());
+    internal::AddWarning(WarningCode::kUndetermined, s.str(), &result->warnings,
+                         &result->warning_codes);
   }
   return num_active;
 }
@@ -299,9 +301,10 @@ std::vector<std::string> WeakParameters(const RefinementOptions& options,
 // The chi-square verdict: an exact fit, or residuals beyond the noise level.
 void WarnOnChiSquare(RefinementResult* result) {
   if (result->dof <= 0) {
-    result->warnings.push_back(
-        "as many positions as parameters: the fit is exact and cannot show whether the model or "
-        "the noise estimate is right; record more positions");
+    internal::AddWarning(WarningCode::kExactFit,
+                         "as many positions as parameters: the fit is exact and cannot show "
+                         "whether the model or the noise estimate is right; record more positions",
+                         &result->warnings, &result->warning_codes);
     return;
   }
   const double p_value = ChiSquareUpperTail(result->chi2, result->dof);
@@ -313,7 +316,8 @@ void WarnOnChiSquare(RefinementResult* result) {
       << " dof, p = " << p_value
       << "): the model misses an effect, a position was disturbed, or the noise is correlated; "
          "the standard deviations are too small by about that factor";
-    result->warnings.push_back(s.str());
+    internal::AddWarning(WarningCode::kResidualsAboveNoise, s.str(), &result->warnings,
+                         &result->warning_codes);
   }
 }
 
@@ -365,9 +369,10 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   Eigen::MatrixXd cov;
   if (options.compute_covariance &&
       !NormalizedCovariance(fit, num_active - result->observability.rank, &m, &cov)) {
-    result->warnings.push_back(
-        "the covariance could not be computed (the problem is rank deficient); no standard "
-        "deviations are reported");
+    internal::AddWarning(WarningCode::kNoCovariance,
+                         "the covariance could not be computed (the problem is rank deficient); "
+                         "no standard deviations are reported",
+                         &result->warnings, &result->warning_codes);
   } else if (options.compute_covariance) {
     result->covariance = fit.norm.Undo(cov);
     result->covariance_available = true;
@@ -387,17 +392,21 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
       if (!Refine(positions, initial, gravity, again, result)) return false;
       result->solve_seconds += first_seconds;
       result->iterations += first_iterations;
-      result->warnings.push_back("the positions do not determine " + listed +
-                                 " (standard deviation beyond max_bias_std / max_matrix_std); "
-                                 "they are held at the coarse fit's value and reported without "
-                                 "a number: add positions with other axes up or down");
+      internal::AddWarning(WarningCode::kUndetermined,
+                           "the positions do not determine " + listed +
+                               " (standard deviation beyond max_bias_std / max_matrix_std); "
+                               "they are held at the coarse fit's value and reported without "
+                               "a number: add positions with other axes up or down",
+                           &result->warnings, &result->warning_codes);
       return true;
     }
     if (!weak.empty()) {
-      result->warnings.push_back("the positions do not determine " + listed +
-                                 " (standard deviation beyond max_bias_std / max_matrix_std); "
-                                 "they are reported without a number: add positions with other "
-                                 "axes up or down");
+      internal::AddWarning(WarningCode::kUndetermined,
+                           "the positions do not determine " + listed +
+                               " (standard deviation beyond max_bias_std / max_matrix_std); "
+                               "they are reported without a number: add positions with other "
+                               "axes up or down",
+                           &result->warnings, &result->warning_codes);
     }
   }
   WarnOnChiSquare(result);

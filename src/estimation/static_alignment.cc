@@ -8,6 +8,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "util/so3.h"
 #include "util/units.h"
 
@@ -420,9 +421,10 @@ void FillAlignmentResult(const FineSolution& fine, bool gyro, double gravity,
 void AddAlignmentWarnings(bool gyro, const StaticAlignmentOptions& options,
                           StaticAlignmentResult* r) {
   if (std::fabs(std::cos(r->pitch)) < 0.05) {
-    r->warnings.push_back(
-        "pitch is near +-90 degrees: roll is not defined there (its standard deviation says so); "
-        "the gravity direction is still determined");
+    internal::AddWarning(WarningCode::kAlignment,
+                         "pitch is near +-90 degrees: roll is not defined there (its standard "
+                         "deviation says so); the gravity direction is still determined",
+                         &r->warnings, &r->warning_codes);
   }
   if (r->heading_observed) return;
   std::ostringstream s;
@@ -437,7 +439,7 @@ void AddAlignmentWarnings(bool gyro, const StaticAlignmentOptions& options,
       << " deg, above align_max_heading_std " << options.max_heading_std_deg
       << " deg (gyroscope bias and noise against Earth rate)";
   }
-  r->warnings.push_back(s.str());
+  internal::AddWarning(WarningCode::kAlignment, s.str(), &r->warnings, &r->warning_codes);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "gravcal/methods/effect_fit.h"
 #include "util/statistics.h"
 
@@ -53,9 +54,10 @@ void CopyEffectFit(const EffectFitResult& fit, Calibration* calibration) {
     }
   }
   if (rotated) {
-    c.warnings.push_back(
-        "effects: accel.std.matrix is from the fit without effects (the housing rotation's "
-        "uncertainty is not propagated through the effect fit)");
+    internal::AddWarning(WarningCode::kParameterSource,
+                         "effects: accel.std.matrix is from the fit without effects (the housing "
+                         "rotation's uncertainty is not propagated through the effect fit)",
+                         &c.warnings, &c.warning_codes);
   }
   if (fit.gyro_fit.fitted) {
     c.gyro.estimated = true;
@@ -65,9 +67,10 @@ void CopyEffectFit(const EffectFitResult& fit, Calibration* calibration) {
     c.gyro.matrix_std.setConstant(NAN);
     c.gyro.covariance = fit.gyro_fit.covariance;
     c.gyro.covariance_names = fit.gyro_fit.parameter_names;
-    c.warnings.push_back(
-        "gyro: static positions determine the gyroscope bias and the effects only; gyro.matrix "
-        "is the identity (not determined)");
+    internal::AddWarning(WarningCode::kMethodScope,
+                         "gyro: static positions determine the gyroscope bias and the effects "
+                         "only; gyro.matrix is the identity (not determined)",
+                         &c.warnings, &c.warning_codes);
   }
 }
 
@@ -86,12 +89,17 @@ void SetEffectResiduals(const EffectFitResult& fit, Calibration* calibration) {
     for (int k = 0; k < n; ++k) c.positions[k].residual_after = fit.accel_residuals[k];
   }
   // The base fit's verdict on its residuals no longer applies.
-  c.warnings.erase(std::remove_if(c.warnings.begin(), c.warnings.end(),
-                                  [](const std::string& w) {
-                                    return w.find("times the noise level (chi2") !=
-                                           std::string::npos;
-                                  }),
-                   c.warnings.end());
+  std::vector<std::string> kept;
+  std::vector<WarningCode> kept_codes;
+  for (size_t i = 0; i < c.warnings.size(); ++i) {
+    const WarningCode code =
+        i < c.warning_codes.size() ? c.warning_codes[i] : WarningCode::kUnclassified;
+    if (c.warnings[i].find("times the noise level (chi2") == std::string::npos) {
+      internal::AddWarning(code, c.warnings[i], &kept, &kept_codes);
+    }
+  }
+  c.warnings.swap(kept);
+  c.warning_codes.swap(kept_codes);
   if (fit.accel_fit.dof() > 0 &&
       ChiSquareUpperTail(fit.accel_fit.chi2, fit.accel_fit.dof()) < 1e-3) {
     std::ostringstream w;
@@ -100,7 +108,7 @@ void SetEffectResiduals(const EffectFitResult& fit, Calibration* calibration) {
       << std::sqrt(fit.accel_fit.chi2 / fit.accel_fit.dof())
       << " times the noise level (chi2 = " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof()
       << " dof): gravcal discover can look for what the model still misses";
-    c.warnings.push_back(w.str());
+    internal::AddWarning(WarningCode::kResidualsAboveNoise, w.str(), &c.warnings, &c.warning_codes);
   }
 }
 
@@ -162,8 +170,10 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   c.effects.reference_temperature = has_temperature ? start.reference_temperature : NAN;
   c.effects.reference_time = start.reference_time;
   if (!undetermined.empty()) {
-    c.warnings.push_back("the positions do not determine " + undetermined +
-                         " of the model with effects; reported without a number");
+    internal::AddWarning(WarningCode::kUndetermined,
+                         "the positions do not determine " + undetermined +
+                             " of the model with effects; reported without a number",
+                         &c.warnings, &c.warning_codes);
   }
   std::ostringstream msg;
   msg << c.message << "; with effects";

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "estimation/accel_uncertainty.h"
 #include "estimation/normalization.h"
 #include "estimation/solver_settings.h"
@@ -301,7 +302,8 @@ void WarnLargeResiduals(GyroCalibrationResult* result) {
         << "): the unit moved during a pose, the gyroscope has an effect the model lacks "
            "(g-sensitivity: set gyro_g_sensitivity), or its noise is not white; the standard "
            "deviations are too small by about that factor";
-      r.warnings.push_back(s.str());
+      internal::AddWarning(WarningCode::kResidualsAboveNoise, s.str(), &r.warnings,
+                           &r.warning_codes);
     }
   }
 }
@@ -336,8 +338,10 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
   if (!internal::CheckGyroInputs(accel, accel_covariance, gravity, options, &r.message) ||
       !internal::PrepareGyroRotations(log, intervals, accel, options, &prep, &m0, &r.warnings,
                                       &r.message)) {
+    internal::CodeNewWarnings(WarningCode::kRotationSkipped, r.warnings, &r.warning_codes);
     return false;
   }
+  internal::CodeNewWarnings(WarningCode::kRotationSkipped, r.warnings, &r.warning_codes);
   r.initial_matrix = m0;
   r.gyro_noise = prep.gyro_cov.diagonal().cwiseSqrt();
 
@@ -373,6 +377,7 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
     internal::FillJointAccel(prep, accel, accel_final, magnitude_sigmas, gravity, &r);
   }
   internal::WarnUndeterminedGyro(r.undetermined, &r.warnings);
+  internal::CodeNewWarnings(WarningCode::kUndetermined, r.warnings, &r.warning_codes);
   internal::WarnLargeResiduals(&r);
   if (!r.converged) {
     r.message = "the gyroscope calibration did not converge (" + r.termination + ": " +
@@ -404,7 +409,7 @@ bool AddGyroscopeCalibration(const ImuLog& log, const std::vector<StaticInterval
   with_poses.estimate_static_variance = c.accel.pose_variance.estimated;
   if (!CalibrateGyroscope(log, intervals, c.accel.model, accel_covariance, c.gravity, with_poses,
                           &g)) {
-    for (const std::string& w : g.warnings) c.warnings.push_back(w);
+    internal::AppendWarnings(g.warnings, g.warning_codes, "", &c.warnings, &c.warning_codes);
     return fail(g.message);
   }
   GyroCalibration& out = c.gyro;
@@ -455,11 +460,12 @@ bool AddGyroscopeCalibration(const ImuLog& log, const std::vector<StaticInterval
     for (size_t k = 0; k < c.positions.size() && k < g.accel.residuals_after.size(); ++k) {
       c.positions[k].residual_after = g.accel.residuals_after[k];
     }
-    c.warnings.push_back(
-        "gyro_joint: the accelerometer's bias and U come from the joint fit with the gyroscope "
-        "rotations");
+    internal::AddWarning(WarningCode::kParameterSource,
+                         "gyro_joint: the accelerometer's bias and U come from the joint fit "
+                         "with the gyroscope rotations",
+                         &c.warnings, &c.warning_codes);
   }
-  for (const std::string& w : g.warnings) c.warnings.push_back(w);
+  internal::AppendWarnings(g.warnings, g.warning_codes, "", &c.warnings, &c.warning_codes);
   c.message += "; " + g.message;
   return true;
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 
+#include "core/warnings.h"
 #include "estimation/accel_uncertainty.h"
 #include "methods/direction_noise.h"
 
@@ -194,9 +195,10 @@ void ComputeGyroCovariance(const GyroPrepared& prep, const GyroLayout& layout,
     }
     StoreCovariance(layout, free, to_si, norm, tangent, result);
   } else {
-    result->warnings.push_back(
-        "the gyroscope covariance could not be computed (the problem is rank deficient); no "
-        "standard deviations are reported");
+    AddWarning(WarningCode::kNoCovariance,
+               "the gyroscope covariance could not be computed (the problem is rank deficient); "
+               "no standard deviations are reported",
+               &result->warnings, &result->warning_codes);
   }
 }
 

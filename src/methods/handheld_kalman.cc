@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/calibration_gravity.h"
+#include "core/warnings.h"
 #include "methods/handheld_filter.h"
 #include "methods/handheld_report.h"
 
@@ -86,7 +87,7 @@ bool ReadStillWindow(const ImuLog& log, const HandheldKalmanOptions& options, Ca
     s << "the first " << options.still_seconds << " s do not look still (accelerometer rms "
       << FormatShort(f_dev) << " m/s^2, gyroscope rms " << FormatShort(w_dev)
       << " rad/s): the initial roll and pitch may be off; start with the unit held still";
-    c->warnings.push_back(s.str());
+    AddWarning(WarningCode::kNotStillAtStart, s.str(), &c->warnings, &c->warning_codes);
   }
   input->log = &log;
   input->accel_scale = sa;
@@ -115,7 +116,7 @@ void WarnGap(const ImuLog& log, double duration, Calibration* c) {
     s << "the log has a gap of " << FormatShort(largest_gap)
       << " s at t = " << FormatShort(gap_time)
       << " s: the navigation runs blind across it and the estimates may be off";
-    c->warnings.push_back(s.str());
+    AddWarning(WarningCode::kLogGap, s.str(), &c->warnings, &c->warning_codes);
   }
 }
 
@@ -184,7 +185,7 @@ void WarnInnovations(double chi2_per_dof, const HandheldKalmanOptions& options, 
       << (options.gyro_terms.matrix_entries.size() > 3 ? "" : "try hk_cross_axis: true; ")
       << (options.estimate_lever_arm ? "" : "try hk_lever_arm: true; ")
       << "gravcal discover on a multi-position session names other effects)";
-    c->warnings.push_back(s.str());
+    AddWarning(WarningCode::kResidualsAboveNoise, s.str(), &c->warnings, &c->warning_codes);
   }
 }
 

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/warnings.h"
+
 namespace gravcal {
 namespace internal {
 namespace {
@@ -89,7 +91,7 @@ std::vector<std::string> ReportConvergence(const HandheldFilter& filter,
         << FormatShort(e.sigma_initial) << " to " << FormatShort(e.sigma_final) << " " << e.unit
         << " (the reported value is mostly the prior); the recording lacks "
         << MissingMotion(e.name);
-      c->warnings.push_back(s.str());
+      AddWarning(WarningCode::kUndetermined, s.str(), &c->warnings, &c->warning_codes);
     }
     c->convergence.entries.push_back(e);
   }

@@ -12,6 +12,7 @@
 #include <memory>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "estimation/robust_loss.h"
 #include "estimation/solver_settings.h"
 #include "estimation/variance_component.h"
@@ -304,9 +305,10 @@ void ComputeCovariance(ceres::Problem* problem, const double scale_back[12], dou
           Eigen::Vector2d(std::sqrt(inflation * ca[0]), std::sqrt(inflation * ca[3]));
     }
   } else {
-    c->warnings.push_back(
-        "known_attitude: the covariance could not be computed (rank deficient); no standard "
-        "deviations are reported");
+    internal::AddWarning(WarningCode::kNoCovariance,
+                         "known_attitude: the covariance could not be computed (rank deficient); "
+                         "no standard deviations are reported",
+                         &c->warnings, &c->warning_codes);
   }
 }
 
@@ -395,15 +397,17 @@ void AccountForPoseVariance(const std::vector<Position>& positions,
   t << "; added to every position's variance, covariance x " << *inflation << " (Student t, "
     << effective_dof << " effective dof)";
   vc.message += t.str();
-  internal::WarnPoseVariance(vc, effective_dof, ro, &c->warnings);
+  internal::WarnPoseVariance(vc, effective_dof, ro, &c->warnings, &c->warning_codes);
 }
 
 // Warnings on the fit's degrees of freedom and chi-square.
 void WarnFit(const RefinementResult& f, Calibration* c) {
   if (f.dof <= 0) {
-    c->warnings.push_back(
-        "known_attitude: as many equations as unknowns; the fit cannot show whether the attitudes "
-        "or the noise estimate are right: record more positions");
+    internal::AddWarning(WarningCode::kExactFit,
+                         "known_attitude: as many equations as unknowns; the fit cannot show "
+                         "whether the attitudes or the noise estimate are right: record more "
+                         "positions",
+                         &c->warnings, &c->warning_codes);
   } else if (ChiSquareUpperTail(f.chi2, f.dof) < 1e-3) {
     std::ostringstream s;
     s.precision(3);
@@ -412,7 +416,8 @@ void WarnFit(const RefinementResult& f, Calibration* c) {
       << f.chi2 << " on " << f.dof
       << " dof): an attitude is wrong or too confident, or a position was disturbed; the "
          "standard deviations are too small by about that factor";
-    c->warnings.push_back(s.str());
+    internal::AddWarning(WarningCode::kResidualsAboveNoise, s.str(), &c->warnings,
+                         &c->warning_codes);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "estimation/variance_component.h"
 #include "util/statistics.h"
 
@@ -99,7 +100,8 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
   if (ExcessIsStructured(placed, initial, gravity, options, *refinement, &tested, &structured)) {
     vc.message += "; not absorbed: a model term explains the excess";
     *pose_variance = vc;
-    refinement->warnings.push_back(structured);
+    AddWarning(WarningCode::kResidualsAboveNoise, structured, &refinement->warnings,
+               &refinement->warning_codes);
     return;
   }
   RefinementOptions again = options;
@@ -129,11 +131,13 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
                                ? ""
                                : " (too few poses to test whether non-orthogonality explains it)");
   *pose_variance = vc;
-  WarnPoseVariance(vc, effective_dof, options, &refinement->warnings);
+  WarnPoseVariance(vc, effective_dof, options, &refinement->warnings,
+                   &refinement->warning_codes);
 }
 
 void WarnPoseVariance(const VarianceComponent& vc, double effective_dof,
-                      const RefinementOptions& options, std::vector<std::string>* warnings) {
+                      const RefinementOptions& options, std::vector<std::string>* warnings,
+                      std::vector<WarningCode>* codes) {
   if (effective_dof < kMinEffectiveDof) {
     std::ostringstream w;
     w.precision(3);
@@ -141,7 +145,7 @@ void WarnPoseVariance(const VarianceComponent& vc, double effective_dof,
       << " effective degrees of freedom (fewer than " << kMinEffectiveDof
       << "): the standard deviations are themselves uncertain by a large factor; more poses "
          "would tell";
-    warnings->push_back(w.str());
+    AddWarning(WarningCode::kPoseScatter, w.str(), warnings, codes);
   }
   const double s = std::sqrt(vc.variance);
   if (s > options.max_pose_disturbance) {
@@ -152,7 +156,7 @@ void WarnPoseVariance(const VarianceComponent& vc, double effective_dof,
       << options.max_pose_disturbance
       << " m/s^2 for a sensor at rest: a pose was disturbed or the model misses an effect (run "
          "`gravcal discover`); the standard deviations include the scatter";
-    warnings->push_back(w.str());
+    AddWarning(WarningCode::kPoseScatter, w.str(), warnings, codes);
   }
 }
 

@@ -29,6 +29,7 @@
 
 #include "gravcal/core/position.h"
 #include "gravcal/core/solver_result.h"
+#include "gravcal/core/types.h"
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
@@ -47,7 +48,8 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
 // effective degrees of freedom, and s above options.max_pose_disturbance.
 // known_attitude uses them too.
 void WarnPoseVariance(const VarianceComponent& vc, double effective_dof,
-                      const RefinementOptions& options, std::vector<std::string>* warnings);
+                      const RefinementOptions& options, std::vector<std::string>* warnings,
+                      std::vector<WarningCode>* codes);
 
 }  // namespace internal
 }  // namespace gravcal

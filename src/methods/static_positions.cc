@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/calibration_gravity.h"
+#include "core/warnings.h"
 #include "gravcal/estimation/refinement.h"
 #include "util/source_prefix.h"
 #include "util/statistics.h"
@@ -29,7 +30,9 @@ bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
   if (!options.IsValid(&c.message)) return false;
   if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
   if (!DetectLogIntervals(log, options.detector, intervals, &c.message)) return false;
-  return PosesFromIntervals(log, *intervals, options, positions, &c.warnings, &c.message);
+  const bool ok = PosesFromIntervals(log, *intervals, options, positions, &c.warnings, &c.message);
+  CodeNewWarnings(WarningCode::kNoiseModel, c.warnings, &c.warning_codes);
+  return ok;
 }
 
 bool PosesFromIntervals(const ImuLog& log, const std::vector<StaticInterval>& intervals,

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "gravcal/estimation/refinement.h"
 #include "methods/pose_variance.h"
 #include "methods/static_positions.h"
@@ -67,7 +68,8 @@ bool FitZeroBias(const std::vector<Position>& positions, double nominal_scale,
   // twelve_position: every standard deviation below carries it.
   internal::AccountForPoseVariance(positions, initial, c->gravity, step4, &c->refinement,
                                    &c->accel.pose_variance);
-  for (const std::string& w : c->refinement.warnings) c->warnings.push_back("step 4: " + w);
+  internal::AppendWarnings(c->refinement.warnings, c->refinement.warning_codes,
+                           "step 4: ", &c->warnings, &c->warning_codes);
   if (!c->refinement.converged) {
     c->not_converged = true;
     c->message = where + "step 4 (zero bias) did not converge: " + c->refinement.message;
@@ -150,21 +152,25 @@ void ReportStep4Uncertainty(AccelParameterization step4_parameterization,
     if (u.rfind("bias_", 0) == 0) c->accel.bias_std(u[5] - 'x') = NAN;
     if (u.rfind("u_", 0) == 0) c->accel.matrix_std(u[2] - 'x', u[3] - 'x') = NAN;
   }
-  c->warnings.push_back(
+  internal::AddWarning(
+      WarningCode::kMethodScope,
       std::string("ten_position: the reference gravity g_a comes from self-alignment on this "
                   "accelerometer, so its direction inherits the sensor's own axes: the "
                   "off-diagonal entries of K (installation misalignment") +
-      (step4_parameterization == AccelParameterization::kScale
-           ? " and non-orthogonality"
-           : "; the non-orthogonality in the sensor's own frame is u_xy, u_xz, u_yz of the "
-             "covariance") +
-      ") are not determined and have no standard deviation; bias and scale come from |g_a| = "
-      "g (step 4). Use known_attitude for all twelve parameters");
+          (step4_parameterization == AccelParameterization::kScale
+               ? " and non-orthogonality"
+               : "; the non-orthogonality in the sensor's own frame is u_xy, u_xz, u_yz of the "
+                 "covariance") +
+          ") are not determined and have no standard deviation; bias and scale come from |g_a| = "
+          "g (step 4). Use known_attitude for all twelve parameters",
+      &c->warnings, &c->warning_codes);
   for (const StaticAlignmentResult& a : second) {
-    for (const std::string& w : a.warnings) {
-      const std::string line = "alignment: " + w;
+    for (size_t i = 0; i < a.warnings.size(); ++i) {
+      const std::string line = "alignment: " + a.warnings[i];
       if (std::find(c->warnings.begin(), c->warnings.end(), line) == c->warnings.end()) {
-        c->warnings.push_back(line);
+        internal::AddWarning(
+            i < a.warning_codes.size() ? a.warning_codes[i] : WarningCode::kUnclassified, line,
+            &c->warnings, &c->warning_codes);
       }
     }
   }
@@ -212,7 +218,7 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
     std::ostringstream s;
     s << "only " << n << " static positions (the procedure has " << ten.recommended_positions
       << "): fewer positions, less averaging of the noise";
-    c.warnings.push_back(s.str());
+    internal::AddWarning(WarningCode::kFewPoses, s.str(), &c.warnings, &c.warning_codes);
   }
 
   // Steps 1-3: align every position on the raw data scaled to m/s^2 by one

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/calibration_gravity.h"
+#include "core/warnings.h"
 #include "estimation/accel_uncertainty.h"
 #include "gravcal/estimation/housing_rotation.h"
 #include "methods/pose_variance.h"
@@ -86,14 +87,15 @@ void AddHousingRotation(const std::vector<Position>& placed, AccelParameterizati
         << housing.positions_used << " axis-aligned positions (placement error seen: "
         << housing.tilt_rms * internal::kRadToDeg
         << " deg rms), so its accuracy is that of the placement";
-      c.warnings.push_back(s.str());
+      internal::AddWarning(WarningCode::kParameterSource, s.str(), &c.warnings, &c.warning_codes);
     } else {
-      c.warnings.push_back(
-          "affine: the rotation of the sensor axes in the housing is not "
-          "determined (" +
-          error +
-          "); it is left at identity with no standard "
-          "deviation");
+      internal::AddWarning(WarningCode::kUndetermined,
+                           "affine: the rotation of the sensor axes in the housing is not "
+                           "determined (" +
+                               error +
+                               "); it is left at identity with no standard "
+                               "deviation",
+                           &c.warnings, &c.warning_codes);
     }
   }
   if (c.refinement.covariance_available) {
@@ -152,7 +154,8 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
                                      &c.refinement, &c.accel.pose_variance);
   }
   c.accel.model = c.refinement.model;
-  for (const std::string& w : c.refinement.warnings) c.warnings.push_back(w);
+  internal::AppendWarnings(c.refinement.warnings, c.refinement.warning_codes, "", &c.warnings,
+                           &c.warning_codes);
 
   // Residual summaries.
   AccelModel nominal;
@@ -218,7 +221,10 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
     return false;
   }
   const bool ok = CalibrateFromPositions(positions, options, calibration);
-  for (const std::string& n : notes) calibration->warnings.push_back(n);
+  for (const std::string& n : notes) {
+    internal::AddWarning(WarningCode::kNoiseModel, n, &calibration->warnings,
+                         &calibration->warning_codes);
+  }
   if (!ok) calibration->message = internal::PrefixSource(log.source, calibration->message);
   return ok;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/methods/effect_fit.h"
 #include "gravcal/methods/gyro_calibration.h"
@@ -118,7 +119,10 @@ bool RunHandheldKalman(const Config& config, const MethodData& data, Calibration
   HandheldKalmanOptions options = HandheldOptions(config);
   const std::string note = data.noise != nullptr ? NoiseModelQ(config, data, &options) : "";
   const bool ok = CalibrateHandheld(*data.log, options, calibration);
-  if (!note.empty()) calibration->warnings.push_back(note);
+  if (!note.empty()) {
+    internal::AddWarning(WarningCode::kNoiseModel, note, &calibration->warnings,
+                         &calibration->warning_codes);
+  }
   return ok;
 }
 
@@ -133,9 +137,10 @@ bool RunRateTable(const Config&, const MethodData& data, Calibration* calibratio
   calibration->success = true;
   calibration->gyro = result.gyro;
   calibration->solver_name = "weighted linear least squares per gyroscope axis";
-  calibration->warnings.push_back(
-      "rate_table calibrates the gyroscope only: the accelerometer model written is the "
-      "identity, not an estimate");
+  internal::AddWarning(WarningCode::kMethodScope,
+                       "rate_table calibrates the gyroscope only: the accelerometer model "
+                       "written is the identity, not an estimate",
+                       &calibration->warnings, &calibration->warning_codes);
   return true;
 }
 

@@ -17,6 +17,7 @@
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/position.h"
 #include "gravcal/core/solver_result.h"
+#include "gravcal/core/types.h"
 
 namespace gravcal {
 
@@ -153,6 +154,8 @@ struct Calibration {
   RefinementResult refinement;
   std::string solver_name;
   std::vector<std::string> warnings;
+  // The code of each warning (same index; core/types.h WarningCode).
+  std::vector<WarningCode> warning_codes;
   std::string message = "Calibrate was not called";
   // Issue 4: filled by recursive methods only.
   EstimateHistory history;

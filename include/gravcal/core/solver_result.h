@@ -93,6 +93,8 @@ struct RefinementResult : LeastSquaresSummary {
   std::vector<double> residuals_after;
   std::vector<double> sigmas;
   std::vector<std::string> warnings;
+  // The code of each warning (same index).
+  std::vector<WarningCode> warning_codes;
   std::string message = "Refine was not called";
 };
 

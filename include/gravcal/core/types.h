@@ -128,6 +128,69 @@ enum class EffectRegressor { kOrientation, kTemperature, kTime };
 const char* ToString(EffectRegressor regressor);
 bool FromString(const std::string& name, EffectRegressor* regressor);
 
+// Why a stretch of a log that looked like a pose is not a static interval
+// (detection/static_detector.h).
+enum class RejectionReason {
+  // Still, but shorter than min_duration_seconds once settle_seconds is
+  // trimmed from each end (or nothing left after trimming).
+  kTooShort,
+  // Nearly still, but the accelerometer's variance was above its threshold
+  // (a disturbed or hand-held pose).
+  kTooMuchMotion,
+  // The accelerometer was still, but the gyroscope's variance was above its
+  // threshold (turning about the gravity direction).
+  kRotating,
+};
+// "too_short", "too_much_motion", "rotating".
+const char* ToString(RejectionReason reason);
+bool FromString(const std::string& name, RejectionReason* reason);
+
+// What kind of thing a warning says. Every warning a method adds to a
+// result (Calibration::warnings and the results it is built from) has its
+// code at the same index of the result's warning_codes, so that a reader
+// (the HTML report) can explain it and name the action that fixes it
+// without parsing the message. The message is for people and is what the
+// calibration JSON holds; the code is not written there.
+enum class WarningCode {
+  // Added without a code: a bug (the report flags it as unexplained).
+  kUnclassified,
+  // No local gravity given: standard gravity used.
+  kStandardGravity,
+  // The poses or the motion do not determine some parameters (named in the
+  // message); they are held and reported without a standard deviation.
+  kUndetermined,
+  // The covariance could not be computed: no standard deviations.
+  kNoCovariance,
+  // As many equations as unknowns: the fit cannot check itself.
+  kExactFit,
+  // The residuals are larger than the noise predicts (chi-square test).
+  kResidualsAboveNoise,
+  // The poses scatter beyond what their samples show (pose variance).
+  kPoseScatter,
+  // Fewer poses than the procedure recommends.
+  kFewPoses,
+  // A stretch between poses too long to be used as a gyroscope rotation.
+  kRotationSkipped,
+  // What the method cannot estimate by design (named in the message).
+  kMethodScope,
+  // Where some numbers come from (housing rotation, joint fit, ...).
+  kParameterSource,
+  // The handheld run did not start still.
+  kNotStillAtStart,
+  // The log has a gap between samples.
+  kLogGap,
+  // About the noise model used for the poses or the filter.
+  kNoiseModel,
+  // A self-alignment could not determine roll or heading.
+  kAlignment,
+};
+// "unclassified", "standard_gravity", "undetermined", "no_covariance",
+// "exact_fit", "residuals_above_noise", "pose_scatter", "few_poses",
+// "rotation_skipped", "method_scope", "parameter_source",
+// "not_still_at_start", "log_gap", "noise_model", "alignment".
+const char* ToString(WarningCode code);
+bool FromString(const std::string& name, WarningCode* code);
+
 }  // namespace gravcal
 
 #endif  // GRAVCAL_CORE_TYPES_H_

@@ -18,6 +18,12 @@
 // The gyroscope only vetoes clear rotation: a hand-held pose shows tremor of
 // 100-250 times the gyroscope's table noise floor (while its accelerometer
 // variance stays within 2-5 times the floor), so its factor is much larger.
+//
+// The detector also reports the stretches that looked like a pose but did
+// not become a static interval (StaticDetection::rejected), each with its
+// reason: still but too short once trimmed, or nearly still (variances below
+// candidate_factor times the thresholds) but moving or rotating too much
+// for at least min_duration. Reporting them never changes the intervals.
 #ifndef GRAVCAL_DETECTION_STATIC_DETECTOR_H_
 #define GRAVCAL_DETECTION_STATIC_DETECTOR_H_
 
@@ -27,6 +33,7 @@
 
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/position.h"
+#include "gravcal/core/types.h"
 
 namespace gravcal {
 
@@ -54,12 +61,32 @@ struct StaticDetectorOptions {
   // ... and only when the gap between them is shorter than this many windows
   // (and the merged interval is still quiet).
   double merge_gap_windows = 2.0;
+  // Runs of windows whose variances are below this times the thresholds,
+  // less the static runs inside them, at least min_duration long after
+  // trimming, are reported as rejected (moving or rotating too much).
+  // Reporting only: the intervals do not depend on it.
+  double candidate_factor = 10.0;
 
   bool IsValid(std::string* error) const;
 };
 
+// A stretch of samples [begin, end) that is not a static interval, and why.
+struct RejectedStretch {
+  size_t begin = 0;
+  size_t end = 0;
+  // log.t[begin] and log.t[end - 1].
+  double t_begin = 0.0;
+  double t_end = 0.0;
+  RejectionReason reason = RejectionReason::kTooShort;
+  // The numbers behind the reason, in words (durations, variance ratios).
+  std::string detail;
+};
+
 struct StaticDetection {
   std::vector<StaticInterval> intervals;
+  // The stretches rejected (see the top of this file), in time order; none
+  // overlaps an interval.
+  std::vector<RejectedStretch> rejected;
   // The noise floor and threshold actually used (variance, raw units^2).
   double accel_noise_floor = 0.0;
   double accel_threshold = 0.0;

@@ -52,6 +52,7 @@
 #include <vector>
 
 #include "gravcal/core/gravity.h"
+#include "gravcal/core/types.h"
 
 namespace gravcal {
 
@@ -121,6 +122,8 @@ struct StaticAlignmentResult {
   double gyro_noise = 0.0;
   int filter_updates = 0;
   std::vector<std::string> warnings;
+  // The code of each warning (same index).
+  std::vector<WarningCode> warning_codes;
   std::string message = "AlignStatic was not called";
 };
 

@@ -151,6 +151,8 @@ struct GyroCalibrationResult : LeastSquaresSummary {
   bool accel_refined = false;
   RefinementResult accel;
   std::vector<std::string> warnings;
+  // The code of each warning (same index).
+  std::vector<WarningCode> warning_codes;
   std::string message = "CalibrateGyroscope was not called";
 };
 

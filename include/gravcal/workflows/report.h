@@ -5,7 +5,8 @@
 //
 // - CalibrationToHtml: a verdict in plain words (good / look at these /
 //   record again, and why), the raw accelerometer and gyroscope against time
-//   with every static interval shaded and numbered, the pose directions on
+//   with every static interval shaded and numbered (and, given the
+//   detection, every stretch the detector rejected, with why), the pose directions on
 //   the sphere, per pose the residual |a| - g before, after the coarse fit
 //   and after refinement (in sigma, with +-3 sigma bands), the parameters
 //   with their standard deviations and where each came from, the
@@ -27,6 +28,7 @@
 
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/noise_characterisation.h"
 #include "gravcal/workflows/fleet_summary.h"
 
@@ -37,6 +39,12 @@ namespace gravcal {
 // "record again" with the message. `source` names the log.
 std::string CalibrationToHtml(const Calibration& calibration, const ImuLog& log,
                               const std::string& source);
+
+// As above, with the static detection of the same log (DetectStaticIntervals
+// with the detector options the calibration used): the stretches it
+// rejected are shaded too, each with its reason in the legend and tooltip.
+std::string CalibrationToHtml(const Calibration& calibration, const ImuLog& log,
+                              const std::string& source, const StaticDetection& detection);
 
 // How fast a batch ran (the batch command measures it).
 struct BatchThroughput {

@@ -6,6 +6,7 @@
 #include "gravcal/workflows/report.h"
 #include "util/statistics.h"
 #include "workflows/report/svg_plot.h"
+#include "workflows/report/warning_advice.h"
 
 namespace gravcal {
 namespace {
@@ -69,56 +70,24 @@ Verdict Judge(const Calibration& c) {
       names += (names.empty() ? "" : ", ") + n;
     v.Raise(Level::kLook, "the poses do not determine " + names);
   }
-  if (!c.warnings.empty()) {
-    v.Raise(Level::kLook, std::to_string(c.warnings.size()) + " warning" +
-                              (c.warnings.size() > 1 ? "s" : "") + " (explained below)");
+  // Warnings that only say what the method cannot do or where a number
+  // comes from do not call for a look.
+  size_t to_look = 0;
+  for (size_t i = 0; i < c.warnings.size(); ++i) {
+    const WarningCode code =
+        i < c.warning_codes.size() ? c.warning_codes[i] : WarningCode::kUnclassified;
+    to_look += code != WarningCode::kMethodScope && code != WarningCode::kParameterSource;
+  }
+  if (to_look > 0) {
+    v.Raise(Level::kLook, std::to_string(to_look) + " warning" + (to_look > 1 ? "s" : "") +
+                              " to look at (explained below)");
   }
   if (v.reasons.empty()) {
     v.reasons.push_back(std::string(c.positions.empty() ? "" : "every pose within 3 sigma, ") +
                         "the residuals match the noise, every parameter determined and no "
-                        "warning");
+                        "warning to look at");
   }
   return v;
-}
-
-// What a warning means for the user and the action that fixes it.
-std::string WarningAction(const std::string& w) {
-  struct Advice {
-    const char* key;
-    const char* action;
-  };
-  static const Advice kAdvice[] = {
-      {"standard gravity",
-       "Give the local gravity (config key gravity) or latitude and height: the scale factors "
-       "absorb the difference otherwise."},
-      {"do not determine",
-       "Record more poses with other axes up and down (or choose a smaller parameterization): "
-       "the parameters named are reported without a number."},
-      {"not determined",
-       "Record more poses with other axes up and down: the parameters named are reported "
-       "without a number."},
-      {"rank deficient",
-       "Record more poses (or fewer parameters): without a covariance no standard deviation "
-       "can be given."},
-      {"as many",
-       "Record more poses than the model has parameters, so that the fit can be checked."},
-      {"scatter",
-       "Look at the poses beyond 3 sigma in the residual plot: re-record a disturbed pose, or "
-       "run `gravcal discover` to name a missing effect."},
-      {"residuals",
-       "Run `gravcal discover` on this log to name the missing effect, and look at the poses "
-       "beyond 3 sigma."},
-      {"diverged",
-       "Check the filter's noise settings (gravcal noise gives them) and the log's units."},
-      {"identity", "Expected for this method: use a static method for the accelerometer."},
-      {"inherits",
-       "Expected for this method: give the attitudes (known_attitude) to determine the "
-       "installation misalignment."},
-  };
-  for (const Advice& a : kAdvice) {
-    if (w.find(a.key) != std::string::npos) return a.action;
-  }
-  return "The warning says what happened; docs/workflows/reports.md lists the usual remedies.";
 }
 
 // The interval shading of the raw-signal plots.
@@ -136,6 +105,31 @@ std::vector<Span> PoseSpans(const Calibration& c) {
       << FormatNumber(p.t_end, "%.1f") << " s, " << p.sample_count << " samples, up "
       << NominalAxisName(c.positions[k].nominal_up);
     s.title = t.str();
+    s.legend = "static interval used (numbered)";
+    spans.push_back(s);
+  }
+  return spans;
+}
+
+// "too short" for RejectionReason::kTooShort ("too_short").
+std::string ReasonWords(RejectionReason reason) {
+  std::string words = ToString(reason);
+  std::replace(words.begin(), words.end(), '_', ' ');
+  return words;
+}
+
+// The shading of the stretches the detector rejected, the reason in the
+// legend and the numbers behind it in the tooltip.
+std::vector<Span> RejectedSpans(const StaticDetection& detection) {
+  std::vector<Span> spans;
+  for (const RejectedStretch& r : detection.rejected) {
+    Span s;
+    s.x0 = r.t_begin;
+    s.x1 = r.t_end;
+    s.color = r.reason == RejectionReason::kTooShort ? "#ff7f0e" : "#d62728";
+    s.css_class = "rejected-stretch";
+    s.legend = "rejected: " + ReasonWords(r.reason);
+    s.title = "rejected, " + ReasonWords(r.reason) + ": " + r.detail;
     spans.push_back(s);
   }
   return spans;
@@ -145,6 +139,13 @@ std::string RawPlot(const ImuLog& log, const std::vector<Eigen::Vector3d>& v, co
                     const std::vector<Span>& spans, const std::string& css) {
   Plot p;
   p.title = std::string(what) + " against time; shaded and numbered: the static intervals used";
+  for (const Span& s : spans) {
+    if (s.css_class == "rejected-stretch") {
+      p.title = std::string(what) +
+                " against time: the static intervals used (numbered) and the stretches rejected";
+      break;
+    }
+  }
   p.x.label = "time, s";
   // The time axis spans the log exactly (ticks inside it).
   if (!log.t.empty()) {
@@ -408,9 +409,8 @@ std::string PoseTable(const Calibration& c) {
   return h.str();
 }
 
-}  // namespace
-
-std::string CalibrationToHtml(const Calibration& c, const ImuLog& log, const std::string& source) {
+std::string CalibrationReport(const Calibration& c, const ImuLog& log, const std::string& source,
+                              const StaticDetection* detection) {
   std::ostringstream h;
   h << internal::HtmlPageStart("gravcal calibration: " + source);
   h << "<h1>Calibration report</h1><p>" << HtmlEscape(source) << " &mdash; method "
@@ -428,14 +428,29 @@ std::string CalibrationToHtml(const Calibration& c, const ImuLog& log, const std
   h << "</ul></div>\n<p>" << HtmlEscape(c.message) << "</p>\n";
 
   h << "<h2 id='signals'>Raw signals and static intervals</h2>";
-  const std::vector<Span> spans = PoseSpans(c);
+  std::vector<Span> spans;
+  if (detection != nullptr) spans = RejectedSpans(*detection);
+  for (const Span& s : PoseSpans(c)) spans.push_back(s);
   if (log.size() > 0) {
     h << RawPlot(log, log.accel, "accelerometer", spans, "plot-raw plot-accel");
     if (log.has_gyro()) h << RawPlot(log, log.gyro, "gyroscope", spans, "plot-raw plot-gyro");
     h << "<p class='note'>Signals longer than the plot is wide are drawn as the band between "
-         "their minimum and maximum in each pixel column. Stretches between the shaded "
-         "intervals were moving, or were still for less than min_duration_seconds, or were "
-         "trimmed by settle_seconds.</p>";
+         "their minimum and maximum in each pixel column. ";
+    if (detection != nullptr) {
+      h << "The static detector rejected " << detection->rejected.size() << " stretch"
+        << (detection->rejected.size() == 1 ? "" : "es")
+        << " (shaded orange: still but shorter than min_duration_seconds once settle_seconds "
+           "is trimmed from each end; red: nearly still, but moving or rotating above the "
+           "thresholds; hover over one for its numbers). The rest between the numbered "
+           "intervals was moving.</p>";
+      if (detection->intervals.size() != c.positions.size()) {
+        h << "<p class='note warn'>The detection shown found " << detection->intervals.size()
+          << " static intervals; the calibration used " << c.positions.size() << ".</p>";
+      }
+    } else {
+      h << "Stretches between the shaded intervals were moving, or were still for less than "
+           "min_duration_seconds, or were trimmed by settle_seconds.</p>";
+    }
   }
 
   if (!c.positions.empty()) {
@@ -486,10 +501,17 @@ std::string CalibrationToHtml(const Calibration& c, const ImuLog& log, const std
   if (c.warnings.empty()) {
     h << "<p>None.</p>";
   } else {
-    h << "<table class='warnings'><tr><th>warning</th><th>what to do</th></tr>";
-    for (const std::string& w : c.warnings) {
-      h << "<tr><td class='warn'>" << HtmlEscape(w) << "</td><td>" << HtmlEscape(WarningAction(w))
-        << "</td></tr>";
+    h << "<table class='warnings'><tr><th>warning</th><th>what it means</th><th>what to "
+         "do</th></tr>";
+    for (size_t i = 0; i < c.warnings.size(); ++i) {
+      const WarningCode code =
+          i < c.warning_codes.size() ? c.warning_codes[i] : WarningCode::kUnclassified;
+      const internal::WarningAdvice advice = internal::AdviceFor(code);
+      const bool explained = !advice.meaning.empty();
+      h << "<tr class='" << (explained ? "warning" : "warning unexplained") << "' data-code='"
+        << ToString(code) << "'><td class='warn'>" << HtmlEscape(c.warnings[i]) << "</td><td>"
+        << HtmlEscape(explained ? advice.meaning : "No explanation is recorded for this warning.")
+        << "</td><td>" << HtmlEscape(advice.action) << "</td></tr>";
     }
     h << "</table>";
   }
@@ -502,6 +524,17 @@ std::string CalibrationToHtml(const Calibration& c, const ImuLog& log, const std
     << FormatNumber(c.residual_refined.rms, "%.4g") << " m/s^2 (refined).</p>";
   h << internal::HtmlPageEnd();
   return h.str();
+}
+
+}  // namespace
+
+std::string CalibrationToHtml(const Calibration& c, const ImuLog& log, const std::string& source) {
+  return CalibrationReport(c, log, source, nullptr);
+}
+
+std::string CalibrationToHtml(const Calibration& c, const ImuLog& log, const std::string& source,
+                              const StaticDetection& detection) {
+  return CalibrationReport(c, log, source, &detection);
 }
 
 }  // namespace gravcal

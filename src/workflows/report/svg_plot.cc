@@ -186,6 +186,7 @@ std::string TickLabel(double value, double step) {
 std::string RenderPlot(const Plot& plot) {
   bool any_end_label = false;
   bool any_legend = false;
+  for (const Span& s : plot.spans) any_legend |= !s.legend.empty();
   double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
   for (const Series& s : plot.series) {
     any_end_label |= !s.end_label.empty();
@@ -405,6 +406,18 @@ std::string RenderPlot(const Plot& plot) {
     o << "<g class='legend'>" << Swatch(s, lx, top - 10) << "<text x='" << Px(lx + 23) << "' y='"
       << Px(top - 6) << "'>" << HtmlEscape(s.name) << "</text></g>";
     lx += 36 + 7.2 * s.name.size();
+  }
+  std::vector<std::string> span_legends;
+  for (const Span& s : plot.spans) {
+    if (s.legend.empty() ||
+        std::find(span_legends.begin(), span_legends.end(), s.legend) != span_legends.end()) {
+      continue;
+    }
+    span_legends.push_back(s.legend);
+    o << "<g class='legend'><rect x='" << Px(lx) << "' y='" << Px(top - 15)
+      << "' width='18' height='10' fill='" << s.color << "' fill-opacity='0.35'/><text x='"
+      << Px(lx + 23) << "' y='" << Px(top - 6) << "'>" << HtmlEscape(s.legend) << "</text></g>";
+    lx += 36 + 7.2 * s.legend.size();
   }
   o << "</svg>";
   return o.str();

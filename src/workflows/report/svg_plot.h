@@ -85,6 +85,9 @@ struct Span {
   std::string color = "#2ca02c";
   std::string css_class = "span";
   std::string title;
+  // Legend text of this kind of span; spans with the same text share one
+  // legend entry. Empty = not in the legend.
+  std::string legend;
 };
 
 // A horizontal (y = value) or vertical (x = value) reference line.
