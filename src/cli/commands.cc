@@ -145,7 +145,8 @@ int RunCalibrate(const CommandArgs& args) {
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
   if (!args.history.empty() && !WriteHistoryCsv(c, args.history, &error)) return Fail(error);
-  if (!WriteCalibrationJson(c, args.config.output_covariance, args.output, &error)) {
+  if (!WriteCalibrationJson(c, args.config.output_covariance,
+                            CalibrationCheckSections(args, input.log), args.output, &error)) {
     if (!args.history.empty()) std::remove(args.history.c_str());
     return Fail(error);
   }
@@ -164,9 +165,18 @@ int RunSimulate(const CommandArgs& args) {
   // period before the first.
   if (!args.plan.empty()) {
     std::vector<PlannedPose> poses;
-    if (!ReadPlanPoses(args.plan, &poses, &error)) return Fail(error);
+    std::vector<PlannedRotation> turns;
+    if (!ReadPlanPoses(args.plan, &poses, &error, &turns)) return Fail(error);
     sim.planned_poses.clear();
     for (const PlannedPose& p : poses) sim.planned_poses.push_back({p.up, p.hold_seconds});
+    // The planned turns, when the plan chose them for the gyroscope.
+    for (const PlannedRotation& r : turns) {
+      if (r.seconds <= 0.0) continue;
+      PlannedHold& to = sim.planned_poses[r.to];
+      to.turn_axis = r.axis;
+      to.turn_angle_deg = r.angle_deg;
+      to.turn_seconds = r.seconds;
+    }
     sim.initial_still_seconds = 0.0;
   }
   // The rate table's constant-rate segments (motion profile rate_table).

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/io/calibration_io.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/plan.h"
 
@@ -80,6 +81,10 @@ int RunExport(const CommandArgs& args);
 int RunPlan(const CommandArgs& args);
 // 0 reported; 1 bad input.
 int RunCheck(const CommandArgs& args);
+// Issue 15: calibrate's "check" section (what the session lacks, as gravcal
+// check says it) for the methods of the magnitude model; prints the text on
+// stderr. Empty when the method has none or the check cannot be made.
+JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

@@ -73,6 +73,14 @@ DEFINE_double(accel_bias_instability, 0.0, "plan, check: accelerometer bias inst
 DEFINE_double(accel_random_walk, 0.0, "plan, check: accelerometer random walk K, m/s^3/sqrt(Hz)");
 DEFINE_double(pose_disturbance, 0.0,
               "plan, check: per-pose disturbance of |a|, m/s^2 rms (0 = none)");
+DEFINE_double(gyro_noise_density, 0.0,
+              "plan: gyroscope white noise N, rad/s/sqrt(Hz) (datasheet; instead of --noise): "
+              "plans the turns between poses for the gyroscope");
+DEFINE_double(attitude_std, 0.0,
+              "plan (method known_attitude): the fixture's roll and pitch standard deviation, "
+              "degrees");
+DEFINE_double(turn_seconds, gravcal::PlanRequest().turn_seconds,
+              "plan: seconds a half turn takes (shorter turns proportionally less)");
 DEFINE_string(plan, "", "simulate: plan.json from gravcal plan (its poses replace sim_scheme)");
 
 DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
@@ -117,7 +125,8 @@ const std::vector<CommandInfo>& Commands() {
        "sigmas (least time meeting --target, or best within --max_time)",
        {"config", "output", "noise", "target", "pose_set", "candidates", "max_time", "overhead",
         "min_hold", "max_hold", "accel_noise_density", "accel_bias_instability",
-        "accel_random_walk", "pose_disturbance", "report"},
+        "accel_random_walk", "pose_disturbance", "report", "gyro_noise_density", "turn_seconds",
+        "attitude_std"},
        gravcal::cli::RunPlan},
       {"check",
        "what a recorded session determines: predicted sigma per parameter, what is "
@@ -368,6 +377,9 @@ void CopyFlags(gravcal::cli::CommandArgs* args) {
   args->plan_request.accel_bias_instability = FLAGS_accel_bias_instability;
   args->plan_request.accel_random_walk = FLAGS_accel_random_walk;
   args->plan_request.pose_disturbance = FLAGS_pose_disturbance;
+  args->plan_request.gyro_noise_density = FLAGS_gyro_noise_density;
+  args->plan_request.turn_seconds = FLAGS_turn_seconds;
+  args->plan_request.attitude_std_deg = FLAGS_attitude_std;
 }
 
 const CommandInfo* FindCommand(const std::string& name) {

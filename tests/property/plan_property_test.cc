@@ -11,6 +11,8 @@
 
 #include <cstdio>
 
+#include "gravcal/methods/known_attitude.h"
+#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
@@ -93,6 +95,147 @@ void CheckPlanSpread(const std::string& target, const std::string& pose_set) {
         << plan.parameter_names[i] << ": spread " << scale_free << " against target "
         << plan.targets_scale_free(i);
   }
+}
+
+// The gyroscope half: the plan's turns (and any extra poses) simulated with
+// the smooth profile, calibrated by the twelve_position pipeline with the
+// gyroscope between poses (configs/twelve_position_gyro.yaml), and the
+// spread of b_g and M_g (in the calibrated accelerometer's frame, as
+// gyro_calibration_test.cc compares it) against gyro_predicted_std.
+void CheckGyroPlanSpread(const std::string& target, const std::string& pose_set) {
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(SourceDir() + "/configs/twelve_position_gyro.yaml", &config, &error))
+      << error;
+  config.simulation.rotation_profile = "smooth";
+  config.calibration.nominal_scale = kStandardGravity / config.simulation.accel_counts_per_g;
+  config.ten_position.gyro_nominal_scale = M_PI / 180.0 / config.simulation.gyro_counts_per_dps;
+  PlanRequest request;
+  request.targets = target;
+  request.pose_set = pose_set;
+  request.accel_noise_density =
+      config.simulation.accel_noise / std::sqrt(config.simulation.sample_rate);
+  request.gyro_noise_density =
+      config.simulation.gyro_noise / std::sqrt(config.simulation.sample_rate);
+  RecordingPlan plan;
+  ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << error;
+  ASSERT_FALSE(plan.gyro_parameter_names.empty()) << plan.message;
+  ASSERT_EQ(plan.rotations.size() + 1, plan.poses.size());
+  config.simulation.initial_still_seconds = 0.0;
+  for (size_t k = 0; k < plan.poses.size(); ++k) {
+    PlannedHold hold{plan.poses[k].up, plan.poses[k].hold_seconds};
+    if (k > 0) {
+      const PlannedRotation& r = plan.rotations[k - 1];
+      hold.turn_axis = r.axis;
+      hold.turn_angle_deg = r.angle_deg;
+      hold.turn_seconds = r.seconds;
+    }
+    config.simulation.planned_poses.push_back(hold);
+  }
+
+  int first = 1, count = kDefaultSeeds;
+  PropertySeeds(&first, &count);
+  SigmaCheck check;
+  const std::vector<std::string>& names = plan.gyro_parameter_names;
+  std::vector<double> sum_squares(names.size(), 0.0);
+  int used = 0;
+  for (int seed = first; seed < first + count; ++seed) {
+    SimulatedSession session;
+    ASSERT_TRUE(Simulate(config.simulation, seed, &session, &error)) << error;
+    PipelineInput input;
+    input.log = session.log;
+    input.source = "seed " + std::to_string(seed);
+    Calibration calibration;
+    ASSERT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
+    ASSERT_TRUE(calibration.gyro.estimated) << "seed " << seed;
+    ASSERT_EQ(calibration.positions.size(), plan.poses.size()) << "seed " << seed;
+    const Eigen::Matrix3d truth_matrix =
+        session.accel_truth.rotation.transpose() * session.gyro_truth.matrix;
+    for (size_t i = 0; i < names.size(); ++i) {
+      const double error_i =
+          i < 3 ? calibration.gyro.model.bias(i) - session.gyro_truth.bias(i) : [&] {
+            const int r = names[i][2] - 'x', c = names[i][3] - 'x';
+            return calibration.gyro.model.matrix(r, c) - truth_matrix(r, c);
+          }();
+      check.Add(names[i], error_i, plan.gyro_predicted_std(i));
+      sum_squares[i] += error_i * error_i;
+    }
+    ++used;
+  }
+  std::printf("gyro plan %s (%s): %zu poses (%d extra), %.1f s\n%s", target.c_str(),
+              pose_set.c_str(), plan.poses.size(), plan.gyro_extra_poses, plan.total_seconds,
+              check.Table().c_str());
+  check.ExpectHonest("gyro plan " + target);
+  if (used >= 200) {
+    for (const std::string& name : names) {
+      EXPECT_LT(std::abs(check.Rms(name) - 1.0), 0.15) << name;
+    }
+  }
+  const SigmaBand band = SigmaBandFor(used);
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (!plan.gyro_targeted[i]) continue;
+    const double spread = std::sqrt(sum_squares[i] / used);
+    const double scale_free =
+        i < 3 ? spread * plan.gyro_nominal_scale : spread / plan.gyro_nominal_scale;
+    EXPECT_LT(scale_free, plan.gyro_targets_scale_free(i) * band.rms_high)
+        << names[i] << ": spread " << scale_free << " against target "
+        << plan.gyro_targets_scale_free(i);
+  }
+}
+
+TEST(PlanProperty, GyroSpreadMatchesPredictionFacesPlus45) {
+  CheckGyroPlanSpread("accel_bias=0.5mg gyro_scale=300ppm gyro_misalignment=0.5mrad", "faces+45");
+}
+
+// The known-attitude model: the plan for method known_attitude (the
+// fixture's attitude noise stated), simulated with that fixture noise and
+// calibrated by CalibrateKnownAttitude; the spread of b and M (raw units)
+// against predicted_std.
+void CheckKnownAttitudePlanSpread(const std::string& target) {
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(SourceDir() + "/configs/known_attitude.yaml", &config, &error))
+      << error;
+  config.calibration.nominal_scale = kStandardGravity / config.simulation.accel_counts_per_g;
+  PlanRequest request;
+  request.targets = target;
+  request.accel_noise_density =
+      config.simulation.accel_noise / std::sqrt(config.simulation.sample_rate);
+  request.attitude_std_deg = config.simulation.fixture_attitude_noise_deg;
+  RecordingPlan plan;
+  ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << error;
+  ASSERT_EQ(plan.parameter_names.size(), 12u);
+  config.simulation.initial_still_seconds = 0.0;
+  for (const PlannedPose& p : plan.poses) {
+    config.simulation.planned_poses.push_back({p.up, p.hold_seconds});
+  }
+  int first = 1, count = kDefaultSeeds;
+  PropertySeeds(&first, &count);
+  SigmaCheck check;
+  for (int seed = first; seed < first + count; ++seed) {
+    SimulatedSession session;
+    ASSERT_TRUE(Simulate(config.simulation, seed, &session, &error)) << error;
+    Calibration c;
+    ASSERT_TRUE(CalibrateKnownAttitude(
+        session.log,
+        SimulatedFixtureAttitudes(session, config.simulation.fixture_attitude_noise_deg,
+                                  static_cast<uint64_t>(seed)),
+        "attitudes", config.calibration, &c))
+        << c.message;
+    const Eigen::Matrix3d m = c.accel.model.matrix() - session.accel_truth.matrix();
+    for (size_t i = 0; i < 12; ++i) {
+      const double error_i =
+          i < 3 ? c.accel.model.bias(i) - session.accel_truth.bias(i) : m((i - 3) / 3, (i - 3) % 3);
+      check.Add(plan.parameter_names[i], error_i, plan.predicted_std(i));
+    }
+  }
+  std::printf("known-attitude plan %s: %zu poses, %.1f s\n%s", target.c_str(), plan.poses.size(),
+              plan.total_seconds, check.Table().c_str());
+  check.ExpectHonest("known-attitude plan " + target);
+}
+
+TEST(PlanProperty, KnownAttitudeSpreadMatchesPrediction) {
+  CheckKnownAttitudePlanSpread("accel_bias=0.2mg accel_scale=100ppm accel_misalignment=0.2mrad");
 }
 
 TEST(PlanProperty, SpreadMatchesPredictionFacesPlus45) {
