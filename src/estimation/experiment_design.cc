@@ -247,32 +247,49 @@ void KeepBetter(const DesignResult& candidate, const DesignOptions& options, Des
 Eigen::MatrixXd KnownAttitudeJacobian(const std::vector<DesignPose>& poses,
                                       const DesignModel& model, const DesignNoise& noise) {
   const double g = model.gravity;
-  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(3 * poses.size(), 12);
+  // x within this of the vertical: roll is the angle of the placement error.
+  const double gimbal_lock = std::cos(10.0 * M_PI / 180.0);
+  std::vector<Eigen::Matrix<double, 3, 12>> blocks;
   for (size_t k = 0; k < poses.size(); ++k) {
     const Eigen::Vector3d n = poses[k].up.normalized();
     const Eigen::Vector3d v = g * n;
     Eigen::Matrix<double, 3, 12> j = Eigen::Matrix<double, 3, 12>::Zero();
     j.leftCols<3>() = -Eigen::Matrix3d::Identity();
     for (int r = 0; r < 3; ++r) j.block<1, 3>(r, 3 + 3 * r) = v.transpose();
-    // n = (-sin p, sin r cos p, cos r cos p).
+    const double usable = poses[k].hold_seconds - model.trimmed_seconds;
+    const Eigen::Vector3d va =
+        usable > 0.0 ? StillMeanVariance(noise.accel, usable) : Eigen::Vector3d::Constant(kInf);
+    if (!va.allFinite()) {
+      blocks.push_back(Eigen::Matrix<double, 3, 12>::Zero());
+      continue;
+    }
+    const Eigen::Matrix3d sensor =
+        Eigen::Matrix3d(va.asDiagonal()) +
+        noise.pose_disturbance * noise.pose_disturbance * Eigen::Matrix3d::Identity();
+    const double a2 = g * g * model.attitude_std * model.attitude_std;
+    // n = (-sin p, sin r cos p, cos r cos p); the attitude errors move it by
+    // dn/droll = (0, n_z, -n_y) and dn/dpitch = (-cos p, -sin r sin p, -cos r sin p).
     const double pitch = std::asin(std::clamp(-n.x(), -1.0, 1.0));
     const double roll = std::atan2(n.y(), n.z());
     const Eigen::Vector3d d_roll(0.0, n.z(), -n.y());
     const Eigen::Vector3d d_pitch(-std::cos(pitch), -std::sin(roll) * std::sin(pitch),
                                   -std::cos(roll) * std::sin(pitch));
-    const double usable = poses[k].hold_seconds - model.trimmed_seconds;
-    const Eigen::Vector3d va =
-        usable > 0.0 ? StillMeanVariance(noise.accel, usable) : Eigen::Vector3d::Constant(kInf);
-    if (!va.allFinite()) continue;
-    const double a2 = g * g * model.attitude_std * model.attitude_std;
-    const Eigen::Matrix3d cov =
-        Eigen::Matrix3d(va.asDiagonal()) +
-        noise.pose_disturbance * noise.pose_disturbance * Eigen::Matrix3d::Identity() +
-        a2 * (d_roll * d_roll.transpose() + d_pitch * d_pitch.transpose());
-    const Eigen::LLT<Eigen::Matrix3d> llt(cov);
-    if (llt.info() != Eigen::Success) continue;
-    rows.block<3, 12>(3 * k, 0) = llt.matrixL().solve(j);
+    Eigen::Matrix3d attitude = d_roll * d_roll.transpose() + d_pitch * d_pitch.transpose();
+    if (std::fabs(n.x()) > gimbal_lock) {
+      // x nearly vertical: the roll is whatever angle the placement error
+      // gives it, and the pitch error moves n along (0, sin r, cos r):
+      // averaged over roll, half of it on each of the other two axes. (The
+      // average of the covariance, not of the information: conservative,
+      // see docs/workflows/plan.md.)
+      attitude = 0.5 * (Eigen::Matrix3d::Identity() - n * n.transpose());
+    }
+    const Eigen::LLT<Eigen::Matrix3d> llt(sensor + a2 * attitude);
+    blocks.push_back(llt.info() == Eigen::Success
+                         ? Eigen::Matrix<double, 3, 12>(llt.matrixL().solve(j))
+                         : Eigen::Matrix<double, 3, 12>::Zero());
   }
+  Eigen::MatrixXd rows(3 * blocks.size(), 12);
+  for (size_t b = 0; b < blocks.size(); ++b) rows.block<3, 12>(3 * b, 0) = blocks[b];
   return rows;
 }
 
@@ -564,10 +581,11 @@ bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignMod
     if (max_time_mode) consider_within(ups);
   }
   if (model.known_attitude) {
-    // The balanced designs (see the header): the six faces one to four times.
+    // The balanced designs (see the header): the six faces, as often as
+    // max_poses allows.
     std::vector<Eigen::Vector3d> faces, repeated;
     CandidateDirections("faces", 0, &faces);
-    for (int times = 1; times <= 4; ++times) {
+    while (true) {
       repeated.insert(repeated.end(), faces.begin(), faces.end());
       if (static_cast<int>(repeated.size()) > options.max_poses) break;
       DesignResult r;

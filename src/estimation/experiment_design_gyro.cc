@@ -248,7 +248,7 @@ std::vector<DesignTurn> CandidateTurns(const Eigen::Vector3d& from, const Eigen:
   std::vector<Eigen::Vector3d> axes;
   const Eigen::Vector3d shortest = v.cross(u);
   if (shortest.norm() > 1e-9) axes.push_back(shortest.normalized());
-  if ((u + v).norm() > 1e-9) axes.push_back((u + v).normalized());
+  if ((u + v).norm() > 1e-9 && free_axes > 0) axes.push_back((u + v).normalized());
   // The family: axes perpendicular to u - v (every axis when u = v, which
   // a design does not ask for).
   const Eigen::Vector3d w = (u - v).norm() > 1e-9 ? (u - v).normalized() : u;

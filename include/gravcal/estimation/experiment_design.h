@@ -187,7 +187,8 @@ bool ShortestHold(const std::vector<Eigen::Vector3d>& ups, const DesignModel& mo
 // above for each pose count, the common hold found by bisection, directions
 // closer than min_separation_deg merged into one longer pose. For the
 // known-attitude model (three rows per pose) the search is over the
-// reference designs and the six faces recorded one to four times: its
+// reference designs and the six faces recorded as often as max_poses
+// allows: its
 // information is the linear regression's, sum_k [1, v_k^T; v_k, v_k v_k^T]
 // (x) Sigma_k^-1, whose A-optimal designs are the balanced ones (sum v_k = 0,
 // sum v_k v_k^T proportional to I), as the six faces are. Returns
@@ -257,10 +258,10 @@ struct DesignTurn {
 };
 
 // The turns that take up direction `from` to `to` about one fixed body
-// axis, with angles in (0, 180]: the axes a with a.from = a.to. Always the
-// shortest turn (about to x from) and the half turn about (from + to); the
-// housing axes among them; with `free_axes` > 0 that many more axes spread
-// over the family. `seconds_per_180` is the duration of a half turn
+// axis, with angles in (0, 180]: the axes a with a.from = a.to. The
+// shortest turn (about to x from) and the housing axes among them (what a
+// person can follow); with `free_axes` > 0 also the half turn about
+// (from + to) and `free_axes` more axes spread over the family. `seconds_per_180` is the duration of a half turn
 // (shorter turns take proportionally less, at least half of it).
 std::vector<DesignTurn> CandidateTurns(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
                                        int free_axes, double seconds_per_180);
