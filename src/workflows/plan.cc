@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -123,6 +124,22 @@ bool DesignOver(const std::string& pose_set, int free_candidates, const DesignMo
                              (!result->meets_targets && subset.worst_ratio < result->worst_ratio));
   if (better) *result = subset;
   return true;
+}
+
+// Datasheet densities (N, and B and K when positive) on every axis of
+// *axes; returns "N = ... <unit>, B = ..., K = ...".
+std::string DatasheetNoise(double n, double b, double k, const char* unit,
+                           std::array<AxisNoiseModel, 3>* axes) {
+  for (AxisNoiseModel& axis : *axes) {
+    axis.white_noise.value = n;
+    if (b > 0.0) axis.bias_instability.value = b;
+    if (k > 0.0) axis.random_walk.value = k;
+  }
+  std::ostringstream s;
+  s << "N = " << n << " " << unit;
+  if (b > 0.0) s << ", B = " << b;
+  if (k > 0.0) s << ", K = " << k;
+  return s.str();
 }
 
 // The gyroscope's half of the plan: the turns between the poses (in
@@ -298,17 +315,9 @@ bool PlanDesignNoise(const PlanRequest& request, DesignNoise* noise, std::string
     }
     *source = "noise model (gravcal noise)";
   } else if (request.accel_noise_density > 0.0) {
-    out = WhiteDesignNoise(request.accel_noise_density);
-    for (AxisNoiseModel& axis : out.accel) {
-      if (request.accel_bias_instability > 0.0)
-        axis.bias_instability.value = request.accel_bias_instability;
-      if (request.accel_random_walk > 0.0) axis.random_walk.value = request.accel_random_walk;
-    }
-    std::ostringstream s;
-    s << "datasheet densities: N = " << request.accel_noise_density << " m/s^2/sqrt(Hz)";
-    if (request.accel_bias_instability > 0.0) s << ", B = " << request.accel_bias_instability;
-    if (request.accel_random_walk > 0.0) s << ", K = " << request.accel_random_walk;
-    *source = s.str();
+    *source = "datasheet densities: " +
+              DatasheetNoise(request.accel_noise_density, request.accel_bias_instability,
+                             request.accel_random_walk, "m/s^2/sqrt(Hz)", &out.accel);
   } else {
     *error = "no noise: give --noise noise.json (gravcal noise) or --accel_noise_density";
     return false;
@@ -320,17 +329,9 @@ bool PlanDesignNoise(const PlanRequest& request, DesignNoise* noise, std::string
                   [](const AxisNoiseModel& a) { return a.white_noise.visible(); })) {
     out.gyro = request.noise_model->gyro;
   } else if (request.gyro_noise_density > 0.0) {
-    for (AxisNoiseModel& axis : out.gyro) {
-      axis.white_noise.value = request.gyro_noise_density;
-      if (request.gyro_bias_instability > 0.0)
-        axis.bias_instability.value = request.gyro_bias_instability;
-      if (request.gyro_random_walk > 0.0) axis.random_walk.value = request.gyro_random_walk;
-    }
-    std::ostringstream s;
-    s << "; gyroscope datasheet densities: N = " << request.gyro_noise_density << " rad/s/sqrt(Hz)";
-    if (request.gyro_bias_instability > 0.0) s << ", B = " << request.gyro_bias_instability;
-    if (request.gyro_random_walk > 0.0) s << ", K = " << request.gyro_random_walk;
-    *source += s.str();
+    *source += "; gyroscope datasheet densities: " +
+               DatasheetNoise(request.gyro_noise_density, request.gyro_bias_instability,
+                              request.gyro_random_walk, "rad/s/sqrt(Hz)", &out.gyro);
   }
   out.pose_disturbance = request.pose_disturbance;
   if (request.pose_disturbance > 0.0) {

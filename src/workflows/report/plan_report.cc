@@ -114,16 +114,19 @@ std::string PlanToHtml(const RecordingPlan& plan) {
     << ". Noise: " << HtmlEscape(plan.noise_source) << ".</p>";
 
   h << "<h2>The sequence</h2><p class='note'>Each picture shows the housing as it should lie "
-       "(the table is the grey line; red x, green y, blue z are the housing's axes). Between "
-       "two poses: the turn to make.</p><div class='sequence'>";
+       "(the table is the grey line; the arrows labelled x, y, z are the housing's axes; the "
+       "box is longest along x and flattest along z). Between two poses: the turn to "
+       "make.</p><div class='sequence' style='display:flex;flex-wrap:wrap;align-items:center'>";
   for (size_t k = 0; k < plan.poses.size(); ++k) {
     const PlannedPose& p = plan.poses[k];
     if (k > 0 && k - 1 < plan.rotations.size()) {
-      h << "<div class='turn'>&rarr; " << HtmlEscape(plan.rotations[k - 1].instruction) << "</div>";
+      h << "<div class='turn' style='width:150px;font-size:smaller;margin:4px'>&rarr; "
+        << HtmlEscape(plan.rotations[k - 1].instruction) << "</div>";
     }
     const bool extra = plan.gyro_extra_poses > 0 &&
                        k >= plan.poses.size() - static_cast<size_t>(plan.gyro_extra_poses);
-    h << "<figure class='pose" << (extra ? " pose-gyro" : "") << "'>"
+    h << "<figure class='pose" << (extra ? " pose-gyro" : "")
+      << "' style='width:180px;margin:4px;font-size:smaller'>"
       << HousingPicture(p.up, static_cast<int>(k + 1)) << "<figcaption>"
       << HtmlEscape(p.instruction) << "; hold " << FormatNumber(p.hold_seconds, "%.1f") << " s"
       << (extra ? " (for the gyroscope)" : "") << "</figcaption></figure>";
