@@ -79,6 +79,9 @@ DEFINE_double(gyro_noise_density, 0.0,
 DEFINE_double(attitude_std, 0.0,
               "plan (method known_attitude): the fixture's roll and pitch standard deviation, "
               "degrees");
+DEFINE_bool(check, false,
+            "calibrate: add what the session lacks (as gravcal check says it) to the output "
+            "and the calibration JSON ('check')");
 DEFINE_double(turn_seconds, gravcal::PlanRequest().turn_seconds,
               "plan: seconds a half turn takes (shorter turns proportionally less)");
 DEFINE_string(plan, "", "simulate: plan.json from gravcal plan (its poses replace sim_scheme)");
@@ -108,7 +111,8 @@ const std::vector<CommandInfo>& Commands() {
       {"calibrate",
        "calibrate the sensors from a log with the config's method (the config key 'method' "
        "lists them)",
-       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report"},
+       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report",
+        "check"},
        gravcal::cli::RunCalibrate},
       {"apply",
        "apply every term of a calibration to a contract CSV log (streaming; - for standard "
@@ -360,6 +364,7 @@ void CopyFlags(gravcal::cli::CommandArgs* args) {
   args->segments = FLAGS_segments;
   args->history = FLAGS_history;
   args->report = FLAGS_report;
+  args->check = FLAGS_check;
   args->kalibr = FLAGS_kalibr;
   args->handheld = FLAGS_handheld;
   args->noise = FLAGS_noise;

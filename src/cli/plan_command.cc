@@ -62,7 +62,7 @@ int RunCheck(const CommandArgs& args) {
 }
 
 JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log) {
-  if (args.config.method != "twelve_position") return {};
+  if (!args.check || args.config.method != "twelve_position") return {};
   std::string error;
   ImuNoise noise;
   PlanRequest request;

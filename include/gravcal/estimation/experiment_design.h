@@ -261,8 +261,8 @@ struct DesignTurn {
 // axis, with angles in (0, 180]: the axes a with a.from = a.to. The
 // shortest turn (about to x from) and the housing axes among them (what a
 // person can follow); with `free_axes` > 0 also the half turn about
-// (from + to) and `free_axes` more axes spread over the family. `seconds_per_180` is the duration of a half turn
-// (shorter turns take proportionally less, at least half of it).
+// (from + to) and `free_axes` more axes spread over the family. `seconds_per_180` is the duration
+// of a half turn (shorter turns take proportionally less, at least half of it).
 std::vector<DesignTurn> CandidateTurns(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
                                        int free_axes, double seconds_per_180);
 
