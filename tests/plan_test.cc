@@ -414,7 +414,7 @@ TEST(PlanCli, ReportAndTheCheckSectionOfCalibrate) {
   EXPECT_EQ(testing_util::Slurp(dir / "plain.json").find("\"check\""), std::string::npos)
       << "the check section only with --check";
   r = testing_util::RunCli({"calibrate", "--config", config, "--input", dir / "twelve/raw.csv",
-                            "--output", dir / "calib.json", "--check"},
+                            "--output", dir / "calib.json", "--check", "true"},
                            dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("extra poses that reduce the worst sigma most"), std::string::npos) << r.err;
