@@ -10,7 +10,8 @@ namespace gravcal {
 namespace {
 
 // range(0): free candidate directions; range(1): 0 = loose targets,
-// 1 = demanding targets (more poses, longer holds).
+// 1 = demanding targets (more poses, longer holds); range(2): 1 = with the
+// gyroscope (full model): its turns chosen and, for its targets, extra poses.
 void BM_PlanFree(benchmark::State& state) {
   Config config;
   PlanRequest request;
@@ -20,6 +21,11 @@ void BM_PlanFree(benchmark::State& state) {
   request.targets = state.range(1) == 0
                         ? "accel_bias=0.5mg accel_scale=200ppm accel_misalignment=0.2mrad"
                         : "accel_bias=0.02mg accel_scale=10ppm accel_misalignment=0.01mrad";
+  if (state.range(2) == 1) {
+    config.gyro.parameterization = GyroParameterization::kFull;
+    request.gyro_noise_density = 2e-4;
+    request.targets += " gyro_scale=200ppm gyro_misalignment=0.5mrad";
+  }
   for (auto _ : state) {
     RecordingPlan plan;
     std::string error;
@@ -31,9 +37,11 @@ void BM_PlanFree(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PlanFree)
-    ->Args({2000, 0})
-    ->Args({2000, 1})
-    ->Args({500, 1})
+    ->Args({2000, 0, 0})
+    ->Args({2000, 1, 0})
+    ->Args({500, 1, 0})
+    ->Args({2000, 0, 1})
+    ->Args({2000, 1, 1})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

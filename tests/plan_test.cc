@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
 #include "gravcal/estimation/experiment_design.h"
@@ -18,6 +19,7 @@
 #include "gravcal/io/plan_io.h"
 #include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/report.h"
 #include "test_util.h"
 
 namespace gravcal {
@@ -241,6 +243,195 @@ TEST(Check, SixFacesNameTheNonOrthogonalityAndTheProposedPosesDetermineIt) {
       << error;
   EXPECT_TRUE(again.undetermined.empty()) << CoverageReportText(again);
   std::printf("%s\n", CoverageReportText(report).c_str());
+}
+
+TEST(ExperimentDesign, CandidateTurnsTakeOneUpDirectionToTheOther) {
+  std::vector<Eigen::Vector3d> ups;
+  ASSERT_TRUE(CandidateDirections("free", 40, &ups));
+  for (size_t a = 0; a < ups.size(); a += 3) {
+    for (size_t b = 1; b < ups.size(); b += 5) {
+      if ((ups[a] - ups[b]).norm() < 1e-6) continue;
+      const std::vector<DesignTurn> turns = CandidateTurns(ups[a], ups[b], 6, 3.0);
+      ASSERT_GE(turns.size(), 3u);
+      EXPECT_GE(CandidateTurns(ups[a], ups[b], 0, 3.0).size(), 1u);
+      for (const DesignTurn& t : turns) {
+        const Eigen::Vector3d moved =
+            Eigen::AngleAxisd(-t.angle_deg * M_PI / 180.0, t.axis) * ups[a];
+        EXPECT_LT((moved - ups[b]).norm(), 1e-9);
+        EXPECT_GT(t.angle_deg, 0.0);
+        EXPECT_LE(t.angle_deg, 180.0 + 1e-9);
+        EXPECT_NEAR(t.axis.norm(), 1.0, 1e-12);
+      }
+    }
+  }
+}
+
+Config GyroConfig() {
+  Config config;
+  std::string error;
+  EXPECT_TRUE(LoadConfigFile(SourceDir() + "/configs/twelve_position_gyro.yaml", &config, &error))
+      << error;
+  return config;
+}
+
+TEST(Plan, GyroTurnsMapThePosesAndBeatTheShortestTurns) {
+  PlanRequest request = Request("accel_bias=0.5mg gyro_scale=300ppm gyro_misalignment=0.5mrad");
+  request.gyro_noise_density = 2e-4;
+  RecordingPlan plan;
+  std::string error;
+  ASSERT_TRUE(MakeRecordingPlan(GyroConfig(), request, &plan, &error)) << error;
+  ASSERT_EQ(plan.gyro_parameter_names.size(), 12u);
+  EXPECT_EQ(plan.gyro_parameter_names[3], "m_xx");
+  ASSERT_EQ(plan.rotations.size() + 1, plan.poses.size());
+  std::vector<DesignPose> poses;
+  std::vector<DesignTurn> chosen, shortest;
+  for (const PlannedPose& p : plan.poses) poses.push_back({p.up, p.hold_seconds});
+  for (const PlannedRotation& r : plan.rotations) {
+    const Eigen::Vector3d moved =
+        Eigen::AngleAxisd(-r.angle_deg * M_PI / 180.0, r.axis) * plan.poses[r.from].up;
+    EXPECT_LT((moved - plan.poses[r.to].up).norm(), 1e-9) << r.instruction;
+    EXPECT_GT(r.seconds, 0.0);
+    EXPECT_NE(r.instruction.find("in about"), std::string::npos) << r.instruction;
+    chosen.push_back({r.axis, r.angle_deg, r.seconds});
+    const PlannedRotation s = TurnBetween(plan.poses[r.from].up, plan.poses[r.to].up);
+    shortest.push_back(
+        {s.axis, s.angle_deg, request.turn_seconds * std::max(0.5, s.angle_deg / 180)});
+  }
+  for (Eigen::Index i = 0; i < plan.gyro_predicted_std_scale_free.size(); ++i) {
+    EXPECT_LE(plan.gyro_predicted_std_scale_free(i), plan.gyro_targets_scale_free(i))
+        << plan.gyro_parameter_names[i];
+  }
+  // The design's criterion is no worse than the shortest turns' between the
+  // same poses.
+  DesignModel model;
+  model.trimmed_seconds = 0.3;
+  GyroDesignModel gyro_model;
+  DesignNoise noise = WhiteDesignNoise(kDensity);
+  for (AxisNoiseModel& a : noise.gyro) a.white_noise.value = request.gyro_noise_density;
+  const Eigen::VectorXd& w = plan.gyro_targets_scale_free;
+  auto phi = [&](const std::vector<DesignTurn>& turns) {
+    const GyroDesignResult r = EvaluateRotations(poses, turns, model, gyro_model, noise, w);
+    return (r.predicted_std.array() / w.array()).square().sum();
+  };
+  EXPECT_LE(phi(chosen), phi(shortest) * (1.0 + 1e-9));
+  std::printf("gyro criterion: chosen turns %.4g, shortest turns %.4g\n", phi(chosen),
+              phi(shortest));
+  // The JSON round trip of the turns simulate reads.
+  std::vector<PlannedRotation> read;
+  ASSERT_TRUE(PlanRotationsFromJson(PlanToJson(plan), "plan", plan.poses.size(), &read, &error))
+      << error;
+  ASSERT_EQ(read.size(), plan.rotations.size());
+  for (size_t k = 0; k < read.size(); ++k) {
+    EXPECT_LT((read[k].axis - plan.rotations[k].axis).norm(), 1e-12);
+    EXPECT_DOUBLE_EQ(read[k].seconds, plan.rotations[k].seconds);
+  }
+}
+
+TEST(ExperimentDesign, OneRotationLeavesTheGyroscopeMatrixUndetermined) {
+  // Two poses, x up then y up, joined by any candidate turn (the quarter
+  // turn about z, the half turn about x + y): one rotation gives two
+  // residuals, too few for the nine entries of M_g, while the static poses
+  // alone determine the bias.
+  DesignModel model;
+  GyroDesignModel gyro_model;
+  DesignNoise noise = WhiteDesignNoise(kDensity);
+  for (AxisNoiseModel& a : noise.gyro) a.white_noise.value = 2e-4;
+  const std::vector<DesignPose> poses = {{Eigen::Vector3d::UnitX(), 10.0},
+                                         {Eigen::Vector3d::UnitY(), 10.0}};
+  for (const DesignTurn& t : CandidateTurns(poses[0].up, poses[1].up, 0, 3.0)) {
+    const GyroDesignResult r =
+        EvaluateRotations(poses, {t}, model, gyro_model, noise, Eigen::VectorXd::Ones(12));
+    // One rotation (two residuals) cannot determine nine matrix entries.
+    EXPECT_FALSE(r.predicted_std.allFinite());
+    // The bias comes from the static poses alone.
+    EXPECT_TRUE(r.predicted_std.head<3>().allFinite());
+  }
+}
+
+TEST(Plan, KnownAttitudeModelPlansTheTwelveParameters) {
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigFile(SourceDir() + "/configs/known_attitude.yaml", &config, &error))
+      << error;
+  PlanRequest request = Request("accel_bias=0.2mg accel_scale=100ppm accel_misalignment=0.5mrad");
+  request.attitude_std_deg = 0.05;
+  RecordingPlan plan;
+  ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << error;
+  ASSERT_EQ(plan.parameter_names.size(), 12u);
+  EXPECT_EQ(plan.parameter_names[4], "m_xy");
+  EXPECT_TRUE(plan.predicted_std.allFinite());
+  EXPECT_TRUE(plan.meets_targets);
+  // A worse fixture needs more: the attitude noise is in the information.
+  PlanRequest coarse = request;
+  coarse.attitude_std_deg = 0.5;
+  RecordingPlan coarse_plan;
+  if (MakeRecordingPlan(config, coarse, &coarse_plan, &error)) {
+    EXPECT_GT(coarse_plan.total_seconds, plan.total_seconds);
+  } else {
+    EXPECT_NE(error.find("meets the targets"), std::string::npos) << error;
+  }
+}
+
+TEST(PlanReport, EveryPoseIsAPictureWithItsTurn) {
+  PlanRequest request = Request("accel_bias=0.5mg gyro_scale=300ppm");
+  request.gyro_noise_density = 2e-4;
+  RecordingPlan plan;
+  std::string error;
+  ASSERT_TRUE(MakeRecordingPlan(GyroConfig(), request, &plan, &error)) << error;
+  const std::string html = PlanToHtml(plan);
+  size_t pictures = 0;
+  for (size_t at = html.find("class='housing'"); at != std::string::npos;
+       at = html.find("class='housing'", at + 1)) {
+    ++pictures;
+  }
+  EXPECT_EQ(pictures, plan.poses.size());
+  size_t turns = 0;
+  for (size_t at = html.find("class='turn'"); at != std::string::npos;
+       at = html.find("class='turn'", at + 1)) {
+    ++turns;
+  }
+  EXPECT_EQ(turns, plan.rotations.size());
+  EXPECT_NE(html.find("m_xy"), std::string::npos);
+  EXPECT_NE(html.find("</html>"), std::string::npos);
+}
+
+TEST(PlanCli, ReportAndTheCheckSectionOfCalibrate) {
+  const testing_util::ScratchDir dir;
+  const std::string config = SourceDir() + "/configs/twelve_position.yaml";
+  testing_util::CliResult r = testing_util::RunCli(
+      {"plan", "--config", config, "--output", dir / "plan.json", "--report", dir / "plan.html",
+       "--accel_noise_density", "0.002", "--target", "accel_bias=0.5mg"},
+      dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(testing_util::Slurp(dir / "plan.html").find("class='housing'"), std::string::npos);
+  r = testing_util::RunCli(
+      {"simulate", "--config", config, "--seed", "5", "--output-dir", dir / "twelve"}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = testing_util::RunCli({"calibrate", "--config", config, "--input", dir / "twelve/raw.csv",
+                            "--output", dir / "plain.json"},
+                           dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(testing_util::Slurp(dir / "plain.json").find("\"check\""), std::string::npos)
+      << "the check section only with --check";
+  r = testing_util::RunCli({"calibrate", "--config", config, "--input", dir / "twelve/raw.csv",
+                            "--output", dir / "calib.json", "--check", "true"},
+                           dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("extra poses that reduce the worst sigma most"), std::string::npos) << r.err;
+  const nlohmann::json calib = nlohmann::json::parse(testing_util::Slurp(dir / "calib.json"));
+  ASSERT_TRUE(calib.contains("check")) << calib.dump(2);
+  const nlohmann::json& check = calib["check"];
+  EXPECT_EQ(check["positions"], 12);
+  EXPECT_TRUE(check["undetermined"].empty());
+  ASSERT_TRUE(check["predicted_std"].contains("u_xy"));
+  // The check's prediction from the recorded poses is the refinement's own
+  // sigma to within the noise model's approximations.
+  const std::vector<std::string> names = calib["accel"]["covariance"]["parameters"];
+  const int i = Index(names, "bias_x");
+  ASSERT_LT(i, static_cast<int>(names.size()));
+  const double reported = std::sqrt(calib["accel"]["covariance"]["matrix"][i][i].get<double>());
+  EXPECT_NEAR(check["predicted_std"]["bias_x"].get<double>() / reported, 1.0, 0.25);
+  EXPECT_FALSE(check["proposed"].empty());
 }
 
 TEST(PlanCli, BadInputExitsNonZeroAndWritesNothing) {

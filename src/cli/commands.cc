@@ -153,7 +153,8 @@ int RunCalibrate(const CommandArgs& args) {
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
   if (!args.history.empty() && !WriteHistoryCsv(c, args.history, &error)) return Fail(error);
-  if (!WriteCalibrationJson(c, args.config.output_covariance, args.output, &error)) {
+  if (!WriteCalibrationJson(c, args.config.output_covariance,
+                            CalibrationCheckSections(args, input.log), args.output, &error)) {
     if (!args.history.empty()) std::remove(args.history.c_str());
     return Fail(error);
   }

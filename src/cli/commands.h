@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/io/calibration_io.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/plan.h"
 
@@ -50,6 +51,8 @@ struct CommandArgs {
   // noise model, which --noise names); simulate: --plan.
   PlanRequest plan_request;
   std::string plan;
+  // calibrate: add the check section (what the session lacks, --check).
+  bool check = false;
   // Arguments that are not flags (merge-summaries: the shard folders).
   std::vector<std::string> positional;
   // batch: "all" makes one unit per sensor_msgs/Imu topic of --input.
@@ -80,6 +83,11 @@ int RunExport(const CommandArgs& args);
 int RunPlan(const CommandArgs& args);
 // 0 reported; 1 bad input.
 int RunCheck(const CommandArgs& args);
+// Issue 15: calibrate's "check" section (what the session lacks, as gravcal
+// check says it) with --check, for the methods of the magnitude model;
+// prints the text on stderr. Empty without --check, when the method has
+// none or when the check cannot be made.
+JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log);
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);

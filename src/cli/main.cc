@@ -73,6 +73,17 @@ DEFINE_double(accel_bias_instability, 0.0, "plan, check: accelerometer bias inst
 DEFINE_double(accel_random_walk, 0.0, "plan, check: accelerometer random walk K, m/s^3/sqrt(Hz)");
 DEFINE_double(pose_disturbance, 0.0,
               "plan, check: per-pose disturbance of |a|, m/s^2 rms (0 = none)");
+DEFINE_double(gyro_noise_density, 0.0,
+              "plan: gyroscope white noise N, rad/s/sqrt(Hz) (datasheet; instead of --noise): "
+              "plans the turns between poses for the gyroscope");
+DEFINE_double(attitude_std, 0.0,
+              "plan (method known_attitude): the fixture's roll and pitch standard deviation, "
+              "degrees");
+DEFINE_bool(check, false,
+            "calibrate: add what the session lacks (as gravcal check says it) to the output "
+            "and the calibration JSON ('check')");
+DEFINE_double(turn_seconds, gravcal::PlanRequest().turn_seconds,
+              "plan: seconds a half turn takes (shorter turns proportionally less)");
 DEFINE_string(plan, "", "simulate: plan.json from gravcal plan (its poses replace sim_scheme)");
 
 DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
@@ -100,7 +111,8 @@ const std::vector<CommandInfo>& Commands() {
       {"calibrate",
        "calibrate the sensors from a log with the config's method (the config key 'method' "
        "lists them)",
-       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report"},
+       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report",
+        "check"},
        gravcal::cli::RunCalibrate},
       {"apply",
        "apply every term of a calibration to a contract CSV log (streaming; - for standard "
@@ -117,7 +129,8 @@ const std::vector<CommandInfo>& Commands() {
        "sigmas (least time meeting --target, or best within --max_time)",
        {"config", "output", "noise", "target", "pose_set", "candidates", "max_time", "overhead",
         "min_hold", "max_hold", "accel_noise_density", "accel_bias_instability",
-        "accel_random_walk", "pose_disturbance", "report"},
+        "accel_random_walk", "pose_disturbance", "report", "gyro_noise_density", "turn_seconds",
+        "attitude_std"},
        gravcal::cli::RunPlan},
       {"check",
        "what a recorded session determines: predicted sigma per parameter, what is "
@@ -351,6 +364,7 @@ void CopyFlags(gravcal::cli::CommandArgs* args) {
   args->segments = FLAGS_segments;
   args->history = FLAGS_history;
   args->report = FLAGS_report;
+  args->check = FLAGS_check;
   args->kalibr = FLAGS_kalibr;
   args->handheld = FLAGS_handheld;
   args->noise = FLAGS_noise;
@@ -368,6 +382,9 @@ void CopyFlags(gravcal::cli::CommandArgs* args) {
   args->plan_request.accel_bias_instability = FLAGS_accel_bias_instability;
   args->plan_request.accel_random_walk = FLAGS_accel_random_walk;
   args->plan_request.pose_disturbance = FLAGS_pose_disturbance;
+  args->plan_request.gyro_noise_density = FLAGS_gyro_noise_density;
+  args->plan_request.turn_seconds = FLAGS_turn_seconds;
+  args->plan_request.attitude_std_deg = FLAGS_attitude_std;
 }
 
 const CommandInfo* FindCommand(const std::string& name) {

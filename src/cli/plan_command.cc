@@ -2,10 +2,13 @@
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/io/plan_io.h"
 #include "gravcal/workflows/plan.h"
+#include "gravcal/workflows/report.h"
 
 namespace gravcal {
 namespace cli {
@@ -28,9 +31,6 @@ bool RequestFromArgs(const CommandArgs& args, ImuNoise* noise, PlanRequest* requ
 
 int RunPlan(const CommandArgs& args) {
   if (args.output.empty()) return Fail("plan needs --output <plan.json>");
-  if (!args.report.empty()) {
-    return Fail("plan: --report (the plan's HTML report) is not available yet; write plan.json");
-  }
   std::string error;
   ImuNoise noise;
   PlanRequest request;
@@ -38,6 +38,10 @@ int RunPlan(const CommandArgs& args) {
   RecordingPlan plan;
   if (!MakeRecordingPlan(args.config, request, &plan, &error)) return Fail(error);
   if (!WritePlanJson(plan, args.output, &error)) return Fail(error);
+  if (!args.report.empty() && !WriteFileAtomically(args.report, PlanToHtml(plan), &error)) {
+    std::remove(args.output.c_str());
+    return Fail(error);
+  }
   std::fprintf(stderr, "gravcal: wrote %s: %s\n", args.output.c_str(), plan.message.c_str());
   return 0;
 }
@@ -55,6 +59,18 @@ int RunCheck(const CommandArgs& args) {
   if (!CheckRecording(log, args.config, request, &report, &error)) return Fail(error);
   std::printf("%s", CoverageReportText(report).c_str());
   return 0;
+}
+
+JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log) {
+  if (!args.check || args.config.method != "twelve_position") return {};
+  std::string error;
+  ImuNoise noise;
+  PlanRequest request;
+  if (!RequestFromArgs(args, &noise, &request, &error)) return {};
+  CoverageReport report;
+  if (!CheckRecording(log, args.config, request, &report, &error)) return {};
+  std::fprintf(stderr, "check: %s", CoverageReportText(report).c_str());
+  return {{"check", CoverageToJson(report)}};
 }
 
 }  // namespace cli

@@ -243,6 +243,56 @@ void KeepBetter(const DesignResult& candidate, const DesignOptions& options, Des
   }
 }
 
+// The known-attitude model's rows (DesignModel): three per pose.
+Eigen::MatrixXd KnownAttitudeJacobian(const std::vector<DesignPose>& poses,
+                                      const DesignModel& model, const DesignNoise& noise) {
+  const double g = model.gravity;
+  // x within this of the vertical: roll is the angle of the placement error.
+  const double gimbal_lock = std::cos(10.0 * M_PI / 180.0);
+  std::vector<Eigen::Matrix<double, 3, 12>> blocks;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    const Eigen::Vector3d n = poses[k].up.normalized();
+    const Eigen::Vector3d v = g * n;
+    Eigen::Matrix<double, 3, 12> j = Eigen::Matrix<double, 3, 12>::Zero();
+    j.leftCols<3>() = -Eigen::Matrix3d::Identity();
+    for (int r = 0; r < 3; ++r) j.block<1, 3>(r, 3 + 3 * r) = v.transpose();
+    const double usable = poses[k].hold_seconds - model.trimmed_seconds;
+    const Eigen::Vector3d va =
+        usable > 0.0 ? StillMeanVariance(noise.accel, usable) : Eigen::Vector3d::Constant(kInf);
+    if (!va.allFinite()) {
+      blocks.push_back(Eigen::Matrix<double, 3, 12>::Zero());
+      continue;
+    }
+    const Eigen::Matrix3d sensor =
+        Eigen::Matrix3d(va.asDiagonal()) +
+        noise.pose_disturbance * noise.pose_disturbance * Eigen::Matrix3d::Identity();
+    const double a2 = g * g * model.attitude_std * model.attitude_std;
+    // n = (-sin p, sin r cos p, cos r cos p); the attitude errors move it by
+    // dn/droll = (0, n_z, -n_y) and dn/dpitch = (-cos p, -sin r sin p, -cos r sin p).
+    const double pitch = std::asin(std::clamp(-n.x(), -1.0, 1.0));
+    const double roll = std::atan2(n.y(), n.z());
+    const Eigen::Vector3d d_roll(0.0, n.z(), -n.y());
+    const Eigen::Vector3d d_pitch(-std::cos(pitch), -std::sin(roll) * std::sin(pitch),
+                                  -std::cos(roll) * std::sin(pitch));
+    Eigen::Matrix3d attitude = d_roll * d_roll.transpose() + d_pitch * d_pitch.transpose();
+    if (std::fabs(n.x()) > gimbal_lock) {
+      // x nearly vertical: the roll is whatever angle the placement error
+      // gives it, and the pitch error moves n along (0, sin r, cos r):
+      // averaged over roll, half of it on each of the other two axes. (The
+      // average of the covariance, not of the information: conservative,
+      // see docs/workflows/plan.md.)
+      attitude = 0.5 * (Eigen::Matrix3d::Identity() - n * n.transpose());
+    }
+    const Eigen::LLT<Eigen::Matrix3d> llt(sensor + a2 * attitude);
+    blocks.push_back(llt.info() == Eigen::Success
+                         ? Eigen::Matrix<double, 3, 12>(llt.matrixL().solve(j))
+                         : Eigen::Matrix<double, 3, 12>::Zero());
+  }
+  Eigen::MatrixXd rows(3 * blocks.size(), 12);
+  for (size_t b = 0; b < blocks.size(); ++b) rows.block<3, 12>(3 * b, 0) = blocks[b];
+  return rows;
+}
+
 }  // namespace
 
 DesignNoise WhiteDesignNoise(double density) {
@@ -260,7 +310,11 @@ bool DesignModel::IsValid(std::string* error) const {
     *error = "DesignModel.trimmed_seconds: must be >= 0";
     return false;
   }
-  if (parameterization == AccelParameterization::kAffine) {
+  if (!(attitude_std >= 0.0 && std::isfinite(attitude_std))) {
+    *error = "DesignModel.attitude_std: must be >= 0";
+    return false;
+  }
+  if (parameterization == AccelParameterization::kAffine && !known_attitude) {
     *error =
         "DesignModel.parameterization: affine adds the housing rotation, which the magnitude "
         "cannot see; plan with scale_misalignment";
@@ -278,8 +332,18 @@ double PoseMagnitudeVariance(const DesignNoise& noise, const DesignModel& model,
   return up.cwiseAbs2().dot(v) + noise.pose_disturbance * noise.pose_disturbance;
 }
 
+std::vector<std::string> DesignParameterNames(const DesignModel& model) {
+  if (!model.known_attitude) return MagnitudeParameterNames(model.parameterization);
+  const char* axes = "xyz";
+  std::vector<std::string> names;
+  for (int i = 0; i < 3; ++i) names.push_back(std::string("bias_") + axes[i]);
+  for (int i = 0; i < 9; ++i) names.push_back(std::string("m_") + axes[i / 3] + axes[i % 3]);
+  return names;
+}
+
 Eigen::MatrixXd DesignJacobian(const std::vector<DesignPose>& poses, const DesignModel& model,
                                const DesignNoise& noise) {
+  if (model.known_attitude) return KnownAttitudeJacobian(poses, model, noise);
   std::vector<Eigen::Vector3d> ups;
   for (const DesignPose& p : poses) ups.push_back(p.up);
   Eigen::MatrixXd rows = UnitRows(ups, model);
@@ -415,7 +479,7 @@ bool CandidateDirections(const std::string& pose_set, int count,
 
 bool DesignOptions::IsValid(const DesignModel& model, std::string* error) const {
   if (!model.IsValid(error)) return false;
-  const int p = NumParameters(model.parameterization);
+  const int p = static_cast<int>(DesignParameterNames(model).size());
   if (targets.size() != p || !targets.allFinite() || !(targets.minCoeff() > 0.0)) {
     *error = "DesignOptions.targets: one positive target per parameter (" + std::to_string(p) + ")";
     return false;
@@ -476,9 +540,10 @@ bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignMod
     result->message = "no candidate orientations";
     return false;
   }
-  const int p = NumParameters(model.parameterization);
+  const int p = static_cast<int>(DesignParameterNames(model).size());
   const Eigen::VectorXd weights = options.targets.cwiseAbs2().cwiseInverse();
-  const Eigen::MatrixXd unit_rows = UnitRows(candidates, model);
+  const Eigen::MatrixXd unit_rows =
+      model.known_attitude ? Eigen::MatrixXd() : UnitRows(candidates, model);
   const bool max_time_mode = options.max_time_seconds > 0.0;
   const int min_poses = p + options.redundancy;
 
@@ -515,11 +580,26 @@ bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignMod
     consider_hold_search(ups);
     if (max_time_mode) consider_within(ups);
   }
+  if (model.known_attitude) {
+    // The balanced designs (see the header): the six faces, as often as
+    // max_poses allows.
+    std::vector<Eigen::Vector3d> faces, repeated;
+    CandidateDirections("faces", 0, &faces);
+    while (true) {
+      repeated.insert(repeated.end(), faces.begin(), faces.end());
+      if (static_cast<int>(repeated.size()) > options.max_poses) break;
+      DesignResult r;
+      if (ShortestHold(repeated, model, noise, options, &r)) KeepBetter(r, options, &best, &have);
+      if (max_time_mode) consider_within(repeated);
+    }
+  }
 
   double hold = options.min_hold_seconds;
-  Eigen::MatrixXd rows = WhitenedRows(unit_rows, candidates, model, noise, hold);
+  Eigen::MatrixXd rows = model.known_attitude
+                             ? Eigen::MatrixXd()
+                             : WhitenedRows(unit_rows, candidates, model, noise, hold);
   std::vector<int> chosen;
-  for (int n = min_poses; n <= options.max_poses; ++n) {
+  for (int n = min_poses; n <= options.max_poses && !model.known_attitude; ++n) {
     const double floor = n * (options.min_hold_seconds + options.overhead_seconds);
     if (max_time_mode && floor > options.max_time_seconds) break;
     if (!max_time_mode && have && best.meets_targets && floor >= best.total_seconds) break;

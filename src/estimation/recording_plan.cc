@@ -34,6 +34,14 @@ ReadableUnit ReadableUnitOf(const std::string& parameter) {
   return {"mrad", 1e3};
 }
 
+ReadableUnit GyroReadableUnitOf(const std::string& parameter) {
+  if (parameter.rfind("bias_", 0) == 0) return {"deg/h", internal::kRadToDeg * 3600.0};
+  if (parameter == "scale" || (parameter.size() == 4 && parameter[2] == parameter[3])) {
+    return {"ppm", 1e6};
+  }
+  return {"mrad", 1e3};
+}
+
 double ReferenceStd(const std::string& parameter) {
   const ReadableUnit unit = ReadableUnitOf(parameter);
   return (unit.unit == "mg" ? 1.0 : (unit.unit == "ppm" ? 100.0 : 0.1)) / unit.factor;
@@ -84,6 +92,11 @@ PlannedRotation TurnBetween(const Eigen::Vector3d& from, const Eigen::Vector3d& 
     }
     axis = Eigen::Vector3d::Unit(a) - u(a) * u;
   }
+  return TurnAbout(axis.normalized(), angle * internal::kRadToDeg, 0.0);
+}
+
+PlannedRotation TurnAbout(const Eigen::Vector3d& axis, double angle_deg, double seconds) {
+  PlannedRotation turn;
   turn.axis = axis.normalized();
   // Snap to a housing axis when within rounding.
   for (int a = 0; a < 3; ++a) {
@@ -91,14 +104,21 @@ PlannedRotation TurnBetween(const Eigen::Vector3d& from, const Eigen::Vector3d& 
       turn.axis = Eigen::Vector3d::Unit(a) * (turn.axis(a) > 0 ? 1.0 : -1.0);
     }
   }
-  turn.angle_deg = angle * internal::kRadToDeg;
+  turn.angle_deg = angle_deg;
+  turn.seconds = seconds;
   if (turn.angle_deg < 1e-6) {
     turn.instruction = "lift the housing and set it down again in the same pose";
     return turn;
   }
-  char text[160];
-  std::snprintf(text, sizeof(text), "turn %.0f degrees about the housing's %s (right hand rule)",
-                turn.angle_deg, AxisText(turn.axis).c_str());
+  char text[200];
+  if (seconds > 0.0) {
+    std::snprintf(text, sizeof(text),
+                  "turn %.0f degrees about the housing's %s (right hand rule), in about %.1f s",
+                  turn.angle_deg, AxisText(turn.axis).c_str(), seconds);
+  } else {
+    std::snprintf(text, sizeof(text), "turn %.0f degrees about the housing's %s (right hand rule)",
+                  turn.angle_deg, AxisText(turn.axis).c_str());
+  }
   turn.instruction = text;
   return turn;
 }

@@ -207,6 +207,23 @@ bool WriteCalibrationJson(const Calibration& calibration, bool include_covarianc
   return WriteFileAtomically(path, CalibrationToJson(calibration, include_covariance), error);
 }
 
+std::string CalibrationToJson(const Calibration& calibration, bool include_covariance,
+                              const JsonSections& sections) {
+  json out = json::parse(CalibrationToJson(calibration, include_covariance));
+  for (const auto& [key, text] : sections) {
+    json section = json::parse(text, nullptr, false);
+    if (!section.is_discarded()) out[key] = std::move(section);
+  }
+  return out.dump(2) + "\n";
+}
+
+bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,
+                          const JsonSections& sections, const std::string& path,
+                          std::string* error) {
+  return WriteFileAtomically(path, CalibrationToJson(calibration, include_covariance, sections),
+                             error);
+}
+
 namespace {
 
 // Reading: every check names the key by its dotted path.

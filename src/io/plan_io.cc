@@ -33,11 +33,13 @@ std::string PlanToJson(const RecordingPlan& plan) {
   }
   Json rotations = Json::array();
   for (const PlannedRotation& r : plan.rotations) {
-    rotations.push_back({{"from", r.from},
-                         {"to", r.to},
-                         {"axis", JsonVector<Json>(r.axis)},
-                         {"angle_deg", JsonNumber<Json>(r.angle_deg)},
-                         {"instruction", r.instruction}});
+    Json turn = {{"from", r.from},
+                 {"to", r.to},
+                 {"axis", JsonVector<Json>(r.axis)},
+                 {"angle_deg", JsonNumber<Json>(r.angle_deg)}};
+    if (r.seconds > 0.0) turn["duration_s"] = JsonNumber<Json>(r.seconds);
+    turn["instruction"] = r.instruction;
+    rotations.push_back(turn);
   }
   Json readable = Json::object(), targets = Json::object();
   for (size_t i = 0; i < plan.parameter_names.size(); ++i) {
@@ -75,8 +77,54 @@ std::string PlanToJson(const RecordingPlan& plan) {
   out["pose_set"] = plan.pose_set;
   out["noise"] = plan.noise_source;
   out["schemes"] = schemes;
+  if (!plan.gyro_parameter_names.empty()) {
+    const std::vector<std::string>& names = plan.gyro_parameter_names;
+    Json gyro_readable = Json::object(), gyro_targets = Json::object();
+    for (size_t i = 0; i < names.size(); ++i) {
+      const ReadableUnit unit = GyroReadableUnitOf(names[i]);
+      gyro_readable[names[i]] = {
+          {"value", JsonNumber<Json>(plan.gyro_predicted_std_scale_free(i) * unit.factor)},
+          {"unit", unit.unit}};
+      gyro_targets[names[i]] = {
+          {"value", JsonNumber<Json>(plan.gyro_targets_scale_free(i) * unit.factor)},
+          {"unit", unit.unit},
+          {"stated", i < plan.gyro_targeted.size() && plan.gyro_targeted[i]}};
+    }
+    out["gyro_predicted_std"] = StdObject(names, plan.gyro_predicted_std);
+    out["gyro_predicted_std_readable"] = gyro_readable;
+    out["gyro_targets"] = gyro_targets;
+    out["gyro_nominal_scale"] = JsonNumber<Json>(plan.gyro_nominal_scale);
+    out["gyro_extra_poses"] = plan.gyro_extra_poses;
+  }
   out["message"] = plan.message;
   return out.dump(2) + "\n";
+}
+
+std::string CoverageToJson(const CoverageReport& r) {
+  Json readable = Json::object();
+  for (size_t i = 0; i < r.parameter_names.size(); ++i) {
+    const ReadableUnit unit = ReadableUnitOf(r.parameter_names[i]);
+    readable[r.parameter_names[i]] = {
+        {"value", JsonNumber<Json>(r.predicted_std_scale_free(i) * unit.factor)},
+        {"unit", unit.unit}};
+  }
+  Json proposed = Json::array();
+  for (const PlannedPose& p : r.proposed) {
+    proposed.push_back({{"up", JsonVector<Json>(p.up)},
+                        {"hold_s", JsonNumber<Json>(p.hold_seconds)},
+                        {"instruction", p.instruction}});
+  }
+  Json out;
+  out["positions"] = r.positions;
+  out["nominal_scale"] = JsonNumber<Json>(r.nominal_scale);
+  out["predicted_std"] = StdObject(r.parameter_names, r.predicted_std);
+  out["predicted_std_readable"] = readable;
+  out["undetermined"] = r.undetermined;
+  out["short_of_target"] = r.short_of_target;
+  out["proposed"] = proposed;
+  out["undetermined_with_proposed"] = r.undetermined_with_proposed;
+  out["message"] = r.message;
+  return out.dump();
 }
 
 bool WritePlanJson(const RecordingPlan& plan, const std::string& path, std::string* error) {
@@ -124,10 +172,63 @@ bool PlanPosesFromJson(const std::string& text, const std::string& name,
   return true;
 }
 
-bool ReadPlanPoses(const std::string& path, std::vector<PlannedPose>* poses, std::string* error) {
+bool PlanRotationsFromJson(const std::string& text, const std::string& name, size_t pose_count,
+                           std::vector<PlannedRotation>* rotations, std::string* error) {
+  rotations->clear();
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    *error = name + ": not a JSON object";
+    return false;
+  }
+  if (!j.contains("rotations")) return true;
+  if (!j["rotations"].is_array()) {
+    *error = name + ": key 'rotations' must be an array";
+    return false;
+  }
+  for (size_t k = 0; k < j["rotations"].size(); ++k) {
+    const nlohmann::json& r = j["rotations"][k];
+    const std::string where = name + ": rotations[" + std::to_string(k) + "]";
+    PlannedRotation turn;
+    bool ok = r.is_object() && r.contains("from") && r["from"].is_number_integer() &&
+              r.contains("to") && r["to"].is_number_integer() && r.contains("axis") &&
+              r["axis"].is_array() && r["axis"].size() == 3 && r.contains("angle_deg") &&
+              r["angle_deg"].is_number();
+    for (int i = 0; ok && i < 3; ++i) {
+      ok = r["axis"][i].is_number();
+      if (ok) turn.axis(i) = r["axis"][i].get<double>();
+    }
+    if (ok) {
+      turn.from = r["from"].get<int>();
+      turn.to = r["to"].get<int>();
+      turn.angle_deg = r["angle_deg"].get<double>();
+      if (r.contains("duration_s") && r["duration_s"].is_number()) {
+        turn.seconds = r["duration_s"].get<double>();
+      }
+    }
+    if (!ok || !(turn.axis.norm() > 0.5 && turn.axis.norm() < 1.5) ||
+        !(turn.angle_deg >= 0.0 && turn.angle_deg <= 180.0) || turn.from < 0 ||
+        turn.to != turn.from + 1 || static_cast<size_t>(turn.to) >= pose_count ||
+        !(turn.seconds >= 0.0 && std::isfinite(turn.seconds))) {
+      *error = where +
+               ": expected from, to = from + 1 (pose indices), a unit 'axis', 'angle_deg' in "
+               "[0, 180] and an optional positive 'duration_s'";
+      return false;
+    }
+    turn.axis.normalize();
+    if (r.contains("instruction") && r["instruction"].is_string()) {
+      turn.instruction = r["instruction"].get<std::string>();
+    }
+    rotations->push_back(turn);
+  }
+  return true;
+}
+
+bool ReadPlanPoses(const std::string& path, std::vector<PlannedPose>* poses, std::string* error,
+                   std::vector<PlannedRotation>* rotations) {
   std::string text;
   if (!ReadFileBytes(path, &text, error)) return false;
-  return PlanPosesFromJson(text, path, poses, error);
+  if (!PlanPosesFromJson(text, path, poses, error)) return false;
+  return rotations == nullptr || PlanRotationsFromJson(text, path, poses->size(), rotations, error);
 }
 
 }  // namespace gravcal

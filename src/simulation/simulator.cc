@@ -1,6 +1,7 @@
 #include "gravcal/simulation/simulator.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -247,14 +248,27 @@ bool DrawTruth(const SimulatorOptions& options, uint64_t seed, std::mt19937_64* 
 
 // Placed attitudes: an arbitrary heading (about navigation z) times the
 // nominal pose times a small placement error (about body axes).
+// True when the planned poses carry their turns (PlannedHold).
+bool PlannedTurns(const SimulatorOptions& options) {
+  return options.planned_poses.size() > 1 &&
+         std::all_of(options.planned_poses.begin() + 1, options.planned_poses.end(),
+                     [](const PlannedHold& p) { return p.turn_axis.norm() > 0.5; });
+}
+
+// With planned turns every pose keeps the first pose's heading (its
+// nominal attitude already follows the turns).
 std::vector<Eigen::Quaterniond> PlaceAttitudes(const SimulatorOptions& options,
                                                const std::vector<Eigen::Quaterniond>& nominal,
                                                MainStream* stream) {
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   const double placement_rad = options.placement_error_deg * kPi / 180.0;
+  const bool chained = PlannedTurns(options);
+  double first_heading = 0.0;
   std::vector<Eigen::Quaterniond> attitudes(nominal.size());
   for (size_t k = 0; k < nominal.size(); ++k) {
-    const double heading = 2.0 * kPi * u01(stream->rng);
+    double heading = 2.0 * kPi * u01(stream->rng);
+    if (k == 0) first_heading = heading;
+    if (chained) heading = first_heading;
     const Eigen::Vector3d tilt = stream->Normal3();
     attitudes[k] = (AxisAngle(heading, Eigen::Vector3d::UnitZ()) * nominal[k] *
                     FromRotationVector(placement_rad * tilt))
@@ -292,6 +306,11 @@ bool PlanTimeline(const SimulatorOptions& options, uint64_t seed,
   for (size_t k = 0; k < plan->profiles.size() && plan->hand; ++k) {
     plan->profiles[k] = HandProfile::Random(options, &extra_rng);
     plan->rotation[k] = std::max(1L, SampleCount(plan->profiles[k].seconds, rate));
+  }
+  // A planned turn's own duration.
+  for (size_t k = 0; k < plan->rotation.size() && k + 1 < options.planned_poses.size(); ++k) {
+    const double seconds = options.planned_poses[k + 1].turn_seconds;
+    if (seconds > 0.0) plan->rotation[k] = std::max(1L, SampleCount(seconds, rate));
   }
   plan->total = static_cast<size_t>(plan->first_still);
   for (size_t k = 1; k < pose_count; ++k) plan->total += static_cast<size_t>(plan->hold[k]);
@@ -462,8 +481,14 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
     if (!SchemeAttitudes(options.scheme, seed, &nominal, &nominal_up, error)) return false;
   }
   std::vector<double> hold_seconds(nominal.size(), options.hold_seconds);
+  const bool chained = PlannedTurns(options);
   for (const PlannedHold& p : options.planned_poses) {
-    nominal.push_back(UpToZenith(p.up));
+    // A turn about the body axis a by t: q' = q exp(t a).
+    nominal.push_back(
+        chained && !nominal.empty()
+            ? (nominal.back() * AxisAngle(p.turn_angle_deg * kPi / 180.0, p.turn_axis.normalized()))
+                  .normalized()
+            : UpToZenith(p.up));
     nominal_up.push_back(UpAxis(nominal.back()));
     hold_seconds.push_back(p.hold_seconds);
   }
@@ -574,12 +599,32 @@ bool CheckTiming(const SimulatorOptions& o, const FieldCheck& c, long* pose_coun
   if (!c.Positive("sample_rate", o.sample_rate) || !c.OneSample("hold_seconds", o.hold_seconds)) {
     return false;
   }
+  Eigen::Vector3d previous_up = Eigen::Vector3d::Zero();
   for (const PlannedHold& p : o.planned_poses) {
     if (!c.OneSample("planned_poses.hold_seconds", p.hold_seconds)) return false;
     if (!(p.up.allFinite() && p.up.norm() > 0.5)) {
       c.Say("SimulatorOptions.planned_poses: every up must be a unit vector");
       return false;
     }
+    if (!p.turn_axis.allFinite() || !(p.turn_angle_deg >= 0.0 && p.turn_angle_deg <= 180.0) ||
+        !(p.turn_seconds >= 0.0 && std::isfinite(p.turn_seconds))) {
+      c.Say(
+          "SimulatorOptions.planned_poses: a turn has a finite axis, an angle in [0, 180] "
+          "degrees and a duration >= 0");
+      return false;
+    }
+    if (PlannedTurns(o) && previous_up.norm() > 0.5) {
+      const Eigen::Vector3d moved =
+          Eigen::AngleAxisd(-p.turn_angle_deg * kPi / 180.0, p.turn_axis.normalized()) *
+          previous_up;
+      if (moved.dot(p.up.normalized()) < std::cos(kPi / 180.0)) {
+        c.Say(
+            "SimulatorOptions.planned_poses: a turn does not take the previous pose's up "
+            "direction to the next one's");
+        return false;
+      }
+    }
+    previous_up = p.up.normalized();
   }
   if (!o.planned_poses.empty()) *pose_count = static_cast<long>(o.planned_poses.size());
   return c.NonNegative("initial_still_seconds", o.initial_still_seconds) &&

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -17,14 +18,20 @@ namespace gravcal {
 
 namespace {
 
-// Unit -> factor to scale-free (m/s^2 for a bias, relative for U).
-bool UnitFactor(const std::string& unit, bool bias, double* factor) {
+// Unit -> factor to scale-free (m/s^2 or rad/s for a bias, relative for a
+// matrix entry).
+bool UnitFactor(const std::string& unit, bool bias, bool gyro, double* factor) {
   static const std::map<std::string, double> kBias = {
       {"mg", 1e-3 * kStandardGravity}, {"ug", 1e-6 * kStandardGravity}, {"m/s^2", 1.0}};
+  static const std::map<std::string, double> kGyroBias = {{"deg/h", internal::kDegToRad / 3600.0},
+                                                          {"dph", internal::kDegToRad / 3600.0},
+                                                          {"deg/s", internal::kDegToRad},
+                                                          {"mdps", 1e-3 * internal::kDegToRad},
+                                                          {"rad/s", 1.0}};
   static const std::map<std::string, double> kMatrix = {
       {"ppm", 1e-6},  {"%", 1e-2},  {"mrad", 1e-3},
       {"urad", 1e-6}, {"rad", 1.0}, {"deg", internal::kDegToRad}};
-  const auto& table = bias ? kBias : kMatrix;
+  const auto& table = bias ? (gyro ? kGyroBias : kBias) : kMatrix;
   const auto it = table.find(unit);
   if (it == table.end()) return false;
   *factor = it->second;
@@ -35,11 +42,19 @@ bool UnitFactor(const std::string& unit, bool bias, double* factor) {
 std::vector<int> TargetColumns(const std::string& name, const std::vector<std::string>& names) {
   static const std::map<std::string, std::vector<std::string>> kGroups = {
       {"accel_bias", {"bias_x", "bias_y", "bias_z"}},
-      {"accel_scale", {"u_xx", "u_yy", "u_zz"}},
-      {"accel_misalignment", {"u_xy", "u_xz", "u_yz"}}};
+      {"accel_scale", {"u_xx", "u_yy", "u_zz", "m_xx", "m_yy", "m_zz"}},
+      {"accel_misalignment",
+       {"u_xy", "u_xz", "u_yz", "m_xy", "m_xz", "m_yx", "m_yz", "m_zx", "m_zy"}},
+      {"gyro_bias", {"bias_x", "bias_y", "bias_z"}},
+      {"gyro_scale", {"m_xx", "m_yy", "m_zz", "scale"}},
+      {"gyro_misalignment", {"m_xy", "m_xz", "m_yx", "m_yz", "m_zx", "m_zy"}}};
   std::vector<std::string> members = {name};
   const auto group = kGroups.find(name);
-  if (group != kGroups.end()) members = group->second;
+  if (group != kGroups.end()) {
+    members = group->second;
+  } else if (name.rfind("gyro_", 0) == 0) {
+    members = {name.substr(5)};
+  }
   std::vector<int> columns;
   for (const std::string& m : members) {
     const auto it = std::find(names.begin(), names.end(), m);
@@ -111,6 +126,98 @@ bool DesignOver(const std::string& pose_set, int free_candidates, const DesignMo
   return true;
 }
 
+// Datasheet densities (N, and B and K when positive) on every axis of
+// *axes; returns "N = ... <unit>, B = ..., K = ...".
+std::string DatasheetNoise(double n, double b, double k, const char* unit,
+                           std::array<AxisNoiseModel, 3>* axes) {
+  for (AxisNoiseModel& axis : *axes) {
+    axis.white_noise.value = n;
+    if (b > 0.0) axis.bias_instability.value = b;
+    if (k > 0.0) axis.random_walk.value = k;
+  }
+  std::ostringstream s;
+  s << "N = " << n << " " << unit;
+  if (b > 0.0) s << ", B = " << b;
+  if (k > 0.0) s << ", K = " << k;
+  return s.str();
+}
+
+// The gyroscope's half of the plan: the turns between the poses (in
+// handling order) chosen for the gyroscope-between-poses model, extra poses
+// appended while its targets need them, and the accelerometer's figures
+// again with those poses.
+bool PlanRotations(const Config& config, const PlanRequest& request,
+                   const internal::PlanStart& start, const DesignModel& model,
+                   const DesignNoise& noise, const DesignOptions& options, RecordingPlan* out,
+                   std::string* error) {
+  const bool stated =
+      std::any_of(start.gyro_targeted.begin(), start.gyro_targeted.end(), [](bool t) { return t; });
+  if (!(noise.gyro[0].white_noise.value > 0.0)) {
+    if (stated) {
+      *error =
+          "gyroscope targets need the gyroscope's noise: --noise noise.json with a gyroscope, or "
+          "--gyro_noise_density";
+      return false;
+    }
+    out->message += "; the gyroscope is not planned (no gyroscope noise: --gyro_noise_density)";
+    return true;
+  }
+  std::vector<DesignPose> poses;
+  for (const PlannedPose& p : out->poses) poses.push_back({p.up, p.hold_seconds});
+  RotationDesignOptions rotation;
+  rotation.targets = start.gyro_targets;
+  rotation.free_axes = request.pose_set == "free" ? 12 : 0;
+  rotation.seconds_per_180 = request.turn_seconds;
+  rotation.extra_hold_seconds = options.min_hold_seconds;
+  rotation.max_extra_poses = std::max(0, options.max_poses - static_cast<int>(out->poses.size()));
+  CandidateDirections("faces+45", 0, &rotation.extra_candidates);
+  GyroDesignModel gyro_model = start.gyro_model;
+  GyroDesignResult design;
+  if (!DesignRotations(poses, model, gyro_model, noise, rotation, &design)) {
+    *error = design.message;
+    return false;
+  }
+  const std::vector<std::string>& names = design.parameter_names;
+  if (!design.meets_targets) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "the gyroscope's targets are not met within " << options.max_poses << " poses: ";
+    for (size_t i = 0; i < names.size(); ++i) {
+      const ReadableUnit unit = GyroReadableUnitOf(names[i]);
+      s << (i ? ", " : "") << names[i] << " " << design.predicted_std(i) * unit.factor << " "
+        << unit.unit << " (target " << start.gyro_targets(i) * unit.factor << ")";
+    }
+    *error = s.str();
+    return false;
+  }
+  for (size_t k = out->poses.size(); k < design.poses.size(); ++k) {
+    out->poses.push_back(
+        {design.poses[k].up, design.poses[k].hold_seconds, PoseInstruction(design.poses[k].up)});
+  }
+  out->rotations.clear();
+  for (size_t k = 0; k < design.turns.size(); ++k) {
+    const DesignTurn& t = design.turns[k];
+    PlannedRotation r = TurnAbout(t.axis, t.angle_deg, t.seconds);
+    r.from = static_cast<int>(k);
+    r.to = static_cast<int>(k + 1);
+    out->rotations.push_back(r);
+  }
+  // The accelerometer with every pose, extra ones included.
+  const DesignResult accel = EvaluateDesign(design.poses, model, noise, options);
+  out->predicted_std_scale_free = accel.predicted_std;
+  out->predicted_std = StdInRawUnits(accel.predicted_std, out->nominal_scale);
+  out->total_seconds = accel.total_seconds;
+  out->gyro_parameter_names = names;
+  out->gyro_nominal_scale = config.ten_position.gyro_nominal_scale;
+  out->gyro_predicted_std_scale_free = design.predicted_std;
+  out->gyro_predicted_std = StdInRawUnits(design.predicted_std, out->gyro_nominal_scale);
+  out->gyro_targets_scale_free = start.gyro_targets;
+  out->gyro_targeted = start.gyro_targeted;
+  out->gyro_extra_poses = design.extra_poses;
+  out->message += "; gyroscope: " + design.message;
+  return true;
+}
+
 }  // namespace
 
 bool PlanRequest::IsValid(std::string* error) const {
@@ -129,20 +236,26 @@ bool PlanRequest::IsValid(std::string* error) const {
         "max_time >= 0, overhead >= 0, 0 < min_hold <= max_hold, max_poses >= 1, extra_poses >= 1";
     return false;
   }
-  for (double v :
-       {accel_noise_density, accel_bias_instability, accel_random_walk, pose_disturbance}) {
+  if (!(turn_seconds > 0.0 && std::isfinite(turn_seconds))) {
+    *error = "turn_seconds must be positive";
+    return false;
+  }
+  for (double v : {accel_noise_density, accel_bias_instability, accel_random_walk, pose_disturbance,
+                   gyro_noise_density, gyro_bias_instability, gyro_random_walk, attitude_std_deg}) {
     if (!(v >= 0.0 && std::isfinite(v))) {
-      *error = "noise densities and pose_disturbance must be >= 0";
+      *error = "noise densities, pose_disturbance and attitude_std must be >= 0";
       return false;
     }
   }
   return true;
 }
 
-bool ParsePlanTargets(const std::string& text, AccelParameterization p, Eigen::VectorXd* targets,
-                      std::string* error) {
-  const std::vector<std::string> names = MagnitudeParameterNames(p);
+bool ParsePlanTargets(const std::string& text, const DesignModel& model, Eigen::VectorXd* targets,
+                      std::string* error, GyroParameterization gp, Eigen::VectorXd* gyro_targets) {
+  const std::vector<std::string> names = DesignParameterNames(model);
+  const std::vector<std::string> gyro_names = GyroDesignParameterNames(gp);
   Eigen::VectorXd out = Eigen::VectorXd::Constant(names.size(), NAN);
+  Eigen::VectorXd gyro_out = Eigen::VectorXd::Constant(gyro_names.size(), NAN);
   std::istringstream in(text);
   std::string entry;
   std::vector<std::string> unknown;
@@ -153,33 +266,39 @@ bool ParsePlanTargets(const std::string& text, AccelParameterization p, Eigen::V
       return false;
     }
     const std::string name = entry.substr(0, eq);
-    const std::vector<int> columns = TargetColumns(name, names);
-    if (columns.empty()) {
+    const bool gyro = name.rfind("gyro_", 0) == 0 && gyro_targets != nullptr;
+    const std::vector<int> columns = TargetColumns(name, gyro ? gyro_names : names);
+    if (columns.empty() || (!gyro && name.rfind("gyro_", 0) == 0)) {
       unknown.push_back(name);
       continue;
     }
+    const bool bias = columns.front() < 3;
     const std::string value_text = entry.substr(eq + 1);
     char* end = nullptr;
     const double value = std::strtod(value_text.c_str(), &end);
     const std::string unit = end ? std::string(end) : "";
     double factor = 0.0;
     if (end == value_text.c_str() || !(value > 0.0 && std::isfinite(value)) ||
-        !UnitFactor(unit, columns.front() < 3, &factor)) {
+        !UnitFactor(unit, bias, gyro, &factor)) {
       *error = "target '" + entry + "': expected a positive number and a unit (" +
-               (columns.front() < 3 ? "mg, ug, m/s^2" : "ppm, %, mrad, urad, rad, deg") + ")";
+               (bias ? (gyro ? "deg/h, dph, deg/s, mdps, rad/s" : "mg, ug, m/s^2")
+                     : "ppm, %, mrad, urad, rad, deg") +
+               ")";
       return false;
     }
-    for (int c : columns) out(c) = value * factor;
+    for (int c : columns) (gyro ? gyro_out : out)(c) = value * factor;
   }
   if (!unknown.empty()) {
-    const bool gyro = std::any_of(unknown.begin(), unknown.end(),
-                                  [](const std::string& n) { return n.rfind("gyro", 0) == 0; });
     *error = "unknown parameter name(s) in --target: " + Join(unknown) +
-             " (known: accel_bias, accel_scale, accel_misalignment, " + Join(names) + ")" +
-             (gyro ? "; gyroscope targets are not planned yet" : "");
+             " (known: accel_bias, accel_scale, accel_misalignment, " + Join(names) +
+             (gyro_targets != nullptr
+                  ? ", gyro_bias, gyro_scale, gyro_misalignment, gyro_<" + Join(gyro_names) + ">"
+                  : std::string()) +
+             ")";
     return false;
   }
   *targets = out;
+  if (gyro_targets != nullptr) *gyro_targets = gyro_out;
   return true;
 }
 
@@ -196,20 +315,23 @@ bool PlanDesignNoise(const PlanRequest& request, DesignNoise* noise, std::string
     }
     *source = "noise model (gravcal noise)";
   } else if (request.accel_noise_density > 0.0) {
-    out = WhiteDesignNoise(request.accel_noise_density);
-    for (AxisNoiseModel& axis : out.accel) {
-      if (request.accel_bias_instability > 0.0)
-        axis.bias_instability.value = request.accel_bias_instability;
-      if (request.accel_random_walk > 0.0) axis.random_walk.value = request.accel_random_walk;
-    }
-    std::ostringstream s;
-    s << "datasheet densities: N = " << request.accel_noise_density << " m/s^2/sqrt(Hz)";
-    if (request.accel_bias_instability > 0.0) s << ", B = " << request.accel_bias_instability;
-    if (request.accel_random_walk > 0.0) s << ", K = " << request.accel_random_walk;
-    *source = s.str();
+    *source = "datasheet densities: " +
+              DatasheetNoise(request.accel_noise_density, request.accel_bias_instability,
+                             request.accel_random_walk, "m/s^2/sqrt(Hz)", &out.accel);
   } else {
     *error = "no noise: give --noise noise.json (gravcal noise) or --accel_noise_density";
     return false;
+  }
+  // The gyroscope, when the noise model shows it or a density is given
+  // (the rotations are planned only then).
+  if (request.noise_model != nullptr &&
+      std::all_of(request.noise_model->gyro.begin(), request.noise_model->gyro.end(),
+                  [](const AxisNoiseModel& a) { return a.white_noise.visible(); })) {
+    out.gyro = request.noise_model->gyro;
+  } else if (request.gyro_noise_density > 0.0) {
+    *source += "; gyroscope datasheet densities: " +
+               DatasheetNoise(request.gyro_noise_density, request.gyro_bias_instability,
+                              request.gyro_random_walk, "rad/s/sqrt(Hz)", &out.gyro);
   }
   out.pose_disturbance = request.pose_disturbance;
   if (request.pose_disturbance > 0.0) {
@@ -231,6 +353,7 @@ bool PlanDesignModel(const Config& config, DesignModel* model, std::string* erro
   // windows reach into it, and `settle` is trimmed from each end); the plan
   // counts the hold minus one `settle`.
   out.trimmed_seconds = config.calibration.detector.settle_seconds;
+  out.known_attitude = config.method == "known_attitude";
   if (!out.IsValid(error)) return false;
   *model = out;
   return true;
@@ -243,9 +366,39 @@ bool StartPlan(const Config& config, const PlanRequest& request, PlanStart* star
   if (!request.IsValid(error)) return false;
   PlanStart out;
   if (!PlanDesignModel(config, &out.model, error)) return false;
-  out.names = MagnitudeParameterNames(out.model.parameterization);
-  Eigen::VectorXd stated;
-  if (!ParsePlanTargets(request.targets, out.model.parameterization, &stated, error)) return false;
+  out.model.attitude_std = request.attitude_std_deg * internal::kDegToRad;
+  out.names = DesignParameterNames(out.model);
+  Eigen::VectorXd stated, gyro_stated;
+  out.gyro_model.parameterization = config.gyro.parameterization == GyroParameterization::kNone
+                                        ? GyroParameterization::kFull
+                                        : config.gyro.parameterization;
+  out.gyro_model.edge_seconds = config.gyro.edge_seconds;
+  if (!ParsePlanTargets(request.targets, out.model, &stated, error, out.gyro_model.parameterization,
+                        &gyro_stated)) {
+    return false;
+  }
+  out.gyro_names = GyroDesignParameterNames(out.gyro_model.parameterization);
+  std::vector<std::string> gyro_stated_names;
+  for (Eigen::Index i = 0; i < gyro_stated.size(); ++i) {
+    if (std::isfinite(gyro_stated(i))) gyro_stated_names.push_back("gyro_" + out.gyro_names[i]);
+  }
+  out.gyro_planned = config.gyro.parameterization != GyroParameterization::kNone;
+  if (!gyro_stated_names.empty() && !out.gyro_planned) {
+    *error = "gyroscope targets (" + Join(gyro_stated_names) +
+             ") but the config calibrates no gyroscope (gyro_model: none): use a gyroscope config "
+             "(e.g. configs/twelve_position_gyro.yaml) or --gyro_model full";
+    return false;
+  }
+  // Untargeted gyroscope parameters: the calibration's limit of a
+  // determined matrix entry, and 1 deg/s for the bias.
+  out.gyro_targets.resize(gyro_stated.size());
+  out.gyro_targeted.resize(gyro_stated.size());
+  for (Eigen::Index i = 0; i < gyro_stated.size(); ++i) {
+    out.gyro_targeted[i] = std::isfinite(gyro_stated(i));
+    out.gyro_targets(i) = out.gyro_targeted[i]
+                              ? gyro_stated(i)
+                              : (i < 3 ? internal::kDegToRad : config.gyro.max_matrix_std);
+  }
   const RefinementOptions& r = config.calibration.refinement;
   const Eigen::Index p = static_cast<Eigen::Index>(out.names.size());
   out.limits.resize(p);
@@ -381,6 +534,9 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
     out.schemes.push_back(c);
   }
   out.message = design.message;
+  if (start.gyro_planned) {
+    if (!PlanRotations(config, request, start, model, noise, options, &out, error)) return false;
+  }
   *plan = out;
   return true;
 }

@@ -124,11 +124,6 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
   for (size_t i = 0; i < names.size(); ++i) {
     if (!out.targeted[i]) yardstick(i) = ReferenceStd(names[i]);
   }
-  for (size_t i = 0; i < names.size(); ++i) {
-    if (out.targeted[i] && !(out.predicted_std_scale_free(i) <= out.targets_scale_free(i))) {
-      out.short_of_target.push_back(names[i]);
-    }
-  }
 
   // Extra poses: the request's noise when given, else white noise of the
   // density the recorded poses show (variance of the mean times duration).

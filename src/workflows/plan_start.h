@@ -24,6 +24,14 @@ struct PlanStart {
   std::vector<bool> targeted;
   // The refinement's limits per parameter (scale-free).
   Eigen::VectorXd limits;
+  // The gyroscope: planned when the config calibrates one; its design model,
+  // parameter names and targets (scale-free; the stated ones, else the
+  // calibration's limits) as above.
+  bool gyro_planned = false;
+  GyroDesignModel gyro_model;
+  std::vector<std::string> gyro_names;
+  Eigen::VectorXd gyro_targets;
+  std::vector<bool> gyro_targeted;
 };
 
 bool StartPlan(const Config& config, const PlanRequest& request, PlanStart* start,

@@ -17,9 +17,18 @@ bool SimulateFromConfig(const Config& config, const SimulationRequest& request,
   sim = config.simulation;
   if (!request.plan_path.empty()) {
     std::vector<PlannedPose> poses;
-    if (!ReadPlanPoses(request.plan_path, &poses, error)) return false;
+    std::vector<PlannedRotation> turns;
+    if (!ReadPlanPoses(request.plan_path, &poses, error, &turns)) return false;
     sim.planned_poses.clear();
     for (const PlannedPose& p : poses) sim.planned_poses.push_back({p.up, p.hold_seconds});
+    // The planned turns, when the plan chose them for the gyroscope.
+    for (const PlannedRotation& r : turns) {
+      if (r.seconds <= 0.0) continue;
+      PlannedHold& to = sim.planned_poses[r.to];
+      to.turn_axis = r.axis;
+      to.turn_angle_deg = r.angle_deg;
+      to.turn_seconds = r.seconds;
+    }
     sim.initial_still_seconds = 0.0;
   }
   files->segments.clear();

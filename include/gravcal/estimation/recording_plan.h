@@ -27,9 +27,13 @@ struct PlannedPose {
 struct PlannedRotation {
   int from = 0;
   int to = 0;
-  // Body-frame unit axis and angle, degrees (shortest turn).
+  // Body-frame unit axis and angle, degrees (the shortest turn, or the one
+  // the gyroscope design chose).
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
   double angle_deg = 0.0;
+  // Suggested duration of the turn, seconds (0 = not planned for the
+  // gyroscope).
+  double seconds = 0.0;
   std::string instruction;
 };
 
@@ -70,6 +74,20 @@ struct RecordingPlan {
   std::vector<PlannedPose> poses;
   std::vector<PlannedRotation> rotations;
   std::vector<SchemeComparison> schemes;
+  // The gyroscope (experiment_design.h), empty names when not planned:
+  // predicted standard deviations keyed by the calibration JSON's gyro
+  // covariance names, in its units (bias raw units, M_g rad/s per raw unit
+  // at gyro_nominal_scale) and scale-free (rad/s, relative); the targets
+  // (scale-free; `gyro_targeted` marks the stated ones); the poses appended
+  // for the gyroscope alone (the last gyro_extra_poses of `poses`).
+  std::vector<std::string> gyro_parameter_names;
+  Eigen::VectorXd gyro_predicted_std;
+  Eigen::VectorXd gyro_predicted_std_scale_free;
+  Eigen::VectorXd gyro_targets_scale_free;
+  std::vector<bool> gyro_targeted;
+  double gyro_nominal_scale = 1.0;
+  int gyro_extra_poses = 0;
+  std::string gyro_noise_source;
   std::string message;
 };
 
@@ -106,6 +124,9 @@ struct ReadableUnit {
   double factor = 1.0;
 };
 ReadableUnit ReadableUnitOf(const std::string& parameter);
+// The same for a gyroscope parameter (scale-free rad/s, relative): bias_*
+// "deg/h"; m_xx, m_yy, m_zz, scale "ppm"; other m_* "mrad".
+ReadableUnit GyroReadableUnitOf(const std::string& parameter);
 
 // The yardstick when no target is stated (scale-free): 1 mg for a bias,
 // 100 ppm for a scale, 0.1 mrad for a non-orthogonality.
@@ -117,6 +138,10 @@ std::string PoseInstruction(const Eigen::Vector3d& up);
 // The shortest turn taking up direction `from` to `to` (about a housing axis
 // when the two are opposite), with its instruction.
 PlannedRotation TurnBetween(const Eigen::Vector3d& from, const Eigen::Vector3d& to);
+
+// A turn about the body axis `axis` by angle_deg over `seconds` (0 = no
+// duration stated), with its instruction.
+PlannedRotation TurnAbout(const Eigen::Vector3d& axis, double angle_deg, double seconds);
 
 // Orders poses for handling: starting from the one nearest z up, each next
 // pose is the nearest remaining (smallest turn); fills plan->rotations.

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
@@ -23,6 +24,16 @@ std::string CalibrationToJson(const Calibration& calibration, bool include_covar
 
 bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,
                           const std::string& path, std::string* error);
+
+// The same with extra top-level sections appended after the calibration's
+// own keys: (key, JSON text) pairs, e.g. calibrate's "check" (plan_io.h,
+// CoverageToJson). A section whose text is not valid JSON is left out.
+using JsonSections = std::vector<std::pair<std::string, std::string>>;
+std::string CalibrationToJson(const Calibration& calibration, bool include_covariance,
+                              const JsonSections& sections);
+bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,
+                          const JsonSections& sections, const std::string& path,
+                          std::string* error);
 
 // Issue 4: the time history of a recursive method (calibration.history) as
 // CSV: a header row with the column names, then one row per epoch. Fails

@@ -36,6 +36,16 @@ namespace gravcal {
 struct PlannedHold {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   double hold_seconds = 10.0;
+  // The turn into this pose from the previous one (the plan's rotations):
+  // body-frame unit axis, angle in degrees (0..180, right hand rule) and
+  // duration in seconds (0 = rotation_seconds). When every pose after the
+  // first has a turn (nonzero axis), the poses follow them from the first
+  // pose's heading (up = R(axis, -angle) previous up must hold within a
+  // degree); otherwise each pose gets a random heading of its own and the
+  // shortest rotation joins them.
+  Eigen::Vector3d turn_axis = Eigen::Vector3d::Zero();
+  double turn_angle_deg = 0.0;
+  double turn_seconds = 0.0;
 };
 
 struct SimulatorOptions {

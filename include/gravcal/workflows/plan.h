@@ -8,9 +8,10 @@
 // seed's schemes, and orders the poses for a person to follow
 // (estimation/recording_plan.h).
 //
-// Only the accelerometer's magnitude model is planned: the gyroscope's
-// between-poses model is not in the Fisher information yet (the plan lists
-// the turns between poses all the same).
+// With a gyroscope (the config's gyro_model, or gyroscope targets) the
+// turns between the poses are chosen for the gyroscope-between-poses model
+// by the same criterion (experiment_design.h, DesignRotations), and extra
+// poses appended when its targets need them.
 #ifndef GRAVCAL_WORKFLOWS_PLAN_H_
 #define GRAVCAL_WORKFLOWS_PLAN_H_
 
@@ -30,6 +31,9 @@ struct PlanRequest {
   // names (accel_bias: bias_x..z, accel_scale: u_xx u_yy u_zz,
   // accel_misalignment: u_xy u_xz u_yz) or parameter names, each with a
   // unit: mg, ug, m/s^2 for a bias; ppm, %, mrad, urad, rad, deg for U.
+  // Gyroscope: gyro_bias (bias_x..z; deg/h, deg/s, rad/s), gyro_scale
+  // (m_xx m_yy m_zz, or scale; ppm, %), gyro_misalignment (the other m_*;
+  // mrad, urad, rad, deg), or gyro_<name> for one parameter (gyro_m_xy).
   std::string targets;
   // faces, faces+45 or free (experiment_design.h).
   std::string pose_set = "faces+45";
@@ -51,6 +55,17 @@ struct PlanRequest {
   double accel_random_walk = 0.0;
   // Per-pose disturbance of |a|, m/s^2 rms; 0 = none.
   double pose_disturbance = 0.0;
+  // Gyroscope white-noise density, rad/s/sqrt(Hz), when no noise model
+  // gives one; and its bias instability (rad/s) and random walk.
+  double gyro_noise_density = 0.0;
+  double gyro_bias_instability = 0.0;
+  double gyro_random_walk = 0.0;
+  // The known-attitude model (method known_attitude): the fixture's
+  // attitude standard deviation, degrees.
+  double attitude_std_deg = 0.0;
+  // Seconds a half turn takes (shorter turns proportionally less, at least
+  // half of it).
+  double turn_seconds = 3.0;
   // Extra poses `check` proposes when every parameter is determined (as many
   // as there are undetermined directions otherwise).
   int extra_poses = 2;
@@ -58,18 +73,22 @@ struct PlanRequest {
   bool IsValid(std::string* error) const;
 };
 
-// Parses `text` (above) into scale-free targets per parameter of `p`
-// (MagnitudeParameterNames order; NaN = none stated). Errors name every
-// unknown name, or the entry with a bad value or unit.
-bool ParsePlanTargets(const std::string& text, AccelParameterization p, Eigen::VectorXd* targets,
-                      std::string* error);
+// Parses `text` (above) into scale-free targets per parameter of `model`
+// (DesignParameterNames order; NaN = none stated) and, when gyro_targets
+// is not null, of `gp` (GyroDesignParameterNames order). Errors name every
+// unknown name (gyroscope names too when gyro_targets is null), or the
+// entry with a bad value or unit.
+bool ParsePlanTargets(const std::string& text, const DesignModel& model, Eigen::VectorXd* targets,
+                      std::string* error, GyroParameterization gp = GyroParameterization::kFull,
+                      Eigen::VectorXd* gyro_targets = nullptr);
 
 // The noise of the request; *source says where it came from.
 bool PlanDesignNoise(const PlanRequest& request, DesignNoise* noise, std::string* source,
                      std::string* error);
 
-// The design model of a config: its parameterisation and gravity, and the
-// seconds of a hold its static detector does not keep.
+// The design model of a config: its parameterisation and gravity, the
+// seconds of a hold its static detector does not keep, and the
+// known-attitude model when the config's method is known_attitude.
 bool PlanDesignModel(const Config& config, DesignModel* model, std::string* error);
 
 // The plan. Returns false with *error (and *plan untouched) on bad input,

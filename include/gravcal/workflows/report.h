@@ -30,6 +30,7 @@
 #include "gravcal/core/imu_log.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/noise_characterisation.h"
+#include "gravcal/estimation/recording_plan.h"
 #include "gravcal/workflows/fleet_summary.h"
 
 namespace gravcal {
@@ -65,6 +66,14 @@ std::string FleetToHtml(const FleetStatistics& statistics, const std::vector<Sum
 
 // The noise model of a still log as an HTML page.
 std::string NoiseToHtml(const ImuNoise& noise, const std::string& source);
+
+// Issue 15: a recording plan (gravcal plan --report) as an HTML page: the
+// poses in order, each as a small picture of the housing lying as it should
+// with its instruction and hold, the turn between each two, the up
+// directions on the sphere, the predicted standard deviations against the
+// targets (accelerometer and, when planned, gyroscope) and the fixed
+// schemes' times.
+std::string PlanToHtml(const RecordingPlan& plan);
 
 }  // namespace gravcal
 
