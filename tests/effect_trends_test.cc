@@ -18,6 +18,7 @@
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
 #include "sigma_check.h"
+#include "test_util.h"
 #include "util/statistics.h"
 
 namespace gravcal {
@@ -34,13 +35,11 @@ constexpr double kLevel = 0.01 / 8.0;
 // hand_placed.yaml correlated accelerometer noise on top of the default
 // white noise (0.02 m/s^2 per sample at 100 Hz).
 SimulatorOptions TwelvePoseWarmUp() {
-  SimulatorOptions o;
+  SimulatorOptions o = testing_util::WarmUpSession();
   o.scheme = "twelve";
   o.hold_seconds = 30.0;
   o.initial_still_seconds = 10.0;
   o.rotation_seconds = 3.0;
-  o.temperature_start = 20.0;
-  o.temperature_end = 35.0;
   o.temperature_tau = 200.0;
   o.accel_bias_random_walk = 2e-5;
   o.accel_bias_instability = 2e-4;
@@ -116,12 +115,11 @@ AccelModel Nominal(const SimulatedSession& session) {
 // chi2 of the accelerometer fit with `effects` over `baseline`.
 SensorFitSummary AccelFit(const std::vector<StaticObservation>& observations,
                           const SimulatedSession& session, AccelParameterization baseline,
-                          const std::vector<Effect>& effects, bool trends = true) {
+                          const std::vector<Effect>& effects) {
   EffectFitOptions options;
   options.parameterization = baseline;
   options.effects = effects;
   options.fit_gyro = false;
-  options.use_within_pose_trends = trends;
   EffectFitResult fit;
   EXPECT_TRUE(FitEffects(observations, Nominal(session), GyroModel(), References(observations),
                          session.gravity, options, &fit))
@@ -307,6 +305,20 @@ TEST(EffectTrends, MagnitudeOnlyPathIsKept) {
   EXPECT_EQ(fit.accel_fit.information, "position magnitudes");
   EXPECT_EQ(fit.accel_fit.num_residuals, 12);
   EXPECT_EQ(fit.accel_fit.trend_residuals, 0);
+  // A fixed extra variance adds to every magnitude's sigma^2.
+  const std::vector<double> white = fit.accel_sigmas;
+  options.magnitude_extra_variance = 4e-8;
+  ASSERT_TRUE(FitEffects(obs, Nominal(session), GyroModel(), References(obs), session.gravity,
+                         options, &fit))
+      << fit.message;
+  for (size_t k = 0; k < white.size(); ++k) {
+    EXPECT_NEAR(fit.accel_sigmas[k], std::sqrt(white[k] * white[k] + 4e-8), 1e-12);
+  }
+  options.magnitude_extra_variance = -1.0;
+  EXPECT_FALSE(FitEffects(obs, Nominal(session), GyroModel(), References(obs), session.gravity,
+                          options, &fit));
+  EXPECT_NE(fit.message.find("magnitude_extra_variance"), std::string::npos) << fit.message;
+  options.magnitude_extra_variance = 0.0;
   options.effects = {Effect::kAccelQuadratic, Effect::kAccelBiasDrift};
   EXPECT_FALSE(FitEffects(obs, Nominal(session), GyroModel(), References(obs), session.gravity,
                           options, &fit));

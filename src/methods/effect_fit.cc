@@ -614,8 +614,10 @@ std::vector<StaticObservation> ObservationsFromIntervals(
 }
 
 bool EffectFitOptions::IsValid(std::string* error) const {
-  if (!(magnitude_variance_prior >= 0.0) || !(magnitude_variance_prior_dof >= 0.0)) {
-    *error = "effect fit: magnitude_variance_prior and its dof must be >= 0";
+  if (!(magnitude_variance_prior >= 0.0) || !(magnitude_variance_prior_dof >= 0.0) ||
+      !(magnitude_extra_variance >= 0.0) || !std::isfinite(magnitude_extra_variance)) {
+    *error =
+        "effect fit: magnitude_extra_variance, magnitude_variance_prior and its dof must be >= 0";
     return false;
   }
   std::string solver_error;
@@ -668,8 +670,8 @@ bool FitEffects(const std::vector<StaticObservation>& observations, const AccelM
     }
     Eigen::MatrixXd jacobian;
     Eigen::VectorXd residuals;
-    if (!FitAccel(observations, initial, initial_parameters, gravity, options, 0.0, &jacobian,
-                  &residuals, result)) {
+    if (!FitAccel(observations, initial, initial_parameters, gravity, options,
+                  options.magnitude_extra_variance, &jacobian, &residuals, result)) {
       return false;
     }
     if (options.magnitude_variance_component && options.compute_covariance) {
@@ -680,7 +682,8 @@ bool FitEffects(const std::vector<StaticObservation>& observations, const AccelM
         for (double sigma : result->accel_sigmas) mean_white += sigma * sigma / n;
         EffectFitResult refit = *result;
         if (!FitAccel(observations, initial, initial_parameters, gravity, options,
-                      component.variance, &jacobian, &residuals, &refit)) {
+                      options.magnitude_extra_variance + component.variance, &jacobian, &residuals,
+                      &refit)) {
           *result = refit;
           return false;
         }
