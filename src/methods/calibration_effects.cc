@@ -123,8 +123,7 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
     c.message = (log.source.empty() ? "" : log.source + ": ") + what;
     return false;
   };
-  const std::vector<StaticObservation> observations =
-      ObservationsFromIntervals(intervals, log.has_gyro());
+  const std::vector<StaticObservation> observations = ObservationsFromIntervals(log, intervals);
   EffectParameters start;
   GyroModel gyro;
   const bool has_temperature = StartParameters(observations, &start, &gyro);
@@ -141,6 +140,11 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   EffectFitOptions fit_options;
   fit_options.parameterization = options.refinement.parameterization;
   fit_options.effects = effects;
+  // The refinement's pose variance (pose_variance: true) carries over: the
+  // magnitudes' extra variance by REML, with the same prior.
+  fit_options.magnitude_variance_component = options.refinement.estimate_pose_variance;
+  fit_options.magnitude_variance_prior = options.refinement.pose_disturbance_prior;
+  fit_options.magnitude_variance_prior_dof = options.refinement.pose_disturbance_prior_dof;
   fit_options.fit_gyro = std::any_of(effects.begin(), effects.end(), [](Effect e) {
     return Info(e).sensor == EffectSensor::kGyroscope;
   });

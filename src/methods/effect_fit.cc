@@ -13,10 +13,13 @@
 
 #include "estimation/normalization.h"
 #include "estimation/solver_settings.h"
+#include "estimation/variance_component.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/refinement.h"
+#include "gravcal/residuals/accel_trend_residual.h"
 #include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "gravcal/residuals/gyro_static_residual.h"
+#include "methods/within_pose_trend.h"
 #include "util/statistics.h"
 
 namespace gravcal {
@@ -41,9 +44,9 @@ ceres::Solver::Options SolverOptions(const EffectFitOptions& o) {
 // (J^T J)^-1 of a whitened Jacobian, with the undetermined parameters (null
 // space) named and their rows and columns NaN; the rest from the
 // pseudo-inverse. Also the leverage of each position (rows_per_position
-// consecutive rows).
+// consecutive rows among the first leverage_rows).
 void CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, int rows_per_position,
-                            SensorFitSummary* fit) {
+                            int leverage_rows, SensorFitSummary* fit) {
   const ObservabilityReport obs =
       AnalyzeObservability(jacobian, fit->parameter_names, kRankTolerance);
   fit->undetermined = obs.undetermined;
@@ -70,7 +73,7 @@ void CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, int rows_per_positi
   }
   fit->covariance = scale.cwiseInverse().asDiagonal() * inverse * scale.cwiseInverse().asDiagonal();
   fit->leverage.clear();
-  for (int k = 0; k * rows_per_position < jacobian.rows(); ++k) {
+  for (int k = 0; k * rows_per_position < leverage_rows; ++k) {
     double h = 0.0;
     for (int r = 0; r < rows_per_position; ++r) {
       const Eigen::RowVectorXd row = scaled.row(k * rows_per_position + r);
@@ -139,39 +142,60 @@ std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const bool on[4]
   return upper_free;
 }
 
-// fit->chi2 and, with `covariance`, the dense Jacobian of the free
-// parameters at `params`; false when the model has no value at a position.
-bool EvaluateAccelFit(const std::vector<std::unique_ptr<ceres::CostFunction>>& owned,
-                      const double* const params[6], const std::vector<int>& upper_free,
-                      const bool on[4], bool covariance, Eigen::MatrixXd* jacobian,
-                      SensorFitSummary* fit) {
+// One residual block of the accelerometer fit: a position's magnitude (1
+// row) or its within-pose trend (3 rows). The cost functions are kept (not
+// owned by the problem) to evaluate the Jacobian at the optimum.
+struct AccelBlock {
+  std::unique_ptr<ceres::CostFunction> cost;
+  int rows = 1;
+  int position = 0;
+  bool trend = false;
+};
+
+// fit->chi2 (and trend_chi2), the whitened residuals (all rows, and the
+// trend residuals per position) and, with
+// `covariance`, the dense Jacobian of the free parameters at `params`, rows
+// in block order; false when the model has no value at a position.
+bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const params[6],
+                      const std::vector<int>& upper_free, const bool on[4], bool covariance,
+                      Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals, SensorFitSummary* fit,
+                      std::vector<Eigen::Vector3d>* trend_residuals) {
   fit->chi2 = 0.0;
-  for (int k = 0; k < static_cast<int>(owned.size()); ++k) {
-    double r = 0.0;
-    double jb[3], ju[6], je[4][3];
+  fit->trend_chi2 = 0.0;
+  int row0 = 0;
+  for (const AccelBlock& block : blocks) {
+    double r[3];
+    double jb[9], ju[18], je[4][9];
     double* jacobians[6] = {jb, ju, je[0], je[1], je[2], je[3]};
-    if (!owned[k]->Evaluate(params, &r, covariance ? jacobians : nullptr)) return false;
-    fit->chi2 += r * r;
-    if (!covariance) continue;
-    int col = 0;
-    for (int i = 0; i < 3; ++i) (*jacobian)(k, col++) = jb[i];
-    for (int i : upper_free) (*jacobian)(k, col++) = ju[i];
-    for (int b = 0; b < 4; ++b) {
-      if (!on[b]) continue;
-      for (int i = 0; i < 3; ++i) (*jacobian)(k, col++) = je[b][i];
+    if (!block.cost->Evaluate(params, r, covariance ? jacobians : nullptr)) return false;
+    for (int row = 0; row < block.rows; ++row) {
+      (*residuals)(row0 + row) = r[row];
+      fit->chi2 += r[row] * r[row];
+      if (block.trend) fit->trend_chi2 += r[row] * r[row];
+      if (!covariance) continue;
+      int col = 0;
+      for (int i = 0; i < 3; ++i) (*jacobian)(row0 + row, col++) = jb[3 * row + i];
+      for (int i : upper_free) (*jacobian)(row0 + row, col++) = ju[6 * row + i];
+      for (int b = 0; b < 4; ++b) {
+        if (!on[b]) continue;
+        for (int i = 0; i < 3; ++i) (*jacobian)(row0 + row, col++) = je[b][3 * row + i];
+      }
     }
+    if (block.trend) (*trend_residuals)[block.position] = Eigen::Vector3d(r[0], r[1], r[2]);
+    row0 += block.rows;
   }
   return true;
 }
 
 // After the accelerometer fit: the covariance (with `covariance`, back in
 // raw units), the bias standard deviations, the residuals and the forces.
+// The first observations.size() rows of the Jacobian are the magnitudes.
 void FinishAccel(const std::vector<StaticObservation>& observations, double gravity, double scale,
                  const Eigen::MatrixXd& jacobian, const std::vector<int>& upper_free,
                  bool covariance, EffectFitResult* result) {
   SensorFitSummary* fit = &result->accel_fit;
   if (covariance) {
-    CovarianceFromJacobian(jacobian, 1, fit);
+    CovarianceFromJacobian(jacobian, 1, static_cast<int>(observations.size()), fit);
     // Back to raw units: b = c + s b', U = U' / s; the effects are in SI.
     Eigen::VectorXd d = Eigen::VectorXd::Ones(jacobian.cols());
     d.head<3>().setConstant(scale);
@@ -188,10 +212,48 @@ void FinishAccel(const std::vector<StaticObservation>& observations, double grav
   }
 }
 
+// The magnitude residual of every position, then the trend residual of
+// every position that has one (with `trends`), in normalised raw units.
+std::vector<AccelBlock> AccelBlocks(const std::vector<StaticObservation>& observations,
+                                    const std::vector<Position>& normalized, double scale,
+                                    const EffectParameters& initial_parameters, double gravity,
+                                    const std::vector<double>& sigmas, bool trends) {
+  std::vector<AccelBlock> blocks;
+  for (size_t k = 0; k < normalized.size(); ++k) {
+    const StaticObservation& o = observations[k];
+    AccelBlock b;
+    b.position = static_cast<int>(k);
+    b.cost.reset(GravityMagnitudeResidual::CreateWithEffects(
+        normalized[k].raw_mean, TemperatureOffset(initial_parameters, o.temperature()),
+        o.time() - initial_parameters.reference_time, gravity, sigmas[k]));
+    blocks.push_back(std::move(b));
+  }
+  if (!trends) return blocks;
+  for (size_t k = 0; k < normalized.size(); ++k) {
+    const StaticObservation& o = observations[k];
+    if (!o.has_trend) continue;
+    // Normalised units: the slope and its standard deviation divide by s.
+    const Eigen::Matrix3d whitening = Whitening(o.accel_slope_cov) * scale;
+    if (!whitening.allFinite()) continue;
+    AccelBlock b;
+    b.position = static_cast<int>(k);
+    b.rows = 3;
+    b.trend = true;
+    b.cost.reset(AccelTrendResidual::Create(normalized[k].raw_mean, o.accel_slope / scale,
+                                            whitening, o.temperature_slope,
+                                            TemperatureOffset(initial_parameters, o.temperature()),
+                                            o.time() - initial_parameters.reference_time));
+    blocks.push_back(std::move(b));
+  }
+  return blocks;
+}
+
 // The accelerometer part. Works in normalised raw units (normalization.h).
 bool FitAccel(const std::vector<StaticObservation>& observations, const AccelModel& initial,
               const EffectParameters& initial_parameters, double gravity,
-              const EffectFitOptions& options, EffectFitResult* result) {
+              const EffectFitOptions& options, double extra_variance,
+              Eigen::MatrixXd* whitened_jacobian, Eigen::VectorXd* whitened_residuals,
+              EffectFitResult* result) {
   const std::vector<Effect>& effects = options.effects;
   const bool free_off_diagonal = options.parameterization != AccelParameterization::kScale ||
                                  Contains(effects, Effect::kAccelMisalignment);
@@ -206,6 +268,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
     }
   }
   if (!SetAccelSigmas(positions, start, result)) return false;
+  for (double& sigma : result->accel_sigmas) sigma = std::sqrt(sigma * sigma + extra_variance);
   const Normalization norm = Normalization::For(start);
   const AccelModel start_n = norm.Apply(start);
   const std::vector<Position> normalized = norm.Apply(positions);
@@ -223,19 +286,18 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
     for (int i = 0; i < 3; ++i) blocks[b][i] = on[b] ? (*kInitial[b])(i) : 0.0;
   }
 
-  // The cost functions are kept (not owned by the problem) to evaluate the
-  // Jacobian at the optimum.
-  std::vector<std::unique_ptr<ceres::CostFunction>> owned;
+  const std::vector<AccelBlock> residuals =
+      AccelBlocks(observations, normalized, norm.scale, initial_parameters, gravity,
+                  result->accel_sigmas, options.use_within_pose_trends);
   std::vector<double*> parameter_blocks = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
   ceres::Problem::Options keep;
   keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(keep);
-  for (size_t k = 0; k < normalized.size(); ++k) {
-    const StaticObservation& o = observations[k];
-    owned.emplace_back(GravityMagnitudeResidual::CreateWithEffects(
-        normalized[k].raw_mean, TemperatureOffset(initial_parameters, o.temperature()),
-        o.time() - initial_parameters.reference_time, gravity, result->accel_sigmas[k]));
-    problem.AddResidualBlock(owned.back().get(), nullptr, parameter_blocks);
+  int num_rows = 0, trend_rows = 0;
+  for (const AccelBlock& b : residuals) {
+    problem.AddResidualBlock(b.cost.get(), nullptr, parameter_blocks);
+    num_rows += b.rows;
+    if (b.trend) trend_rows += b.rows;
   }
   if (!free_off_diagonal) {
     problem.SetManifold(upper, new ceres::SubsetManifold(6, {1, 2, 4}));
@@ -247,7 +309,8 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   ceres::Solve(SolverOptions(options), &problem, &summary);
   SensorFitSummary& fit = result->accel_fit;
   fit.fitted = true;
-  fit.information = "position magnitudes";
+  fit.information =
+      trend_rows > 0 ? "position magnitudes + within-pose trends" : "position magnitudes";
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
   fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {
@@ -257,15 +320,17 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
 
   const std::vector<int> upper_free = SetAccelParameterNames(free_off_diagonal, on, &fit);
   const int np = static_cast<int>(fit.parameter_names.size());
-  const int n = static_cast<int>(normalized.size());
-  Eigen::MatrixXd jacobian(n, np);
+  Eigen::MatrixXd jacobian(num_rows, np);
+  Eigen::VectorXd residual_rows(num_rows);
   const double* params[6] = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
-  if (!EvaluateAccelFit(owned, params, upper_free, on, options.compute_covariance, &jacobian,
-                        &fit)) {
+  result->accel_trend_residuals.assign(observations.size(), Eigen::Vector3d::Zero());
+  if (!EvaluateAccelFit(residuals, params, upper_free, on, options.compute_covariance, &jacobian,
+                        &residual_rows, &fit, &result->accel_trend_residuals)) {
     result->message = "accelerometer effect fit: the model has no value at a position";
     return false;
   }
-  fit.num_residuals = n;
+  fit.num_residuals = num_rows;
+  fit.trend_residuals = trend_rows;
   fit.num_parameters = np;
 
   AccelModel fitted_n = start_n;
@@ -282,7 +347,48 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
 
   FinishAccel(observations, gravity, norm.scale, jacobian, upper_free, options.compute_covariance,
               result);
+  *whitened_jacobian = std::move(jacobian);
+  *whitened_residuals = std::move(residual_rows);
   return true;
+}
+
+// REML of one extra variance of the magnitudes (magnitude_variance_component)
+// from a finished fit and its whitened Jacobian (magnitude rows first). The
+// magnitude rows enter unwhitened (m/s^2, sigma_k), the trend rows whitened
+// (sigma 1): s^2, of the order of sigma_k^2 (1e-7 (m/s^2)^2), is then
+// immaterial beside the trend rows' unit variance, so it is the magnitudes'
+// excess alone. False when the magnitudes leave no degree of freedom.
+bool MagnitudeVariance(const EffectFitResult& fit, const Eigen::MatrixXd& whitened_jacobian,
+                       const Eigen::VectorXd& whitened_residuals, const EffectFitOptions& options,
+                       VarianceComponent* component) {
+  const int n = static_cast<int>(fit.accel_sigmas.size());
+  const int rows = static_cast<int>(whitened_jacobian.rows());
+  // Residual directions of the magnitudes: n minus what the parameters
+  // take from them beyond what the trends already determine.
+  const std::vector<std::string>& names = fit.accel_fit.parameter_names;
+  const int trend_rank =
+      rows > n
+          ? AnalyzeObservability(whitened_jacobian.bottomRows(rows - n), names, kRankTolerance).rank
+          : 0;
+  const int magnitude_dof = n - (fit.accel_fit.rank - trend_rank);
+  if (magnitude_dof < 1 && !(options.magnitude_variance_prior_dof > 0.0)) {
+    component->message =
+        "the position magnitudes leave no residual degree of freedom: their extra variance is "
+        "not estimated (give a prior)";
+    return false;
+  }
+  internal::VariancePrior prior;
+  prior.variance = options.magnitude_variance_prior * options.magnitude_variance_prior;
+  prior.dof = options.magnitude_variance_prior_dof;
+  Eigen::VectorXd r = whitened_residuals;
+  Eigen::VectorXd sigmas = Eigen::VectorXd::Ones(r.size());
+  Eigen::MatrixXd jacobian = whitened_jacobian;
+  for (int k = 0; k < n; ++k) {
+    r(k) *= fit.accel_sigmas[k];
+    sigmas(k) = fit.accel_sigmas[k];
+    jacobian.row(k) *= fit.accel_sigmas[k];
+  }
+  return internal::EstimateVarianceComponent(r, sigmas, jacobian, component, prior);
 }
 
 // Per position, L_k^-1 of the covariance of the mean reading; false with
@@ -404,7 +510,7 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   result->parameters.gyro_temperature_bias = Eigen::Vector3d(temperature_bias);
   result->parameters.gyro_bias_drift = Eigen::Vector3d(drift);
   if (options.compute_covariance) {
-    CovarianceFromJacobian(jacobian, 3, &fit);
+    CovarianceFromJacobian(jacobian, 3, 3 * n, &fit);
     for (int i = 0; i < 3; ++i) result->gyro_bias_std(i) = fit.Std(fit.parameter_names[i]);
   }
   result->gyro_residuals.resize(n);
@@ -473,7 +579,47 @@ std::vector<StaticObservation> ObservationsFromIntervals(
   return out;
 }
 
+bool WithinPoseTrendOptions::IsValid(std::string* error) const {
+  if (batches < 4) {
+    *error = "within-pose trends: batches must be at least 4";
+    return false;
+  }
+  if (min_batch_samples < 1) {
+    *error = "within-pose trends: min_batch_samples must be at least 1";
+    return false;
+  }
+  if (!(min_seconds > 0.0)) {
+    *error = "within-pose trends: min_seconds must be positive";
+    return false;
+  }
+  return true;
+}
+
+std::vector<StaticObservation> ObservationsFromIntervals(
+    const ImuLog& log, const std::vector<StaticInterval>& intervals,
+    const WithinPoseTrendOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) return {};
+  std::vector<StaticObservation> out = ObservationsFromIntervals(intervals, log.has_gyro());
+  const std::vector<internal::PoseTrend> trends = internal::WithinPoseTrends(
+      log, intervals, options.batches, options.min_batch_samples, options.min_seconds);
+  for (size_t k = 0; k < out.size(); ++k) {
+    if (!trends[k].valid) continue;
+    out[k].has_trend = true;
+    out[k].accel_slope = trends[k].accel_slope;
+    out[k].accel_slope_cov = trends[k].accel_slope_cov;
+    out[k].temperature_slope = trends[k].temperature_slope;
+  }
+  return out;
+}
+
 bool EffectFitOptions::IsValid(std::string* error) const {
+  if (!(magnitude_variance_prior >= 0.0) || !(magnitude_variance_prior_dof >= 0.0) ||
+      !(magnitude_extra_variance >= 0.0) || !std::isfinite(magnitude_extra_variance)) {
+    *error =
+        "effect fit: magnitude_extra_variance, magnitude_variance_prior and its dof must be >= 0";
+    return false;
+  }
   std::string solver_error;
   if (!solver.IsValid(&solver_error)) {
     *error = "effect fit: " + solver_error;
@@ -508,15 +654,47 @@ bool FitEffects(const std::vector<StaticObservation>& observations, const AccelM
         needed += Info(e).num_parameters;
       }
     }
-    if (n < needed) {
+    int trends = 0;
+    if (options.use_within_pose_trends) {
+      trends =
+          static_cast<int>(std::count_if(observations.begin(), observations.end(),
+                                         [](const StaticObservation& o) { return o.has_trend; }));
+    }
+    if (n + 3 * trends < needed) {
       std::ostringstream s;
       s << "the accelerometer model with " << needed << " parameters needs at least " << needed
         << " static positions, found " << n;
+      if (trends > 0) s << " (and " << trends << " within-pose trends)";
       result->message = s.str();
       return false;
     }
-    if (!FitAccel(observations, initial, initial_parameters, gravity, options, result)) {
+    Eigen::MatrixXd jacobian;
+    Eigen::VectorXd residuals;
+    if (!FitAccel(observations, initial, initial_parameters, gravity, options,
+                  options.magnitude_extra_variance, &jacobian, &residuals, result)) {
       return false;
+    }
+    if (options.magnitude_variance_component && options.compute_covariance) {
+      VarianceComponent component;
+      if (MagnitudeVariance(*result, jacobian, residuals, options, &component) &&
+          component.variance > 0.0) {
+        double mean_white = 0.0;
+        for (double sigma : result->accel_sigmas) mean_white += sigma * sigma / n;
+        EffectFitResult refit = *result;
+        if (!FitAccel(observations, initial, initial_parameters, gravity, options,
+                      options.magnitude_extra_variance + component.variance, &jacobian, &residuals,
+                      &refit)) {
+          *result = refit;
+          return false;
+        }
+        *result = refit;
+        component.absorbed = true;
+        result->magnitude_variance_inflation =
+            internal::StudentInflation(component, mean_white, nullptr);
+        result->accel_fit.covariance *= result->magnitude_variance_inflation;
+        result->accel_bias_std *= std::sqrt(result->magnitude_variance_inflation);
+      }
+      result->magnitude_variance = component;
     }
   } else {
     result->accel_residuals.resize(n);

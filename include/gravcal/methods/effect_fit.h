@@ -7,7 +7,20 @@
 //
 //   r_k = ( |h^-1( U (v_k - b), dT_k, dt_k )| - g ) / sigma_k
 //
-// sigma_k from the position's own covariance of the mean (refinement.h).
+// sigma_k from the position's own covariance of the mean (refinement.h),
+// plus, with use_within_pose_trends and for every position whose
+// observation carries a within-pose trend, the AccelTrendResidual
+// (residuals/accel_trend_residual.h): three whitened values comparing the
+// slope of the raw mean against time within the pose with the slope the
+// temperature and drift terms predict,
+//
+//   t_k = L_k^-1 ( ghat_k - U^-1 ((c q_k + beta) Tdot_k + delta) ).
+//
+// Its noise L_k L_k^T is from the pose's batch means about their line,
+// pooled over the poses (src/methods/within_pose_trend.h). These are 3 more
+// residuals per pose that see beta, c and delta directly in every axis, so
+// a twelve-position session can test and estimate them; the quadratic term
+// and the model's bias, scale and non-orthogonality predict no trend.
 // Gyroscope (when the positions have it): minimises sum_k |L_k^-1 e_k|^2,
 //
 //   e_k = u_k - b_g - (G f_k + gamma dT_k + eta dt_k),
@@ -27,8 +40,10 @@
 
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/gyro_model.h"
+#include "gravcal/core/imu_log.h"
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/position.h"
+#include "gravcal/core/solver_result.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/solver_tolerances.h"
 #include "gravcal/methods/twelve_position.h"
@@ -44,6 +59,15 @@ struct StaticObservation {
   // Mean raw gyroscope vector and the covariance of that mean.
   Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();
   Eigen::Matrix3d gyro_mean_cov = Eigen::Matrix3d::Identity();
+  // The within-pose trend (AccelTrendResidual): slope of the raw
+  // accelerometer mean against time, raw units per second, its covariance,
+  // and the slope of the temperature, degC per second (0 without a
+  // temperature column). has_trend is false for a pose too short for it or
+  // when the observations were made without the log's samples.
+  bool has_trend = false;
+  Eigen::Vector3d accel_slope = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d accel_slope_cov = Eigen::Matrix3d::Identity();
+  double temperature_slope = 0.0;
 
   // Middle of the interval, s.
   double time() const { return 0.5 * (accel.t_begin + accel.t_end); }
@@ -51,9 +75,28 @@ struct StaticObservation {
 };
 
 // One observation per interval (the accelerometer part as
-// PositionsFromIntervals makes it).
+// PositionsFromIntervals makes it), without within-pose trends.
 std::vector<StaticObservation> ObservationsFromIntervals(
     const std::vector<StaticInterval>& intervals, bool has_gyro);
+
+// How the within-pose trends are read from the samples (within_pose_trend.h).
+struct WithinPoseTrendOptions {
+  // Batches per pose (>= 4); the noise is pooled over the poses.
+  int batches = 10;
+  // A pose gets a trend when it has batches * min_batch_samples samples
+  // (>= 1) and lasts min_seconds (> 0) or more.
+  int min_batch_samples = 5;
+  double min_seconds = 3.0;
+
+  bool IsValid(std::string* error) const;
+};
+
+// The same observations with each pose's within-pose trend from the samples
+// of `log` (the log the intervals were detected in). An empty result when
+// the options are invalid.
+std::vector<StaticObservation> ObservationsFromIntervals(
+    const ImuLog& log, const std::vector<StaticInterval>& intervals,
+    const WithinPoseTrendOptions& options = WithinPoseTrendOptions());
 
 struct EffectFitOptions {
   // The baseline accelerometer model: kScale holds the off-diagonal of U at
@@ -67,6 +110,30 @@ struct EffectFitOptions {
   // refits of a gyroscope effect alone.
   bool fit_accel = true;
   bool compute_covariance = true;
+  // Add the AccelTrendResidual of every observation that has a trend; false
+  // = the position magnitudes alone.
+  bool use_within_pose_trends = true;
+  // Estimate one extra variance s^2 common to the position magnitudes by
+  // REML (src/estimation/variance_component.h), refit with sigma_k^2 + s^2
+  // and inflate the covariance by the Student factor of the estimate: what
+  // the pose means share beyond their samples' noise (bias instability and
+  // random walk wander from pose to pose, placement). For estimates with
+  // honest standard deviations (calibrate --effects); off for the
+  // likelihood-ratio tests, where every model must see the same noise.
+  // Skipped when the magnitudes leave no residual degree of freedom beyond
+  // what the trends determine and no prior is given.
+  bool magnitude_variance_component = false;
+  // A fixed extra variance (m/s^2)^2 added to every magnitude's sigma_k^2
+  // (>= 0; the REML above adds to it): for likelihood-ratio tests, where
+  // every model must see the same noise, a value from outside the models
+  // compared (a noise model, a prior). The REML of a model without the
+  // candidate absorbs it: on twelve poses with the drift and both tempcos
+  // fitted, a hidden k2 is then found in 3 of 20 seeds instead of 20.
+  double magnitude_extra_variance = 0.0;
+  // A prior on s (m/s^2, >= 0) on prior_dof (>= 0) degrees of freedom
+  // (variance_component.h; 0 = none, REML alone).
+  double magnitude_variance_prior = 0.0;
+  double magnitude_variance_prior_dof = 0.0;
 
   // Stopping rules of the Ceres solve.
   SolverTolerances solver = {50, 1e-12, 1e-12, 1e-10};
@@ -78,12 +145,17 @@ struct EffectFitOptions {
 struct SensorFitSummary {
   bool fitted = false;
   bool converged = false;
-  // Scalar residuals (one per position for the accelerometer, three for the
-  // gyroscope) and free parameters.
+  // Scalar residuals (one per position for the accelerometer plus three per
+  // within-pose trend, three per position for the gyroscope) and free
+  // parameters.
   int num_residuals = 0;
   int num_parameters = 0;
   // Sum of squared whitened residuals.
   double chi2 = 0.0;
+  // The part of num_residuals and chi2 from the within-pose trends (0 when
+  // none was used); the rest is from the position magnitudes.
+  int trend_residuals = 0;
+  double trend_chi2 = 0.0;
   int dof() const { return num_residuals - num_parameters; }
   // Standard deviation of the named parameter from the covariance; NaN
   // when it was not estimated or no covariance was computed.
@@ -96,8 +168,9 @@ struct SensorFitSummary {
   // the covariance).
   std::vector<std::string> undetermined;
   int rank = 0;
-  // Leverage of each position, diag of J (J^T J)^+ J^T (the largest of its
-  // three rows for the gyroscope): near 1, the other positions do not
+  // Leverage of each position, diag of J (J^T J)^+ J^T (of its magnitude
+  // row for the accelerometer, the largest of its three rows for the
+  // gyroscope): near 1, the other positions do not
   // determine the model without it, so it cannot be predicted by them.
   // Only computed with the covariance.
   std::vector<double> leverage;
@@ -117,6 +190,10 @@ struct EffectFitResult {
   EffectParameters parameters;
   std::vector<Effect> effects;
   SensorFitSummary accel_fit;
+  // The extra magnitude variance (magnitude_variance_component), (m/s^2)^2,
+  // and the factor the accelerometer covariance was multiplied by.
+  VarianceComponent magnitude_variance;
+  double magnitude_variance_inflation = 1.0;
   SensorFitSummary gyro_fit;
   // Standard deviations of b (raw units), b_g (raw units) and each effect.
   Eigen::Vector3d accel_bias_std = Eigen::Vector3d::Constant(NAN);
@@ -130,6 +207,9 @@ struct EffectFitResult {
   std::vector<Eigen::Vector3d> forces;
   std::vector<Eigen::Vector3d> gyro_residuals;
   std::vector<Eigen::Vector3d> gyro_sigmas;
+  // Per position, the whitened within-pose trend residual t_k (zero where
+  // the position has none or trends were not used).
+  std::vector<Eigen::Vector3d> accel_trend_residuals;
   std::vector<std::string> warnings;
   std::string message = "FitEffects was not called";
 };

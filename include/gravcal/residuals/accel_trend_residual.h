@@ -1,0 +1,106 @@
+// gravcal/residuals/accel_trend_residual.h: the per-pose Ceres residual that
+// compares the trend of the raw accelerometer mean within a static pose with
+// the trend the effects predict.
+//
+// Within pose k the sensor is still, so the true specific force s is
+// constant and, by the sensor model of model_effects.h, per axis i
+//
+//   m_i(t) = (1 + c_i dT(t)) q_i + beta_i dT(t) + delta_i dt(t),   q_i = s_i + k2_i s_i^2,
+//
+// affine in dT and dt. The least-squares slope against time of the raw mean
+// v(t) = b + U^-1 m(t) over the pose is therefore exactly
+//
+//   g_k = U^-1 mdot_k,   mdot_{k,i} = (c_i q_i + beta_i) Tdot_k + delta_i,
+//
+// with Tdot_k the least-squares slope of the temperature against time over
+// the same pose (0 without a temperature column). q is read from the pose's
+// mean raw vector v_k at its mean offsets (dT_k, dt_k):
+//
+//   q_i = ( [U (v_k - b)]_i - beta_i dT_k - delta_i dt_k ) / (1 + c_i dT_k).
+//
+// The residual (3 values, dimensionless, unit variance) is
+//
+//   r_k = L_k^-1 ( ghat_k - U^-1 mdot_k ),
+//
+// ghat_k the measured slope (raw units per second) and L_k L_k^T its
+// covariance. The quadratic term drops out (q is constant within a pose),
+// so k2 only enters through the magnitude residual; a bias, scale or
+// non-orthogonality error alone predicts no trend. Blocks as
+// GravityMagnitudeResidual::CreateWithEffects: b (3), U (6: u00 u01 u02 u11
+// u12 u22), k2 (3, unused here), beta (3), c (3), delta (3), so both
+// residuals of a pose share one parameter list. The slope is uncorrelated
+// with the pose's mean (the regression is centred on the mean time), so the
+// two residuals of a pose add independently to chi2.
+#ifndef GRAVCAL_RESIDUALS_ACCEL_TREND_RESIDUAL_H_
+#define GRAVCAL_RESIDUALS_ACCEL_TREND_RESIDUAL_H_
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/ceres.h>
+
+#include <Eigen/Core>
+
+namespace gravcal {
+
+struct AccelTrendResidual {
+  // raw_mean v_k, slope ghat_k (raw units/s), whitening L_k^-1, Tdot_k
+  // (degC/s), dT_k = T_k - T_ref (0 when unknown) and dt_k = t_k - t_ref.
+  AccelTrendResidual(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& slope,
+                     const Eigen::Matrix3d& whitening, double temperature_slope,
+                     double temperature_offset, double time_offset)
+      : raw_mean_(raw_mean),
+        slope_(slope),
+        whitening_(whitening),
+        temperature_slope_(temperature_slope),
+        temperature_offset_(temperature_offset),
+        time_offset_(time_offset) {}
+
+  template <typename T>
+  bool operator()(const T* const bias, const T* const upper, const T* const /*quadratic*/,
+                  const T* const temperature_bias, const T* const temperature_scale,
+                  const T* const drift, T* residual) const {
+    const T d0 = T(raw_mean_(0)) - bias[0];
+    const T d1 = T(raw_mean_(1)) - bias[1];
+    const T d2 = T(raw_mean_(2)) - bias[2];
+    const T m[3] = {upper[0] * d0 + upper[1] * d1 + upper[2] * d2, upper[3] * d1 + upper[4] * d2,
+                    upper[5] * d2};
+    T rate[3];
+    for (int i = 0; i < 3; ++i) {
+      const T q =
+          (m[i] - temperature_bias[i] * T(temperature_offset_) - drift[i] * T(time_offset_)) /
+          (T(1.0) + temperature_scale[i] * T(temperature_offset_));
+      rate[i] = (temperature_scale[i] * q + temperature_bias[i]) * T(temperature_slope_) + drift[i];
+    }
+    // U^-1 mdot by back substitution (U upper triangular).
+    T predicted[3];
+    predicted[2] = rate[2] / upper[5];
+    predicted[1] = (rate[1] - upper[4] * predicted[2]) / upper[3];
+    predicted[0] = (rate[0] - upper[1] * predicted[1] - upper[2] * predicted[2]) / upper[0];
+    T e[3];
+    for (int i = 0; i < 3; ++i) e[i] = T(slope_(i)) - predicted[i];
+    for (int r = 0; r < 3; ++r) {
+      residual[r] =
+          T(whitening_(r, 0)) * e[0] + T(whitening_(r, 1)) * e[1] + T(whitening_(r, 2)) * e[2];
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& slope,
+                                     const Eigen::Matrix3d& whitening, double temperature_slope,
+                                     double temperature_offset, double time_offset) {
+    return new ceres::AutoDiffCostFunction<AccelTrendResidual, 3, 3, 6, 3, 3, 3, 3>(
+        new AccelTrendResidual(raw_mean, slope, whitening, temperature_slope, temperature_offset,
+                               time_offset));
+  }
+
+ private:
+  const Eigen::Vector3d raw_mean_;
+  const Eigen::Vector3d slope_;
+  const Eigen::Matrix3d whitening_;
+  const double temperature_slope_;
+  const double temperature_offset_;
+  const double time_offset_;
+};
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_RESIDUALS_ACCEL_TREND_RESIDUAL_H_
