@@ -322,7 +322,7 @@ bool DiscoverEffects(const ImuLog& log, const CalibrationOptions& calibration,
     return false;
   }
   result->source = log.source;
-  const bool ok = DiscoverFromObservations(ObservationsFromIntervals(intervals, log.has_gyro()),
+  const bool ok = DiscoverFromObservations(ObservationsFromIntervals(log, intervals),
                                            calibration, baseline_effects, options, result);
   if (!ok) result->message = internal::PrefixSource(log.source, result->message);
   return ok;

@@ -107,8 +107,11 @@ void AddGroups(const DiscoveryContext& ctx, Disagreement* disagreement) {
 std::string SummaryLine(const DiscoveryContext& ctx, const Disagreement& d, int n) {
   std::ostringstream s;
   s.precision(3);
-  s << "accelerometer |a| - g: " << std::sqrt(d.accel_chi2 / std::max(n, 1)) << " sigma rms (chi2 "
-    << d.accel_chi2 << " on " << d.accel_dof << " dof, p = " << d.accel_p << ")";
+  double magnitude_chi2 = 0.0;
+  for (const PositionDisagreement& p : d.positions) magnitude_chi2 += p.accel_z * p.accel_z;
+  s << "accelerometer |a| - g: " << std::sqrt(magnitude_chi2 / std::max(n, 1))
+    << " sigma rms (chi2 " << d.accel_chi2 << " on " << d.accel_dof << " dof, p = " << d.accel_p
+    << ")";
   if (!d.worst_accel.empty()) {
     const PositionDisagreement& w = d.positions[d.worst_accel[0]];
     s << ", worst position " << w.index << " (" << w.axis << " up, t = " << w.time << " s, "
@@ -155,6 +158,9 @@ Disagreement Locate(const DiscoveryContext& ctx, const EffectFitResult& fit, int
     }
     d.positions.push_back(p);
   }
+  // The within-pose trend rows (when the fit used them) are part of the
+  // accelerometer's likelihood and of its dof: chi2 and dof count the same rows.
+  d.accel_chi2 += fit.accel_fit.trend_chi2;
   d.accel_dof = fit.accel_fit.dof();
   d.accel_p = ChiSquareUpperTail(d.accel_chi2, d.accel_dof);
   if (ctx.has_gyro && fit.gyro_fit.fitted) {
