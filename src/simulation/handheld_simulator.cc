@@ -7,6 +7,7 @@
 
 #include "gravcal/estimation/strapdown.h"
 #include "simulation/sensor_noise.h"
+#include "util/random_vector.h"
 #include "util/units.h"
 
 namespace gravcal {
@@ -134,7 +135,9 @@ struct MotionStream {
   std::mt19937_64 rng;
   std::normal_distribution<double> n01{0.0, 1.0};
   std::uniform_real_distribution<double> u01{0.0, 1.0};
-  Vec3 Normal3() { return Vec3(n01(rng), n01(rng), n01(rng)); }
+  Vec3 Normal3() {
+    return internal::DrawVector3([this] { return n01(rng); });
+  }
 };
 
 // The truth sensors, as in simulator.cc: scale in SI per raw unit.
