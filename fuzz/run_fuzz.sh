@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Runs the fuzz targets of a GRAVCAL_FUZZ build.
 #   fuzz/run_fuzz.sh <build dir> <target|all> <seconds per target>
-# With FUZZ_RUNS=<n> in the environment, each target runs n inputs from a
-# fixed seed (-seed=1) instead of a time: the same inputs on every machine,
-# so CI is reproducible (a finding there is found again here).
+# With FUZZ_SEED=<n>, libFuzzer's random choices start from that seed (CI
+# uses 1: the same inputs in the same order on every machine, so a finding
+# is found again here, though a time budget may stop earlier or later on a
+# slower machine). With FUZZ_RUNS=<n>, each target runs n inputs from seed
+# 1 instead of a time (exactly reproducible).
 # Targets named in FUZZ_REGRESSIONS_ONLY (space separated) only run their
-# regression inputs (CI: ros1_bag runs about 50 inputs/s under the
-# sanitizers, too slow for its budget).
+# regression inputs.
 # Each target first runs its regression inputs (fuzz/regressions/<target>/,
 # inputs that once crashed or broke an invariant, kept after the fix), then
 # fuzzes for the given time from the seed corpus (fuzz/corpus/<target>/ and
@@ -43,6 +44,7 @@ for t in $targets; do
   esac
   start=$SECONDS
   budget=(-max_total_time="$seconds")
+  if [ -n "${FUZZ_SEED:-}" ]; then budget+=(-seed="$FUZZ_SEED"); fi
   if [ -n "${FUZZ_RUNS:-}" ]; then budget=(-runs="$FUZZ_RUNS" -seed=1); fi
   if ! "$exe" "${budget[@]}" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
     -artifact_prefix="$crashes/" -print_final_stats=1 "$work" "$build/fuzz/seeds/$t" \

@@ -74,6 +74,22 @@ class BatchFaultsTest : public ::testing::Test {
     ASSERT_EQ(clean.exit_code, 0) << clean.err;
     clean_summary_ = new std::string(WithoutTimes(Slurp(*scratch_ / "clean/summary.csv")));
   }
+  // Unit "hang" (a new FIFO at `fifo` that nobody writes: a hung network
+  // file system looks the same), then unit1 .. unit<count - 1> of the
+  // fleet; *base is the fleet's config. Failures are the test's.
+  static std::vector<BatchUnit> HangThenUnits(const std::string& fifo, int count, Config* base) {
+    EXPECT_EQ(mkfifo(fifo.c_str(), 0644), 0) << fifo;
+    std::string error;
+    EXPECT_TRUE(LoadConfigFile(ConfigPath(), base, &error)) << error;
+    std::vector<BatchUnit> units(count);
+    units[0].id = "hang";
+    units[0].path = fifo;
+    for (int k = 1; k < count; ++k) {
+      units[k].id = "unit" + std::to_string(k);
+      units[k].path = UnitPath(k);
+    }
+    return units;
+  }
   static void TearDownTestSuite() {
     delete scratch_;
     delete clean_summary_;
@@ -203,18 +219,23 @@ TEST_F(BatchFaultsTest, OutputFolderBecomingUnwritableLosesNothingWritten) {
   ExpectResumesToCleanResult(out);
 }
 
-// One unit's file is truncated and rewritten over and over while batches
-// read it: every run ends with that unit calibrated or failed with a message
-// naming it, never a crash or a result marked current for bytes it did not
-// use; once the file is left alone, a run resumes to the clean result.
+// One unit's file is truncated and rewritten in place, and replaced by
+// another file renamed over it, over and over while batches read it: every
+// run ends with that unit calibrated or failed with a message naming it,
+// never a crash or a result marked current for bytes it did not use; once
+// the file is left alone, a run resumes to the clean result.
 TEST_F(BatchFaultsTest, UnitFileRewrittenWhileBeingReadGivesAResultOrAMessage) {
   const std::string victim = UnitPath(2);
+  const std::string replacement = *scratch_ / "replacement.csv";
   const std::string good = Slurp(victim);
   std::atomic<bool> done{false};
   std::thread churn([&] {
     for (int i = 0; !done; ++i) {
-      std::ofstream f(victim, std::ios::binary | std::ios::trunc);
+      const bool replace = i % 4 >= 2;  // Two rewrites in place, two replacements.
+      std::ofstream f(replace ? replacement : victim, std::ios::binary | std::ios::trunc);
       f << good.substr(0, (i % 2 == 0) ? good.size() / 3 : good.size());
+      f.close();
+      if (replace) std::filesystem::rename(replacement, victim);
     }
   });
   const std::string out = *scratch_ / "churn";
@@ -276,17 +297,10 @@ TEST_F(BatchFaultsTest, RunawayUnitTimesOutAndTheBatchGoesOn) {
 // of the caller's; a fresh worker took its place meanwhile.
 TEST_F(BatchFaultsTest, LibraryAbandonsTheRunawayWorkerSafely) {
   const std::string fifo = *scratch_ / "hang_library.csv";
-  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
   Config base;
+  std::vector<BatchUnit> units = HangThenUnits(fifo, 3, &base);
+  ASSERT_FALSE(HasFailure());
   std::string error;
-  ASSERT_TRUE(LoadConfigFile(ConfigPath(), &base, &error)) << error;
-  std::vector<BatchUnit> units(3);
-  units[0].id = "hang";
-  units[0].path = fifo;
-  for (int k = 1; k < 3; ++k) {
-    units[k].id = "unit" + std::to_string(k);
-    units[k].path = UnitPath(k);
-  }
   BatchOptions options;
   options.threads = 1;
   options.unit_timeout_seconds = 0.5;
@@ -308,6 +322,58 @@ TEST_F(BatchFaultsTest, LibraryAbandonsTheRunawayWorkerSafely) {
   results.clear();
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_EQ(calls, 2);
+}
+
+// A stop (what SIGTERM sets) while a unit hangs: the hanging unit is
+// abandoned once stop_grace_seconds are over, not waited for; the unit no
+// worker started is not run; each says so, and no callback is called for
+// either. The abandoned worker comes back after the run and touches nothing.
+TEST_F(BatchFaultsTest, StopAbandonsTheUnitStillInFlightAfterTheGrace) {
+  const std::string fifo = *scratch_ / "hang_on_stop.csv";
+  Config base;
+  std::vector<BatchUnit> units = HangThenUnits(fifo, 2, &base);
+  ASSERT_FALSE(HasFailure());
+  std::string error;
+  std::atomic<bool> stop{false};
+  BatchOptions options;
+  options.threads = 1;
+  options.stop = &stop;
+  options.stop_grace_seconds = 0.3;
+  std::atomic<int> calls{0};
+  options.on_result = [&calls](size_t, const BatchResult&) { ++calls; };
+  // The stop comes once the worker has opened the FIFO (opening its write
+  // end without blocking succeeds only then); the write end stays open and
+  // silent, so the worker hangs in its read.
+  std::atomic<int> writer{-1};
+  std::thread stopper([&] {
+    for (int i = 0; i < 60000 && writer < 0; ++i) {
+      writer = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+      if (writer < 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    stop = true;
+  });
+  std::vector<BatchResult> results;
+  const bool ran = CalibrateBatch(units, base, options, &results, &error);
+  stopper.join();
+  ASSERT_TRUE(ran) << error;
+  ASSERT_GE(writer, 0) << "the worker never opened the FIFO";
+  ASSERT_EQ(results.size(), 2u);
+  EXPECT_EQ(results[0].status, BatchStatus::kFailed);
+  EXPECT_TRUE(results[0].not_run);
+  EXPECT_FALSE(results[0].timed_out);
+  EXPECT_NE(results[0].message.find("hang: abandoned in flight: the batch was stopped"),
+            std::string::npos)
+      << results[0].message;
+  EXPECT_EQ(results[1].status, BatchStatus::kFailed);
+  EXPECT_TRUE(results[1].not_run);
+  EXPECT_NE(results[1].message.find("unit1: not run"), std::string::npos) << results[1].message;
+  EXPECT_EQ(calls, 0);
+  // Release the abandoned reader: it reads an empty file and goes away.
+  close(writer);
+  units.clear();
+  results.clear();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(calls, 0);
 }
 
 // SIGTERM in the middle: the unit in flight finishes, no new one starts, the

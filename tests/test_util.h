@@ -20,6 +20,7 @@
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
+#include "util/random_vector.h"
 
 namespace gravcal {
 namespace testing_util {
@@ -39,7 +40,7 @@ inline Eigen::VectorXd FreeParameters(const AccelModel& m, AccelParameterization
 // A uniformly random unit vector.
 inline Eigen::Vector3d RandomDirection(std::mt19937_64* rng) {
   std::normal_distribution<double> n(0.0, 1.0);
-  Eigen::Vector3d v(n(*rng), n(*rng), n(*rng));
+  const Eigen::Vector3d v = internal::DrawVector3([&] { return n(*rng); });
   return v.normalized();
 }
 
@@ -69,13 +70,13 @@ inline std::vector<Position> MakePositions(const AccelModel& truth,
   const Eigen::Matrix3d l = raw_cov_mean.llt().matrixL();
   std::vector<Position> out;
   for (size_t k = 0; k < directions.size(); ++k) {
-    const Eigen::Vector3d tilt(tilt_rad * n(*rng), tilt_rad * n(*rng), tilt_rad * n(*rng));
+    const Eigen::Vector3d tilt = tilt_rad * internal::DrawVector3([&] { return n(*rng); });
     const Eigen::Matrix3d r =
         tilt.norm() > 0 ? Eigen::AngleAxisd(tilt.norm(), tilt.normalized()).toRotationMatrix()
                         : Eigen::Matrix3d::Identity();
     const Eigen::Vector3d f = gravity * (r * directions[k]);
     Position p;
-    p.raw_mean = truth.Invert(f) + l * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+    p.raw_mean = truth.Invert(f) + l * internal::DrawVector3([&] { return n(*rng); });
     p.raw_mean_cov = raw_cov_mean;
     p.sample_count = samples;
     p.t_begin = 10.0 * k;

@@ -262,6 +262,10 @@ bool ReadBatchSettings(const CommandArgs& args, BatchSettings* s, std::string* e
   s->batch.keep_calibrations = false;
   s->batch.unit_timeout_seconds = args.unit_timeout;
   s->batch.stop = &g_stop;
+  // Below the 30 s that Slurm (KillWait), Kubernetes
+  // (terminationGracePeriodSeconds) and AWS Batch (the ECS stop timeout) wait
+  // by default between SIGTERM and SIGKILL, so that the summary is written.
+  s->batch.stop_grace_seconds = 20.0;
   if (!s->batch.IsValid(error)) return false;
   if (IsSchedulerShard(args.shard)) {
     return ShardFromScheduler(args.shard, ProcessEnvironment(), &s->shard, &s->shard_source, error);

@@ -5,6 +5,8 @@
 #include <Eigen/QR>
 #include <cmath>
 
+#include "util/random_vector.h"
+
 namespace gravcal {
 
 int NumParameters(AccelParameterization p) {
@@ -78,8 +80,8 @@ AccelModel AccelModel::Random(AccelParameterization p, double nominal_scale, dou
     model.upper(1, 2) = nominal_scale * misalignment_std * n01(*rng);
   }
   if (p == AccelParameterization::kAffine) {
-    const Eigen::Vector3d angles(misalignment_std * n01(*rng), misalignment_std * n01(*rng),
-                                 misalignment_std * n01(*rng));
+    const Eigen::Vector3d angles =
+        misalignment_std * internal::DrawVector3([&] { return n01(*rng); });
     model.rotation =
         Eigen::AngleAxisd(angles.norm(), angles.norm() > 0.0 ? Eigen::Vector3d(angles.normalized())
                                                              : Eigen::Vector3d::UnitX())

@@ -5,7 +5,9 @@
 namespace gravcal {
 
 const std::vector<EffectInfo>& EffectCatalogue() {
-  static const std::vector<EffectInfo> catalogue = [] {
+  // Never destroyed (Google style for static storage): a batch worker abandoned
+  // with a hung unit may still read it while the process exits (found by TSan).
+  static const std::vector<EffectInfo>& catalogue = *new std::vector<EffectInfo>([] {
     std::vector<EffectInfo> entries = {
         {Effect::kAccelMisalignment,
          "non-orthogonality of the accelerometer axes (cross-axis terms u_xy, u_xz, u_yz of U), "
@@ -68,7 +70,7 @@ const std::vector<EffectInfo>& EffectCatalogue() {
     // The names come from the one table in types.cc.
     for (EffectInfo& info : entries) info.name = ToString(info.effect);
     return entries;
-  }();
+  }());
   return catalogue;
 }
 

@@ -7,6 +7,7 @@
 
 #include "gravcal/estimation/strapdown.h"
 #include "simulation/sensor_noise.h"
+#include "util/random_vector.h"
 #include "util/units.h"
 
 namespace gravcal {
@@ -134,12 +135,8 @@ struct MotionStream {
   std::mt19937_64 rng;
   std::normal_distribution<double> n01{0.0, 1.0};
   std::uniform_real_distribution<double> u01{0.0, 1.0};
-  // Sequenced in g++'s order, as simulator.cc's MainStream::Normal3.
   Vec3 Normal3() {
-    const double z = n01(rng);
-    const double y = n01(rng);
-    const double x = n01(rng);
-    return Vec3(x, y, z);
+    return internal::DrawVector3([this] { return n01(rng); });
   }
 };
 

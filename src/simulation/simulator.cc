@@ -11,6 +11,7 @@
 
 #include "gravcal/core/gravity.h"
 #include "simulation/sensor_noise.h"
+#include "util/random_vector.h"
 
 namespace gravcal {
 namespace {
@@ -151,7 +152,7 @@ struct HandProfile {
                 (options.hand_max_seconds - options.hand_min_seconds) * u01(*rng);
     for (double& cj : p.c) cj = 0.5 * (u01(*rng) - 0.5);
     p.amplitude = options.hand_wobble_deg * kPi / 180.0 * n01(*rng);
-    Eigen::Vector3d v(n01(*rng), n01(*rng), n01(*rng));
+    const Eigen::Vector3d v = internal::DrawVector3([&] { return n01(*rng); });
     if (v.norm() > 0.0) p.wobble_axis = v.normalized();
     return p;
   }
@@ -176,12 +177,7 @@ void DrawEffects(const SimulatorOptions& o, uint64_t seed, SimulatedSession* s) 
   std::mt19937_64 rng(seed ^ 0x6a09e667f3bcc909ULL);
   std::normal_distribution<double> n01(0.0, 1.0);
   auto draw3 = [&](double std) -> Eigen::Vector3d {
-    // Sequenced (z, y, x: the order g++ gave the unsequenced arguments), so a
-    // seed is the same session whatever the compiler.
-    const double z = n01(rng);
-    const double y = n01(rng);
-    const double x = n01(rng);
-    return Eigen::Vector3d(x, y, z) * std;
+    return internal::DrawVector3([&] { return n01(rng); }) * std;
   };
   EffectParameters& e = s->effects;
   e.reference_temperature = o.effect_reference_temperature;
@@ -203,14 +199,8 @@ struct MainStream {
   explicit MainStream(uint64_t seed) : rng(seed) {}
   std::mt19937_64 rng;
   std::normal_distribution<double> n01{0.0, 1.0};
-  // Sequenced z, y, x: function arguments are evaluated in an unspecified
-  // order (g++ right to left, clang left to right), and a seed must be the
-  // same session whatever the compiler; z first is g++'s order.
   Eigen::Vector3d Normal3() {
-    const double z = n01(rng);
-    const double y = n01(rng);
-    const double x = n01(rng);
-    return Eigen::Vector3d(x, y, z);
+    return internal::DrawVector3([this] { return n01(rng); });
   }
 };
 

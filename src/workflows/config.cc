@@ -13,7 +13,9 @@ namespace gravcal {
 namespace internal {
 
 const std::vector<ConfigSection>& ConfigSections() {
-  static const std::vector<ConfigSection> sections = {
+  // Never destroyed (Google style for static storage): a batch worker abandoned
+  // with a hung unit may still read it while the process exits (found by TSan).
+  static const std::vector<ConfigSection>& sections = *new std::vector<ConfigSection>{
       GeneralSection(),   InputSection(),          GravitySection(),         DetectorSection(),
       PoseNoiseSection(), ModelSection(),          SolverSection(),          GyroSection(),
       AlignmentSection(), HandheldKalmanSection(), EffectsSection(),         DiscoverySection(),
@@ -101,7 +103,9 @@ bool Config::IsValid(std::string* error) const {
 }
 
 const std::vector<ConfigKey>& ConfigKeys() {
-  static const std::vector<ConfigKey> keys = [] {
+  // Never destroyed (Google style for static storage): a batch worker abandoned
+  // with a hung unit may still read it while the process exits (found by TSan).
+  static const std::vector<ConfigKey>& keys = *new std::vector<ConfigKey>([] {
     std::vector<ConfigKey> k;
     for (const ConfigSection& section : ConfigSections()) {
       for (const ConfigKeyHandler& h : section.keys) {
@@ -109,7 +113,7 @@ const std::vector<ConfigKey>& ConfigKeys() {
       }
     }
     return k;
-  }();
+  }());
   return keys;
 }
 

@@ -147,7 +147,9 @@ bool RunRateTable(const Config&, const MethodData& data, Calibration* calibratio
 }  // namespace
 
 const std::vector<CalibrationMethod>& CalibrationMethods() {
-  static const std::vector<CalibrationMethod> methods = {
+  // Never destroyed (Google style for static storage): a batch worker abandoned
+  // with a hung unit may still read it while the process exits (found by TSan).
+  static const std::vector<CalibrationMethod>& methods = *new std::vector<CalibrationMethod>{
       {"twelve_position",
        "multi-position magnitude fit",
        {"gravity", "detector", "pose_noise", "model", "solver", "gyro", "effects"},
