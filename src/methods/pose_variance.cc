@@ -131,8 +131,7 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
                                ? ""
                                : " (too few poses to test whether non-orthogonality explains it)");
   *pose_variance = vc;
-  WarnPoseVariance(vc, effective_dof, options, &refinement->warnings,
-                   &refinement->warning_codes);
+  WarnPoseVariance(vc, effective_dof, options, &refinement->warnings, &refinement->warning_codes);
 }
 
 void WarnPoseVariance(const VarianceComponent& vc, double effective_dof,
