@@ -16,7 +16,6 @@ using internal::Median;
 namespace internal {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kTerms = 4;  // quantisation, white noise, bias instability, random walk
 
 // The standard normal quantile by bisection of erfc (for confidence levels:
