@@ -4,6 +4,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "gravcal/io/log_reader.h"
 
@@ -118,6 +120,17 @@ std::string Format(double v) {
   return s.str();
 }
 
+// still.<key>, a sample index: a non-negative integer. A float (9e99) or a
+// negative number is refused here, before any conversion to size_t.
+size_t StillIndex(const json& still, const char* key) {
+  const json& v = still.at(key);
+  if (!v.is_number_unsigned()) {
+    throw std::runtime_error(std::string("still.") + key +
+                             " is not a sample index (a non-negative integer)");
+  }
+  return v.get<size_t>();
+}
+
 }  // namespace
 }  // namespace internal
 
@@ -159,8 +172,11 @@ bool NoiseFromJson(const std::string& text, const std::string& name, ImuNoise* n
     ImuNoiseModel& m = parsed.model;
     m.rate_hz = in.at("rate_hz").get<double>();
     const json& still = in.at("still");
-    m.still_begin = still.at("begin").get<size_t>();
-    m.still_end = still.at("end").get<size_t>();
+    m.still_begin = internal::StillIndex(still, "begin");
+    m.still_end = internal::StillIndex(still, "end");
+    if (m.still_end <= m.still_begin) {
+      throw std::runtime_error("still.end is not after still.begin");
+    }
     m.still_t_begin = still.at("t_begin").get<double>();
     m.still_t_end = still.at("t_end").get<double>();
     const double confidence = in.value("confidence", 0.683);
