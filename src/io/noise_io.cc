@@ -174,8 +174,8 @@ bool NoiseFromJson(const std::string& text, const std::string& name, ImuNoise* n
     const json& still = in.at("still");
     m.still_begin = internal::StillIndex(still, "begin");
     m.still_end = internal::StillIndex(still, "end");
-    if (m.still_end <= m.still_begin) {
-      throw std::runtime_error("still.end is not after still.begin");
+    if (m.still_end < m.still_begin) {
+      throw std::runtime_error("still.end is before still.begin");
     }
     m.still_t_begin = still.at("t_begin").get<double>();
     m.still_t_end = still.at("t_end").get<double>();
