@@ -466,5 +466,27 @@ TEST(PlanCli, BadInputExitsNonZeroAndWritesNothing) {
   EXPECT_NE(r.out.find("u_xy"), std::string::npos) << r.out;
 }
 
+TEST(PlanIo, TurnIndicesOutsideThePosesAreRefusedNotWrapped) {
+  // Two poses; a turn 0 -> 1 reads, while indices that only fit after being
+  // narrowed to int (2^32 and 2^32 + 1 would become 0 and 1) are refused.
+  const std::string poses =
+      R"({"poses": [{"up": [0, 0, 1], "hold_s": 10}, {"up": [1, 0, 0], "hold_s": 10}],)";
+  const auto turns = [&](const std::string& from, const std::string& to) {
+    return poses + R"( "rotations": [{"from": )" + from + R"(, "to": )" + to +
+           R"(, "axis": [0, 1, 0], "angle_deg": 90}]})";
+  };
+  std::vector<PlannedRotation> read;
+  std::string error;
+  ASSERT_TRUE(PlanRotationsFromJson(turns("0", "1"), "plan.json", 2, &read, &error)) << error;
+  ASSERT_EQ(read.size(), 1u);
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"4294967296", "4294967297"}, {"-1", "0"}, {"1", "2"}, {"18446744073709551615", "0"}}) {
+    error.clear();
+    EXPECT_FALSE(PlanRotationsFromJson(turns(from, to), "plan.json", 2, &read, &error))
+        << from << " -> " << to;
+    EXPECT_NE(error.find("plan.json: rotations[0]"), std::string::npos) << error;
+  }
+}
+
 }  // namespace
 }  // namespace gravcal

@@ -1,6 +1,7 @@
 #include "gravcal/io/plan_io.h"
 
 #include <cmath>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 
 #include "gravcal/io/files.h"
@@ -198,8 +199,13 @@ bool PlanRotationsFromJson(const std::string& text, const std::string& name, siz
       if (ok) turn.axis(i) = r["axis"][i].get<double>();
     }
     if (ok) {
-      turn.from = r["from"].get<int>();
-      turn.to = r["to"].get<int>();
+      // Read wide and range-check before narrowing, so 2^32 + 1 is refused
+      // rather than read as pose 1.
+      const int64_t from = r["from"].get<int64_t>();
+      const int64_t to = r["to"].get<int64_t>();
+      ok = from >= 0 && to >= 0 && static_cast<uint64_t>(to) < pose_count;
+      turn.from = ok ? static_cast<int>(from) : -1;
+      turn.to = ok ? static_cast<int>(to) : -1;
       turn.angle_deg = r["angle_deg"].get<double>();
       if (r.contains("duration_s") && r["duration_s"].is_number()) {
         turn.seconds = r["duration_s"].get<double>();
