@@ -1,4 +1,5 @@
 """noise and discover from Python equal `gravcal noise` / `gravcal discover`."""
+import numpy as np
 import pytest
 
 import gravcal
@@ -15,6 +16,47 @@ def test_noise_equals_cli(tmp_path):
     result = gravcal.noise(tmp_path / "raw.csv", nominal_scale=float(scale))
     assert strip_times(result) == strip_times(read_json(out))
     assert result["accel"]["x"]["white_noise"]["value"] > 0
+
+
+def test_noise_writes_the_clis_files(tmp_path):
+    # A still log whose white noise and random walk show on every axis (so
+    # Kalibr's imu.yaml can be written), in m/s^2 and rad/s.
+    rate, n = 100.0, 120000
+    rng = np.random.default_rng(1)
+
+    def still(white, walk, mean):
+        steps = walk / np.sqrt(rate) * rng.standard_normal((n, 3))
+        return np.asarray(mean) + white * np.sqrt(rate) * rng.standard_normal((n, 3)) + \
+            np.cumsum(steps, axis=0)
+
+    path = tmp_path / "still.csv"
+    gravcal.log(np.arange(n) / rate, still(2e-3, 5e-3, [0.0, 0.0, 9.80665]),
+                still(2e-4, 5e-4, [0.0, 0.0, 0.0])).to_csv(path)
+    units = {"nominal_scale": 1.0, "gyro_nominal_scale": 1.0}
+    files = ("kalibr", "handheld", "report")
+    run_cli("noise", "--input", path, "--nominal_scale", 1, "--gyro_nominal_scale", 1,
+            "--output", tmp_path / "cli.json",
+            *[x for f in files for x in ("--" + f, tmp_path / ("cli_" + f))])
+    result = gravcal.noise(str(path), **units, **{f: tmp_path / ("py_" + f) for f in files})
+    assert strip_times(result) == strip_times(read_json(tmp_path / "cli.json"))
+    for f in files:
+        cli = (tmp_path / ("cli_" + f)).read_bytes()
+        assert (tmp_path / ("py_" + f)).read_bytes() == cli, f
+    assert b"accelerometer_random_walk" in (tmp_path / "cli_kalibr").read_bytes()
+    assert (tmp_path / "cli_report").read_text().lstrip().lower().startswith("<!doctype html")
+
+
+def test_noise_kalibr_failure_writes_nothing(tmp_path):
+    # White noise alone: no random walk shows, so Kalibr's file cannot be
+    # written; the error names it and no file is left, as with the CLI.
+    rng = np.random.default_rng(2)
+    n = 30000
+    accel = [0.0, 0.0, 9.80665] + 2e-2 * rng.standard_normal((n, 3))
+    log = gravcal.log(np.arange(n) / 100.0, accel, 2e-3 * rng.standard_normal((n, 3)))
+    with pytest.raises(gravcal.Error, match="py_kalibr"):
+        gravcal.noise(log, nominal_scale=1.0, kalibr=tmp_path / "py_kalibr",
+                      report=tmp_path / "py_report")
+    assert not (tmp_path / "py_kalibr").exists() and not (tmp_path / "py_report").exists()
 
 
 def test_discover_equals_cli(tmp_path):

@@ -77,10 +77,12 @@ std::string HousingPicture(const Eigen::Vector3d& up, int number) {
 }
 
 // One row per parameter: predicted sigma and target in readable units.
-std::string SigmaTable(const std::string& caption, const std::vector<std::string>& names,
-                       const Eigen::VectorXd& std, const Eigen::VectorXd& targets,
-                       const std::vector<bool>& targeted,
+std::string SigmaTable(const std::string& caption, const SensorPrediction& prediction,
                        ReadableUnit (*unit_of)(const std::string&)) {
+  const std::vector<std::string>& names = prediction.parameter_names;
+  const Eigen::VectorXd& std = prediction.predicted_std_scale_free;
+  const Eigen::VectorXd& targets = prediction.targets_scale_free;
+  const std::vector<bool>& targeted = prediction.targeted;
   std::ostringstream s;
   s << "<table class='sigma'><caption>" << HtmlEscape(caption)
     << "</caption><tr><th>parameter</th><th>predicted sigma</th><th>target</th></tr>";
@@ -142,13 +144,9 @@ std::string PlanToHtml(const RecordingPlan& plan) {
   h << internal::RenderSphere("up directions of the poses (sensor frame)", ups, labels);
 
   h << "<h2>Predicted standard deviations</h2>";
-  h << SigmaTable("accelerometer (calibration JSON: accel.covariance)", plan.parameter_names,
-                  plan.predicted_std_scale_free, plan.targets_scale_free, plan.targeted,
-                  ReadableUnitOf);
-  if (!plan.gyro_parameter_names.empty()) {
-    h << SigmaTable("gyroscope (calibration JSON: gyro.covariance)", plan.gyro_parameter_names,
-                    plan.gyro_predicted_std_scale_free, plan.gyro_targets_scale_free,
-                    plan.gyro_targeted, GyroReadableUnitOf);
+  h << SigmaTable("accelerometer (calibration JSON: accel.covariance)", plan.accel, ReadableUnitOf);
+  if (!plan.gyro.parameter_names.empty()) {
+    h << SigmaTable("gyroscope (calibration JSON: gyro.covariance)", plan.gyro, GyroReadableUnitOf);
   }
   if (!plan.schemes.empty()) {
     h << "<h2>Against fixed schemes</h2><table class='schemes'><tr><th>scheme</th><th>poses</th>"
