@@ -532,12 +532,12 @@ std::string DomText(const std::string& text) {
 }
 
 // Empty when the plan report's DOM shows the plan of plan.json: every pose
-// in order as a housing picture captioned with its instruction and hold (the
-// gyroscope's extra poses marked), the turn between each two poses with its
-// instruction, a dot per pose on the sphere, a row per parameter in the
-// accelerometer's table (and the gyroscope's when planned) with its
-// predicted sigma, and the fixed schemes' table; otherwise the first thing
-// missing.
+// in order as a housing picture of its up direction (the picture's data-up)
+// captioned with its instruction and hold (the gyroscope's extra poses
+// marked), the turn between each two poses with its instruction, a dot per
+// pose on the sphere, a row per parameter in the accelerometer's table (and
+// the gyroscope's when planned) with its predicted sigma, and the fixed
+// schemes' table; otherwise the first thing missing.
 std::string PlanReportProblem(const std::string& dom, const nlohmann::json& plan) {
   const nlohmann::json& poses = plan["poses"];
   const nlohmann::json& turns = plan["rotations"];
@@ -565,6 +565,13 @@ std::string PlanReportProblem(const std::string& dom, const nlohmann::json& plan
     const std::string caption = DomText(poses[k]["instruction"].get<std::string>()) + "; hold " +
                                 Printf("%.1f", poses[k]["hold_s"].get<double>()) + " s";
     if (f.find("<svg class=\"housing\"") == std::string::npos) return pose + ": no picture";
+    std::istringstream drawn(Attribute(f, "data-up"));
+    Eigen::Vector3d up;
+    for (int i = 0; i < 3; ++i) {
+      if (!(drawn >> up(i)) || std::fabs(up(i) - poses[k]["up"][i].get<double>()) > 1e-3) {
+        return pose + ": the picture is not of its up direction";
+      }
+    }
     if (f.find(caption) == std::string::npos) return pose + ": caption is not '" + caption + "'";
     if (f.find(">" + std::to_string(k + 1) + "</text>") == std::string::npos) {
       return pose + ": picture not numbered";
@@ -628,8 +635,9 @@ TEST(ReportBrowser, PlanReport) {
   const std::string dom = OpenReport(html, "plan", dir, 0);
   EXPECT_EQ(PlanReportProblem(dom, plan), "");
 
-  // Planted: a turn left out, a pose left out, two captions swapped, the
-  // gyroscope's table dropped, an extra pose not marked.
+  // Planted: a turn left out, a pose left out, the gyroscope's table
+  // dropped, two captions swapped, a picture of another direction, an extra
+  // pose not marked.
   auto cut = [&](const std::string& open, const std::string& close, size_t nth) {
     size_t a = 0;
     for (size_t i = 0; i <= nth; ++i) a = dom.find(open, i ? a + 1 : 0);
@@ -649,6 +657,10 @@ TEST(ReportBrowser, PlanReport) {
   swapped.replace(b + 12, second.size(), first);
   swapped.replace(a + 12, first.size(), second);
   EXPECT_NE(PlanReportProblem(swapped, plan), "");
+  std::string turned = dom;
+  const size_t drawn = turned.find("data-up=\"", turned.find("<figure class=\"pose", 0) + 1);
+  turned.replace(drawn + 9, turned.find('"', drawn + 9) - drawn - 9, "0.0000 0.0000 -1.0000");
+  EXPECT_NE(PlanReportProblem(turned, plan), "");
   std::string unmarked = dom;
   unmarked.replace(unmarked.rfind("pose pose-gyro"), 14, "pose");
   EXPECT_NE(PlanReportProblem(unmarked, plan), "");

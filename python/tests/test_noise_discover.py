@@ -47,16 +47,24 @@ def test_noise_writes_the_clis_files(tmp_path):
 
 
 def test_noise_kalibr_failure_writes_nothing(tmp_path):
-    # White noise alone: no random walk shows, so Kalibr's file cannot be
-    # written; the error names it and no file is left, as with the CLI.
+    # 5 s of rest: enough for the curve, too short to show the random walk
+    # Kalibr needs. The CLI and Python fail with the same line and leave no
+    # file (the texts are made before any file is written).
     rng = np.random.default_rng(2)
-    n = 30000
-    accel = [0.0, 0.0, 9.80665] + 2e-2 * rng.standard_normal((n, 3))
-    log = gravcal.log(np.arange(n) / 100.0, accel, 2e-3 * rng.standard_normal((n, 3)))
-    with pytest.raises(gravcal.Error, match="py_kalibr"):
-        gravcal.noise(log, nominal_scale=1.0, kalibr=tmp_path / "py_kalibr",
-                      report=tmp_path / "py_report")
-    assert not (tmp_path / "py_kalibr").exists() and not (tmp_path / "py_report").exists()
+    n = 500
+    path = tmp_path / "five.csv"
+    gravcal.log(np.arange(n) / 100.0, [0.0, 0.0, 9.80665] + 2e-3 * rng.standard_normal((n, 3)),
+                2e-4 * rng.standard_normal((n, 3))).to_csv(path)
+    files = {"kalibr": tmp_path / "imu.yaml", "report": tmp_path / "noise.html"}
+    code, error = run_cli("noise", "--input", path, "--nominal_scale", 1, "--gyro_nominal_scale", 1,
+                          "--noise_find_still", "false", "--output", tmp_path / "noise.json",
+                          *[x for f, p in files.items() for x in ("--" + f, p)], ok=False)
+    assert code == 1 and "Kalibr needs" in error
+    with pytest.raises(gravcal.Error) as raised:
+        gravcal.noise(str(path), nominal_scale=1.0, gyro_nominal_scale=1.0, noise_find_still=False,
+                      **files)
+    assert str(raised.value) == error
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["five.csv"]
 
 
 def test_discover_equals_cli(tmp_path):

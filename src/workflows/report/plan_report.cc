@@ -24,7 +24,8 @@ Eigen::Matrix3d PoseRotation(const Eigen::Vector3d& up) {
 // A small picture of the housing in one pose: a box (longest along x,
 // flattest along z, so the faces can be told apart) seen from the front
 // right and above, resting on a table line, with the housing's x, y and z
-// axes as coloured arrows and the pose number.
+// axes as coloured arrows and the pose number. data-up states the up
+// direction drawn (for tests/report_browser_test.cc).
 std::string HousingPicture(const Eigen::Vector3d& up, int number) {
   const Eigen::Matrix3d r = PoseRotation(up);
   // Camera: looking along -view; screen right and screen up.
@@ -46,8 +47,10 @@ std::string HousingPicture(const Eigen::Vector3d& up, int number) {
   double lowest = 0.0;
   for (const Eigen::Vector3d& c : corners) lowest = std::min(lowest, (r * c).z());
   std::ostringstream s;
-  s << "<svg class='housing' width='" << size << "' height='" << size << "' viewBox='0 0 " << size
-    << " " << size << "' xmlns='http://www.w3.org/2000/svg'>";
+  s << "<svg class='housing' data-up='" << FormatNumber(up.x(), "%.4f") << " "
+    << FormatNumber(up.y(), "%.4f") << " " << FormatNumber(up.z(), "%.4f") << "' width='" << size
+    << "' height='" << size << "' viewBox='0 0 " << size << " " << size
+    << "' xmlns='http://www.w3.org/2000/svg'>";
   const double table_y = cy - scale * (lowest * Eigen::Vector3d::UnitZ()).dot(screen_up);
   s << "<line x1='8' y1='" << FormatNumber(table_y, "%.1f") << "' x2='" << size - 8 << "' y2='"
     << FormatNumber(table_y, "%.1f") << "' stroke='#bbb' stroke-width='3'/>";
