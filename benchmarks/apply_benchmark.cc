@@ -75,10 +75,7 @@ void BM_ApplyEveryTerm(benchmark::State& state) {
     }
     ImuSample s;
     while (reader.Next(&s, &error)) {
-      Eigen::Vector3d a;
-      corrector.CorrectAccel(s.accel, s.temperature, s.t, &a);
-      s.gyro = corrector.CorrectGyro(s.gyro, a, s.temperature, s.t);
-      s.accel = a;
+      corrector.CorrectRow(s.temperature, s.t, &s.accel, &s.gyro);
       writer.Write(s, &error);
     }
     if (!error.empty() || !writer.Commit(&error)) {

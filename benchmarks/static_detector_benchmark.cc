@@ -8,6 +8,7 @@
 
 #include "gravcal/core/position.h"
 #include "gravcal/detection/static_detector.h"
+#include "util/random_vector.h"
 
 namespace gravcal {
 namespace {
@@ -28,8 +29,7 @@ ImuLog MakeBenchmarkLog(size_t n) {
   const size_t move = 300;
   Eigen::Vector3d up(0.0, 0.0, 1.0);
   while (log.size() < n) {
-    const Eigen::Vector3d next =
-        Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng)).normalized();
+    const Eigen::Vector3d next = internal::DrawVector3([&] { return uniform(rng); }).normalized();
     const Eigen::Vector3d axis = up.cross(next).normalized();
     const double angle = std::acos(std::max(-1.0, std::min(1.0, up.dot(next))));
     for (size_t i = 0; i < still + move && log.size() < n; ++i) {

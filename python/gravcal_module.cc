@@ -252,11 +252,11 @@ void WriteCalibration(const PyCalibration& c, const std::string& path) {
   Check(WriteFileAtomically(path, c.Json(), &error), error);
 }
 
-// Applies everything the calibration holds (core/imu_corrector.h, the same
-// corrector as `gravcal apply`) to every row: accel (N, 3) raw -> m/s^2 and,
-// when given, gyro (N, 3) raw -> rad/s with the corrected accel for the
-// g-sensitivity. temp (N) and t (N) feed the temperature and time terms and
-// are required by name when the calibration has such terms.
+// Applies everything the calibration holds (core/imu_corrector.h, row by
+// row with ImuCorrector::CorrectRow, as `gravcal apply` does) to every row: accel (N, 3) raw ->
+// m/s^2 and, when given, gyro (N, 3) raw -> rad/s with the corrected accel for the g-sensitivity.
+// temp (N) and t (N) feed the temperature and time terms and are required by name when the
+// calibration has such terms.
 py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, const py::object& gyro,
                            const py::object& temp, const py::object& t) {
   std::vector<Eigen::Vector3d> a = ToVectors(accel, "accel", -1);
@@ -289,16 +289,12 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
     double* ao = a_out.mutable_data();
     double* wo = w_out.mutable_data();
     for (size_t i = 0; i < a.size(); ++i) {
-      Eigen::Vector3d si;
-      if (!corrector.CorrectAccel(a[i], temperature[i], time[i], &si)) {
+      if (!corrector.CorrectRow(temperature[i], time[i], &a[i], w.empty() ? nullptr : &w[i])) {
         bad_row = i;
         break;
       }
-      Eigen::Map<Eigen::Vector3d>(ao + 3 * i) = si;
-      if (!w.empty()) {
-        Eigen::Map<Eigen::Vector3d>(wo + 3 * i) =
-            corrector.CorrectGyro(w[i], si, temperature[i], time[i]);
-      }
+      Eigen::Map<Eigen::Vector3d>(ao + 3 * i) = a[i];
+      if (!w.empty()) Eigen::Map<Eigen::Vector3d>(wo + 3 * i) = w[i];
     }
   }
   Check(bad_row == a.size(),
@@ -467,8 +463,10 @@ std::vector<BatchUnit> UnitsFromFolder(const std::string& folder, const std::str
 // ---------------------------------------------------------------------------
 // Noise and discovery: the JSON text of noise.json and discovery.json.
 
-// `gravcal noise` (workflows/noise_workflow.h).
-std::string Noise(const Config& config, const LogHandle& input) {
+// `gravcal noise` (workflows/noise_workflow.h): noise.json's text, and
+// the files of `files` written as the CLI writes them (WriteNoiseFiles, the
+// report titled with the log's source).
+std::string Noise(const Config& config, const LogHandle& input, const NoiseFiles& files) {
   NoiseOptions options;
   std::string error;
   Check(NoiseOptionsFromConfig(config, &options, &error), error);
@@ -476,7 +474,8 @@ std::string Noise(const Config& config, const LogHandle& input) {
   bool ok;
   {
     py::gil_scoped_release release;
-    ok = CharacteriseLogNoise(input->log, options, &noise, &error);
+    ok = CharacteriseLogNoise(input->log, options, &noise, &error) &&
+         WriteNoiseFiles(noise, input->log.source, files, nullptr, &error);
   }
   Check(ok, error);
   return NoiseToJson(noise);
@@ -554,13 +553,14 @@ py::dict CheckSession(const Config& config, const LogHandle& log, PlanRequest re
   }
   Check(ok, error);
   py::dict d;
-  d["parameters"] = report.parameter_names;
+  const SensorPrediction& accel = report.accel;
+  d["parameters"] = accel.parameter_names;
   d["positions"] = report.positions;
-  d["nominal_scale"] = report.nominal_scale;
-  d["predicted_std"] = report.predicted_std;
-  d["predicted_std_scale_free"] = report.predicted_std_scale_free;
-  d["targets_scale_free"] = report.targets_scale_free;
-  d["targeted"] = report.targeted;
+  d["nominal_scale"] = accel.nominal_scale;
+  d["predicted_std"] = accel.predicted_std;
+  d["predicted_std_scale_free"] = accel.predicted_std_scale_free;
+  d["targets_scale_free"] = accel.targets_scale_free;
+  d["targeted"] = accel.targeted;
   d["undetermined"] = report.undetermined;
   d["short_of_target"] = report.short_of_target;
   d["proposed"] = PosesList(report.proposed);
@@ -739,7 +739,13 @@ PYBIND11_MODULE(_gravcal, m) {
       },
       py::arg("specs"));
   m.def("batch", &Batch, py::arg("units"), py::arg("config"), py::arg("threads"));
-  m.def("noise", &Noise, py::arg("config"), py::arg("log"));
+  m.def(
+      "noise",
+      [](const Config& config, const LogHandle& log, const std::string& kalibr,
+         const std::string& handheld, const std::string& report) {
+        return Noise(config, log, {"", kalibr, handheld, report});
+      },
+      py::arg("config"), py::arg("log"), py::arg("kalibr"), py::arg("handheld"), py::arg("report"));
   m.def("discover", &Discover, py::arg("config"), py::arg("log"));
   m.def("write_file", [](const std::string& path, const std::string& text) {
     std::string error;

@@ -23,6 +23,7 @@
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/imu_stream.h"
 #include "gravcal/io/log_reader.h"
+#include "util/random_vector.h"
 
 namespace gravcal {
 namespace {
@@ -360,8 +361,8 @@ std::vector<ImuSample> Samples(size_t n) {
   for (size_t i = 0; i < n; ++i) {
     ImuSample s;
     s.t = i;
-    s.accel = Eigen::Vector3d(accel(rng), accel(rng), accel(rng));
-    s.gyro = Eigen::Vector3d(gyro(rng), gyro(rng), gyro(rng));
+    s.accel = internal::DrawVector3([&] { return accel(rng); });
+    s.gyro = internal::DrawVector3([&] { return gyro(rng); });
     samples.push_back(s);
   }
   return samples;

@@ -26,6 +26,7 @@
 #include "gravcal/workflows/pipeline.h"
 #include "sigma_check.h"
 #include "test_util.h"
+#include "util/random_vector.h"
 
 namespace gravcal {
 namespace {
@@ -239,7 +240,7 @@ ImuLog SessionWithoutZRotation(const GyroModel& gyro, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01(0.0, 1.0);
   auto noise = [&](double s) -> Eigen::Vector3d {
-    return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)) * s;
+    return internal::DrawVector3([&] { return n01(rng); }) * s;
   };
   ImuLog log;
   log.source = "no_z_rotation";

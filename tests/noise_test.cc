@@ -20,6 +20,7 @@
 #include "sigma_check.h"
 #include "still_log.h"
 #include "test_util.h"
+#include "util/random_vector.h"
 
 namespace gravcal {
 namespace {
@@ -77,7 +78,13 @@ TEST(AllanDeviation, MatchesDefinition) {
   std::normal_distribution<double> n01(0.0, 1.0);
   std::vector<double> x(1000);
   double walk = 0.0;
-  for (double& v : x) v = 5.0 + n01(rng) + (walk += 0.1 * n01(rng));
+  // The white draw first, then the walk's (the order g++ gave the single
+  // unsequenced expression this was, so the numbers are unchanged).
+  for (double& v : x) {
+    const double white = n01(rng);
+    walk += 0.1 * n01(rng);
+    v = 5.0 + white + walk;
+  }
   AllanOptions options;
   options.points_per_octave = 3;
   AllanDeviation curve;
@@ -265,8 +272,8 @@ TEST(CharacteriseNoise, RefusesMovingLog) {
     // Turning all the time about x, at a varying rate.
     const double angle = 0.8 * t + 0.5 * std::sin(0.3 * t);
     log.accel.push_back(9.81 * Eigen::Vector3d(n01(rng), std::sin(angle), std::cos(angle)));
-    log.gyro.push_back(
-        Eigen::Vector3d(0.8 + 0.15 * std::cos(0.3 * t) + n01(rng), n01(rng), n01(rng)));
+    log.gyro.push_back(Eigen::Vector3d(0.8 + 0.15 * std::cos(0.3 * t), 0.0, 0.0) +
+                       internal::DrawVector3([&] { return n01(rng); }));
   }
   ImuNoise noise;
   EXPECT_FALSE(CharacteriseNoise(log, NoiseOptions(), &noise));

@@ -135,9 +135,10 @@ TEST(Plan, MeetsTargetsAndNeverTakesLongerThanTheSeedsTwelvePositions) {
       std::string error;
       ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << target << ": " << error;
       EXPECT_TRUE(plan.meets_targets);
-      for (size_t i = 0; i < plan.parameter_names.size(); ++i) {
-        EXPECT_LE(plan.predicted_std_scale_free(i), plan.targets_scale_free(i) * (1 + 1e-9))
-            << target << " " << plan.parameter_names[i];
+      for (size_t i = 0; i < plan.accel.parameter_names.size(); ++i) {
+        EXPECT_LE(plan.accel.predicted_std_scale_free(i),
+                  plan.accel.targets_scale_free(i) * (1 + 1e-9))
+            << target << " " << plan.accel.parameter_names[i];
       }
       const SchemeComparison& twelve = plan.schemes[0];
       ASSERT_EQ(twelve.name, "twelve");
@@ -280,8 +281,8 @@ TEST(Plan, GyroTurnsMapThePosesAndBeatTheShortestTurns) {
   RecordingPlan plan;
   std::string error;
   ASSERT_TRUE(MakeRecordingPlan(GyroConfig(), request, &plan, &error)) << error;
-  ASSERT_EQ(plan.gyro_parameter_names.size(), 12u);
-  EXPECT_EQ(plan.gyro_parameter_names[3], "m_xx");
+  ASSERT_EQ(plan.gyro.parameter_names.size(), 12u);
+  EXPECT_EQ(plan.gyro.parameter_names[3], "m_xx");
   ASSERT_EQ(plan.rotations.size() + 1, plan.poses.size());
   std::vector<DesignPose> poses;
   std::vector<DesignTurn> chosen, shortest;
@@ -297,9 +298,9 @@ TEST(Plan, GyroTurnsMapThePosesAndBeatTheShortestTurns) {
     shortest.push_back(
         {s.axis, s.angle_deg, request.turn_seconds * std::max(0.5, s.angle_deg / 180)});
   }
-  for (Eigen::Index i = 0; i < plan.gyro_predicted_std_scale_free.size(); ++i) {
-    EXPECT_LE(plan.gyro_predicted_std_scale_free(i), plan.gyro_targets_scale_free(i))
-        << plan.gyro_parameter_names[i];
+  for (Eigen::Index i = 0; i < plan.gyro.predicted_std_scale_free.size(); ++i) {
+    EXPECT_LE(plan.gyro.predicted_std_scale_free(i), plan.gyro.targets_scale_free(i))
+        << plan.gyro.parameter_names[i];
   }
   // The design's criterion is no worse than the shortest turns' between the
   // same poses.
@@ -308,7 +309,7 @@ TEST(Plan, GyroTurnsMapThePosesAndBeatTheShortestTurns) {
   GyroDesignModel gyro_model;
   DesignNoise noise = WhiteDesignNoise(kDensity);
   for (AxisNoiseModel& a : noise.gyro) a.white_noise.value = request.gyro_noise_density;
-  const Eigen::VectorXd& w = plan.gyro_targets_scale_free;
+  const Eigen::VectorXd& w = plan.gyro.targets_scale_free;
   auto phi = [&](const std::vector<DesignTurn>& turns) {
     const GyroDesignResult r = EvaluateRotations(poses, turns, model, gyro_model, noise, w);
     return (r.predicted_std.array() / w.array()).square().sum();
@@ -357,9 +358,9 @@ TEST(Plan, KnownAttitudeModelPlansTheTwelveParameters) {
   request.attitude_std_deg = 0.05;
   RecordingPlan plan;
   ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << error;
-  ASSERT_EQ(plan.parameter_names.size(), 12u);
-  EXPECT_EQ(plan.parameter_names[4], "m_xy");
-  EXPECT_TRUE(plan.predicted_std.allFinite());
+  ASSERT_EQ(plan.accel.parameter_names.size(), 12u);
+  EXPECT_EQ(plan.accel.parameter_names[4], "m_xy");
+  EXPECT_TRUE(plan.accel.predicted_std.allFinite());
   EXPECT_TRUE(plan.meets_targets);
   // A worse fixture needs more: the attitude noise is in the information.
   PlanRequest coarse = request;

@@ -1,4 +1,4 @@
-// Issue 17: every HTML report (calibrate, batch, noise, discover --report)
+// Issue 17: every HTML report (calibrate, batch, noise, discover, plan --report)
 // opened in a real browser. Headless Chromium loads the file (file://, no
 // network); a test fails on any console message (the reports log nothing, so
 // any message is an error or a warning), checks the sections in the DOM the
@@ -27,6 +27,7 @@
 #include "gravcal/workflows/report.h"
 #include "still_log.h"
 #include "test_util.h"
+#include "util/random_vector.h"
 
 namespace gravcal {
 namespace {
@@ -359,7 +360,7 @@ TEST(ReportBrowser, RejectedStretchesAreShadedWithTheirReason) {
   std::mt19937 rng(1);
   std::normal_distribution<double> tremor(0.0, std::sqrt(19.0 * clean.accel_noise_floor / 3.0));
   for (size_t i = clean.intervals[3].begin; i < clean.intervals[3].end; ++i) {
-    log.accel[i] += Eigen::Vector3d(tremor(rng), tremor(rng), tremor(rng));
+    log.accel[i] += internal::DrawVector3([&] { return tremor(rng); });
   }
   // Pose 8 cut to 1.5 s by a jolt after its first 1.5 s.
   const StaticInterval& cut = clean.intervals[7];
@@ -512,6 +513,157 @@ TEST(ReportBrowser, DiscoveryReport) {
       SimulateAndReport("discover", ConfigPath("discovery.yaml"), 2, "discovery", dir);
   ASSERT_FALSE(HasFailure());
   OpenReport(html, "discovery", dir, 4);
+}
+
+// printf of one number (the report's FormatNumber).
+std::string Printf(const char* format, double v) {
+  char b[64];
+  std::snprintf(b, sizeof(b), format, v);
+  return b;
+}
+
+// Text as the browser serialises a text node (&, <, > escaped).
+std::string DomText(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    out += c == '&' ? "&amp;" : c == '<' ? "&lt;" : c == '>' ? "&gt;" : std::string(1, c);
+  }
+  return out;
+}
+
+// Empty when the plan report's DOM shows the plan of plan.json: every pose
+// in order as a housing picture of its up direction (the picture's data-up)
+// captioned with its instruction and hold (the gyroscope's extra poses
+// marked), the turn between each two poses with its instruction, a dot per
+// pose on the sphere, a row per parameter in the accelerometer's table (and
+// the gyroscope's when planned) with its predicted sigma, and the fixed
+// schemes' table; otherwise the first thing missing.
+std::string PlanReportProblem(const std::string& dom, const nlohmann::json& plan) {
+  const nlohmann::json& poses = plan["poses"];
+  const nlohmann::json& turns = plan["rotations"];
+  const size_t extra = plan.value("gyro_extra_poses", 0);
+  if (Count(dom, "<figure class=\"pose") != poses.size()) return "not one figure per pose";
+  if (Count(dom, "<svg class=\"housing\"") != poses.size()) return "not one picture per pose";
+  if (Count(dom, "class=\"turn\"") != turns.size()) return "not one turn per pair of poses";
+  if (Count(dom, "class=\"pose-dot\"") != poses.size()) return "not one sphere dot per pose";
+  size_t at = 0;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    const std::string pose = "pose " + std::to_string(k + 1);
+    const size_t figure = dom.find("<figure class=\"pose", at);
+    if (figure == std::string::npos) return pose + ": no figure";
+    if (k > 0) {
+      const size_t turn = dom.find("class=\"turn\"", at);
+      const std::string instruction = DomText(turns[k - 1]["instruction"].get<std::string>());
+      if (turn == std::string::npos || turn > figure ||
+          dom.substr(turn, dom.find("</div>", turn) - turn).find(instruction) ==
+              std::string::npos) {
+        return "turn " + std::to_string(k) + " (" + instruction + ") not before " + pose;
+      }
+    }
+    at = dom.find("</figure>", figure);
+    const std::string f = dom.substr(figure, at - figure);
+    const std::string caption = DomText(poses[k]["instruction"].get<std::string>()) + "; hold " +
+                                Printf("%.1f", poses[k]["hold_s"].get<double>()) + " s";
+    if (f.find("<svg class=\"housing\"") == std::string::npos) return pose + ": no picture";
+    std::istringstream drawn(Attribute(f, "data-up"));
+    Eigen::Vector3d up;
+    for (int i = 0; i < 3; ++i) {
+      if (!(drawn >> up(i)) || std::fabs(up(i) - poses[k]["up"][i].get<double>()) > 1e-3) {
+        return pose + ": the picture is not of its up direction";
+      }
+    }
+    if (f.find(caption) == std::string::npos) return pose + ": caption is not '" + caption + "'";
+    if (f.find(">" + std::to_string(k + 1) + "</text>") == std::string::npos) {
+      return pose + ": picture not numbered";
+    }
+    const bool gyro = k + extra >= poses.size();
+    if ((f.find("pose-gyro") != std::string::npos) != gyro ||
+        (f.find("(for the gyroscope)") != std::string::npos) != gyro) {
+      return pose + (gyro ? ": not" : ": wrongly") + " marked as a gyroscope pose";
+    }
+  }
+  // The tables: one per planned sensor, a row per parameter with its sigma.
+  std::vector<std::string> sensors = {"predicted_std_readable"};
+  if (plan.contains("gyro_predicted_std_readable"))
+    sensors.push_back("gyro_predicted_std_readable");
+  if (Count(dom, "<table class=\"sigma\">") != sensors.size()) return "not one table per sensor";
+  size_t table = 0;
+  for (const std::string& key : sensors) {
+    table = dom.find("<table class=\"sigma\">", table + 1);
+    const std::string t = dom.substr(table, dom.find("</table>", table) - table);
+    if (Count(t, "<tr>") != plan[key].size() + 1) return key + ": not a row per parameter";
+    for (const auto& [name, readable] : plan[key].items()) {
+      const std::string row = "<td>" + name + "</td><td>" +
+                              Printf("%.3g", readable["value"].get<double>()) + " " +
+                              readable["unit"].get<std::string>() + "</td>";
+      if (t.find(row) == std::string::npos) return key + ": no row '" + row + "'";
+    }
+  }
+  const size_t schemes = dom.find("<table class=\"schemes\">");
+  if (schemes == std::string::npos) return "no schemes table";
+  const std::string t = dom.substr(schemes, dom.find("</table>", schemes) - schemes);
+  if (t.find("<td>this plan</td><td>" + std::to_string(poses.size()) + "</td>") ==
+      std::string::npos) {
+    return "schemes table: no row for this plan";
+  }
+  for (const auto& [name, scheme] : plan["schemes"].items()) {
+    if (t.find("<td>" + name + "</td><td>" + std::to_string(scheme["poses"].get<int>()) +
+               "</td>") == std::string::npos) {
+      return "schemes table: no row for " + name;
+    }
+  }
+  return "";
+}
+
+// plan --report with the gyroscope (extra poses for it, timed turns): every
+// planned pose drawn and every turn listed in order, the tables, nothing
+// external loaded; then defects planted into the DOM, each of which the
+// check must catch.
+TEST(ReportBrowser, PlanReport) {
+  SKIP_WITHOUT_BROWSER();
+  ScratchDir dir;
+  const std::string html = dir / "plan.html";
+  const testing_util::CliResult r =
+      RunCli({"plan", "--config", ConfigPath("twelve_position_gyro.yaml"), "--accel_noise_density",
+              "2e-3", "--gyro_noise_density", "2e-4", "--target", "accel_bias=0.5mg gyro_bias=5dph",
+              "--pose_set", "faces+45", "--output", dir / "plan.json", "--report", html},
+             dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json plan = nlohmann::json::parse(Slurp(dir / "plan.json"));
+  ASSERT_GT(plan["gyro_extra_poses"].get<int>(), 0) << "the plan should need extra poses";
+  ASSERT_EQ(plan["rotations"].size() + 1, plan["poses"].size());
+  const std::string dom = OpenReport(html, "plan", dir, 0);
+  EXPECT_EQ(PlanReportProblem(dom, plan), "");
+
+  // Planted: a turn left out, a pose left out, the gyroscope's table
+  // dropped, two captions swapped, a picture of another direction, an extra
+  // pose not marked.
+  auto cut = [&](const std::string& open, const std::string& close, size_t nth) {
+    size_t a = 0;
+    for (size_t i = 0; i <= nth; ++i) a = dom.find(open, i ? a + 1 : 0);
+    const size_t b = dom.find(close, a) + close.size();
+    return dom.substr(0, a) + dom.substr(b);
+  };
+  EXPECT_NE(PlanReportProblem(cut("<div class=\"turn\"", "</div>", 3), plan), "");
+  EXPECT_NE(PlanReportProblem(cut("<figure class=\"pose", "</figure>", 5), plan), "");
+  EXPECT_NE(PlanReportProblem(cut("<table class=\"sigma\">", "</table>", 1), plan), "");
+  std::string swapped = dom;
+  const std::string first = DomText(plan["poses"][0]["instruction"].get<std::string>());
+  const std::string second = DomText(plan["poses"][1]["instruction"].get<std::string>());
+  ASSERT_NE(first, second);
+  const size_t a = swapped.find("<figcaption>" + first);
+  const size_t b = swapped.find("<figcaption>" + second, a);
+  ASSERT_NE(b, std::string::npos);
+  swapped.replace(b + 12, second.size(), first);
+  swapped.replace(a + 12, first.size(), second);
+  EXPECT_NE(PlanReportProblem(swapped, plan), "");
+  std::string turned = dom;
+  const size_t drawn = turned.find("data-up=\"", turned.find("<figure class=\"pose", 0) + 1);
+  turned.replace(drawn + 9, turned.find('"', drawn + 9) - drawn - 9, "0.0000 0.0000 -1.0000");
+  EXPECT_NE(PlanReportProblem(turned, plan), "");
+  std::string unmarked = dom;
+  unmarked.replace(unmarked.rfind("pose pose-gyro"), 14, "pose");
+  EXPECT_NE(PlanReportProblem(unmarked, plan), "");
 }
 
 // A one-hour 200 Hz session: the report stays under 2 MB (min/max

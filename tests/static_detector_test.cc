@@ -14,6 +14,7 @@
 #include "gravcal/core/position.h"
 #include "gravcal/io/log_reader.h"
 #include "test_util.h"
+#include "util/random_vector.h"
 
 namespace gravcal {
 namespace {
@@ -209,7 +210,7 @@ TEST(StaticDetector, ReportsNearlyStillStretchesWithTheirReason) {
   std::mt19937 rng(11);
   std::normal_distribution<double> tremor(0.0, 0.02 * std::sqrt(19.0));
   for (size_t i = truth[1].begin; i < truth[1].end; ++i) {
-    log.accel[i] += Eigen::Vector3d(tremor(rng), tremor(rng), tremor(rng));
+    log.accel[i] += internal::DrawVector3([&] { return tremor(rng); });
   }
   for (size_t i = truth[4].begin; i < truth[4].end; ++i) {
     // Pose 4 has x down: rocking about x leaves gravity where it is.
@@ -288,7 +289,7 @@ TEST(StaticDetector, MergesABriefBumpButNotAPickUp) {
   std::mt19937 rng(7);
   std::normal_distribution<double> normal(0.0, 0.3);
   for (size_t i = 1000; i < 1010; ++i)
-    tapped.accel[i] += Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    tapped.accel[i] += internal::DrawVector3([&] { return normal(rng); });
   StaticDetection d;
   ASSERT_TRUE(DetectStaticIntervals(tapped, StaticDetectorOptions(), &d)) << d.message;
   ExpectMatches(d, truth, 30, 30);

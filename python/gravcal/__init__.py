@@ -455,11 +455,15 @@ def batch(units, config=None, threads=0, *, pattern="*.csv", **keys):
     return results
 
 
-def noise(log=None, *, config=None, t=None, accel=None, gyro=None, temp=None, **keys):
+def noise(log=None, *, config=None, kalibr=None, handheld=None, report=None, t=None, accel=None,
+          gyro=None, temp=None, **keys):
     """The noise model of a still log (Allan deviation), as ``gravcal noise``
-    writes noise.json: a dict."""
+    writes noise.json: a dict. ``kalibr``, ``handheld`` and ``report`` write
+    Kalibr's imu.yaml, the handheld filter's keys and the HTML report there
+    (the CLI's --kalibr, --handheld, --report; the same library call)."""
     cfg = _config(config, **keys)
-    return _result(_gravcal.noise(cfg, _as_log(log, cfg, t, accel, gyro, temp)))
+    paths = ["" if p is None else _os.fspath(p) for p in (kalibr, handheld, report)]
+    return _result(_gravcal.noise(cfg, _as_log(log, cfg, t, accel, gyro, temp), *paths))
 
 
 def discover(log=None, *, config=None, report=None, t=None, accel=None, gyro=None, temp=None,

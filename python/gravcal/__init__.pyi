@@ -101,7 +101,9 @@ def simulate(config: ConfigLike = ..., seed: int = ..., *, plan: Optional[PathLi
 def batch(units: Union[PathLike, Sequence[Union[PathLike, Log, Mapping[str, Any]]]],
           config: ConfigLike = ..., threads: int = ..., *, pattern: str = ...,
           **keys: Any) -> List[BatchResult]: ...
-def noise(log: LogLike = ..., *, config: ConfigLike = ..., t: Optional[ArrayLike] = ...,
+def noise(log: LogLike = ..., *, config: ConfigLike = ..., kalibr: Optional[PathLike] = ...,
+          handheld: Optional[PathLike] = ..., report: Optional[PathLike] = ...,
+          t: Optional[ArrayLike] = ...,
           accel: Optional[ArrayLike] = ..., gyro: Optional[ArrayLike] = ...,
           temp: Optional[ArrayLike] = ..., **keys: Any) -> Result: ...
 def discover(log: LogLike = ..., *, config: ConfigLike = ..., report: Optional[PathLike] = ...,

@@ -126,16 +126,12 @@ int RunApply(const CommandArgs& args) {
   }
   size_t count = 0;
   for (bool more = any; more; more = reader.next(&sample, &error)) {
-    Eigen::Vector3d a;
-    if (!corrector.CorrectAccel(sample.accel, sample.temperature, sample.t, &a)) {
+    if (!corrector.CorrectRow(sample.temperature, sample.t, &sample.accel,
+                              reader.has_gyro ? &sample.gyro : nullptr)) {
       writer.Abort();
       return Fail(reader.name + ": sample at t = " + std::to_string(sample.t) +
                   ": the quadratic term has no real root (reading outside the calibrated range)");
     }
-    if (reader.has_gyro) {
-      sample.gyro = corrector.CorrectGyro(sample.gyro, a, sample.temperature, sample.t);
-    }
-    sample.accel = a;
     if (!writer.Write(sample, &error)) return Fail(error);
     ++count;
   }

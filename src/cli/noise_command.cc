@@ -6,9 +6,7 @@
 
 #include "cli/commands.h"
 #include "gravcal/io/log_reader.h"
-#include "gravcal/io/noise_io.h"
 #include "gravcal/workflows/noise_workflow.h"
-#include "gravcal/workflows/report.h"
 
 namespace gravcal {
 namespace cli {
@@ -42,24 +40,9 @@ int RunNoise(const CommandArgs& args) {
   if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
   ImuNoise noise;
   if (!CharacteriseLogNoise(log, options, &noise, &error)) return Fail(error);
-  // Every text first, then the files, so that a failure leaves none.
-  std::string kalibr;
-  if (!args.kalibr.empty() && !NoiseToKalibrYaml(noise.model, &kalibr, &error)) {
-    return Fail(args.kalibr + ": " + error);
-  }
   std::vector<std::string> written;
-  auto write = [&](const std::string& path, const std::string& text) {
-    if (path.empty()) return true;
-    if (!WriteFileAtomically(path, text, &error)) {
-      for (const std::string& w : written) std::remove(w.c_str());
-      return false;
-    }
-    written.push_back(path);
-    return true;
-  };
-  if (!write(args.output, NoiseToJson(noise)) || !write(args.kalibr, kalibr) ||
-      !write(args.handheld, NoiseToHandheldYaml(noise.model)) ||
-      !write(args.report, args.report.empty() ? "" : NoiseToHtml(noise, args.input))) {
+  if (!WriteNoiseFiles(noise, args.input, {args.output, args.kalibr, args.handheld, args.report},
+                       &written, &error)) {
     return Fail(error);
   }
   const char* axes = "xyz";

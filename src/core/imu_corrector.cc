@@ -45,6 +45,15 @@ Eigen::Vector3d ImuCorrector::CorrectGyro(const Eigen::Vector3d& raw,
   return gyro.matrix * u;
 }
 
+bool ImuCorrector::CorrectRow(double temperature, double time, Eigen::Vector3d* accel,
+                              Eigen::Vector3d* gyro) const {
+  Eigen::Vector3d a;
+  if (!CorrectAccel(*accel, temperature, time, &a)) return false;
+  if (gyro != nullptr) *gyro = CorrectGyro(*gyro, a, temperature, time);
+  *accel = a;
+  return true;
+}
+
 ImuCorrector ImuCorrector::WithEffects(const std::vector<Effect>& keep) const {
   ImuCorrector out = *this;
   out.active_effects.clear();

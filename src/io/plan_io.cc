@@ -23,6 +23,32 @@ Json StdObject(const std::vector<std::string>& names, const Eigen::VectorXd& std
   return out;
 }
 
+// One sensor's part of plan.json: its predicted_std (calibration JSON
+// units), the same readable (value and unit) and its targets.
+struct PredictionJson {
+  Json std;
+  Json readable = Json::object();
+  Json targets = Json::object();
+};
+
+PredictionJson PredictionToJson(const SensorPrediction& p,
+                                ReadableUnit (*unit_of)(const std::string&)) {
+  PredictionJson out;
+  out.std = StdObject(p.parameter_names, p.predicted_std);
+  for (size_t i = 0; i < p.parameter_names.size(); ++i) {
+    const std::string& name = p.parameter_names[i];
+    const ReadableUnit unit = unit_of(name);
+    out.readable[name] = {{"value", JsonNumber<Json>(p.predicted_std_scale_free(i) * unit.factor)},
+                          {"unit", unit.unit}};
+    if (static_cast<Eigen::Index>(i) < p.targets_scale_free.size()) {
+      out.targets[name] = {{"value", JsonNumber<Json>(p.targets_scale_free(i) * unit.factor)},
+                           {"unit", unit.unit},
+                           {"stated", i < p.targeted.size() && p.targeted[i]}};
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string PlanToJson(const RecordingPlan& plan) {
@@ -42,59 +68,36 @@ std::string PlanToJson(const RecordingPlan& plan) {
     turn["instruction"] = r.instruction;
     rotations.push_back(turn);
   }
-  Json readable = Json::object(), targets = Json::object();
-  for (size_t i = 0; i < plan.parameter_names.size(); ++i) {
-    const ReadableUnit unit = ReadableUnitOf(plan.parameter_names[i]);
-    readable[plan.parameter_names[i]] = {
-        {"value", JsonNumber<Json>(plan.predicted_std_scale_free(i) * unit.factor)},
-        {"unit", unit.unit}};
-    if (static_cast<Eigen::Index>(i) < plan.targets_scale_free.size()) {
-      targets[plan.parameter_names[i]] = {
-          {"value", JsonNumber<Json>(plan.targets_scale_free(i) * unit.factor)},
-          {"unit", unit.unit},
-          {"stated", i < plan.targeted.size() && plan.targeted[i]}};
-    }
-  }
   Json schemes = Json::object();
   for (const SchemeComparison& s : plan.schemes) {
     schemes[s.name] = {{"poses", s.poses},
                        {"hold_s", JsonNumber<Json>(s.hold_seconds)},
                        {"total_time_s", JsonNumber<Json>(s.total_seconds)},
                        {"meets_targets", s.meets_targets},
-                       {"predicted_std", StdObject(plan.parameter_names, s.predicted_std)}};
+                       {"predicted_std", StdObject(plan.accel.parameter_names, s.predicted_std)}};
   }
   Json out;
   out["poses"] = poses;
   out["rotations"] = rotations;
-  out["predicted_std"] = StdObject(plan.parameter_names, plan.predicted_std);
-  out["predicted_std_readable"] = readable;
-  out["targets"] = targets;
+  PredictionJson accel = PredictionToJson(plan.accel, ReadableUnitOf);
+  out["predicted_std"] = std::move(accel.std);
+  out["predicted_std_readable"] = std::move(accel.readable);
+  out["targets"] = std::move(accel.targets);
   out["total_time_s"] = JsonNumber<Json>(plan.total_seconds);
   out["overhead_s"] = JsonNumber<Json>(plan.overhead_seconds);
   out["meets_targets"] = plan.meets_targets;
-  out["nominal_scale"] = JsonNumber<Json>(plan.nominal_scale);
+  out["nominal_scale"] = JsonNumber<Json>(plan.accel.nominal_scale);
   out["gravity"] = JsonNumber<Json>(plan.gravity);
   out["criterion"] = plan.criterion;
   out["pose_set"] = plan.pose_set;
   out["noise"] = plan.noise_source;
   out["schemes"] = schemes;
-  if (!plan.gyro_parameter_names.empty()) {
-    const std::vector<std::string>& names = plan.gyro_parameter_names;
-    Json gyro_readable = Json::object(), gyro_targets = Json::object();
-    for (size_t i = 0; i < names.size(); ++i) {
-      const ReadableUnit unit = GyroReadableUnitOf(names[i]);
-      gyro_readable[names[i]] = {
-          {"value", JsonNumber<Json>(plan.gyro_predicted_std_scale_free(i) * unit.factor)},
-          {"unit", unit.unit}};
-      gyro_targets[names[i]] = {
-          {"value", JsonNumber<Json>(plan.gyro_targets_scale_free(i) * unit.factor)},
-          {"unit", unit.unit},
-          {"stated", i < plan.gyro_targeted.size() && plan.gyro_targeted[i]}};
-    }
-    out["gyro_predicted_std"] = StdObject(names, plan.gyro_predicted_std);
-    out["gyro_predicted_std_readable"] = gyro_readable;
-    out["gyro_targets"] = gyro_targets;
-    out["gyro_nominal_scale"] = JsonNumber<Json>(plan.gyro_nominal_scale);
+  if (!plan.gyro.parameter_names.empty()) {
+    PredictionJson gyro = PredictionToJson(plan.gyro, GyroReadableUnitOf);
+    out["gyro_predicted_std"] = std::move(gyro.std);
+    out["gyro_predicted_std_readable"] = std::move(gyro.readable);
+    out["gyro_targets"] = std::move(gyro.targets);
+    out["gyro_nominal_scale"] = JsonNumber<Json>(plan.gyro.nominal_scale);
     out["gyro_extra_poses"] = plan.gyro_extra_poses;
   }
   out["message"] = plan.message;
@@ -102,13 +105,7 @@ std::string PlanToJson(const RecordingPlan& plan) {
 }
 
 std::string CoverageToJson(const CoverageReport& r) {
-  Json readable = Json::object();
-  for (size_t i = 0; i < r.parameter_names.size(); ++i) {
-    const ReadableUnit unit = ReadableUnitOf(r.parameter_names[i]);
-    readable[r.parameter_names[i]] = {
-        {"value", JsonNumber<Json>(r.predicted_std_scale_free(i) * unit.factor)},
-        {"unit", unit.unit}};
-  }
+  PredictionJson accel = PredictionToJson(r.accel, ReadableUnitOf);
   Json proposed = Json::array();
   for (const PlannedPose& p : r.proposed) {
     proposed.push_back({{"up", JsonVector<Json>(p.up)},
@@ -117,9 +114,9 @@ std::string CoverageToJson(const CoverageReport& r) {
   }
   Json out;
   out["positions"] = r.positions;
-  out["nominal_scale"] = JsonNumber<Json>(r.nominal_scale);
-  out["predicted_std"] = StdObject(r.parameter_names, r.predicted_std);
-  out["predicted_std_readable"] = readable;
+  out["nominal_scale"] = JsonNumber<Json>(r.accel.nominal_scale);
+  out["predicted_std"] = std::move(accel.std);
+  out["predicted_std_readable"] = std::move(accel.readable);
   out["undetermined"] = r.undetermined;
   out["short_of_target"] = r.short_of_target;
   out["proposed"] = proposed;

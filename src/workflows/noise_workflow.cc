@@ -2,8 +2,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "gravcal/core/gravity.h"
+#include "gravcal/io/files.h"
+#include "gravcal/io/noise_io.h"
+#include "gravcal/workflows/report.h"
 
 namespace gravcal {
 
@@ -38,6 +42,32 @@ bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoi
                 log.source.c_str(), g, options.accel_scale);
   *error = text;
   return false;
+}
+
+bool WriteNoiseFiles(const ImuNoise& noise, const std::string& source, const NoiseFiles& files,
+                     std::vector<std::string>* written, std::string* error) {
+  std::vector<std::pair<std::string, std::string>> texts;  // path, text
+  if (!files.json.empty()) texts.emplace_back(files.json, NoiseToJson(noise));
+  if (!files.kalibr.empty()) {
+    std::string yaml;
+    if (!NoiseToKalibrYaml(noise.model, &yaml, error)) {
+      *error = files.kalibr + ": " + *error;
+      return false;
+    }
+    texts.emplace_back(files.kalibr, yaml);
+  }
+  if (!files.handheld.empty()) texts.emplace_back(files.handheld, NoiseToHandheldYaml(noise.model));
+  if (!files.report.empty()) texts.emplace_back(files.report, NoiseToHtml(noise, source));
+  std::vector<std::string> done;
+  for (const auto& [path, text] : texts) {
+    if (!WriteFileAtomically(path, text, error)) {
+      for (const std::string& w : done) std::remove(w.c_str());
+      return false;
+    }
+    done.push_back(path);
+  }
+  if (written != nullptr) *written = done;
+  return true;
 }
 
 }  // namespace gravcal

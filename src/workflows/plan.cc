@@ -204,15 +204,11 @@ bool PlanRotations(const Config& config, const PlanRequest& request,
   }
   // The accelerometer with every pose, extra ones included.
   const DesignResult accel = EvaluateDesign(design.poses, model, noise, options);
-  out->predicted_std_scale_free = accel.predicted_std;
-  out->predicted_std = StdInRawUnits(accel.predicted_std, out->nominal_scale);
+  out->accel.predicted_std_scale_free = accel.predicted_std;
+  out->accel.predicted_std = StdInRawUnits(accel.predicted_std, out->accel.nominal_scale);
   out->total_seconds = accel.total_seconds;
-  out->gyro_parameter_names = names;
-  out->gyro_nominal_scale = config.ten_position.gyro_nominal_scale;
-  out->gyro_predicted_std_scale_free = design.predicted_std;
-  out->gyro_predicted_std = StdInRawUnits(design.predicted_std, out->gyro_nominal_scale);
-  out->gyro_targets_scale_free = start.gyro_targets;
-  out->gyro_targeted = start.gyro_targeted;
+  out->gyro = internal::Prediction(names, design.predicted_std, start.gyro_targets,
+                                   start.gyro_targeted, config.ten_position.gyro_nominal_scale);
   out->gyro_extra_poses = design.extra_poses;
   out->message += "; gyroscope: " + design.message;
   return true;
@@ -361,6 +357,19 @@ bool PlanDesignModel(const Config& config, DesignModel* model, std::string* erro
 
 namespace internal {
 
+SensorPrediction Prediction(const std::vector<std::string>& names,
+                            const Eigen::VectorXd& std_scale_free, const Eigen::VectorXd& targets,
+                            const std::vector<bool>& targeted, double nominal_scale) {
+  SensorPrediction p;
+  p.parameter_names = names;
+  p.predicted_std_scale_free = std_scale_free;
+  p.predicted_std = StdInRawUnits(std_scale_free, nominal_scale);
+  p.targets_scale_free = targets;
+  p.targeted = targeted;
+  p.nominal_scale = nominal_scale;
+  return p;
+}
+
 bool StartPlan(const Config& config, const PlanRequest& request, PlanStart* start,
                std::string* error) {
   if (!request.IsValid(error)) return false;
@@ -431,7 +440,6 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   DesignNoise noise;
   RecordingPlan out;
   if (!PlanDesignNoise(request, &noise, &out.noise_source, error)) return false;
-  out.targeted = start.targeted;
 
   DesignOptions options;
   options.targets = targets;
@@ -503,13 +511,10 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   std::vector<PlannedPose> poses;
   for (const DesignPose& p : design.poses) poses.push_back({p.up, p.hold_seconds, ""});
   OrderForHandling(poses, &out);
-  out.parameter_names = names;
-  out.nominal_scale = config.calibration.nominal_scale;
+  out.accel = internal::Prediction(names, design.predicted_std, targets, start.targeted,
+                                   config.calibration.nominal_scale);
   out.gravity = model.gravity;
   out.overhead_seconds = request.overhead_seconds;
-  out.predicted_std_scale_free = design.predicted_std;
-  out.predicted_std = StdInRawUnits(design.predicted_std, out.nominal_scale);
-  out.targets_scale_free = targets;
   out.total_seconds = design.total_seconds;
   out.meets_targets = design.meets_targets;
   out.pose_set = request.pose_set;
@@ -530,7 +535,7 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
     }
     c.hold_seconds = c.meets_targets ? r.poses.front().hold_seconds : NAN;
     c.total_seconds = c.meets_targets ? r.total_seconds : NAN;
-    c.predicted_std = StdInRawUnits(r.predicted_std, out.nominal_scale);
+    c.predicted_std = StdInRawUnits(r.predicted_std, out.accel.nominal_scale);
     out.schemes.push_back(c);
   }
   out.message = design.message;

@@ -105,24 +105,21 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
   Eigen::MatrixXd fisher = j.transpose() * j;
 
   CoverageReport out;
-  out.parameter_names = names;
   out.positions = static_cast<int>(positions.size());
-  out.nominal_scale = scale;
   const Eigen::VectorXd& limit = start.limits;
-  out.predicted_std_scale_free = DeterminedStd(fisher, limit);
-  out.predicted_std = StdInRawUnits(out.predicted_std_scale_free, scale);
-  out.targets_scale_free = start.targets;
-  out.targeted = start.targeted;
+  out.accel = internal::Prediction(names, DeterminedStd(fisher, limit), start.targets,
+                                   start.targeted, scale);
+  const SensorPrediction& accel = out.accel;
   for (size_t i = 0; i < names.size(); ++i) {
-    if (out.targeted[i] && !(out.predicted_std_scale_free(i) <= out.targets_scale_free(i))) {
+    if (accel.targeted[i] && !(accel.predicted_std_scale_free(i) <= accel.targets_scale_free(i))) {
       out.short_of_target.push_back(names[i]);
     }
   }
-  out.undetermined = Undetermined(names, out.predicted_std_scale_free);
+  out.undetermined = Undetermined(names, accel.predicted_std_scale_free);
   // Proposals are ranked against the stated targets, else the yardstick.
-  Eigen::VectorXd yardstick = out.targets_scale_free;
+  Eigen::VectorXd yardstick = accel.targets_scale_free;
   for (size_t i = 0; i < names.size(); ++i) {
-    if (!out.targeted[i]) yardstick(i) = ReferenceStd(names[i]);
+    if (!accel.targeted[i]) yardstick(i) = ReferenceStd(names[i]);
   }
 
   // Extra poses: the request's noise when given, else white noise of the
@@ -148,7 +145,7 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
   // One or two poses, or as many as there are undetermined parameters
   // (each pose adds one row to the information: one direction at most).
   const int count = std::max(request.extra_poses, static_cast<int>(out.undetermined.size()));
-  Eigen::VectorXd current = out.predicted_std_scale_free;
+  Eigen::VectorXd current = accel.predicted_std_scale_free;
   for (int step = 0; step < count; ++step) {
     int best = -1;
     std::pair<int, double> best_shortfall = {static_cast<int>(names.size()) + 1, kInf};
@@ -188,8 +185,9 @@ std::string CoverageReportText(const CoverageReport& r) {
   s.precision(3);
   s << "poses recorded: " << r.positions << "\n";
   s << "parameter  predicted sigma      target          verdict\n";
-  for (size_t i = 0; i < r.parameter_names.size(); ++i) {
-    const std::string& name = r.parameter_names[i];
+  const SensorPrediction& accel = r.accel;
+  for (size_t i = 0; i < accel.parameter_names.size(); ++i) {
+    const std::string& name = accel.parameter_names[i];
     const ReadableUnit unit = ReadableUnitOf(name);
     const bool undetermined =
         std::find(r.undetermined.begin(), r.undetermined.end(), name) != r.undetermined.end();
@@ -198,13 +196,13 @@ std::string CoverageReportText(const CoverageReport& r) {
     std::ostringstream sigma, target;
     sigma.precision(3);
     target.precision(3);
-    if (std::isfinite(r.predicted_std_scale_free(i))) {
-      sigma << r.predicted_std_scale_free(i) * unit.factor << " " << unit.unit;
+    if (std::isfinite(accel.predicted_std_scale_free(i))) {
+      sigma << accel.predicted_std_scale_free(i) * unit.factor << " " << unit.unit;
     } else {
       sigma << "-";
     }
-    if (r.targeted[i]) {
-      target << r.targets_scale_free(i) * unit.factor << " " << unit.unit;
+    if (accel.targeted[i]) {
+      target << accel.targets_scale_free(i) * unit.factor << " " << unit.unit;
     } else {
       target << "-";
     }

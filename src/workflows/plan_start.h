@@ -1,6 +1,6 @@
 // Private: the set-up shared by gravcal plan and gravcal check
 // (workflows/plan.h): the request checked, the design model of the config,
-// and the targets per parameter.
+// the targets per parameter, and a sensor's prediction from them.
 #ifndef GRAVCAL_SRC_WORKFLOWS_PLAN_START_H_
 #define GRAVCAL_SRC_WORKFLOWS_PLAN_START_H_
 
@@ -36,6 +36,12 @@ struct PlanStart {
 
 bool StartPlan(const Config& config, const PlanRequest& request, PlanStart* start,
                std::string* error);
+
+// A sensor's prediction from its scale-free standard deviations (the raw
+// units' ones at nominal_scale, StdInRawUnits) and its targets.
+SensorPrediction Prediction(const std::vector<std::string>& names,
+                            const Eigen::VectorXd& std_scale_free, const Eigen::VectorXd& targets,
+                            const std::vector<bool>& targeted, double nominal_scale);
 
 }  // namespace internal
 }  // namespace gravcal

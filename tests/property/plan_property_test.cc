@@ -25,15 +25,10 @@ namespace gravcal {
 namespace testing_util {
 namespace {
 
-// One planned sensor's parameters (names, predicted_std in the calibration
-// JSON's units, scale-free targets, which are stated, the nominal scale) and
-// how to read each parameter's error from a calibrated seed.
+// One planned sensor's prediction and how to read each parameter's error
+// from a calibrated seed.
 struct PlannedParameters {
-  std::vector<std::string> names;
-  Eigen::VectorXd predicted_std;
-  Eigen::VectorXd targets_scale_free;
-  std::vector<bool> targeted;
-  double nominal_scale = 1.0;
+  SensorPrediction sensor;
   std::function<std::vector<double>(const SimulatedSession&, const Calibration&)> errors;
 };
 
@@ -43,10 +38,11 @@ struct PlannedParameters {
 // (>= 200), and the spread of every stated target below it.
 void CheckSpread(const Config& config, size_t poses, const std::string& label,
                  const PlannedParameters& p) {
+  const SensorPrediction& s = p.sensor;
   int first = 1, count = kDefaultSeeds;
   PropertySeeds(&first, &count);
   SigmaCheck check;
-  std::vector<double> sum_squares(p.names.size(), 0.0);
+  std::vector<double> sum_squares(s.parameter_names.size(), 0.0);
   std::string error;
   for (int seed = first; seed < first + count; ++seed) {
     SimulatedSession session;
@@ -58,8 +54,8 @@ void CheckSpread(const Config& config, size_t poses, const std::string& label,
     ASSERT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
     ASSERT_EQ(calibration.positions.size(), poses) << "seed " << seed;
     const std::vector<double> errors = p.errors(session, calibration);
-    for (size_t i = 0; i < p.names.size(); ++i) {
-      check.Add(p.names[i], errors[i], p.predicted_std(i));
+    for (size_t i = 0; i < s.parameter_names.size(); ++i) {
+      check.Add(s.parameter_names[i], errors[i], s.predicted_std(i));
       sum_squares[i] += errors[i] * errors[i];
     }
   }
@@ -68,20 +64,20 @@ void CheckSpread(const Config& config, size_t poses, const std::string& label,
   // The criterion, asserted where the seeds can resolve it (the
   // 400-seed run): the spread within 15 % of predicted_std.
   if (count >= 200) {
-    for (const std::string& name : p.names) {
+    for (const std::string& name : s.parameter_names) {
       EXPECT_LT(std::abs(check.Rms(name) - 1.0), 0.15) << label << " " << name;
     }
   }
   // Every stated target met by the spread actually seen (scale-free), within
   // the band's allowance for a finite number of seeds.
   const SigmaBand band = SigmaBandFor(count);
-  for (size_t i = 0; i < p.names.size(); ++i) {
-    if (!p.targeted[i]) continue;
+  for (size_t i = 0; i < s.parameter_names.size(); ++i) {
+    if (!s.targeted[i]) continue;
     const double spread = std::sqrt(sum_squares[i] / count);
-    const double scale_free = i < 3 ? spread * p.nominal_scale : spread / p.nominal_scale;
-    EXPECT_LT(scale_free, p.targets_scale_free(i) * band.rms_high)
-        << label << " " << p.names[i] << ": spread " << scale_free << " against target "
-        << p.targets_scale_free(i);
+    const double scale_free = i < 3 ? spread * s.nominal_scale : spread / s.nominal_scale;
+    EXPECT_LT(scale_free, s.targets_scale_free(i) * band.rms_high)
+        << label << " " << s.parameter_names[i] << ": spread " << scale_free << " against target "
+        << s.targets_scale_free(i);
   }
 }
 
@@ -105,11 +101,7 @@ void CheckPlanSpread(const std::string& target, const std::string& pose_set) {
     config.simulation.planned_poses.push_back({p.up, p.hold_seconds});
   }
 
-  PlannedParameters p{plan.parameter_names,
-                      plan.predicted_std,
-                      plan.targets_scale_free,
-                      plan.targeted,
-                      plan.nominal_scale,
+  PlannedParameters p{plan.accel,
                       [](const SimulatedSession& session, const Calibration& calibration) {
                         double estimate[9], truth[9];
                         const AccelModel& e = calibration.accel.model;
@@ -149,7 +141,7 @@ void CheckGyroPlanSpread(const std::string& target, const std::string& pose_set)
       config.simulation.gyro_noise / std::sqrt(config.simulation.sample_rate);
   RecordingPlan plan;
   ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << error;
-  ASSERT_FALSE(plan.gyro_parameter_names.empty()) << plan.message;
+  ASSERT_FALSE(plan.gyro.parameter_names.empty()) << plan.message;
   ASSERT_EQ(plan.rotations.size() + 1, plan.poses.size());
   config.simulation.initial_still_seconds = 0.0;
   for (size_t k = 0; k < plan.poses.size(); ++k) {
@@ -163,12 +155,8 @@ void CheckGyroPlanSpread(const std::string& target, const std::string& pose_set)
     config.simulation.planned_poses.push_back(hold);
   }
 
-  const std::vector<std::string> names = plan.gyro_parameter_names;
-  PlannedParameters p{names,
-                      plan.gyro_predicted_std,
-                      plan.gyro_targets_scale_free,
-                      plan.gyro_targeted,
-                      plan.gyro_nominal_scale,
+  const std::vector<std::string> names = plan.gyro.parameter_names;
+  PlannedParameters p{plan.gyro,
                       [names](const SimulatedSession& session, const Calibration& calibration) {
                         EXPECT_TRUE(calibration.gyro.estimated);
                         const Eigen::Matrix3d truth_matrix =
@@ -211,7 +199,7 @@ void CheckKnownAttitudePlanSpread(const std::string& target) {
   request.attitude_std_deg = config.simulation.fixture_attitude_noise_deg;
   RecordingPlan plan;
   ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << error;
-  ASSERT_EQ(plan.parameter_names.size(), 12u);
+  ASSERT_EQ(plan.accel.parameter_names.size(), 12u);
   config.simulation.initial_still_seconds = 0.0;
   for (const PlannedPose& p : plan.poses) {
     config.simulation.planned_poses.push_back({p.up, p.hold_seconds});
@@ -233,7 +221,7 @@ void CheckKnownAttitudePlanSpread(const std::string& target) {
     for (size_t i = 0; i < 12; ++i) {
       const double error_i =
           i < 3 ? c.accel.model.bias(i) - session.accel_truth.bias(i) : m((i - 3) / 3, (i - 3) % 3);
-      check.Add(plan.parameter_names[i], error_i, plan.predicted_std(i));
+      check.Add(plan.accel.parameter_names[i], error_i, plan.accel.predicted_std(i));
     }
   }
   std::printf("known-attitude plan %s: %zu poses, %.1f s\n%s", target.c_str(), plan.poses.size(),
@@ -244,7 +232,7 @@ void CheckKnownAttitudePlanSpread(const std::string& target) {
   // (an upper bound on the spread; averaging the information instead gave a
   // lower bound, rms z up to 2.3). Asserted: no sigma too small, no bias.
   const SigmaBand band = SigmaBandFor(count);
-  for (const std::string& name : plan.parameter_names) {
+  for (const std::string& name : plan.accel.parameter_names) {
     EXPECT_LT(check.Rms(name), band.rms_high) << name;
     EXPECT_LT(std::abs(check.Mean(name)), band.mean_bound) << name;
   }

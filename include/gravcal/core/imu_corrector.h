@@ -55,6 +55,12 @@ struct ImuCorrector {
   // w from u and the corrected a. Without a gyroscope model, returns u.
   Eigen::Vector3d CorrectGyro(const Eigen::Vector3d& raw, const Eigen::Vector3d& accel,
                               double temperature, double time) const;
+  // One row of a log, in place: *accel v -> a (CorrectAccel), then, when
+  // `gyro` is not null, *gyro u -> w with that a (CorrectGyro). False (both
+  // unchanged) when CorrectAccel fails. The row step of `gravcal apply` and
+  // Python's Calibration.apply, so the two give the same numbers.
+  bool CorrectRow(double temperature, double time, Eigen::Vector3d* accel,
+                  Eigen::Vector3d* gyro) const;
 
   // The same model with only the terms a target can hold: the effects in
   // `keep` (others dropped). Used to measure what an export truncates.

@@ -52,18 +52,28 @@ struct SchemeComparison {
   Eigen::VectorXd predicted_std;
 };
 
-struct RecordingPlan {
-  // Names and order of predicted_std (the calibration JSON covariance's).
+// One sensor's predicted standard deviations in a plan: the accelerometer's
+// (names and units of the calibration JSON's accel covariance: bias raw
+// units, U m/s^2 per raw unit at nominal_scale; scale-free: bias m/s^2, U
+// relative) or the gyroscope's (its gyro covariance: bias raw units, M_g
+// rad/s per raw unit at nominal_scale; scale-free: rad/s, relative).
+struct SensorPrediction {
+  // Names and order of the vectors below; empty when the sensor is not
+  // planned.
   std::vector<std::string> parameter_names;
-  // Calibration JSON units (bias: raw units; U: m/s^2 per raw unit) at
-  // nominal_scale, and scale-free (bias m/s^2, U relative).
+  // Calibration JSON units at nominal_scale, and scale-free.
   Eigen::VectorXd predicted_std;
   Eigen::VectorXd predicted_std_scale_free;
   // Scale-free targets; `targeted` marks the ones the user set (the others
-  // are the refinement's limits of a determined parameter).
+  // are the calibration's limits of a determined parameter).
   Eigen::VectorXd targets_scale_free;
   std::vector<bool> targeted;
   double nominal_scale = 1.0;
+};
+
+struct RecordingPlan {
+  // The accelerometer.
+  SensorPrediction accel;
   double gravity = 9.80665;
   double overhead_seconds = 0.0;
   double total_seconds = 0.0;
@@ -73,21 +83,12 @@ struct RecordingPlan {
   std::string noise_source;
   std::vector<PlannedPose> poses;
   std::vector<PlannedRotation> rotations;
+  // Judged on the accelerometer (predicted_std in accel's units).
   std::vector<SchemeComparison> schemes;
-  // The gyroscope (experiment_design.h), empty names when not planned:
-  // predicted standard deviations keyed by the calibration JSON's gyro
-  // covariance names, in its units (bias raw units, M_g rad/s per raw unit
-  // at gyro_nominal_scale) and scale-free (rad/s, relative); the targets
-  // (scale-free; `gyro_targeted` marks the stated ones); the poses appended
-  // for the gyroscope alone (the last gyro_extra_poses of `poses`).
-  std::vector<std::string> gyro_parameter_names;
-  Eigen::VectorXd gyro_predicted_std;
-  Eigen::VectorXd gyro_predicted_std_scale_free;
-  Eigen::VectorXd gyro_targets_scale_free;
-  std::vector<bool> gyro_targeted;
-  double gyro_nominal_scale = 1.0;
+  // The gyroscope (experiment_design.h), empty names when not planned, and
+  // the poses appended for it alone (the last gyro_extra_poses of `poses`).
+  SensorPrediction gyro;
   int gyro_extra_poses = 0;
-  std::string gyro_noise_source;
   std::string message;
 };
 
@@ -96,14 +97,10 @@ struct RecordingPlan {
 // undetermined or short of its target, and the extra poses that would
 // help most.
 struct CoverageReport {
-  std::vector<std::string> parameter_names;
+  // The accelerometer's prediction from the poses recorded; infinity =
+  // undetermined.
+  SensorPrediction accel;
   int positions = 0;
-  double nominal_scale = 1.0;
-  // Calibration JSON units and scale-free; infinity = undetermined.
-  Eigen::VectorXd predicted_std;
-  Eigen::VectorXd predicted_std_scale_free;
-  Eigen::VectorXd targets_scale_free;
-  std::vector<bool> targeted;
   // Parameters the poses do not determine (a null direction, or a standard
   // deviation beyond the refinement's limits), and stated targets not met.
   std::vector<std::string> undetermined;

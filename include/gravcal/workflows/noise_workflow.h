@@ -1,6 +1,7 @@
 // gravcal/workflows/noise_workflow.h: the noise model of a still log with
-// the options a configuration gives, as `gravcal noise` computes it. The
-// command-line tool and the Python package both call these two functions.
+// the options a configuration gives, as `gravcal noise` computes it, and the
+// files it writes. The command-line tool and the Python package both call
+// these functions.
 //
 // The config's noise section supplies the Allan and fit settings; the raw
 // units come from nominal_scale (accelerometer, m/s^2 per raw unit) and
@@ -10,6 +11,7 @@
 #define GRAVCAL_WORKFLOWS_NOISE_WORKFLOW_H_
 
 #include <string>
+#include <vector>
 
 #include "gravcal/core/imu_log.h"
 #include "gravcal/estimation/noise_characterisation.h"
@@ -28,6 +30,25 @@ bool NoiseOptionsFromConfig(const Config& config, NoiseOptions* options, std::st
 // *error (naming log.source) on either failure.
 bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise* noise,
                           std::string* error);
+
+// The files of `gravcal noise`; an empty path is not written.
+struct NoiseFiles {
+  // noise.json (io/noise_io.h).
+  std::string json;
+  // Kalibr's imu.yaml (NoiseToKalibrYaml).
+  std::string kalibr;
+  // The handheld filter's hk_* keys (NoiseToHandheldYaml).
+  std::string handheld;
+  // The HTML report (workflows/report.h, NoiseToHtml), titled `source`.
+  std::string report;
+};
+
+// Writes `files` for `noise`: every text first, then each file atomically,
+// in the order above; on a failure the files already written are removed,
+// so none is left. *written (may be null): the paths written, in order.
+// False with a one-line *error (naming the file).
+bool WriteNoiseFiles(const ImuNoise& noise, const std::string& source, const NoiseFiles& files,
+                     std::vector<std::string>* written, std::string* error);
 
 }  // namespace gravcal
 

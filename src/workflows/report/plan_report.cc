@@ -24,7 +24,8 @@ Eigen::Matrix3d PoseRotation(const Eigen::Vector3d& up) {
 // A small picture of the housing in one pose: a box (longest along x,
 // flattest along z, so the faces can be told apart) seen from the front
 // right and above, resting on a table line, with the housing's x, y and z
-// axes as coloured arrows and the pose number.
+// axes as coloured arrows and the pose number. data-up states the up
+// direction drawn (for tests/report_browser_test.cc).
 std::string HousingPicture(const Eigen::Vector3d& up, int number) {
   const Eigen::Matrix3d r = PoseRotation(up);
   // Camera: looking along -view; screen right and screen up.
@@ -46,8 +47,10 @@ std::string HousingPicture(const Eigen::Vector3d& up, int number) {
   double lowest = 0.0;
   for (const Eigen::Vector3d& c : corners) lowest = std::min(lowest, (r * c).z());
   std::ostringstream s;
-  s << "<svg class='housing' width='" << size << "' height='" << size << "' viewBox='0 0 " << size
-    << " " << size << "' xmlns='http://www.w3.org/2000/svg'>";
+  s << "<svg class='housing' data-up='" << FormatNumber(up.x(), "%.4f") << " "
+    << FormatNumber(up.y(), "%.4f") << " " << FormatNumber(up.z(), "%.4f") << "' width='" << size
+    << "' height='" << size << "' viewBox='0 0 " << size << " " << size
+    << "' xmlns='http://www.w3.org/2000/svg'>";
   const double table_y = cy - scale * (lowest * Eigen::Vector3d::UnitZ()).dot(screen_up);
   s << "<line x1='8' y1='" << FormatNumber(table_y, "%.1f") << "' x2='" << size - 8 << "' y2='"
     << FormatNumber(table_y, "%.1f") << "' stroke='#bbb' stroke-width='3'/>";
@@ -77,10 +80,12 @@ std::string HousingPicture(const Eigen::Vector3d& up, int number) {
 }
 
 // One row per parameter: predicted sigma and target in readable units.
-std::string SigmaTable(const std::string& caption, const std::vector<std::string>& names,
-                       const Eigen::VectorXd& std, const Eigen::VectorXd& targets,
-                       const std::vector<bool>& targeted,
+std::string SigmaTable(const std::string& caption, const SensorPrediction& prediction,
                        ReadableUnit (*unit_of)(const std::string&)) {
+  const std::vector<std::string>& names = prediction.parameter_names;
+  const Eigen::VectorXd& std = prediction.predicted_std_scale_free;
+  const Eigen::VectorXd& targets = prediction.targets_scale_free;
+  const std::vector<bool>& targeted = prediction.targeted;
   std::ostringstream s;
   s << "<table class='sigma'><caption>" << HtmlEscape(caption)
     << "</caption><tr><th>parameter</th><th>predicted sigma</th><th>target</th></tr>";
@@ -142,13 +147,9 @@ std::string PlanToHtml(const RecordingPlan& plan) {
   h << internal::RenderSphere("up directions of the poses (sensor frame)", ups, labels);
 
   h << "<h2>Predicted standard deviations</h2>";
-  h << SigmaTable("accelerometer (calibration JSON: accel.covariance)", plan.parameter_names,
-                  plan.predicted_std_scale_free, plan.targets_scale_free, plan.targeted,
-                  ReadableUnitOf);
-  if (!plan.gyro_parameter_names.empty()) {
-    h << SigmaTable("gyroscope (calibration JSON: gyro.covariance)", plan.gyro_parameter_names,
-                    plan.gyro_predicted_std_scale_free, plan.gyro_targets_scale_free,
-                    plan.gyro_targeted, GyroReadableUnitOf);
+  h << SigmaTable("accelerometer (calibration JSON: accel.covariance)", plan.accel, ReadableUnitOf);
+  if (!plan.gyro.parameter_names.empty()) {
+    h << SigmaTable("gyroscope (calibration JSON: gyro.covariance)", plan.gyro, GyroReadableUnitOf);
   }
   if (!plan.schemes.empty()) {
     h << "<h2>Against fixed schemes</h2><table class='schemes'><tr><th>scheme</th><th>poses</th>"
