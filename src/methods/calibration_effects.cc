@@ -112,6 +112,26 @@ void SetEffectResiduals(const EffectFitResult& fit, Calibration* calibration) {
   }
 }
 
+// The variance of the gyroscope's bias about its session value from the
+// noise model, (rad/s)^2: B^2 + K^2 T / 6 (the random walk's mean square
+// about its mean over T s), the largest over the axes; 0 without a model.
+double GyroBiasWanderVariance(const ImuNoiseModel* model,
+                              const std::vector<StaticObservation>& observations) {
+  if (model == nullptr || observations.empty()) return 0.0;
+  const double seconds = observations.back().accel.t_end - observations.front().accel.t_begin;
+  double largest = 0.0;
+  for (const AxisNoiseModel& axis : model->gyro) {
+    double v = 0.0;
+    if (axis.bias_instability.visible())
+      v += axis.bias_instability.value * axis.bias_instability.value;
+    if (axis.random_walk.visible()) {
+      v += axis.random_walk.value * axis.random_walk.value * std::max(0.0, seconds) / 6.0;
+    }
+    if (std::isfinite(v)) largest = std::max(largest, v);
+  }
+  return largest;
+}
+
 }  // namespace
 
 bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>& intervals,
@@ -123,7 +143,10 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
     c.message = (log.source.empty() ? "" : log.source + ": ") + what;
     return false;
   };
-  const std::vector<StaticObservation> observations = ObservationsFromIntervals(log, intervals);
+  std::vector<StaticObservation> observations = ObservationsFromIntervals(log, intervals);
+  // Issue 21: with a gyroscope, the turns between the poses link their
+  // directions (use_between_pose_rotations).
+  const int turns = AddBetweenPoseTurns(log, intervals, &observations);
   EffectParameters start;
   GyroModel gyro;
   const bool has_temperature = StartParameters(observations, &start, &gyro);
@@ -145,6 +168,9 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   fit_options.magnitude_variance_component = options.refinement.estimate_pose_variance;
   fit_options.magnitude_variance_prior = options.refinement.pose_disturbance_prior;
   fit_options.magnitude_variance_prior_dof = options.refinement.pose_disturbance_prior_dof;
+  fit_options.use_between_pose_rotations = turns > 0;
+  fit_options.rotation_gyro_bias_variance =
+      GyroBiasWanderVariance(options.pose_noise.model, observations);
   fit_options.fit_gyro = std::any_of(effects.begin(), effects.end(), [](Effect e) {
     return Info(e).sensor == EffectSensor::kGyroscope;
   });
@@ -183,7 +209,11 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   msg << c.message << "; with effects";
   for (Effect e : effects) msg << " " << ToString(e);
   msg.precision(3);
-  msg << " (accelerometer chi2 " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof() << " dof)";
+  msg << " (accelerometer chi2 " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof()
+      << " dof from " << fit.accel_fit.information << ")";
+  for (const std::string& w : fit.warnings) {
+    internal::AddWarning(WarningCode::kMethodScope, "effects: " + w, &c.warnings, &c.warning_codes);
+  }
   c.message = msg.str();
   return true;
 }
