@@ -21,6 +21,13 @@
 // residuals per pose that see beta, c and delta directly in every axis, so
 // a twelve-position session can test and estimate them; the quadratic term
 // and the model's bias, scale and non-orthogonality predict no trend.
+// With use_between_pose_rotations, also the AccelRotationResidual
+// (residuals/accel_rotation_residual.h) of every turn between consecutive
+// poses: two whitened values saying how far the gyroscope's integrated turn
+// misses carrying the corrected direction of one pose to that of the next,
+// with the gyroscope's M_g and b_g estimated alongside (weights:
+// src/methods/between_pose_rotations.h). The directions see what the
+// magnitudes cannot: on the seed's twelve poses the quadratic term of z.
 // Gyroscope (when the positions have it): minimises sum_k |L_k^-1 e_k|^2,
 //
 //   e_k = u_k - b_g - (G f_k + gamma dT_k + eta dt_k),
