@@ -371,5 +371,61 @@ TEST(EffectRotations, CalibrateEstimatesAllFourEffectsWithHonestSigmas) {
   check.ExpectHonest("all four effects");
 }
 
+// Hidden gyroscope effects: the bias drift and temperature bias are taken
+// out by the turns' local level at rest (the mean of the two poses' static
+// means), so no accelerometer effect is named; a g-sensitivity is not
+// modelled in the turns: the rows exceed their noise and the fit says so,
+// and calibrate --effects then fits without them.
+TEST(EffectRotations, HiddenGyroscopeEffectsAreNotTakenForAccelerometerOnes) {
+  for (int which = 0; which < 3; ++which) {
+    SimulatorOptions sim = TwelvePoseWarmUp();
+    // 0.01 deg/s/K, 0.03 deg/s/min, 0.05 deg/s/g (discovery_test.cc).
+    if (which == 0) sim.gyro_temperature_bias_std = 1.7e-4;
+    if (which == 1) sim.gyro_bias_drift_std = 1e-5;
+    if (which == 2) sim.gyro_g_sensitivity_std = 9e-5;
+    int significant = 0, warned = 0;
+    for (int seed = 1; seed <= 10; ++seed) {
+      SimulatedSession session;
+      std::string error;
+      ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
+      const std::vector<StaticObservation> obs = SessionObservations(session);
+      const EffectFitResult base =
+          Fit(obs, session, AccelParameterization::kScaleMisalignment, {}, true);
+      if (!base.warnings.empty()) ++warned;
+      for (const HiddenEffect& h : kHidden) {
+        const SensorFitSummary ext =
+            Fit(obs, session, AccelParameterization::kScaleMisalignment, {h.effect}, true)
+                .accel_fit;
+        if (ChiSquareUpperTail(base.accel_fit.chi2 - ext.chi2, 3) < kLevel) ++significant;
+      }
+      if (which == 2 && seed == 1) {
+        Config config;
+        config.effects = {Effect::kAccelQuadratic};
+        config.calibration.gravity.gravity = session.gravity;
+        PipelineInput input;
+        input.log = session.log;
+        Calibration calibration;
+        ASSERT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
+        EXPECT_EQ(calibration.message.find("rotations between poses"), std::string::npos)
+            << calibration.message;
+        bool said = false;
+        for (const std::string& w : calibration.warnings) {
+          said = said || w.find("exceed their noise") != std::string::npos;
+        }
+        EXPECT_TRUE(said);
+      }
+    }
+    std::printf(
+        "gyroscope effect %d: %d of 40 accelerometer tests significant, warned in %d of 10\n",
+        which, significant, warned);
+    if (which < 2) {
+      EXPECT_LE(significant, 2);
+      EXPECT_LE(warned, 1);
+    } else {
+      EXPECT_GE(warned, 9);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace gravcal

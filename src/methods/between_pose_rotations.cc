@@ -168,7 +168,13 @@ bool WeighRows(const std::vector<StaticObservation>& observations, const Normali
       white += c * c * ri * rate_cov * ri.transpose();
       shared += c * ri;
     }
-    const Eigen::Matrix3d angle_cov = white + gyro_bias_variance * shared * shared.transpose();
+    // The local level's noise (the two static means, averaged) and the
+    // bias's wander, both constant over the turn.
+    const Eigen::Matrix3d level_cov = m * (0.25 * (from.gyro_mean_cov + to.gyro_mean_cov)) *
+                                      rows->scale * rows->scale * m.transpose();
+    const Eigen::Matrix3d angle_cov =
+        white + shared * (level_cov + gyro_bias_variance * Eigen::Matrix3d::Identity()) *
+                    shared.transpose();
     const Eigen::Matrix3d px = Skew(rn.transpose() * d_s);
     // The poses' direction noise: the mean's covariance and the extra
     // variance, both through the same projection.
@@ -268,8 +274,11 @@ bool PrepareRotationRows(const std::vector<StaticObservation>& observations,
     const StaticObservation& to = observations[pair.second];
     AccelRotationData d;
     d.turn.t = to.turn_t;
+    // The turn's rate about the local level at rest, the mean of the two
+    // poses' static means (rows->gyro_bias is a common correction to it).
+    const Eigen::Vector3d level = 0.5 * (from.gyro_mean + to.gyro_mean);
     for (const Eigen::Vector3d& u : to.turn_gyro) {
-      d.turn.gyro.push_back((u - rows->center) * rows->scale);
+      d.turn.gyro.push_back((u - level) * rows->scale);
     }
     d.start_raw = NormalizedRaw(norm, from.accel.raw_mean);
     d.end_raw = NormalizedRaw(norm, to.accel.raw_mean);

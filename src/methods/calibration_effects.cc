@@ -178,6 +178,18 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   if (!FitEffects(observations, c.accel.model, gyro, start, c.gravity, fit_options, &fit)) {
     return fail("fit with effects: " + fit.message);
   }
+  if (fit.accel_fit.rotation_residuals > 0 &&
+      ChiSquareUpperTail(fit.accel_fit.rotation_chi2, fit.accel_fit.rotation_residuals - 12) <
+          1e-3) {
+    // The turns carry something they do not model: the effects from the
+    // poses alone, saying why.
+    const std::vector<std::string> why = fit.warnings;
+    fit_options.use_between_pose_rotations = false;
+    if (!FitEffects(observations, c.accel.model, gyro, start, c.gravity, fit_options, &fit)) {
+      return fail("fit with effects: " + fit.message);
+    }
+    for (const std::string& w : why) fit.warnings.push_back(w + "; not used");
+  }
   std::string undetermined;
   for (const SensorFitSummary* s : {&fit.accel_fit, &fit.gyro_fit}) {
     for (const std::string& name : s->undetermined) {

@@ -152,6 +152,10 @@ std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const bool on[4]
   return upper_free;
 }
 
+// Start of the warning FitEffects gives when the rotation rows exceed their
+// noise (p < 0.001).
+constexpr char kRotationsExceedNoise[] = "the rotations between poses exceed their noise";
+
 // Columns of the gyroscope's nuisance parameters (b_g' 3, M_g' 9) with the
 // rotations between poses.
 constexpr int kRotationGyroColumns = 12;
@@ -414,6 +418,16 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   fit.rotation_residuals = rotation_rows_count;
   fit.num_parameters = np;
   if (rotations) {
+    // Turns that miss far beyond their noise: something the rotation rows
+    // do not model (a gyroscope g-sensitivity, a turn cut short).
+    const int rotation_dof = rotation_rows_count - kRotationGyroColumns;
+    if (rotation_dof > 0 && ChiSquareUpperTail(fit.rotation_chi2, rotation_dof) < 1e-3) {
+      std::ostringstream w;
+      w.precision(3);
+      w << kRotationsExceedNoise << " (chi2 " << fit.rotation_chi2 << " on about " << rotation_dof
+        << " dof): something the turns do not model, such as a gyroscope g-sensitivity";
+      result->warnings.push_back(w.str());
+    }
     const Eigen::Matrix3d m =
         Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation_rows.gyro_matrix);
     result->rotation_gyro_matrix = rotation_rows.scale * m;
