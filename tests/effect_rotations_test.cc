@@ -10,12 +10,14 @@
 #include <cstdio>
 #include <memory>
 
+#include "effect_session.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/methods/effect_fit.h"
 #include "gravcal/residuals/accel_rotation_residual.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
+#include "jacobian_check.h"
 #include "sigma_check.h"
 #include "test_util.h"
 #include "util/statistics.h"
@@ -24,53 +26,29 @@ namespace gravcal {
 namespace {
 
 using internal::ChiSquareUpperTail;
+using testing_util::Nominal;
+using testing_util::References;
+using testing_util::SessionIntervals;
+using testing_util::TwelvePoseWarmUp;
+using testing_util::WithHidden;
 
-SimulatorOptions TwelvePoseWarmUp() {
-  SimulatorOptions o = testing_util::WarmUpSession();
-  o.scheme = "twelve";
-  o.hold_seconds = 30.0;
-  o.initial_still_seconds = 10.0;
-  o.rotation_seconds = 3.0;
-  o.temperature_tau = 200.0;
-  o.accel_bias_random_walk = 2e-5;
-  o.accel_bias_instability = 2e-4;
-  return o;
-}
-
+// The session's observations with trends and the turns between the poses.
 std::vector<StaticObservation> SessionObservations(const SimulatedSession& session) {
-  std::vector<StaticInterval> intervals;
-  for (const SimulatedPose& p : session.poses) {
-    intervals.push_back(MakeInterval(session.log, p.begin, p.end));
-  }
+  const std::vector<StaticInterval> intervals = SessionIntervals(session);
   std::vector<StaticObservation> obs = ObservationsFromIntervals(session.log, intervals);
   AddBetweenPoseTurns(session.log, intervals, &obs);
   return obs;
 }
 
-EffectParameters References(const std::vector<StaticObservation>& observations) {
-  EffectParameters p;
-  for (const StaticObservation& o : observations) {
-    p.reference_time += o.time() / observations.size();
-    p.reference_temperature += o.temperature() / observations.size();
-  }
-  return p;
-}
-
-AccelModel Nominal(const SimulatedSession& session) {
-  AccelModel m;
-  m.bias.setZero();
-  m.upper = Eigen::Matrix3d::Identity() / session.accel_units_per_si;
-  return m;
-}
-
+// The accelerometer fit with `effects` over `baseline`, with or without the
+// rotations between poses.
 EffectFitResult Fit(const std::vector<StaticObservation>& obs, const SimulatedSession& session,
                     AccelParameterization baseline, const std::vector<Effect>& effects,
-                    bool rotations, bool trends = true) {
+                    bool rotations) {
   EffectFitOptions options;
   options.parameterization = baseline;
   options.effects = effects;
   options.fit_gyro = false;
-  options.use_within_pose_trends = trends;
   options.use_between_pose_rotations = rotations;
   EffectFitResult fit;
   EXPECT_TRUE(FitEffects(obs, Nominal(session), GyroModel(), References(obs), session.gravity,
@@ -83,26 +61,6 @@ EffectFitResult Fit(const std::vector<StaticObservation>& obs, const SimulatedSe
 // over the eight candidates of the catalogue.
 constexpr double kLevel = 0.01 / 8.0;
 
-SimulatorOptions WithHidden(SimulatorOptions o, Effect e, double std) {
-  switch (e) {
-    case Effect::kAccelQuadratic:
-      o.accel_quadratic_std = std;
-      break;
-    case Effect::kAccelTemperatureBias:
-      o.accel_temperature_bias_std = std;
-      break;
-    case Effect::kAccelTemperatureScale:
-      o.accel_temperature_scale_std = std;
-      break;
-    case Effect::kAccelBiasDrift:
-      o.accel_bias_drift_std = std;
-      break;
-    default:
-      break;
-  }
-  return o;
-}
-
 // Typical consumer-MEMS sizes (tests/effect_trends_test.cc).
 struct HiddenEffect {
   Effect effect;
@@ -114,6 +72,22 @@ const HiddenEffect kHidden[] = {
     {Effect::kAccelTemperatureScale, 1e-4},
     {Effect::kAccelBiasDrift, 8.2e-5},
 };
+
+// calibrate --effects on the session; with pose_variance as
+// tests/effect_trends_test.cc: the pose variance with a prior from the
+// simulated correlated noise.
+bool CalibrateWithEffects(const SimulatedSession& session, const std::vector<Effect>& effects,
+                          bool pose_variance, Calibration* calibration) {
+  Config config;
+  config.effects = effects;
+  config.calibration.gravity.gravity = session.gravity;
+  config.calibration.refinement.estimate_pose_variance = pose_variance;
+  config.calibration.refinement.pose_disturbance_prior = pose_variance ? 2.5e-4 : 0.0;
+  config.calibration.refinement.pose_disturbance_prior_dof = pose_variance ? 10.0 : 0.0;
+  PipelineInput input;
+  input.log = session.log;
+  return RunCalibration(config, input, calibration);
+}
 
 // The residual's autodiff Jacobian against central differences, with every
 // effect on and a real turn.
@@ -142,30 +116,10 @@ TEST(AccelRotationResidual, JacobianMatchesNumericDifferences) {
   double delta[3] = {8e-5, -5e-5, 2e-5};
   double gyro_bias[3] = {0.01, -0.02, 0.005};
   double gyro_matrix[9] = {1.0, 0.01, -0.02, 0.005, 0.98, 0.01, -0.01, 0.02, 1.03};
-  double* params[8] = {bias, upper, k2, beta, c, delta, gyro_bias, gyro_matrix};
-  const int sizes[8] = {3, 6, 3, 3, 3, 3, 3, 9};
-  const double steps[8] = {1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8, 1e-6, 1e-6};
-  double r[2];
-  double jac[8][18];
-  double* jacobians[8] = {jac[0], jac[1], jac[2], jac[3], jac[4], jac[5], jac[6], jac[7]};
-  ASSERT_TRUE(cost->Evaluate(params, r, jacobians));
-  for (int b = 0; b < 8; ++b) {
-    for (int i = 0; i < sizes[b]; ++i) {
-      const double x = params[b][i];
-      double rp[2], rm[2];
-      params[b][i] = x + steps[b];
-      cost->Evaluate(params, rp, nullptr);
-      params[b][i] = x - steps[b];
-      cost->Evaluate(params, rm, nullptr);
-      params[b][i] = x;
-      for (int row = 0; row < 2; ++row) {
-        const double numeric = (rp[row] - rm[row]) / (2.0 * steps[b]);
-        const double analytic = jac[b][row * sizes[b] + i];
-        EXPECT_NEAR(analytic, numeric, 1e-4 * std::max(1.0, std::fabs(analytic)))
-            << "block " << b << " entry " << i << " row " << row;
-      }
-    }
-  }
+  std::vector<std::vector<double>> jacobians;
+  testing_util::ExpectJacobianMatchesCentralDifferences(
+      *cost, {bias, upper, k2, beta, c, delta, gyro_bias, gyro_matrix}, {3, 6, 3, 3, 3, 3, 3, 9},
+      {1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8, 1e-6, 1e-6}, 1e-4, &jacobians);
 }
 
 // The rows are counted and named; the gyroscope estimated with them is the
@@ -338,18 +292,10 @@ TEST(EffectRotations, CalibrateEstimatesAllFourEffectsWithHonestSigmas) {
     SimulatedSession session;
     std::string error;
     ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
-    Config config;
-    for (const HiddenEffect& h : kHidden) config.effects.push_back(h.effect);
-    config.calibration.gravity.gravity = session.gravity;
-    // As tests/effect_trends_test.cc: the pose variance with a prior from
-    // the simulated correlated noise.
-    config.calibration.refinement.estimate_pose_variance = true;
-    config.calibration.refinement.pose_disturbance_prior = 2.5e-4;
-    config.calibration.refinement.pose_disturbance_prior_dof = 10.0;
-    PipelineInput input;
-    input.log = session.log;
+    std::vector<Effect> effects;
+    for (const HiddenEffect& h : kHidden) effects.push_back(h.effect);
     Calibration calibration;
-    ASSERT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
+    ASSERT_TRUE(CalibrateWithEffects(session, effects, true, &calibration)) << calibration.message;
     EXPECT_NE(calibration.message.find("rotations between poses"), std::string::npos)
         << calibration.message;
     ASSERT_EQ(calibration.effects.estimates.size(), 4u);
@@ -399,13 +345,9 @@ TEST(EffectRotations, HiddenGyroscopeEffectsAreNotTakenForAccelerometerOnes) {
         if (ChiSquareUpperTail(base.accel_fit.chi2 - ext.chi2, 3) < kLevel) ++significant;
       }
       if (which == 2 && seed == 1) {
-        Config config;
-        config.effects = {Effect::kAccelQuadratic};
-        config.calibration.gravity.gravity = session.gravity;
-        PipelineInput input;
-        input.log = session.log;
         Calibration calibration;
-        ASSERT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
+        ASSERT_TRUE(CalibrateWithEffects(session, {Effect::kAccelQuadratic}, false, &calibration))
+            << calibration.message;
         EXPECT_EQ(calibration.message.find("rotations between poses"), std::string::npos)
             << calibration.message;
         bool said = false;

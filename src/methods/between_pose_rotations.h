@@ -3,11 +3,18 @@
 // observations a turn joins, the gyroscope's normalisation and starting
 // values, and the weight of every AccelRotationResidual.
 //
-// The gyroscope enters normalised, u' = (u - center) * scale, with center
-// the mean of the poses' gyroscope means and scale the cube root of |det
-// M_0| of the linear initial matrix (gyro_initial_matrix.h), so that b_g'
-// is near 0 and M_g' near a rotation: M_g = scale M_g', b_g = center +
-// b_g' / scale.
+// The gyroscope of a turn from pose s to pose e enters about its local
+// level at rest and normalised, u' = (u - l) * scale, l = (ubar_s +
+// ubar_e) / 2 the mean of the two poses' static means, scale the cube root
+// of |det M_0| of the linear initial matrix (gyro_initial_matrix.h), so
+// that M_g' is near a rotation and b_g' (common to all turns) near 0:
+// M_g = scale M_g'. The local level takes out what moves the bias over the
+// session (drift, temperature, the wander of bias instability and random
+// walk): a hidden gyroscope drift or temperature bias is then not taken for
+// an accelerometer effect. A g-sensitivity G f changes during the turn and
+// is not modelled; the fit warns when the rows exceed their noise.
+// result->rotation_gyro_bias reports center + b_g' / scale, center the
+// mean of all static means.
 //
 // Weights. The direction error e = E (R(dq)^T d_s - d_e) of a turn has the
 // covariance
@@ -21,8 +28,11 @@
 // integrated white noise of the gyroscope over the turn (per sample the
 // pooled still covariance of the poses, weighted by its share c_i of the
 // trapezoid and turned into the end frame: sum c_i^2 R^T R_i Sigma_w R_i^T
-// R) and A_b = B V B^T, B = sum c_i R^T R_i, the wander V of the bias about
-// its session value (rotation_gyro_bias_variance). W = chol(C)^-1. The
+// R) and A_b = B (M_g' (Sigma_s + Sigma_e) M_g'^T / 4 + V) B^T, B = sum c_i
+// R^T R_i, from the noise of the local level (the two static means'
+// covariances Sigma) and the wander V of the bias about it
+// (rotation_gyro_bias_variance), both constant over the turn.
+// W = chol(C)^-1. The
 // weights are fixed per solve, computed at the start of the fit after a
 // first fit of the gyroscope alone with the accelerometer held.
 #ifndef GRAVCAL_SRC_METHODS_BETWEEN_POSE_ROTATIONS_H_

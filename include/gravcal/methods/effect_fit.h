@@ -263,8 +263,10 @@ struct EffectFitResult {
   std::vector<Eigen::Vector3d> accel_trend_residuals;
   // With the rotations between poses: the gyroscope estimated with them,
   // w = M_g (u - b_g) in the accelerometer's orthogonalised frame (raw
-  // units; NaN when not used), and each turn's whitened residual (2 values)
-  // with the observation indices it joins.
+  // units; NaN when not used; b_g is the poses' mean rest level plus the
+  // common correction, each turn using its own level, between_pose_
+  // rotations.h), and each turn's whitened residual (2 values) with the
+  // observation indices it joins.
   Eigen::Matrix3d rotation_gyro_matrix = Eigen::Matrix3d::Constant(NAN);
   Eigen::Vector3d rotation_gyro_bias = Eigen::Vector3d::Constant(NAN);
   std::vector<Eigen::Vector2d> rotation_residuals;

@@ -15,7 +15,8 @@
 // The gyroscope rate in the same frame is w_i = M_g (u_i - b_g) (M_g: 9
 // free entries, rad/s per raw unit, so it absorbs the rotation between the
 // gyroscope's axes and the accelerometer's orthogonalised frame; b_g raw
-// units), integrated as IntegrateGyroRotation (gyro_rotation_residual.h)
+// units; u_i may be given about a level of the caller's, then b_g is the
+// correction to it), integrated as IntegrateGyroRotation (gyro_rotation_residual.h)
 // into the attitude change dq of pose e relative to pose s. Gravity is fixed
 // in the navigation frame, so a right model carries d_s into d_e:
 //
@@ -89,18 +90,7 @@ struct AccelRotationResidual {
     }
     T dq[4];
     IntegrateGyroRotation<T>(data_.turn, gyro_bias, gyro_matrix, nullptr, dq);
-    // R(dq)^T d_s: rotate by the conjugate.
-    const T conjugate[4] = {dq[0], -dq[1], -dq[2], -dq[3]};
-    T predicted[3];
-    ceres::UnitQuaternionRotatePoint(conjugate, start, predicted);
-    T e[2];
-    for (int j = 0; j < 2; ++j) {
-      e[j] = T(0.0);
-      for (int i = 0; i < 3; ++i) e[j] += data_.tangent(j, i) * (predicted[i] - end[i]);
-    }
-    const Eigen::Matrix2d& w = data_.sqrt_information;
-    residual[0] = w(0, 0) * e[0] + w(0, 1) * e[1];
-    residual[1] = w(1, 0) * e[0] + w(1, 1) * e[1];
+    WhitenedTurnError<T>(dq, start, end, data_.tangent, data_.sqrt_information, residual);
     return true;
   }
 
