@@ -43,8 +43,25 @@ void CopyEffectFit(const EffectFitResult& fit, Calibration* calibration) {
   c.accel.model.upper = fit.accel.upper;
   c.accel.model.parameterization = fit.accel.parameterization;
   c.accel.bias_std = fit.accel_bias_std;
-  c.accel.covariance = fit.accel_fit.covariance;
-  c.accel.covariance_names = fit.accel_fit.parameter_names;
+  // The accelerometer's parameters only: the gyroscope's nuisance
+  // parameters of the rotations between poses (rotation_gyro_*) are left
+  // out (the marginal covariance drops their rows and columns).
+  std::vector<int> kept;
+  c.accel.covariance_names.clear();
+  for (size_t i = 0; i < fit.accel_fit.parameter_names.size(); ++i) {
+    const std::string& name = fit.accel_fit.parameter_names[i];
+    if (name.rfind("rotation_gyro_", 0) == 0) continue;
+    kept.push_back(static_cast<int>(i));
+    c.accel.covariance_names.push_back(name);
+  }
+  const int n = static_cast<int>(kept.size());
+  c.accel.covariance.resize(fit.accel_fit.covariance.size() > 0 ? n : 0,
+                            fit.accel_fit.covariance.size() > 0 ? n : 0);
+  for (int r = 0; r < c.accel.covariance.rows(); ++r) {
+    for (int col = 0; col < n; ++col) {
+      c.accel.covariance(r, col) = fit.accel_fit.covariance(kept[r], kept[col]);
+    }
+  }
   const bool rotated = !c.accel.model.rotation.isIdentity(0.0);
   static const char* kUpperNames[3][3] = {
       {"u_xx", "u_xy", "u_xz"}, {"", "u_yy", "u_yz"}, {"", "", "u_zz"}};
