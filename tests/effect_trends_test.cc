@@ -11,12 +11,14 @@
 #include <cstdio>
 #include <random>
 
+#include "effect_session.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/methods/effect_fit.h"
 #include "gravcal/residuals/accel_trend_residual.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
+#include "jacobian_check.h"
 #include "sigma_check.h"
 #include "test_util.h"
 #include "util/statistics.h"
@@ -25,26 +27,15 @@ namespace gravcal {
 namespace {
 
 using internal::ChiSquareUpperTail;
+using testing_util::Nominal;
+using testing_util::References;
+using testing_util::SessionIntervals;
+using testing_util::TwelvePoseWarmUp;
+using testing_util::WithHidden;
 
 // The family-wise level of discovery (discovery_significance 0.01) divided
 // over the eight candidates of the catalogue.
 constexpr double kLevel = 0.01 / 8.0;
-
-// The seed's twelve poses held 30 s during a warm-up 20 -> 35 degC (time
-// constant 200 s, so the poses see different temperature rates), with the
-// hand_placed.yaml correlated accelerometer noise on top of the default
-// white noise (0.02 m/s^2 per sample at 100 Hz).
-SimulatorOptions TwelvePoseWarmUp() {
-  SimulatorOptions o = testing_util::WarmUpSession();
-  o.scheme = "twelve";
-  o.hold_seconds = 30.0;
-  o.initial_still_seconds = 10.0;
-  o.rotation_seconds = 3.0;
-  o.temperature_tau = 200.0;
-  o.accel_bias_random_walk = 2e-5;
-  o.accel_bias_instability = 2e-4;
-  return o;
-}
 
 struct HiddenEffect {
   Effect effect;
@@ -64,52 +55,10 @@ const HiddenEffect kHidden[] = {
     {Effect::kAccelMisalignment, 0.0, AccelParameterization::kScale},
 };
 
-SimulatorOptions WithHidden(SimulatorOptions o, Effect e, double std) {
-  switch (e) {
-    case Effect::kAccelQuadratic:
-      o.accel_quadratic_std = std;
-      break;
-    case Effect::kAccelTemperatureBias:
-      o.accel_temperature_bias_std = std;
-      break;
-    case Effect::kAccelTemperatureScale:
-      o.accel_temperature_scale_std = std;
-      break;
-    case Effect::kAccelBiasDrift:
-      o.accel_bias_drift_std = std;
-      break;
-    default:
-      break;
-  }
-  return o;
-}
-
 // The observations of a simulated session's poses (the simulator's own
 // still periods, so that detection is not under test here) with trends.
 std::vector<StaticObservation> SessionObservations(const SimulatedSession& session) {
-  std::vector<StaticInterval> intervals;
-  for (const SimulatedPose& p : session.poses) {
-    intervals.push_back(MakeInterval(session.log, p.begin, p.end));
-  }
-  return ObservationsFromIntervals(session.log, intervals);
-}
-
-// References as calibrate sets them: mean time and temperature of the poses.
-EffectParameters References(const std::vector<StaticObservation>& observations) {
-  EffectParameters p;
-  for (const StaticObservation& o : observations) {
-    p.reference_time += o.time() / observations.size();
-    p.reference_temperature += o.temperature() / observations.size();
-  }
-  return p;
-}
-
-// The nominal model of the simulated sensor: no bias, U = I / units.
-AccelModel Nominal(const SimulatedSession& session) {
-  AccelModel m;
-  m.bias.setZero();
-  m.upper = Eigen::Matrix3d::Identity() / session.accel_units_per_si;
-  return m;
+  return ObservationsFromIntervals(session.log, SessionIntervals(session));
 }
 
 // chi2 of the accelerometer fit with `effects` over `baseline`.
@@ -150,32 +99,12 @@ TEST(AccelTrendResidual, JacobianMatchesNumericDifferences) {
   double beta[3] = {0.002, -0.001, 0.003};
   double c[3] = {1e-4, -2e-4, 3e-4};
   double delta[3] = {8e-5, -5e-5, 2e-5};
-  double* params[6] = {bias, upper, k2, beta, c, delta};
-  const int sizes[6] = {3, 6, 3, 3, 3, 3};
-  const double steps[6] = {1e-2, 1e-9, 1e-6, 1e-6, 1e-7, 1e-8};
-  double r[3];
-  double jac[6][18];
-  double* jacobians[6] = {jac[0], jac[1], jac[2], jac[3], jac[4], jac[5]};
-  ASSERT_TRUE(cost->Evaluate(params, r, jacobians));
-  for (int b = 0; b < 6; ++b) {
-    for (int i = 0; i < sizes[b]; ++i) {
-      const double x = params[b][i];
-      double rp[3], rm[3];
-      params[b][i] = x + steps[b];
-      cost->Evaluate(params, rp, nullptr);
-      params[b][i] = x - steps[b];
-      cost->Evaluate(params, rm, nullptr);
-      params[b][i] = x;
-      for (int row = 0; row < 3; ++row) {
-        const double numeric = (rp[row] - rm[row]) / (2.0 * steps[b]);
-        const double analytic = jac[b][row * sizes[b] + i];
-        EXPECT_NEAR(analytic, numeric, 1e-5 * std::max(1.0, std::fabs(analytic)))
-            << "block " << b << " entry " << i << " row " << row;
-      }
-    }
-  }
+  std::vector<std::vector<double>> jac;
+  testing_util::ExpectJacobianMatchesCentralDifferences(
+      *cost, {bias, upper, k2, beta, c, delta}, {3, 6, 3, 3, 3, 3},
+      {1e-2, 1e-9, 1e-6, 1e-6, 1e-7, 1e-8}, 1e-5, &jac);
   // The quadratic term predicts no trend.
-  for (int i = 0; i < 3 * 3; ++i) EXPECT_EQ(jac[2][i], 0.0);
+  for (double d : jac[2]) EXPECT_EQ(d, 0.0);
 }
 
 // A still log with a known linear trend and white noise: the slope is

@@ -22,6 +22,7 @@
 #include "gravcal/detection/static_detector.h"
 
 // residuals
+#include "gravcal/residuals/accel_rotation_residual.h"
 #include "gravcal/residuals/accel_trend_residual.h"
 #include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "gravcal/residuals/gyro_rotation_residual.h"

@@ -43,8 +43,25 @@ void CopyEffectFit(const EffectFitResult& fit, Calibration* calibration) {
   c.accel.model.upper = fit.accel.upper;
   c.accel.model.parameterization = fit.accel.parameterization;
   c.accel.bias_std = fit.accel_bias_std;
-  c.accel.covariance = fit.accel_fit.covariance;
-  c.accel.covariance_names = fit.accel_fit.parameter_names;
+  // The accelerometer's parameters only: the gyroscope's nuisance
+  // parameters of the rotations between poses (rotation_gyro_*) are left
+  // out (the marginal covariance drops their rows and columns).
+  std::vector<int> kept;
+  c.accel.covariance_names.clear();
+  for (size_t i = 0; i < fit.accel_fit.parameter_names.size(); ++i) {
+    const std::string& name = fit.accel_fit.parameter_names[i];
+    if (name.rfind("rotation_gyro_", 0) == 0) continue;
+    kept.push_back(static_cast<int>(i));
+    c.accel.covariance_names.push_back(name);
+  }
+  const int n = static_cast<int>(kept.size());
+  c.accel.covariance.resize(fit.accel_fit.covariance.size() > 0 ? n : 0,
+                            fit.accel_fit.covariance.size() > 0 ? n : 0);
+  for (int r = 0; r < c.accel.covariance.rows(); ++r) {
+    for (int col = 0; col < n; ++col) {
+      c.accel.covariance(r, col) = fit.accel_fit.covariance(kept[r], kept[col]);
+    }
+  }
   const bool rotated = !c.accel.model.rotation.isIdentity(0.0);
   static const char* kUpperNames[3][3] = {
       {"u_xx", "u_xy", "u_xz"}, {"", "u_yy", "u_yz"}, {"", "", "u_zz"}};
@@ -112,6 +129,26 @@ void SetEffectResiduals(const EffectFitResult& fit, Calibration* calibration) {
   }
 }
 
+// The variance of the gyroscope's bias about its session value from the
+// noise model, (rad/s)^2: B^2 + K^2 T / 6 (the random walk's mean square
+// about its mean over T s), the largest over the axes; 0 without a model.
+double GyroBiasWanderVariance(const ImuNoiseModel* model,
+                              const std::vector<StaticObservation>& observations) {
+  if (model == nullptr || observations.empty()) return 0.0;
+  const double seconds = observations.back().accel.t_end - observations.front().accel.t_begin;
+  double largest = 0.0;
+  for (const AxisNoiseModel& axis : model->gyro) {
+    double v = 0.0;
+    if (axis.bias_instability.visible())
+      v += axis.bias_instability.value * axis.bias_instability.value;
+    if (axis.random_walk.visible()) {
+      v += axis.random_walk.value * axis.random_walk.value * std::max(0.0, seconds) / 6.0;
+    }
+    if (std::isfinite(v)) largest = std::max(largest, v);
+  }
+  return largest;
+}
+
 }  // namespace
 
 bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>& intervals,
@@ -123,7 +160,10 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
     c.message = (log.source.empty() ? "" : log.source + ": ") + what;
     return false;
   };
-  const std::vector<StaticObservation> observations = ObservationsFromIntervals(log, intervals);
+  std::vector<StaticObservation> observations = ObservationsFromIntervals(log, intervals);
+  // Issue 21: with a gyroscope, the turns between the poses link their
+  // directions (use_between_pose_rotations).
+  const int turns = AddBetweenPoseTurns(log, intervals, &observations);
   EffectParameters start;
   GyroModel gyro;
   const bool has_temperature = StartParameters(observations, &start, &gyro);
@@ -145,12 +185,27 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   fit_options.magnitude_variance_component = options.refinement.estimate_pose_variance;
   fit_options.magnitude_variance_prior = options.refinement.pose_disturbance_prior;
   fit_options.magnitude_variance_prior_dof = options.refinement.pose_disturbance_prior_dof;
+  fit_options.use_between_pose_rotations = turns > 0;
+  fit_options.rotation_gyro_bias_variance =
+      GyroBiasWanderVariance(options.pose_noise.model, observations);
   fit_options.fit_gyro = std::any_of(effects.begin(), effects.end(), [](Effect e) {
     return Info(e).sensor == EffectSensor::kGyroscope;
   });
   EffectFitResult fit;
   if (!FitEffects(observations, c.accel.model, gyro, start, c.gravity, fit_options, &fit)) {
     return fail("fit with effects: " + fit.message);
+  }
+  if (fit.accel_fit.rotation_residuals > 0 &&
+      ChiSquareUpperTail(fit.accel_fit.rotation_chi2, fit.accel_fit.rotation_residuals - 12) <
+          1e-3) {
+    // The turns carry something they do not model: the effects from the
+    // poses alone, saying why.
+    const std::vector<std::string> why = fit.warnings;
+    fit_options.use_between_pose_rotations = false;
+    if (!FitEffects(observations, c.accel.model, gyro, start, c.gravity, fit_options, &fit)) {
+      return fail("fit with effects: " + fit.message);
+    }
+    for (const std::string& w : why) fit.warnings.push_back(w + "; not used");
   }
   std::string undetermined;
   for (const SensorFitSummary* s : {&fit.accel_fit, &fit.gyro_fit}) {
@@ -183,7 +238,11 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   msg << c.message << "; with effects";
   for (Effect e : effects) msg << " " << ToString(e);
   msg.precision(3);
-  msg << " (accelerometer chi2 " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof() << " dof)";
+  msg << " (accelerometer chi2 " << fit.accel_fit.chi2 << " on " << fit.accel_fit.dof()
+      << " dof from " << fit.accel_fit.information << ")";
+  for (const std::string& w : fit.warnings) {
+    internal::AddWarning(WarningCode::kMethodScope, "effects: " + w, &c.warnings, &c.warning_codes);
+  }
   c.message = msg.str();
   return true;
 }

@@ -16,9 +16,11 @@
 #include "estimation/variance_component.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/refinement.h"
+#include "gravcal/residuals/accel_rotation_residual.h"
 #include "gravcal/residuals/accel_trend_residual.h"
 #include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "gravcal/residuals/gyro_static_residual.h"
+#include "methods/between_pose_rotations.h"
 #include "methods/within_pose_trend.h"
 #include "util/statistics.h"
 
@@ -122,7 +124,7 @@ constexpr Effect kAccelBlockEffect[4] = {Effect::kAccelQuadratic, Effect::kAccel
 
 // fit->parameter_names (the columns of the dense Jacobian); returns the
 // indices of the free entries of U.
-std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const bool on[4],
+std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const bool on[4], bool rotations,
                                         SensorFitSummary* fit) {
   static const char* kUpperNames[6] = {"u_xx", "u_xy", "u_xz", "u_yy", "u_yz", "u_zz"};
   fit->parameter_names = {"bias_x", "bias_y", "bias_z"};
@@ -139,39 +141,64 @@ std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const bool on[4]
       fit->parameter_names.push_back(n);
     }
   }
+  if (rotations) {
+    for (const char* n : {"rotation_gyro_bias_x", "rotation_gyro_bias_y", "rotation_gyro_bias_z",
+                          "rotation_gyro_m_xx", "rotation_gyro_m_xy", "rotation_gyro_m_xz",
+                          "rotation_gyro_m_yx", "rotation_gyro_m_yy", "rotation_gyro_m_yz",
+                          "rotation_gyro_m_zx", "rotation_gyro_m_zy", "rotation_gyro_m_zz"}) {
+      fit->parameter_names.push_back(n);
+    }
+  }
   return upper_free;
 }
 
+// Start of the warning FitEffects gives when the rotation rows exceed their
+// noise (p < 0.001).
+constexpr char kRotationsExceedNoise[] = "the rotations between poses exceed their noise";
+
+// Columns of the gyroscope's nuisance parameters (b_g' 3, M_g' 9) with the
+// rotations between poses.
+constexpr int kRotationGyroColumns = 12;
+
 // One residual block of the accelerometer fit: a position's magnitude (1
-// row) or its within-pose trend (3 rows). The cost functions are kept (not
-// owned by the problem) to evaluate the Jacobian at the optimum.
+// row), its within-pose trend (3 rows) or a rotation between two poses (2
+// rows, which also take the gyroscope's blocks b_g', M_g'). The cost
+// functions are kept (not owned by the problem) to evaluate the Jacobian at
+// the optimum.
 struct AccelBlock {
   std::unique_ptr<ceres::CostFunction> cost;
   int rows = 1;
   int position = 0;
   bool trend = false;
+  bool rotation = false;
 };
 
 // fit->chi2 (and trend_chi2), the whitened residuals (all rows, and the
 // trend residuals per position) and, with
 // `covariance`, the dense Jacobian of the free parameters at `params`, rows
 // in block order; false when the model has no value at a position.
-bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const params[6],
-                      const std::vector<int>& upper_free, const bool on[4], bool covariance,
-                      Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals, SensorFitSummary* fit,
-                      std::vector<Eigen::Vector3d>* trend_residuals) {
+// params holds the six accelerometer blocks and, with rotations, b_g' and
+// M_g' (their columns last).
+bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const params[8],
+                      const std::vector<int>& upper_free, const bool on[4], bool rotations,
+                      bool covariance, Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals,
+                      SensorFitSummary* fit, std::vector<Eigen::Vector3d>* trend_residuals,
+                      std::vector<Eigen::Vector2d>* rotation_residuals) {
   fit->chi2 = 0.0;
   fit->trend_chi2 = 0.0;
+  fit->rotation_chi2 = 0.0;
+  rotation_residuals->clear();
   int row0 = 0;
   for (const AccelBlock& block : blocks) {
     double r[3];
-    double jb[9], ju[18], je[4][9];
-    double* jacobians[6] = {jb, ju, je[0], je[1], je[2], je[3]};
+    double jb[9], ju[18], je[4][9], jgb[9], jgm[27];
+    double* jacobians[8] = {jb, ju, je[0], je[1], je[2], je[3], jgb, jgm};
     if (!block.cost->Evaluate(params, r, covariance ? jacobians : nullptr)) return false;
     for (int row = 0; row < block.rows; ++row) {
       (*residuals)(row0 + row) = r[row];
       fit->chi2 += r[row] * r[row];
       if (block.trend) fit->trend_chi2 += r[row] * r[row];
+      if (block.rotation) fit->rotation_chi2 += r[row] * r[row];
       if (!covariance) continue;
       int col = 0;
       for (int i = 0; i < 3; ++i) (*jacobian)(row0 + row, col++) = jb[3 * row + i];
@@ -180,8 +207,16 @@ bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const
         if (!on[b]) continue;
         for (int i = 0; i < 3; ++i) (*jacobian)(row0 + row, col++) = je[b][3 * row + i];
       }
+      if (!rotations) continue;
+      for (int i = 0; i < 3; ++i) {
+        (*jacobian)(row0 + row, col++) = block.rotation ? jgb[3 * row + i] : 0.0;
+      }
+      for (int i = 0; i < 9; ++i) {
+        (*jacobian)(row0 + row, col++) = block.rotation ? jgm[9 * row + i] : 0.0;
+      }
     }
     if (block.trend) (*trend_residuals)[block.position] = Eigen::Vector3d(r[0], r[1], r[2]);
+    if (block.rotation) rotation_residuals->push_back(Eigen::Vector2d(r[0], r[1]));
     row0 += block.rows;
   }
   return true;
@@ -192,14 +227,21 @@ bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const
 // The first observations.size() rows of the Jacobian are the magnitudes.
 void FinishAccel(const std::vector<StaticObservation>& observations, double gravity, double scale,
                  const Eigen::MatrixXd& jacobian, const std::vector<int>& upper_free,
-                 bool covariance, EffectFitResult* result) {
+                 bool covariance, const internal::RotationRows* rotations,
+                 EffectFitResult* result) {
   SensorFitSummary* fit = &result->accel_fit;
   if (covariance) {
     CovarianceFromJacobian(jacobian, 1, static_cast<int>(observations.size()), fit);
-    // Back to raw units: b = c + s b', U = U' / s; the effects are in SI.
+    // Back to raw units: b = c + s b', U = U' / s; the effects are in SI;
+    // the gyroscope's b_g = c_g + b_g' / s_g, M_g = s_g M_g'.
     Eigen::VectorXd d = Eigen::VectorXd::Ones(jacobian.cols());
     d.head<3>().setConstant(scale);
     for (size_t i = 0; i < upper_free.size(); ++i) d(3 + i) = 1.0 / scale;
+    if (rotations != nullptr) {
+      const int g0 = static_cast<int>(jacobian.cols()) - kRotationGyroColumns;
+      d.segment<3>(g0).setConstant(1.0 / rotations->scale);
+      d.segment<9>(g0 + 3).setConstant(rotations->scale);
+    }
     fit->covariance = d.asDiagonal() * fit->covariance * d.asDiagonal();
     for (int i = 0; i < 3; ++i) result->accel_bias_std(i) = fit->Std(fit->parameter_names[i]);
   }
@@ -286,18 +328,50 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
     for (int i = 0; i < 3; ++i) blocks[b][i] = on[b] ? (*kInitial[b])(i) : 0.0;
   }
 
-  const std::vector<AccelBlock> residuals =
+  std::vector<AccelBlock> residuals =
       AccelBlocks(observations, normalized, norm.scale, initial_parameters, gravity,
                   result->accel_sigmas, options.use_within_pose_trends);
   std::vector<double*> parameter_blocks = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
+  // The rotations between poses, with the gyroscope's blocks.
+  internal::RotationRows rotation_rows;
+  bool rotations = false;
+  if (options.use_between_pose_rotations) {
+    const internal::AccelBlocks held = {{bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]}};
+    std::string why;
+    rotations = internal::PrepareRotationRows(observations, norm, initial_parameters, held,
+                                              extra_variance, options.rotation_gyro_bias_variance,
+                                              options.solver, &rotation_rows, &why);
+    if (!rotations && std::find(result->warnings.begin(), result->warnings.end(), why) ==
+                          result->warnings.end()) {
+      result->warnings.push_back(why);
+    }
+  }
+  if (rotations) {
+    for (size_t j = 0; j < rotation_rows.data.size(); ++j) {
+      AccelBlock b;
+      b.position = rotation_rows.poses[j].second;
+      b.rows = 2;
+      b.rotation = true;
+      b.cost.reset(AccelRotationResidual::Create(rotation_rows.data[j]));
+      residuals.push_back(std::move(b));
+    }
+  }
   ceres::Problem::Options keep;
   keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(keep);
-  int num_rows = 0, trend_rows = 0;
+  int num_rows = 0, trend_rows = 0, rotation_rows_count = 0;
   for (const AccelBlock& b : residuals) {
-    problem.AddResidualBlock(b.cost.get(), nullptr, parameter_blocks);
+    if (b.rotation) {
+      std::vector<double*> with_gyro = parameter_blocks;
+      with_gyro.push_back(rotation_rows.gyro_bias);
+      with_gyro.push_back(rotation_rows.gyro_matrix);
+      problem.AddResidualBlock(b.cost.get(), nullptr, with_gyro);
+    } else {
+      problem.AddResidualBlock(b.cost.get(), nullptr, parameter_blocks);
+    }
     num_rows += b.rows;
     if (b.trend) trend_rows += b.rows;
+    if (b.rotation) rotation_rows_count += b.rows;
   }
   if (!free_off_diagonal) {
     problem.SetManifold(upper, new ceres::SubsetManifold(6, {1, 2, 4}));
@@ -311,6 +385,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   fit.fitted = true;
   fit.information =
       trend_rows > 0 ? "position magnitudes + within-pose trends" : "position magnitudes";
+  if (rotations) fit.information += " + rotations between poses";
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
   fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {
@@ -318,20 +393,48 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
     return false;
   }
 
-  const std::vector<int> upper_free = SetAccelParameterNames(free_off_diagonal, on, &fit);
+  const std::vector<int> upper_free =
+      SetAccelParameterNames(free_off_diagonal, on, rotations, &fit);
   const int np = static_cast<int>(fit.parameter_names.size());
   Eigen::MatrixXd jacobian(num_rows, np);
   Eigen::VectorXd residual_rows(num_rows);
-  const double* params[6] = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
+  const double* params[8] = {bias,
+                             upper,
+                             blocks[0],
+                             blocks[1],
+                             blocks[2],
+                             blocks[3],
+                             rotation_rows.gyro_bias,
+                             rotation_rows.gyro_matrix};
   result->accel_trend_residuals.assign(observations.size(), Eigen::Vector3d::Zero());
-  if (!EvaluateAccelFit(residuals, params, upper_free, on, options.compute_covariance, &jacobian,
-                        &residual_rows, &fit, &result->accel_trend_residuals)) {
+  if (!EvaluateAccelFit(residuals, params, upper_free, on, rotations, options.compute_covariance,
+                        &jacobian, &residual_rows, &fit, &result->accel_trend_residuals,
+                        &result->rotation_residuals)) {
     result->message = "accelerometer effect fit: the model has no value at a position";
     return false;
   }
   fit.num_residuals = num_rows;
   fit.trend_residuals = trend_rows;
+  fit.rotation_residuals = rotation_rows_count;
   fit.num_parameters = np;
+  if (rotations) {
+    // Turns that miss far beyond their noise: something the rotation rows
+    // do not model (a gyroscope g-sensitivity, a turn cut short).
+    const int rotation_dof = rotation_rows_count - kRotationGyroColumns;
+    if (rotation_dof > 0 && ChiSquareUpperTail(fit.rotation_chi2, rotation_dof) < 1e-3) {
+      std::ostringstream w;
+      w.precision(3);
+      w << kRotationsExceedNoise << " (chi2 " << fit.rotation_chi2 << " on about " << rotation_dof
+        << " dof): something the turns do not model, such as a gyroscope g-sensitivity";
+      result->warnings.push_back(w.str());
+    }
+    const Eigen::Matrix3d m =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation_rows.gyro_matrix);
+    result->rotation_gyro_matrix = rotation_rows.scale * m;
+    result->rotation_gyro_bias =
+        rotation_rows.center + Eigen::Vector3d(rotation_rows.gyro_bias) / rotation_rows.scale;
+    result->rotation_poses = rotation_rows.poses;
+  }
 
   AccelModel fitted_n = start_n;
   fitted_n.bias = Eigen::Vector3d(bias[0], bias[1], bias[2]);
@@ -346,7 +449,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   result->parameters.accel_bias_drift = Eigen::Vector3d(blocks[3]);
 
   FinishAccel(observations, gravity, norm.scale, jacobian, upper_free, options.compute_covariance,
-              result);
+              rotations ? &rotation_rows : nullptr, result);
   *whitened_jacobian = std::move(jacobian);
   *whitened_residuals = std::move(residual_rows);
   return true;
@@ -615,9 +718,11 @@ std::vector<StaticObservation> ObservationsFromIntervals(
 
 bool EffectFitOptions::IsValid(std::string* error) const {
   if (!(magnitude_variance_prior >= 0.0) || !(magnitude_variance_prior_dof >= 0.0) ||
-      !(magnitude_extra_variance >= 0.0) || !std::isfinite(magnitude_extra_variance)) {
+      !(magnitude_extra_variance >= 0.0) || !std::isfinite(magnitude_extra_variance) ||
+      !(rotation_gyro_bias_variance >= 0.0) || !std::isfinite(rotation_gyro_bias_variance)) {
     *error =
-        "effect fit: magnitude_extra_variance, magnitude_variance_prior and its dof must be >= 0";
+        "effect fit: magnitude_extra_variance, magnitude_variance_prior and its dof and "
+        "rotation_gyro_bias_variance must be >= 0";
     return false;
   }
   std::string solver_error;
@@ -660,11 +765,18 @@ bool FitEffects(const std::vector<StaticObservation>& observations, const AccelM
           static_cast<int>(std::count_if(observations.begin(), observations.end(),
                                          [](const StaticObservation& o) { return o.has_trend; }));
     }
-    if (n + 3 * trends < needed) {
+    int rotation_extra = 0;
+    if (options.use_between_pose_rotations) {
+      const int turns = static_cast<int>(internal::TurnPairs(observations).size());
+      if (turns >= internal::kMinRotations) rotation_extra = 2 * turns - kRotationGyroColumns;
+    }
+    if (n + 3 * trends + rotation_extra < needed) {
       std::ostringstream s;
       s << "the accelerometer model with " << needed << " parameters needs at least " << needed
         << " static positions, found " << n;
       if (trends > 0) s << " (and " << trends << " within-pose trends)";
+      if (rotation_extra > 0)
+        s << " (and " << rotation_extra / 2 + 6 << " rotations between poses)";
       result->message = s.str();
       return false;
     }

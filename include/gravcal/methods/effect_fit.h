@@ -21,6 +21,13 @@
 // residuals per pose that see beta, c and delta directly in every axis, so
 // a twelve-position session can test and estimate them; the quadratic term
 // and the model's bias, scale and non-orthogonality predict no trend.
+// With use_between_pose_rotations, also the AccelRotationResidual
+// (residuals/accel_rotation_residual.h) of every turn between consecutive
+// poses: two whitened values saying how far the gyroscope's integrated turn
+// misses carrying the corrected direction of one pose to that of the next,
+// with the gyroscope's M_g and b_g estimated alongside (weights:
+// src/methods/between_pose_rotations.h). The directions see what the
+// magnitudes cannot: on the seed's twelve poses the quadratic term of z.
 // Gyroscope (when the positions have it): minimises sum_k |L_k^-1 e_k|^2,
 //
 //   e_k = u_k - b_g - (G f_k + gamma dT_k + eta dt_k),
@@ -36,6 +43,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
@@ -68,6 +76,16 @@ struct StaticObservation {
   Eigen::Vector3d accel_slope = Eigen::Vector3d::Zero();
   Eigen::Matrix3d accel_slope_cov = Eigen::Matrix3d::Identity();
   double temperature_slope = 0.0;
+  // The pose's place in its session (0, 1, ...; -1 unknown) and the turn
+  // into it from the session's previous pose: the samples from the last one
+  // of that pose to the first of this one (AddBetweenPoseTurns). A rotation
+  // row joins two observations only when their session indices are
+  // consecutive, so leaving a pose out drops both of its turns.
+  int session_index = -1;
+  bool has_turn = false;
+  std::vector<double> turn_t;
+  std::vector<Eigen::Vector3d> turn_gyro;
+  std::vector<Eigen::Vector3d> turn_accel;
 
   // Middle of the interval, s.
   double time() const { return 0.5 * (accel.t_begin + accel.t_end); }
@@ -97,6 +115,19 @@ struct WithinPoseTrendOptions {
 std::vector<StaticObservation> ObservationsFromIntervals(
     const ImuLog& log, const std::vector<StaticInterval>& intervals,
     const WithinPoseTrendOptions& options = WithinPoseTrendOptions());
+
+// Issue 21: sets (*observations)[k].session_index = k and, for every k >= 1,
+// the turn's samples from intervals[k - 1] to intervals[k] (observations
+// made from `intervals` of `log`, in order). The turn starts edge_seconds
+// (at most a quarter of the interval) before the end of the one and ends as
+// far into the other, as in the gyroscope calibration: static detection
+// lets the slow start and end of a motion into an interval, and a turn the
+// gyroscope does not integrate is an error no model absorbs. Turns longer
+// than max_turn_seconds are left out. Nothing without a gyroscope or when
+// the sizes differ. Returns the turns added.
+int AddBetweenPoseTurns(const ImuLog& log, const std::vector<StaticInterval>& intervals,
+                        std::vector<StaticObservation>* observations, double edge_seconds = 0.5,
+                        double max_turn_seconds = 60.0);
 
 struct EffectFitOptions {
   // The baseline accelerometer model: kScale holds the off-diagonal of U at
@@ -138,6 +169,23 @@ struct EffectFitOptions {
   // Stopping rules of the Ceres solve.
   SolverTolerances solver = {50, 1e-12, 1e-12, 1e-10};
 
+  // Issue 21: add the AccelRotationResidual
+  // (residuals/accel_rotation_residual.h) of every turn between consecutive
+  // poses that the observations carry (AddBetweenPoseTurns): the
+  // gyroscope's integrated turn must carry the corrected accelerometer
+  // direction of one pose to that of the next. Two rows per turn, counted in
+  // the accelerometer's num_residuals and chi2 (and apart in
+  // rotation_residuals, rotation_chi2); the gyroscope's M_g (9) and b_g (3)
+  // are estimated with the accelerometer as nuisance parameters (named
+  // rotation_gyro_*). Needs at least 7 turns; with fewer the rows are left
+  // out with a warning.
+  bool use_between_pose_rotations = false;
+  // The variance of the gyroscope's bias about its session value,
+  // (rad/s)^2 per axis (>= 0): bias instability and rate random walk, B^2 +
+  // K^2 T / 6 over a session of T s from a noise model; it adds to each
+  // turn's integrated white noise. 0 = white noise only.
+  double rotation_gyro_bias_variance = 0.0;
+
   bool IsValid(std::string* error) const;
 };
 
@@ -156,6 +204,9 @@ struct SensorFitSummary {
   // none was used); the rest is from the position magnitudes.
   int trend_residuals = 0;
   double trend_chi2 = 0.0;
+  // The same for the rotations between poses (use_between_pose_rotations).
+  int rotation_residuals = 0;
+  double rotation_chi2 = 0.0;
   int dof() const { return num_residuals - num_parameters; }
   // Standard deviation of the named parameter from the covariance; NaN
   // when it was not estimated or no covariance was computed.
@@ -210,6 +261,16 @@ struct EffectFitResult {
   // Per position, the whitened within-pose trend residual t_k (zero where
   // the position has none or trends were not used).
   std::vector<Eigen::Vector3d> accel_trend_residuals;
+  // With the rotations between poses: the gyroscope estimated with them,
+  // w = M_g (u - b_g) in the accelerometer's orthogonalised frame (raw
+  // units; NaN when not used; b_g is the poses' mean rest level plus the
+  // common correction, each turn using its own level, between_pose_
+  // rotations.h), and each turn's whitened residual (2 values) with the
+  // observation indices it joins.
+  Eigen::Matrix3d rotation_gyro_matrix = Eigen::Matrix3d::Constant(NAN);
+  Eigen::Vector3d rotation_gyro_bias = Eigen::Vector3d::Constant(NAN);
+  std::vector<Eigen::Vector2d> rotation_residuals;
+  std::vector<std::pair<int, int>> rotation_poses;
   std::vector<std::string> warnings;
   std::string message = "FitEffects was not called";
 };

@@ -156,6 +156,25 @@ void IntegrateGyroRotation(const GyroRotationData& data, const T* bias, const T*
   }
 }
 
+// r = W E (R(dq)^T d_s - d_e), the whitened direction error of a turn dq
+// (w, x, y, z) from start direction d_s to end direction d_e.
+template <typename T>
+void WhitenedTurnError(const T* dq, const T* start, const T* end,
+                       const Eigen::Matrix<double, 2, 3>& tangent, const Eigen::Matrix2d& w,
+                       T* residual) {
+  // R(dq)^T d_s: rotate by the conjugate.
+  const T conjugate[4] = {dq[0], -dq[1], -dq[2], -dq[3]};
+  T predicted[3];
+  ceres::UnitQuaternionRotatePoint(conjugate, start, predicted);
+  T e[2];
+  for (int j = 0; j < 2; ++j) {
+    e[j] = T(0.0);
+    for (int i = 0; i < 3; ++i) e[j] += tangent(j, i) * (predicted[i] - end[i]);
+  }
+  residual[0] = w(0, 0) * e[0] + w(0, 1) * e[1];
+  residual[1] = w(1, 0) * e[0] + w(1, 1) * e[1];
+}
+
 struct GyroRotationResidual {
   explicit GyroRotationResidual(GyroRotationData data) : data_(std::move(data)) {}
 
@@ -226,18 +245,7 @@ struct GyroRotationResidual {
     }
     T dq[4];
     IntegrateGyroRotation<T>(data_, bias, matrix, g_sensitivity, dq);
-    // R(dq)^T d_s: rotate by the conjugate.
-    const T conjugate[4] = {dq[0], -dq[1], -dq[2], -dq[3]};
-    T predicted[3];
-    ceres::UnitQuaternionRotatePoint(conjugate, start, predicted);
-    T e[2];
-    for (int j = 0; j < 2; ++j) {
-      e[j] = T(0.0);
-      for (int i = 0; i < 3; ++i) e[j] += data_.tangent(j, i) * (predicted[i] - end[i]);
-    }
-    const Eigen::Matrix2d& w = data_.sqrt_information;
-    residual[0] = w(0, 0) * e[0] + w(0, 1) * e[1];
-    residual[1] = w(1, 0) * e[0] + w(1, 1) * e[1];
+    WhitenedTurnError<T>(dq, start, end, data_.tangent, data_.sqrt_information, residual);
     return true;
   }
 

@@ -1,0 +1,85 @@
+// Shared by the effect tests (effect_trends_test.cc,
+// effect_rotations_test.cc): the simulated twelve-position session with a
+// warm-up and the nominal model and references a fit starts from.
+#ifndef GRAVCAL_TESTS_EFFECT_SESSION_H_
+#define GRAVCAL_TESTS_EFFECT_SESSION_H_
+
+#include <vector>
+
+#include "gravcal/detection/static_detector.h"
+#include "gravcal/methods/effect_fit.h"
+#include "gravcal/simulation/simulator.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace testing_util {
+
+// The seed's twelve poses held 30 s during a warm-up 20 -> 35 degC (time
+// constant 200 s, so the poses see different temperature rates), with the
+// hand_placed.yaml correlated accelerometer noise on top of the default
+// white noise (0.02 m/s^2 per sample at 100 Hz).
+inline SimulatorOptions TwelvePoseWarmUp() {
+  SimulatorOptions o = WarmUpSession();
+  o.scheme = "twelve";
+  o.hold_seconds = 30.0;
+  o.initial_still_seconds = 10.0;
+  o.rotation_seconds = 3.0;
+  o.temperature_tau = 200.0;
+  o.accel_bias_random_walk = 2e-5;
+  o.accel_bias_instability = 2e-4;
+  return o;
+}
+
+// The simulated hidden effect `e` drawn per axis with standard deviation
+// `std` (accelerometer block effects; others unchanged).
+inline SimulatorOptions WithHidden(SimulatorOptions o, Effect e, double std) {
+  switch (e) {
+    case Effect::kAccelQuadratic:
+      o.accel_quadratic_std = std;
+      break;
+    case Effect::kAccelTemperatureBias:
+      o.accel_temperature_bias_std = std;
+      break;
+    case Effect::kAccelTemperatureScale:
+      o.accel_temperature_scale_std = std;
+      break;
+    case Effect::kAccelBiasDrift:
+      o.accel_bias_drift_std = std;
+      break;
+    default:
+      break;
+  }
+  return o;
+}
+
+// The simulator's own still periods (so that detection is not under test).
+inline std::vector<StaticInterval> SessionIntervals(const SimulatedSession& session) {
+  std::vector<StaticInterval> intervals;
+  for (const SimulatedPose& p : session.poses) {
+    intervals.push_back(MakeInterval(session.log, p.begin, p.end));
+  }
+  return intervals;
+}
+
+// References as calibrate sets them: mean time and temperature of the poses.
+inline EffectParameters References(const std::vector<StaticObservation>& observations) {
+  EffectParameters p;
+  for (const StaticObservation& o : observations) {
+    p.reference_time += o.time() / observations.size();
+    p.reference_temperature += o.temperature() / observations.size();
+  }
+  return p;
+}
+
+// The nominal model of the simulated sensor: no bias, U = I / units.
+inline AccelModel Nominal(const SimulatedSession& session) {
+  AccelModel m;
+  m.bias.setZero();
+  m.upper = Eigen::Matrix3d::Identity() / session.accel_units_per_si;
+  return m;
+}
+
+}  // namespace testing_util
+}  // namespace gravcal
+
+#endif  // GRAVCAL_TESTS_EFFECT_SESSION_H_
