@@ -14,7 +14,8 @@
 // (estimation/variance_component.h; 1 without pose_variance). The rms over
 // the poses of residual / sqrt(var_k) must lie in [0.7, 1.4] (where the fit
 // has two or more residual degrees of freedom), and the full fit must not
-// carry the chi-square warning.
+// carry the chi-square warning. When the full fit sets the configured
+// prior aside (methods/pose_variance.h), so do the refits.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -100,6 +101,10 @@ TEST(LeaveOnePoseOut, RealRecordingsPredictWithinTheirSigmas) {
     options.gravity = GravityOptions();
     options.gravity.gravity = c.gravity;
     options.nominal_up.clear();
+    // A prior the full fit set aside (it conflicts with this recording) is
+    // not brought back by a refit with one pose fewer, whose weaker
+    // conflict test might keep it.
+    if (c.accel.pose_variance.prior_set_aside) options.refinement.pose_disturbance_prior_dof = 0.0;
     double sum = 0.0;
     int used = 0;
     std::string zs;

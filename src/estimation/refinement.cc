@@ -46,6 +46,10 @@ bool RefinementOptions::IsValid(std::string* error) const {
     *error = "pose_disturbance_prior_dof >= 0 and, when it is positive, pose_disturbance_prior > 0";
     return false;
   }
+  if (!(prior_conflict_level > 0.0 && prior_conflict_level < 0.5)) {
+    *error = "prior_conflict_level: must be in (0, 0.5)";
+    return false;
+  }
   return solver.IsValid(error);
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "gravcal/core/noise_model.h"
 
 namespace gravcal {
@@ -24,6 +25,25 @@ double ModelWander(const AxisNoiseModel& axis, double seconds) {
     shown = true;
   }
   return shown ? v : NAN;
+}
+
+// The kNoiseModel warning of the header: hand-placed poses without a
+// noise model. `sized`: the poses' scatter gave W.
+void WarnWithoutNoiseModel(const GyroCalibrationOptions& options, bool sized,
+                           GyroCalibrationResult* r) {
+  if (options.noise_model != nullptr || !options.estimate_static_variance) return;
+  std::ostringstream s;
+  s << "no noise model (--noise): the gyroscope's standard deviations assume white noise, and "
+       "its bias's wander over the session is counted ";
+  if (sized) {
+    s << "only as " << kWanderPerScatter << " times the static poses' scatter";
+  } else {
+    s << "not at all (the static poses show no scatter beyond their white noise)";
+  }
+  s << "; one session cannot size it, and the bias's sigma is then too small by 10-30 % "
+       "(simulated hand-placed sessions); record a still log, run `gravcal noise` and pass "
+       "--noise";
+  AddWarning(WarningCode::kNoiseModel, s.str(), &r->warnings, &r->warning_codes);
 }
 
 }  // namespace
@@ -71,11 +91,11 @@ bool SessionBiasWander(const GyroPrepared& prep, const GyroCalibrationOptions& o
 void AddSessionBiasWander(const GyroPrepared& prep, const GyroCalibrationOptions& options,
                           GyroCalibrationResult* result) {
   GyroCalibrationResult& r = *result;
+  if (!r.covariance_available) return;
   Eigen::Matrix3d wander;
-  if (!r.covariance_available ||
-      !SessionBiasWander(prep, options, r.model.matrix, &wander, &r.bias_wander_note)) {
-    return;
-  }
+  const bool sized = SessionBiasWander(prep, options, r.model.matrix, &wander, &r.bias_wander_note);
+  WarnWithoutNoiseModel(options, sized, &r);
+  if (!sized) return;
   int rows[3] = {-1, -1, -1};
   for (size_t i = 0; i < r.parameter_names.size(); ++i) {
     for (int a = 0; a < 3; ++a) {

@@ -37,7 +37,11 @@
 //   of a pose's mean exceeds the scatter (hand_placed.yaml: 8e-9 against
 //   1e-9 (rad/s)^2) one session sizes s^2 to about +-200 %, often 0, and
 //   the bias's error / sigma rms stays 1.1-1.3 (1.6-1.7 without it); a
-//   noise model measured on a long still log is what sizes W well.
+//   noise model measured on a long still log is what sizes W well. So
+//   whenever the poses' scatter is estimated (pose_variance, the
+//   hand-placed configs) and no model is given, a kNoiseModel warning says
+//   that the gyroscope's sigmas assume white noise and how the wander was
+//   (or was not) counted, rather than leaving it silent.
 #ifndef GRAVCAL_SRC_METHODS_GYRO_BIAS_WANDER_H_
 #define GRAVCAL_SRC_METHODS_GYRO_BIAS_WANDER_H_
 
@@ -59,8 +63,9 @@ bool SessionBiasWander(const GyroPrepared& prep, const GyroCalibrationOptions& o
                        const Eigen::Matrix3d& matrix, Eigen::Matrix3d* wander, std::string* note);
 
 // Adds W to the bias rows and columns of result->covariance and to
-// result->bias_std, and fills result->bias_wander_std and bias_wander_note.
-// Nothing when SessionBiasWander has nothing or no covariance is available.
+// result->bias_std, and fills result->bias_wander_std and bias_wander_note;
+// adds the warning above to result->warnings. Nothing when no covariance is
+// available; no W when SessionBiasWander has none.
 void AddSessionBiasWander(const GyroPrepared& prep, const GyroCalibrationOptions& options,
                           GyroCalibrationResult* result);
 

@@ -15,9 +15,27 @@ namespace internal {
 
 namespace {
 
+// The configured prior on s^2 (estimation/variance_component.h).
+VariancePrior ConfiguredPrior(const RefinementOptions& options) {
+  VariancePrior prior;
+  prior.variance = options.pose_disturbance_prior * options.pose_disturbance_prior;
+  prior.dof = options.pose_disturbance_prior_dof;
+  return prior;
+}
+
+// c0 = 1 + s0^2 h, h = mean_k 1 / sigma_k^2: the prior's variance per
+// white-weighted residual in chi2's units (header, step 1).
+double PriorInChiSquareUnits(const VariancePrior& prior, const std::vector<double>& sigmas) {
+  double h = 0.0;
+  for (double sigma : sigmas) h += 1.0 / (sigma * sigma);
+  h /= std::max<size_t>(sigmas.size(), 1);
+  return 1.0 + prior.variance * h;
+}
+
 // REML s^2 from the residuals of `fit`, over its estimated (not held) columns.
 bool EstimateFromFit(const std::vector<Position>& placed, const RefinementOptions& options,
-                     const RefinementResult& fit, VarianceComponent* vc) {
+                     const RefinementResult& fit, const VariancePrior& prior,
+                     VarianceComponent* vc) {
   const int n = static_cast<int>(placed.size());
   const Eigen::MatrixXd all = MagnitudeJacobian(placed, fit.model, std::vector<double>(n, 1.0));
   std::vector<int> columns;
@@ -31,44 +49,124 @@ bool EstimateFromFit(const std::vector<Position>& placed, const RefinementOption
   for (size_t i = 0; i < columns.size(); ++i) jacobian.col(i) = all.col(columns[i]);
   const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(fit.residuals_after.data(), n);
   const Eigen::VectorXd sigmas = Eigen::Map<const Eigen::VectorXd>(fit.sigmas.data(), n);
-  VariancePrior prior;
-  prior.variance = options.pose_disturbance_prior * options.pose_disturbance_prior;
-  prior.dof = options.pose_disturbance_prior_dof;
   return EstimateVarianceComponent(r, sigmas, jacobian, vc, prior);
 }
 
-// The F test of the scale model against scale_misalignment (see the
-// header). True with `text` naming the term when the richer model explains
-// the excess; `tested` false when the richer model cannot be fitted.
-bool ExcessIsStructured(const std::vector<Position>& placed, const AccelModel& initial,
-                        double gravity, const RefinementOptions& options,
-                        const RefinementResult& fit, bool* tested, std::string* text) {
-  *tested = false;
+// The next richer parameterisation (scale -> scale_misalignment) fitted
+// with the white sigmas; false when there is none or it cannot be fitted
+// (it may be exact: dof 0).
+bool FitRicherModel(const std::vector<Position>& placed, const AccelModel& initial, double gravity,
+                    const RefinementOptions& options, RefinementResult* rich) {
   if (options.parameterization != AccelParameterization::kScale) return false;
-  RefinementOptions rich = options;
-  rich.parameterization = AccelParameterization::kScaleMisalignment;
-  rich.estimate_pose_variance = false;
-  rich.extra_variance = 0.0;
-  RefinementResult r;
-  if (!Refine(placed, initial, gravity, rich, &r) || !r.converged || r.dof <= 0 ||
-      !r.observability.undetermined.empty() || !(r.chi2 > 0.0)) {
-    return false;
-  }
-  *tested = true;
-  const int extra = r.num_parameters - fit.num_parameters;
-  const double f = ((fit.chi2 - r.chi2) / extra) / (r.chi2 / r.dof);
-  const double p = f > 0.0 ? FUpperTail(f, extra, r.dof) : 1.0;
-  if (!(p < options.structure_test_level)) return false;
+  RefinementOptions o = options;
+  o.parameterization = AccelParameterization::kScaleMisalignment;
+  o.estimate_pose_variance = false;
+  o.extra_variance = 0.0;
+  return Refine(placed, initial, gravity, o, rich) && rich->converged && rich->dof >= 0 &&
+         rich->observability.undetermined.empty() && rich->chi2 >= 0.0 &&
+         rich->sigmas.size() == placed.size();
+}
+
+// Step 1 of the header: true (with `text`) when `judged`'s residuals
+// contradict the prior, so it must be set aside.
+bool PriorConflicts(const RefinementResult& judged, bool richer, const VariancePrior& prior,
+                    double level, std::string* text) {
+  if (!(prior.dof > 0.0) || judged.dof < 1) return false;
+  const double c0 = PriorInChiSquareUnits(prior, judged.sigmas);
+  const double ratio = judged.chi2 / judged.dof / c0;
+  const double above = FUpperTail(ratio, judged.dof, prior.dof);
+  const double below = ratio > 0.0 ? FUpperTail(1.0 / ratio, prior.dof, judged.dof) : 0.0;
+  if (!(std::min(above, below) < level)) return false;
+  std::ostringstream s;
+  s.precision(3);
+  s << "the poses scatter " << (above < below ? "far more" : "far less")
+    << " than the pose-disturbance prior allows (chi2 / dof = " << judged.chi2 / judged.dof
+    << " on " << judged.dof << " dof" << (richer ? " with non-orthogonality" : "") << " against "
+    << c0 << " for s0 = " << std::sqrt(prior.variance) << " m/s^2 on " << prior.dof
+    << " dof, p = " << std::min(above, below) << " < prior_conflict_level " << level
+    << "): the prior is set aside and the standard deviations rest on this recording's own "
+       "scatter; set pose_disturbance_prior to what this setup scatters by";
+  *text = s.str();
+  return true;
+}
+
+// Step 2 of the header: true with `text` naming the term when the richer
+// model explains the excess; *tested false when the test has no degrees of
+// freedom.
+bool ExcessIsStructured(const RefinementResult& fit, const RefinementResult& rich,
+                        const VariancePrior& prior, double level, bool* tested, std::string* text) {
+  const double pooled_dof = rich.dof + prior.dof;
+  *tested = pooled_dof > 0.0;
+  if (!*tested) return false;
+  const double pooled = prior.dof * PriorInChiSquareUnits(prior, rich.sigmas);
+  const int extra = rich.num_parameters - fit.num_parameters;
+  const double f = ((fit.chi2 - rich.chi2) / extra) / ((rich.chi2 + pooled) / pooled_dof);
+  const double p = f > 0.0 ? FUpperTail(f, extra, pooled_dof) : 1.0;
+  if (!(p < level)) return false;
   std::ostringstream s;
   s.precision(3);
   s << "the excess over the noise is structured, not pose-to-pose scatter: non-orthogonality "
        "(u_xy, u_xz, u_yz, the 'scale_misalignment' model) explains it (chi2 "
-    << fit.chi2 << " -> " << r.chi2 << ", F = " << f << " on " << extra << " and " << r.dof
-    << " dof, p = " << p
+    << fit.chi2 << " -> " << rich.chi2 << ", F = " << f << " on " << extra << " and " << pooled_dof
+    << " dof";
+  if (prior.dof > 0.0) s << " (" << rich.dof << " + the prior's " << prior.dof << ")";
+  s << ", p = " << p
     << "); it is not absorbed as noise and the standard deviations are the white-noise ones: "
        "fit parameterization: scale_misalignment, or run `gravcal discover`";
   *text = s.str();
   return true;
+}
+
+// Re-solves with s^2 added to every variance and the Student factor on the
+// covariance; false (vc->message says why) when the re-weighted fit fails.
+bool Absorb(const std::vector<Position>& placed, const AccelModel& initial, double gravity,
+            const RefinementOptions& options, RefinementResult* refinement, VarianceComponent* vc,
+            double* effective_dof) {
+  RefinementOptions again = options;
+  again.extra_variance = vc->variance;
+  RefinementResult absorbed;
+  if (!Refine(placed, initial, gravity, again, &absorbed) || !absorbed.converged) {
+    vc->message += "; not absorbed: the re-weighted fit failed (" + absorbed.message + ")";
+    return false;
+  }
+  // s^2 is estimated: error / sigma is Student-t like (variance_component.h).
+  double white_variance = 0.0;
+  for (double sigma : refinement->sigmas) white_variance += sigma * sigma;
+  white_variance /= std::max<size_t>(refinement->sigmas.size(), 1);
+  const double inflation = StudentInflation(*vc, white_variance, effective_dof);
+  if (absorbed.covariance_available) absorbed.covariance *= inflation;
+  absorbed.solve_seconds += refinement->solve_seconds;
+  absorbed.iterations += refinement->iterations;
+  *refinement = absorbed;
+  vc->absorbed = true;
+  std::ostringstream t;
+  t.precision(3);
+  t << "; added to every pose's variance, covariance x " << inflation << " (Student t, "
+    << *effective_dof << " effective dof)";
+  vc->message += t.str();
+  return true;
+}
+
+// Steps 2 and 3 of the header for an estimated s^2 > 0 (`prior` as used).
+void ExplainOrAbsorb(const std::vector<Position>& placed, const AccelModel& initial, double gravity,
+                     const RefinementOptions& options, const RefinementResult* rich,
+                     const VariancePrior& prior, RefinementResult* refinement,
+                     VarianceComponent* vc) {
+  bool tested = false;
+  std::string structured;
+  if (rich != nullptr && ExcessIsStructured(*refinement, *rich, prior, options.structure_test_level,
+                                            &tested, &structured)) {
+    vc->message += "; not absorbed: a model term explains the excess";
+    AddWarning(WarningCode::kResidualsAboveNoise, structured, &refinement->warnings,
+               &refinement->warning_codes);
+    return;
+  }
+  double effective_dof = INFINITY;
+  if (!Absorb(placed, initial, gravity, options, refinement, vc, &effective_dof)) return;
+  if (!tested && options.parameterization == AccelParameterization::kScale) {
+    vc->message += " (too few poses to test whether non-orthogonality explains it)";
+  }
+  WarnPoseVariance(*vc, effective_dof, options, &refinement->warnings, &refinement->warning_codes);
 }
 
 }  // namespace
@@ -86,52 +184,30 @@ void AccountForPoseVariance(const std::vector<Position>& placed, const AccelMode
     pose_variance->message = "not estimated: the fit did not converge";
     return;
   }
+  RefinementResult rich;
+  const bool has_rich = FitRicherModel(placed, initial, gravity, options, &rich);
+  const bool judge_rich = has_rich && rich.dof >= 1;
+  VariancePrior prior = ConfiguredPrior(options);
+  std::string conflict;
+  const bool set_aside = PriorConflicts(judge_rich ? rich : *refinement, judge_rich, prior,
+                                        options.prior_conflict_level, &conflict);
+  if (set_aside) prior = VariancePrior();
   VarianceComponent vc;
-  if (!EstimateFromFit(placed, options, *refinement, &vc)) {
+  if (!EstimateFromFit(placed, options, *refinement, prior, &vc)) {
     pose_variance->message = "not estimated: " + vc.message;
     return;
   }
-  if (vc.at_boundary) {
-    *pose_variance = vc;
-    return;
+  if (!vc.at_boundary) {
+    ExplainOrAbsorb(placed, initial, gravity, options, has_rich ? &rich : nullptr, prior,
+                    refinement, &vc);
   }
-  bool tested = false;
-  std::string structured;
-  if (ExcessIsStructured(placed, initial, gravity, options, *refinement, &tested, &structured)) {
-    vc.message += "; not absorbed: a model term explains the excess";
-    *pose_variance = vc;
-    AddWarning(WarningCode::kResidualsAboveNoise, structured, &refinement->warnings,
+  if (set_aside) {
+    vc.prior_set_aside = true;
+    vc.message += "; the prior is set aside (it conflicts with these residuals)";
+    AddWarning(WarningCode::kPoseScatter, conflict, &refinement->warnings,
                &refinement->warning_codes);
-    return;
   }
-  RefinementOptions again = options;
-  again.extra_variance = vc.variance;
-  RefinementResult absorbed;
-  if (!Refine(placed, initial, gravity, again, &absorbed) || !absorbed.converged) {
-    vc.message += "; not absorbed: the re-weighted fit failed (" + absorbed.message + ")";
-    *pose_variance = vc;
-    return;
-  }
-  // s^2 is estimated: error / sigma is Student-t like (variance_component.h).
-  double white_variance = 0.0;
-  for (double sigma : refinement->sigmas) white_variance += sigma * sigma;
-  white_variance /= std::max<size_t>(refinement->sigmas.size(), 1);
-  double effective_dof = INFINITY;
-  const double inflation = StudentInflation(vc, white_variance, &effective_dof);
-  if (absorbed.covariance_available) absorbed.covariance *= inflation;
-  absorbed.solve_seconds += refinement->solve_seconds;
-  absorbed.iterations += refinement->iterations;
-  *refinement = absorbed;
-  vc.absorbed = true;
-  std::ostringstream t;
-  t.precision(3);
-  t << "; added to every pose's variance, covariance x " << inflation << " (Student t, "
-    << effective_dof << " effective dof)";
-  vc.message += t.str() + (tested || options.parameterization != AccelParameterization::kScale
-                               ? ""
-                               : " (too few poses to test whether non-orthogonality explains it)");
   *pose_variance = vc;
-  WarnPoseVariance(vc, effective_dof, options, &refinement->warnings, &refinement->warning_codes);
 }
 
 void WarnPoseVariance(const VarianceComponent& vc, double effective_dof,

@@ -8,19 +8,49 @@
 // pose_disturbance_prior_dof > 0 the estimate leans on the prior s0
 // (estimation/variance_component.h). ten_position's step 4 uses it too.
 //
-// A variance component must not hide a missing model term. Before absorbing
-// the excess, the next richer parameterisation (scale -> scale_misalignment)
-// is fitted with the same white sigmas and compared by an F test, which does
-// not depend on the common scale of the excess:
+// A variance component must not hide a missing model term, and a prior
+// must not make the sigmas dishonest. In order:
 //
-//   F = ((chi2_scale - chi2_rich) / 3) / (chi2_rich / dof_rich) ~ F(3, dof_rich).
+// 1. The prior, if any, is checked against the residuals. Both fits below
+//    are weighted by the white sigmas alone; if the excess is pose-to-pose
+//    scatter s^2, a white-weighted residual has variance c = 1 + s^2 h in
+//    chi2's units, h = mean_k 1 / sigma_k^2 (exact for equal sigma_k, a
+//    fair mean otherwise), so chi2 / c ~ chi2(dof). The prior s0^2 on nu0
+//    degrees of freedom, read as an independent estimate of s^2 (nu0 s0^2 /
+//    s^2 ~ chi2(nu0): what a scaled inverse chi-square prior states when it
+//    is the truth), gives c0 = 1 + s0^2 h, and
 //
-// When its upper tail is below structure_test_level, the excess is the
-// non-orthogonality's: nothing is absorbed, the fit's chi-square warning
-// stays, and a warning names the term and points to `gravcal discover`.
-// When s exceeds max_pose_disturbance, the excess is absorbed but a warning
-// says it is implausible for a sensor at rest. Otherwise no warning: the
-// scatter is what hand-placed poses show.
+//      R = (chi2 / dof) / c0 ~ F(dof, nu0).
+//
+//    When R lies in either tail beyond prior_conflict_level, this recording
+//    contradicts the prior: a kPoseScatter warning says so, and the prior is
+//    set aside (REML alone, pose_variance.prior_set_aside). R is taken from
+//    the richer fit below when it has residual degrees of freedom (so a
+//    missing term is not read as a conflict), else from the fit itself.
+//
+// 2. Before absorbing the excess, the next richer parameterisation (scale
+//    -> scale_misalignment, q = 3 more parameters) is fitted with the same
+//    white sigmas and compared by an F test. (chi2_scale - chi2_rich) / c ~
+//    chi2(q) independent of chi2_rich / c ~ chi2(dof_rich), and the prior
+//    adds nu0 c0 / c ~ chi2(nu0) to the denominator's pool:
+//
+//      F = ((chi2_scale - chi2_rich) / q)
+//          / ((chi2_rich + nu0 c0) / (dof_rich + nu0))  ~  F(q, dof_rich + nu0).
+//
+//    c cancels, so the test does not depend on the size of the excess. With
+//    nu0 = 0 (no prior, or set aside) it is the classical test on dof_rich;
+//    the prior gives it power where the poses leave the richer model few
+//    degrees of freedom or none (nine poses). The distribution is exact when
+//    the prior is the truth and s^2 h >> 1; otherwise the prior's white part
+//    1 is a constant where F assumes it random, which makes the denominator
+//    steadier than F(q, .) allows and the test slightly conservative. When
+//    its upper tail is below structure_test_level, the excess is the
+//    non-orthogonality's: nothing is absorbed, the fit's chi-square warning
+//    stays, and a warning names the term and points to `gravcal discover`.
+//
+// 3. Otherwise s^2 is absorbed. When s exceeds max_pose_disturbance a
+//    warning says it is implausible for a sensor at rest; else no warning:
+//    the scatter is what hand-placed poses show.
 #ifndef GRAVCAL_SRC_METHODS_POSE_VARIANCE_H_
 #define GRAVCAL_SRC_METHODS_POSE_VARIANCE_H_
 

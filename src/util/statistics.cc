@@ -87,16 +87,16 @@ double BetaContinuedFraction(double a, double b, double x) {
 double RegularizedBeta(double a, double b, double x) {
   if (x <= 0.0) return 0.0;
   if (x >= 1.0) return 1.0;
-  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
-                                a * std::log(x) + b * std::log1p(-x));
+  const double front =
+      std::exp(LogGamma(a + b) - LogGamma(a) - LogGamma(b) + a * std::log(x) + b * std::log1p(-x));
   if (x < (a + 1.0) / (a + b + 2.0)) return front * BetaContinuedFraction(a, b, x) / a;
   return 1.0 - front * BetaContinuedFraction(b, a, 1.0 - x) / b;
 }
 
 }  // namespace
 
-double FUpperTail(double f, int d1, int d2) {
-  if (d1 <= 0 || d2 <= 0 || !(f > 0.0)) return 1.0;
+double FUpperTail(double f, double d1, double d2) {
+  if (!(d1 > 0.0) || !(d2 > 0.0) || !(f > 0.0)) return 1.0;
   return RegularizedBeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
 }
 

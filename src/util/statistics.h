@@ -12,8 +12,9 @@ namespace internal {
 double ChiSquareUpperTail(double x, int dof);
 
 // P(X > f) for X ~ F(d1, d2) (regularised incomplete beta function,
-// continued fraction).
-double FUpperTail(double f, int d1, int d2);
+// continued fraction). The degrees of freedom need not be whole (a prior's
+// weight is one).
+double FUpperTail(double f, double d1, double d2);
 
 // Median of the values (copy taken).
 double Median(std::vector<double> values);

@@ -163,7 +163,7 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
        {"gravity", "detector", "pose_noise", "alignment"},
        {"parameterization", "allow_undetermined", "loss", "loss_scale", "covariance",
         "max_iterations", "pose_variance", "max_pose_disturbance", "structure_test_level",
-        "pose_disturbance_prior", "pose_disturbance_prior_dof"},
+        "pose_disturbance_prior", "pose_disturbance_prior_dof", "prior_conflict_level"},
        MethodSideInput::kNone,
        [](const Config& c, std::string* e) { return c.ten_position.IsValid(e); },
        RunTenPosition,

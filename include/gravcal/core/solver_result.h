@@ -57,6 +57,9 @@ struct VarianceComponent {
   // repeated, so every standard deviation carries it; false when the excess
   // was left unexplained (a structured term explains it, or s^2 = 0).
   bool absorbed = false;
+  // True when a prior on s^2 was configured but the residuals conflict with
+  // it (methods/pose_variance.h): the estimate is then REML alone.
+  bool prior_set_aside = false;
   std::string message = "EstimateVarianceComponent was not called";
 };
 

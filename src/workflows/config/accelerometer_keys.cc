@@ -128,6 +128,9 @@ ConfigSection SolverSection() {
           GRAVCAL_DOUBLE("pose_disturbance_prior_dof",
                          calibration.refinement.pose_disturbance_prior_dof,
                          "pose_variance: weight of that prior in degrees of freedom (0 = none)"),
+          GRAVCAL_DOUBLE("prior_conflict_level", calibration.refinement.prior_conflict_level,
+                         "pose_variance: set the prior aside when the poses' scatter is in "
+                         "either tail of F(dof, prior dof) beyond this"),
       }};
 }
 
