@@ -32,8 +32,9 @@ int RunDiscover(const CommandArgs& args) {
   }
   for (size_t i = 0; i < result.steps.size(); ++i) {
     const DiscoveryStep& s = result.steps[i];
-    std::fprintf(stderr, "gravcal: step %zu: %s (p = %.3g, delta BIC %.1f; from the %s)\n", i + 1,
-                 ToString(s.effect), s.p_value, s.delta_bic, s.information.c_str());
+    std::fprintf(stderr, "gravcal: step %zu: %s (p = %.3g, delta BIC %.1f; from the %s%s%s)\n",
+                 i + 1, ToString(s.effect), s.p_value, s.delta_bic, s.information.c_str(),
+                 s.confirmed_by.empty() ? "" : "; confirmed by the ", s.confirmed_by.c_str());
   }
   for (const SensorVerdict& v : result.sensors) {
     std::fprintf(stderr, "gravcal: %s (from the %s)\n", v.verdict.c_str(), v.information.c_str());

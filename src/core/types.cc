@@ -127,6 +127,8 @@ const EnumName<WarningCode> kWarningCodes[] = {
     {WarningCode::kLogGap, "log_gap"},
     {WarningCode::kNoiseModel, "noise_model"},
     {WarningCode::kAlignment, "alignment"},
+    {WarningCode::kEffectUntestable, "effect_untestable"},
+    {WarningCode::kRotationsAboveNoise, "rotations_above_noise"},
 };
 
 }  // namespace

@@ -100,6 +100,19 @@ Eigen::Matrix3d Whitening(const Eigen::Matrix3d& covariance) {
   return l.inverse();
 }
 
+// The whitening of a pose's trend residual (accel_trend_residual.h), raw
+// units: L^-1 of the slope's covariance, or with trend_along_gravity the
+// one row n^T / sqrt(n^T cov n), n the direction of `centered_mean` (the
+// pose's mean raw vector less the bias).
+AccelTrendResidual::Whitening TrendWhitening(const StaticObservation& o,
+                                             const Eigen::Vector3d& centered_mean) {
+  if (!o.trend_along_gravity) return Whitening(o.accel_slope_cov);
+  const Eigen::RowVector3d n = centered_mean.normalized().transpose();
+  const double variance = n * o.accel_slope_cov * n.transpose();
+  if (!(variance > 0.0)) return AccelTrendResidual::Whitening::Constant(1, 3, NAN);
+  return n / std::sqrt(variance);
+}
+
 // result->accel_sigmas from the positions' own noise at `start`; false with
 // the message when one is not positive and finite.
 bool SetAccelSigmas(const std::vector<Position>& positions, const AccelModel& start,
@@ -215,7 +228,11 @@ bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const
         (*jacobian)(row0 + row, col++) = block.rotation ? jgm[9 * row + i] : 0.0;
       }
     }
-    if (block.trend) (*trend_residuals)[block.position] = Eigen::Vector3d(r[0], r[1], r[2]);
+    if (block.trend) {
+      Eigen::Vector3d t = Eigen::Vector3d::Zero();
+      for (int row = 0; row < block.rows; ++row) t(row) = r[row];
+      (*trend_residuals)[block.position] = t;
+    }
     if (block.rotation) rotation_residuals->push_back(Eigen::Vector2d(r[0], r[1]));
     row0 += block.rows;
   }
@@ -275,11 +292,12 @@ std::vector<AccelBlock> AccelBlocks(const std::vector<StaticObservation>& observ
     const StaticObservation& o = observations[k];
     if (!o.has_trend) continue;
     // Normalised units: the slope and its standard deviation divide by s.
-    const Eigen::Matrix3d whitening = Whitening(o.accel_slope_cov) * scale;
+    const AccelTrendResidual::Whitening whitening =
+        TrendWhitening(o, normalized[k].raw_mean) * scale;
     if (!whitening.allFinite()) continue;
     AccelBlock b;
     b.position = static_cast<int>(k);
-    b.rows = 3;
+    b.rows = static_cast<int>(whitening.rows());
     b.trend = true;
     b.cost.reset(AccelTrendResidual::Create(normalized[k].raw_mean, o.accel_slope / scale,
                                             whitening, o.temperature_slope,
@@ -704,14 +722,16 @@ std::vector<StaticObservation> ObservationsFromIntervals(
   std::string error;
   if (!options.IsValid(&error)) return {};
   std::vector<StaticObservation> out = ObservationsFromIntervals(intervals, log.has_gyro());
-  const std::vector<internal::PoseTrend> trends = internal::WithinPoseTrends(
-      log, intervals, options.batches, options.min_batch_samples, options.min_seconds);
+  const std::vector<internal::PoseTrend> trends =
+      internal::WithinPoseTrends(log, intervals, options.batches, options.min_batch_samples,
+                                 options.min_seconds, options.along_gravity_only);
   for (size_t k = 0; k < out.size(); ++k) {
     if (!trends[k].valid) continue;
     out[k].has_trend = true;
     out[k].accel_slope = trends[k].accel_slope;
     out[k].accel_slope_cov = trends[k].accel_slope_cov;
     out[k].temperature_slope = trends[k].temperature_slope;
+    out[k].trend_along_gravity = options.along_gravity_only;
   }
   return out;
 }
@@ -759,18 +779,20 @@ bool FitEffects(const std::vector<StaticObservation>& observations, const AccelM
         needed += Info(e).num_parameters;
       }
     }
-    int trends = 0;
+    int trends = 0, trend_rows = 0;
     if (options.use_within_pose_trends) {
-      trends =
-          static_cast<int>(std::count_if(observations.begin(), observations.end(),
-                                         [](const StaticObservation& o) { return o.has_trend; }));
+      for (const StaticObservation& o : observations) {
+        if (!o.has_trend) continue;
+        ++trends;
+        trend_rows += o.trend_along_gravity ? 1 : 3;
+      }
     }
     int rotation_extra = 0;
     if (options.use_between_pose_rotations) {
       const int turns = static_cast<int>(internal::TurnPairs(observations).size());
       if (turns >= internal::kMinRotations) rotation_extra = 2 * turns - kRotationGyroColumns;
     }
-    if (n + 3 * trends + rotation_extra < needed) {
+    if (n + trend_rows + rotation_extra < needed) {
       std::ostringstream s;
       s << "the accelerometer model with " << needed << " parameters needs at least " << needed
         << " static positions, found " << n;

@@ -69,7 +69,8 @@ BatchLine FitBatchLine(const ImuLog& log, const StaticInterval& s, int batches) 
 
 std::vector<PoseTrend> WithinPoseTrends(const ImuLog& log,
                                         const std::vector<StaticInterval>& intervals, int batches,
-                                        int min_batch_samples, double min_seconds) {
+                                        int min_batch_samples, double min_seconds,
+                                        bool along_gravity) {
   std::vector<PoseTrend> trends(intervals.size());
   std::vector<BatchLine> lines(intervals.size());
   Eigen::Matrix3d pooled = Eigen::Matrix3d::Zero();
@@ -91,7 +92,7 @@ std::vector<PoseTrend> WithinPoseTrends(const ImuLog& log,
   // Fewer than two poses, or too few degrees of freedom for the factor:
   // no trends (the fit keeps the magnitudes alone).
   if (usable < 2 || !(dof > 8.0)) return trends;
-  const Eigen::Matrix3d per_sample = pooled / (dof - 4.0);
+  const Eigen::Matrix3d per_sample = pooled / (dof - (along_gravity ? 2.0 : 4.0));
   for (size_t k = 0; k < intervals.size(); ++k) {
     if (!lines[k].valid) continue;
     Eigen::Matrix3d batch_cov = per_sample / lines[k].batch_samples;

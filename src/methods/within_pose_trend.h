@@ -29,7 +29,13 @@
 // freedom would make each pose's whitened slope a Hotelling T^2 (mean
 // 3 nu_k / (nu_k - 4) = 6 instead of 3) and bias every chi2 test; pooling
 // leaves nu in the hundreds, and the factor nu / (nu - 4) makes the
-// expected x^T cov^-1 x of a 3-vector exactly 3. A batch mean cannot be
+// expected x^T cov^-1 x of a 3-vector exactly 3. When only the component
+// along gravity is used (along_gravity), a scalar t on nu degrees of
+// freedom, the factor is nu / (nu - 2): E[t^2] = nu / (nu - 2) for
+// Student's t, so the whitened component has unit mean square. Fewer,
+// longer batches (5 of 6 s on a 30 s hold) count more of the correlated
+// noise in each batch mean at the price of fewer degrees of freedom, which
+// the pooling over the poses restores. A batch mean cannot be
 // known better than its rounding when the data do not dither: an axis whose
 // batch means never changed gets step^2 / 12 (the interval's resolution).
 #ifndef GRAVCAL_SRC_METHODS_WITHIN_POSE_TREND_H_
@@ -56,10 +62,13 @@ struct PoseTrend {
 
 // One trend per interval of the log. A pose gets one when it has at least
 // `batches` * `min_batch_samples` samples and lasts `min_seconds` or more;
-// none at all when fewer than two poses qualify (no pooled noise).
+// none at all when fewer than two poses qualify (no pooled noise). With
+// along_gravity the covariance carries the scalar Student factor (it is
+// then meant for the component along the pose's mean only).
 std::vector<PoseTrend> WithinPoseTrends(const ImuLog& log,
                                         const std::vector<StaticInterval>& intervals, int batches,
-                                        int min_batch_samples, double min_seconds);
+                                        int min_batch_samples, double min_seconds,
+                                        bool along_gravity);
 
 }  // namespace internal
 }  // namespace gravcal

@@ -15,10 +15,24 @@ namespace {
 // chi2 on dof degrees of freedom with p >= 0.01.
 bool FitsNoise(double chi2, int dof) { return dof >= 1 && ChiSquareUpperTail(chi2, dof) >= 0.01; }
 
+// Columns of the gyroscope's nuisance parameters in an accelerometer fit
+// with the rotations between poses (effect_fit.h).
+constexpr int kRotationGyroParameters = 12;
+
+// The residual degrees of freedom the position magnitudes keep when e is
+// added to the accelerometer fit `now`: positions minus accelerometer
+// parameters (the gyroscope's nuisance parameters of the rotations are
+// not the magnitudes' to determine).
+int MagnitudeDof(const SensorFitSummary& now, int positions, Effect e) {
+  const int nuisance = now.rotation_residuals > 0 ? kRotationGyroParameters : 0;
+  return positions - (now.num_parameters - nuisance + Info(e).num_parameters);
+}
+
 // Why an effect cannot be tried in this session, or "".
 std::string NotApplicable(const DiscoveryContext& ctx, const std::vector<Effect>& current, Effect e,
-                          const DiscoveryOptions& options, int sensor_residuals,
-                          int sensor_parameters) {
+                          const DiscoveryOptions& options, const SensorFitSummary& now) {
+  const int sensor_residuals = now.num_residuals;
+  const int sensor_parameters = now.num_parameters;
   const EffectInfo& info = Info(e);
   if (Contains(current, e)) return "already in the model";
   if (e == Effect::kAccelMisalignment && ctx.parameterization != AccelParameterization::kScale) {
@@ -38,15 +52,28 @@ std::string NotApplicable(const DiscoveryContext& ctx, const std::vector<Effect>
   }
   const int per_position = info.sensor == EffectSensor::kGyroscope ? 3 : 1;
   const int dof = sensor_residuals - sensor_parameters - info.num_parameters;
-  if (dof < options.min_dof || dof - per_position < 1) {
+  // Accelerometer: the magnitudes alone must keep min_dof unless trend or
+  // rotation rows can confirm the effect (ChooseCandidate).
+  const bool confirmable =
+      info.sensor == EffectSensor::kAccelerometer &&
+      (now.rotation_residuals > 0 ||
+       (now.trend_residuals > 0 && info.regressor != EffectRegressor::kOrientation));
+  const int positions = static_cast<int>(ctx.observations->size());
+  const bool magnitudes_short = info.sensor == EffectSensor::kAccelerometer &&
+                                MagnitudeDof(now, positions, e) < options.min_dof && !confirmable;
+  if (dof < options.min_dof || dof - per_position < 1 || magnitudes_short) {
     std::ostringstream s;
-    s << "too few positions: " << sensor_residuals / per_position << " positions give "
-      << sensor_residuals << " residuals for " << sensor_parameters << " + " << info.num_parameters
+    const int shown = magnitudes_short ? positions : sensor_residuals;
+    s << "too few positions: " << shown / per_position << " positions give " << shown
+      << " residuals for " << sensor_parameters << " + " << info.num_parameters
       << " parameters (needs " << options.min_dof
       << " left over, and one in every leave-one-out fold); record more poses"
       << (IsAccel(e) && ctx.parameterization != AccelParameterization::kScale
               ? " or use parameterization: scale"
-              : "");
+              : "")
+      << (IsAccel(e) ? ", hold them 10 s or longer (within-pose trends), or record the "
+                       "gyroscope (rotations between poses)"
+                     : "");
     return s.str();
   }
   return "";
@@ -79,8 +106,7 @@ void TryCandidate(const DiscoveryContext& ctx, const ModelAssessment& current, E
   c->effect = e;
   const bool accel = IsAccel(e);
   const SensorFitSummary& now = accel ? current.fit.accel_fit : current.fit.gyro_fit;
-  c->reason =
-      NotApplicable(ctx, current.effects, e, options, now.num_residuals, now.num_parameters);
+  c->reason = NotApplicable(ctx, current.effects, e, options, now);
   if (!c->reason.empty()) {
     // Warn once per effect; "already in the model / baseline" is no news.
     if (c->reason.rfind("already", 0) != 0) {
@@ -110,6 +136,19 @@ void TryCandidate(const DiscoveryContext& ctx, const ModelAssessment& current, E
   c->information = ext.information;
   c->dof = Info(e).num_parameters;
   c->delta_chi2 = now.chi2 - ext.chi2;
+  if (accel) {
+    c->magnitude_dof = MagnitudeDof(now, static_cast<int>(ctx.observations->size()), e);
+    // The trend and rotation rows' own share of delta chi2, on the
+    // effect's dof: they confirm an effect the magnitudes cannot test.
+    auto part = [&](int rows, double before, double after) {
+      if (rows == 0) return static_cast<double>(NAN);
+      return before - after > 0.0 ? ChiSquareUpperTail(before - after, c->dof) : 1.0;
+    };
+    if (Info(e).regressor != EffectRegressor::kOrientation) {
+      c->trend_p_value = part(ext.trend_residuals, now.trend_chi2, ext.trend_chi2);
+    }
+    c->rotation_p_value = part(ext.rotation_residuals, now.rotation_chi2, ext.rotation_chi2);
+  }
   c->gap = InSampleGap(extended_fit, ctx.has_gyro);
   // The other sensor's part was not refitted: its gap is the current one.
   if (accel) {
@@ -152,7 +191,9 @@ int PairLookAhead(const DiscoveryContext& ctx, const ModelAssessment& current,
   std::vector<int> masked;
   for (size_t i = 0; i < scores->size(); ++i) {
     const CandidateScore& c = (*scores)[i];
-    if (c.tried && c.p_value < SensorAlpha(*scores, IsAccel(c.effect), options) &&
+    const bool testable =
+        !IsAccel(c.effect) || c.magnitude_dof >= options.min_dof || !c.confirmed_by.empty();
+    if (c.tried && testable && c.p_value < SensorAlpha(*scores, IsAccel(c.effect), options) &&
         c.delta_bic < -options.min_bic_gain) {
       masked.push_back(static_cast<int>(i));
     }
@@ -301,6 +342,19 @@ int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,
     }
     if (!(after < before)) {
       why << "cross-validated gap " << after << " sigma not below " << before << "; ";
+    }
+    c.confirmed_by.clear();
+    if (accel && c.magnitude_dof < options.min_dof) {
+      if (c.trend_p_value < alpha) {
+        c.confirmed_by = "within-pose trends (p = " + FormatNumber("%.2g", c.trend_p_value) + ")";
+      } else if (c.rotation_p_value < alpha) {
+        c.confirmed_by =
+            "rotations between poses (p = " + FormatNumber("%.2g", c.rotation_p_value) + ")";
+      } else {
+        why << "the magnitudes keep " << c.magnitude_dof << " residual dof (needs "
+            << options.min_dof << ") and neither the within-pose trends (p = " << c.trend_p_value
+            << ") nor the rotations between poses (p = " << c.rotation_p_value << ") confirm it; ";
+      }
     }
     c.reason = why.str();
     if (!c.reason.empty()) c.reason.resize(c.reason.size() - 2);

@@ -22,6 +22,8 @@ struct DiscoveryContext {
   bool has_gyro = false;
   bool has_temperature = false;
   double temperature_range = 0.0;
+  // The accelerometer's fits take the rotations between poses as rows.
+  bool use_rotations = false;
 };
 
 inline bool IsAccel(Effect e) { return Info(e).sensor == EffectSensor::kAccelerometer; }
@@ -46,6 +48,8 @@ inline bool FitDiscoveryModel(const DiscoveryContext& ctx,
   o.fit_accel = fit_accel;
   o.fit_gyro = fit_gyro && ctx.has_gyro;
   o.compute_covariance = covariance;
+  o.use_within_pose_trends = true;
+  o.use_between_pose_rotations = ctx.use_rotations && fit_accel;
   return FitEffects(observations, start.accel, start.gyro, start.parameters, ctx.gravity, o, out);
 }
 

@@ -132,6 +132,12 @@ json CandidatesJson(const std::vector<CandidateScore>& scores) {
       j["gap_after"] = Number(Of(c.gap, accel));
       j["cv_gap_after"] = Number(Of(c.cv_gap, accel));
       j["cv_gap_after_sigma"] = Number(SigmaOf(c.cv_gap, accel));
+      if (accel) {
+        j["magnitude_dof"] = c.magnitude_dof;
+        j["trend_p_value"] = Number(c.trend_p_value);
+        j["rotation_p_value"] = Number(c.rotation_p_value);
+        j["confirmed_by"] = c.confirmed_by;
+      }
     }
     if (!c.reason.empty()) j["reason"] = c.reason;
     out.push_back(j);
@@ -342,6 +348,7 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
               {"description", Info(s.effect).description},
               {"sensor", accel ? "accelerometer" : "gyroscope"},
               {"information", s.information},
+              {"confirmed_by", s.confirmed_by},
               {"parameters", ParametersJson(s.estimate)},
               {"p_value", Number(s.p_value)},
               {"delta_bic", Number(s.delta_bic)},
@@ -386,6 +393,12 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
   }
   out["sensors"] = sensors;
   out["warnings"] = r.warnings;
+  json codes = json::array();
+  for (size_t i = 0; i < r.warnings.size(); ++i) {
+    codes.push_back(
+        ToString(i < r.warning_codes.size() ? r.warning_codes[i] : WarningCode::kUnclassified));
+  }
+  out["warning_codes"] = codes;
   out["message"] = r.message;
   out["time_s"] = r.seconds;
   return out.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
@@ -442,6 +455,7 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
     const bool accel = IsAccel(s.effect);
     h << "<tr><td>" << i + 1 << "</td><td>+ " << ToString(s.effect) << "</td><td>"
       << HtmlEscape(Info(s.effect).description) << "</td><td>" << HtmlEscape(s.information)
+      << (s.confirmed_by.empty() ? "" : "; confirmed by the " + HtmlEscape(s.confirmed_by))
       << "</td><td>" << FormatNumber(s.p_value, "%.3g") << "</td><td>"
       << FormatNumber(s.delta_bic, "%.1f") << "</td>" << GapCells(s.gap_before, s.gap_after, accel)
       << GapCells(s.cv_gap_before, s.cv_gap_after, accel) << "</tr>";
@@ -500,7 +514,12 @@ std::string DiscoveryToHtml(const DiscoveryResult& r) {
   }
   if (!r.warnings.empty()) {
     h << "<h2>Warnings</h2><ul>";
-    for (const std::string& w : r.warnings) h << "<li class='warn'>" << HtmlEscape(w) << "</li>";
+    for (size_t i = 0; i < r.warnings.size(); ++i) {
+      const WarningCode code =
+          i < r.warning_codes.size() ? r.warning_codes[i] : WarningCode::kUnclassified;
+      h << "<li class='warn'><code>" << ToString(code) << "</code> " << HtmlEscape(r.warnings[i])
+        << "</li>";
+    }
     h << "</ul>";
   }
   h << internal::HtmlPageEnd();

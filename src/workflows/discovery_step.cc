@@ -138,6 +138,7 @@ bool TakeStep(const DiscoveryContext& ctx, const DiscoveryOptions& options,
   s.delta_bic = chosen.delta_bic;
   s.dof = chosen.dof;
   s.information = chosen.information;
+  s.confirmed_by = chosen.confirmed_by;
   s.where = where;
   s.candidates = scores;
   s.gap_before = current->gap;

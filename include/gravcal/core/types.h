@@ -183,11 +183,19 @@ enum class WarningCode {
   kNoiseModel,
   // A self-alignment could not determine roll or heading.
   kAlignment,
+  // Discovery: an effect of the catalogue cannot be tested in this session
+  // (no gyroscope or temperature column, too few poses, not identified).
+  kEffectUntestable,
+  // The rotations between poses exceed their noise (a gyroscope
+  // g-sensitivity, a turn the gyroscope does not integrate); they are left
+  // out of the fits.
+  kRotationsAboveNoise,
 };
 // "unclassified", "standard_gravity", "undetermined", "no_covariance",
 // "exact_fit", "residuals_above_noise", "pose_scatter", "few_poses",
 // "rotation_skipped", "method_scope", "parameter_source",
-// "not_still_at_start", "log_gap", "noise_model", "alignment".
+// "not_still_at_start", "log_gap", "noise_model", "alignment",
+// "effect_untestable", "rotations_above_noise".
 const char* ToString(WarningCode code);
 bool FromString(const std::string& name, WarningCode* code);
 

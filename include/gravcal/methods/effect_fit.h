@@ -10,15 +10,17 @@
 // sigma_k from the position's own covariance of the mean (refinement.h),
 // plus, with use_within_pose_trends and for every position whose
 // observation carries a within-pose trend, the AccelTrendResidual
-// (residuals/accel_trend_residual.h): three whitened values comparing the
+// (residuals/accel_trend_residual.h): three whitened values (or, with
+// WithinPoseTrendOptions::along_gravity_only, the one along the pose's
+// mean direction) comparing the
 // slope of the raw mean against time within the pose with the slope the
 // temperature and drift terms predict,
 //
-//   t_k = L_k^-1 ( ghat_k - U^-1 ((c q_k + beta) Tdot_k + delta) ).
+//   t_k = W_k ( ghat_k - U^-1 ((c q_k + beta) Tdot_k + delta) ).
 //
-// Its noise L_k L_k^T is from the pose's batch means about their line,
-// pooled over the poses (src/methods/within_pose_trend.h). These are 3 more
-// residuals per pose that see beta, c and delta directly in every axis, so
+// Its noise is from the pose's batch means about their line,
+// pooled over the poses (src/methods/within_pose_trend.h). These are more
+// residuals per pose that see beta, c and delta directly, so
 // a twelve-position session can test and estimate them; the quadratic term
 // and the model's bias, scale and non-orthogonality predict no trend.
 // With use_between_pose_rotations, also the AccelRotationResidual
@@ -76,6 +78,9 @@ struct StaticObservation {
   Eigen::Vector3d accel_slope = Eigen::Vector3d::Zero();
   Eigen::Matrix3d accel_slope_cov = Eigen::Matrix3d::Identity();
   double temperature_slope = 0.0;
+  // The trend is used along the pose's mean direction only (one row, for
+  // gravity; WithinPoseTrendOptions::along_gravity_only).
+  bool trend_along_gravity = false;
   // The pose's place in its session (0, 1, ...; -1 unknown) and the turn
   // into it from the session's previous pose: the samples from the last one
   // of that pose to the first of this one (AddBetweenPoseTurns). A rotation
@@ -105,6 +110,12 @@ struct WithinPoseTrendOptions {
   // (>= 1) and lasts min_seconds (> 0) or more.
   int min_batch_samples = 5;
   double min_seconds = 3.0;
+  // Keep only the slope's component along the pose's mean direction
+  // (gravity): one row per pose instead of three. The cross-gravity
+  // components also carry slow tilts of the placement and tremor, which no
+  // catalogue effect models; the along-gravity one sees a tilt only to
+  // second order.
+  bool along_gravity_only = false;
 
   bool IsValid(std::string* error) const;
 };

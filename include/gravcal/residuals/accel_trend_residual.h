@@ -18,14 +18,18 @@
 //
 //   q_i = ( [U (v_k - b)]_i - beta_i dT_k - delta_i dt_k ) / (1 + c_i dT_k).
 //
-// The residual (3 values, dimensionless, unit variance) is
+// The residual (dimensionless, unit variance) is
 //
-//   r_k = L_k^-1 ( ghat_k - U^-1 mdot_k ),
+//   r_k = W_k ( ghat_k - U^-1 mdot_k ),
 //
-// ghat_k the measured slope (raw units per second) and L_k L_k^T its
-// covariance. The quadratic term drops out (q is constant within a pose),
-// so k2 only enters through the magnitude residual; a bias, scale or
-// non-orthogonality error alone predicts no trend. Blocks as
+// ghat_k the measured slope (raw units per second) and W_k its whitening:
+// either W_k = L_k^-1 (3 rows), L_k L_k^T the covariance of the slope, or
+// the single row W_k = n_k^T / sqrt(n_k^T L_k L_k^T n_k) with n_k the unit
+// direction of the pose's raw mean, which keeps the slope along gravity
+// only (a slow tilt of the placement or tremor turns the cross-gravity
+// components by g dtheta but the along-gravity one only by g dtheta^2 / 2). The quadratic term
+// drops out (q is constant within a pose), so k2 only enters through the magnitude residual; a
+// bias, scale or non-orthogonality error alone predicts no trend. Blocks as
 // GravityMagnitudeResidual::CreateWithEffects: b (3), U (6: u00 u01 u02 u11
 // u12 u22), k2 (3, unused here), beta (3), c (3), delta (3), so both
 // residuals of a pose share one parameter list. The slope is uncorrelated
@@ -42,10 +46,14 @@
 namespace gravcal {
 
 struct AccelTrendResidual {
-  // raw_mean v_k, slope ghat_k (raw units/s), whitening L_k^-1, Tdot_k
-  // (degC/s), dT_k = T_k - T_ref (0 when unknown) and dt_k = t_k - t_ref.
+  // The whitening's rows: one (along gravity) to three.
+  using Whitening = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 3, 3>;
+
+  // raw_mean v_k, slope ghat_k (raw units/s), whitening W_k (1 to 3 rows),
+  // Tdot_k (degC/s), dT_k = T_k - T_ref (0 when unknown) and
+  // dt_k = t_k - t_ref.
   AccelTrendResidual(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& slope,
-                     const Eigen::Matrix3d& whitening, double temperature_slope,
+                     const Whitening& whitening, double temperature_slope,
                      double temperature_offset, double time_offset)
       : raw_mean_(raw_mean),
         slope_(slope),
@@ -77,25 +85,27 @@ struct AccelTrendResidual {
     predicted[0] = (rate[0] - upper[1] * predicted[1] - upper[2] * predicted[2]) / upper[0];
     T e[3];
     for (int i = 0; i < 3; ++i) e[i] = T(slope_(i)) - predicted[i];
-    for (int r = 0; r < 3; ++r) {
+    for (int r = 0; r < whitening_.rows(); ++r) {
       residual[r] =
           T(whitening_(r, 0)) * e[0] + T(whitening_(r, 1)) * e[1] + T(whitening_(r, 2)) * e[2];
     }
     return true;
   }
 
+  // One residual per row of `whitening`.
   static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& slope,
-                                     const Eigen::Matrix3d& whitening, double temperature_slope,
+                                     const Whitening& whitening, double temperature_slope,
                                      double temperature_offset, double time_offset) {
-    return new ceres::AutoDiffCostFunction<AccelTrendResidual, 3, 3, 6, 3, 3, 3, 3>(
+    return new ceres::AutoDiffCostFunction<AccelTrendResidual, ceres::DYNAMIC, 3, 6, 3, 3, 3, 3>(
         new AccelTrendResidual(raw_mean, slope, whitening, temperature_slope, temperature_offset,
-                               time_offset));
+                               time_offset),
+        static_cast<int>(whitening.rows()));
   }
 
  private:
   const Eigen::Vector3d raw_mean_;
   const Eigen::Vector3d slope_;
-  const Eigen::Matrix3d whitening_;
+  const Whitening whitening_;
   const double temperature_slope_;
   const double temperature_offset_;
   const double time_offset_;

@@ -41,7 +41,16 @@
 //
 // Each decision says which information of the session it used
 // (SensorFitSummary::information: "position magnitudes" for the
-// accelerometer, "static mean rates" for the gyroscope).
+// accelerometer, with "+ within-pose trends" and "+ rotations between
+// poses" when those rows are in its fits; "static mean rates" for the
+// gyroscope). Issue 21: the trends and rotations are rows of the same
+// likelihood as the magnitudes (effect_fit.h), so the chi2 tests, BIC and
+// cross-validation see them all; an accelerometer effect that leaves the
+// magnitudes fewer than min_dof residual degrees of freedom is named only
+// when the trends' or rotations' own rows confirm it
+// (CandidateScore::confirmed_by). Without a gyroscope, with poses shorter
+// than min_trend_seconds, or with rotations exceeding their noise, the
+// accelerometer falls back to what is left (down to the magnitudes alone).
 //
 // The gap is the rms of measured minus simulated: |a| - g over positions for
 // the accelerometer (m/s^2), the gyroscope residual over positions and axes
@@ -56,6 +65,7 @@
 
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/model_effects.h"
+#include "gravcal/core/types.h"
 #include "gravcal/methods/effect_fit.h"
 #include "gravcal/methods/twelve_position.h"
 
@@ -83,6 +93,19 @@ struct DiscoveryOptions {
   double min_temperature_range = 0.5;
   // Positions listed in each `where`.
   int where_count = 3;
+  // Issue 21: the accelerometer's fits and tests also use the slope of
+  // each pose's mean along gravity during the hold (within-pose trends,
+  // 5 batch means per pose), for poses held at least min_trend_seconds;
+  // shorter poses stay magnitude-only (their few batches would say more
+  // about the noise than about a trend).
+  bool use_within_pose_trends = true;
+  double min_trend_seconds = 10.0;
+  // Issue 21: with a gyroscope, the turns between consecutive poses as
+  // rows of the accelerometer's fits (effect_fit.h,
+  // use_between_pose_rotations), with the gyroscope's matrix and bias
+  // estimated jointly; left out, with a warning, when they exceed their
+  // noise under the richest accelerometer model.
+  bool use_between_pose_rotations = true;
 
   bool IsValid(std::string* error) const;
 };
@@ -181,6 +204,19 @@ struct CandidateScore {
   // (SensorFitSummary::information of its sensor), e.g. "position
   // magnitudes".
   std::string information;
+  // Accelerometer effects: the residual degrees of freedom the extended
+  // model leaves the position magnitudes (positions minus accelerometer
+  // parameters). Below DiscoveryOptions::min_dof the magnitudes cannot
+  // test the effect on their own, and it is named only when the
+  // within-pose trends or the rotations confirm it: the part of delta chi2
+  // from their rows alone, on the effect's dof, with its p-value (NaN when
+  // those rows are not used or do not see the effect).
+  int magnitude_dof = 0;
+  double trend_p_value = NAN;
+  double rotation_p_value = NAN;
+  // "" when the magnitudes suffice; else what confirmed it, e.g.
+  // "rotations between poses (p = 3e-09)".
+  std::string confirmed_by;
 };
 
 struct DiscoveryStep {
@@ -189,8 +225,11 @@ struct DiscoveryStep {
   double p_value = NAN;
   double delta_bic = NAN;
   int dof = 0;
-  // Which information the decision used (its candidate's `information`).
+  // Which information the decision used (its candidate's `information`),
+  // and what confirmed it when the magnitudes alone could not
+  // (CandidateScore::confirmed_by).
   std::string information;
+  std::string confirmed_by;
   // Of the sensor the effect belongs to (and the other, unchanged).
   Gap gap_before;
   Gap gap_after;
@@ -266,6 +305,8 @@ struct DiscoveryResult {
   // sensors' unexplained excess, if any.
   std::string verdict;
   std::vector<std::string> warnings;
+  // The code of each warning (core/types.h), same index.
+  std::vector<WarningCode> warning_codes;
   double seconds = 0.0;
   std::string message = "Discover was not called";
 

@@ -46,6 +46,12 @@ ConfigSection DiscoverySection() {
                       "residual dof an extended model must keep"),
           GRAVCAL_DOUBLE("discovery_min_temperature_range", discovery.min_temperature_range,
                          "degC the positions must span for temperature effects to be tried"),
+          GRAVCAL_BOOL("discovery_use_within_pose_trends", discovery.use_within_pose_trends,
+                       "accelerometer tests also use each pose's trend along gravity"),
+          GRAVCAL_DOUBLE("discovery_min_trend_seconds", discovery.min_trend_seconds,
+                         "poses held at least this long give a within-pose trend"),
+          GRAVCAL_BOOL("discovery_use_rotations", discovery.use_between_pose_rotations,
+                       "accelerometer tests also use the gyroscope's turns between poses"),
       }};
 }
 

@@ -70,6 +70,19 @@ WarningAdvice AdviceFor(WarningCode code) {
       return {"A self-alignment could not determine roll or heading, as the message says.",
               "Expected near +-90 degrees pitch or without gyrocompassing; give the latitude "
               "(and a gyroscope good enough) when the heading is needed."};
+    case WarningCode::kEffectUntestable:
+      return {
+          "An effect of the catalogue cannot be tested on this session, for the reason the "
+          "message gives; the verdict says nothing about it.",
+          "Record what the message asks for (a temperature column, a gyroscope, more or "
+          "longer poses, a temperature change) when that effect matters."};
+    case WarningCode::kRotationsAboveNoise:
+      return {
+          "The gyroscope's turns between the poses disagree with the accelerometer beyond "
+          "their noise even with every accelerometer effect, so they were left out: the "
+          "decisions use the magnitudes (and the within-pose trends) only.",
+          "Fit the gyroscope's g-sensitivity first (gravcal discover names it), or turn "
+          "more slowly and steadily between the poses."};
   }
   return {"", ""};
 }
