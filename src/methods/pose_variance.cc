@@ -23,6 +23,9 @@ VariancePrior ConfiguredPrior(const RefinementOptions& options) {
   return prior;
 }
 
+// The lower tail's level is this times prior_conflict_level (header).
+constexpr double kLessScatterLevelFactor = 0.01;
+
 // h = mean_k 1 / sigma_k^2: s^2 in a white-weighted chi2's units (header).
 double MeanInverseVariance(const std::vector<double>& sigmas) {
   double h = 0.0;
@@ -73,15 +76,16 @@ bool PriorConflicts(const RefinementResult& judged, bool richer, const VarianceP
   const double h = MeanInverseVariance(judged.sigmas);
   const double above = PriorPredictiveUpperTail(judged.chi2, judged.dof, prior, h);
   const double below = 1.0 - above;
-  if (!(std::min(above, below) < level)) return false;
+  // Less scatter than the prior needs stronger evidence (header).
+  if (!(above < level) && !(below < kLessScatterLevelFactor * level)) return false;
   std::ostringstream s;
   s.precision(3);
   s << "the poses scatter " << (above < below ? "far more" : "far less")
     << " than the pose-disturbance prior allows (chi2 / dof = " << judged.chi2 / judged.dof
     << " on " << judged.dof << " dof" << (richer ? " with non-orthogonality" : "")
     << " against about " << 1.0 + prior.variance * h << " for s0 = " << std::sqrt(prior.variance)
-    << " m/s^2 on " << prior.dof << " dof, p = " << std::min(above, below)
-    << " < prior_conflict_level " << level
+    << " m/s^2 on " << prior.dof << " dof, p = " << std::min(above, below) << " < "
+    << (above < below ? level : kLessScatterLevelFactor * level)
     << "): the prior is set aside and the standard deviations rest on this recording's own "
        "scatter; set pose_disturbance_prior to what this setup scatters by";
   *text = s.str();
