@@ -9,6 +9,8 @@
 #include <sstream>
 #include <vector>
 
+#include "util/statistics.h"
+
 namespace gravcal {
 namespace internal {
 
@@ -233,6 +235,24 @@ bool EstimateWhitenedVarianceComponent(const Eigen::VectorXd& residuals,
   Estimate(problem, prior, result);
   if (known_variance != nullptr) *known_variance = problem.d.mean();
   return true;
+}
+
+double PriorPredictiveUpperTail(double chi2, int dof, const VariancePrior& prior, double h) {
+  if (!(prior.dof > 0.0) || dof < 1) return 1.0;
+  // Trapezoid over t = log X, density of t: f(e^t) e^t. X from 1e-12 nu0
+  // (far below any prior's tail of interest) to the mean plus 40 sd.
+  const double lo = std::log(1e-12 * prior.dof);
+  const double hi = std::log(prior.dof + 40.0 * std::sqrt(2.0 * prior.dof) + 10.0);
+  const int kSteps = 2000;
+  const double step = (hi - lo) / kSteps;
+  double sum = 0.0, weight = 0.0;
+  for (int i = 0; i <= kSteps; ++i) {
+    const double x = std::exp(lo + i * step);
+    const double w = ChiSquareDensity(x, prior.dof) * x * (i == 0 || i == kSteps ? 0.5 : 1.0);
+    sum += w * ChiSquareUpperTail(chi2 / (1.0 + prior.dof * prior.variance * h / x), dof);
+    weight += w;
+  }
+  return weight > 0.0 ? sum / weight : 1.0;
 }
 
 double StudentInflation(const VarianceComponent& component, double mean_white_variance,

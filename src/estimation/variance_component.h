@@ -101,6 +101,19 @@ bool EstimateWhitenedVarianceComponent(const Eigen::VectorXd& residuals,
                                        const VariancePrior& prior = VariancePrior(),
                                        double* known_variance = nullptr);
 
+// The prior predictive upper tail of a white-weighted chi-square on `dof`
+// (dof >= 1) when s^2 has the prior above and adds s^2 h to every
+// residual's variance in chi2's units (h = 1 / sigma^2 for equal sigmas):
+// with s^2 = nu0 s0^2 / X, X ~ chi2(nu0), chi2 = (1 + s^2 h) Y, Y ~ chi2(dof),
+//
+//   P(chi2_rep > chi2) = E_X[ Q_dof( chi2 / (1 + nu0 s0^2 h / X) ) ],
+//
+// Q_dof the chi-square upper tail, integrated over log X. When s^2 h >> 1
+// it is the F(dof, nu0) tail of (chi2 / dof) / (s0^2 h); unlike that it
+// counts the white part, which a prior far below it cannot move. 1 when
+// there is no prior.
+double PriorPredictiveUpperTail(double chi2, int dof, const VariancePrior& prior, double h);
+
 constexpr double kMinEffectiveDof = 3.0;
 
 // nu / (nu - 2) for an estimated component (1 when s^2 = 0 or not

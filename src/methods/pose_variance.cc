@@ -23,13 +23,14 @@ VariancePrior ConfiguredPrior(const RefinementOptions& options) {
   return prior;
 }
 
-// c0 = 1 + s0^2 h, h = mean_k 1 / sigma_k^2: the prior's variance per
-// white-weighted residual in chi2's units (header, step 1).
-double PriorInChiSquareUnits(const VariancePrior& prior, const std::vector<double>& sigmas) {
+// The lower tail's level is this times prior_conflict_level (header).
+constexpr double kLessScatterLevelFactor = 0.01;
+
+// h = mean_k 1 / sigma_k^2: s^2 in a white-weighted chi2's units (header).
+double MeanInverseVariance(const std::vector<double>& sigmas) {
   double h = 0.0;
   for (double sigma : sigmas) h += 1.0 / (sigma * sigma);
-  h /= std::max<size_t>(sigmas.size(), 1);
-  return 1.0 + prior.variance * h;
+  return h / std::max<size_t>(sigmas.size(), 1);
 }
 
 // REML s^2 from the residuals of `fit`, over its estimated (not held) columns.
@@ -72,18 +73,19 @@ bool FitRicherModel(const std::vector<Position>& placed, const AccelModel& initi
 bool PriorConflicts(const RefinementResult& judged, bool richer, const VariancePrior& prior,
                     double level, std::string* text) {
   if (!(prior.dof > 0.0) || judged.dof < 1) return false;
-  const double c0 = PriorInChiSquareUnits(prior, judged.sigmas);
-  const double ratio = judged.chi2 / judged.dof / c0;
-  const double above = FUpperTail(ratio, judged.dof, prior.dof);
-  const double below = ratio > 0.0 ? FUpperTail(1.0 / ratio, prior.dof, judged.dof) : 0.0;
-  if (!(std::min(above, below) < level)) return false;
+  const double h = MeanInverseVariance(judged.sigmas);
+  const double above = PriorPredictiveUpperTail(judged.chi2, judged.dof, prior, h);
+  const double below = 1.0 - above;
+  // Less scatter than the prior needs stronger evidence (header).
+  if (!(above < level) && !(below < kLessScatterLevelFactor * level)) return false;
   std::ostringstream s;
   s.precision(3);
   s << "the poses scatter " << (above < below ? "far more" : "far less")
     << " than the pose-disturbance prior allows (chi2 / dof = " << judged.chi2 / judged.dof
-    << " on " << judged.dof << " dof" << (richer ? " with non-orthogonality" : "") << " against "
-    << c0 << " for s0 = " << std::sqrt(prior.variance) << " m/s^2 on " << prior.dof
-    << " dof, p = " << std::min(above, below) << " < prior_conflict_level " << level
+    << " on " << judged.dof << " dof" << (richer ? " with non-orthogonality" : "")
+    << " against about " << 1.0 + prior.variance * h << " for s0 = " << std::sqrt(prior.variance)
+    << " m/s^2 on " << prior.dof << " dof, p = " << std::min(above, below) << " < "
+    << (above < below ? level : kLessScatterLevelFactor * level)
     << "): the prior is set aside and the standard deviations rest on this recording's own "
        "scatter; set pose_disturbance_prior to what this setup scatters by";
   *text = s.str();
@@ -98,7 +100,7 @@ bool ExcessIsStructured(const RefinementResult& fit, const RefinementResult& ric
   const double pooled_dof = rich.dof + prior.dof;
   *tested = pooled_dof > 0.0;
   if (!*tested) return false;
-  const double pooled = prior.dof * PriorInChiSquareUnits(prior, rich.sigmas);
+  const double pooled = prior.dof * (1.0 + prior.variance * MeanInverseVariance(rich.sigmas));
   const int extra = rich.num_parameters - fit.num_parameters;
   const double f = ((fit.chi2 - rich.chi2) / extra) / ((rich.chi2 + pooled) / pooled_dof);
   const double p = f > 0.0 ? FUpperTail(f, extra, pooled_dof) : 1.0;

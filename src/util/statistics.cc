@@ -109,6 +109,12 @@ double ChiSquareUpperTail(double x, int dof) {
   return GammaContinuedFraction(a, hx);
 }
 
+double ChiSquareDensity(double x, double dof) {
+  if (!(x > 0.0) || !(dof > 0.0)) return 0.0;
+  const double a = 0.5 * dof;
+  return std::exp((a - 1.0) * std::log(x) - 0.5 * x - a * std::log(2.0) - LogGamma(a));
+}
+
 double Median(std::vector<double> values) {
   if (values.empty()) return 0.0;
   const size_t mid = values.size() / 2;

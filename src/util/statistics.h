@@ -11,6 +11,10 @@ namespace internal {
 // upper incomplete gamma function, series / continued fraction).
 double ChiSquareUpperTail(double x, int dof);
 
+// The density of a chi-square with `dof` degrees of freedom (need not be
+// whole) at x >= 0.
+double ChiSquareDensity(double x, double dof);
+
 // P(X > f) for X ~ F(d1, d2) (regularised incomplete beta function,
 // continued fraction). The degrees of freedom need not be whole (a prior's
 // weight is one).

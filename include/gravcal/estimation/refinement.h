@@ -64,9 +64,10 @@ struct RefinementOptions {
   // degrees of freedom (0 = none, REML alone).
   double pose_disturbance_prior = 0.0;
   double pose_disturbance_prior_dof = 0.0;
-  // The prior is set aside (REML alone, with a warning) when the residuals'
-  // scatter against it falls in either tail of F(dof, prior dof) beyond
-  // this level: a prior this recording contradicts must not size its sigmas.
+  // The prior is set aside (REML alone, with a warning) when the residuals
+  // scatter more than it allows beyond this level, or less beyond a
+  // hundredth of it (methods/pose_variance.h): a prior this recording
+  // contradicts must not size its sigmas.
   double prior_conflict_level = 0.01;
   // Stopping rules of the solve (max_iterations 100, tolerances 1e-14, 1e-14,
   // 1e-12).
