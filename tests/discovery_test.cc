@@ -9,6 +9,7 @@
 #include <functional>
 #include <random>
 
+#include "effect_session.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
@@ -18,15 +19,14 @@ namespace gravcal {
 namespace {
 
 // Magnitudes a real MEMS sensor shows (simulator.h documents the ranges),
-// at or below the typical values: k2 1.5e-4 per m/s^2 (about 1500 ug/g^2),
-// accelerometer bias tempco 0.2 mg/K, scale tempco 0.01 %/K, bias drift
-// 8e-5 m/s^2/s (0.5 mg per minute during warm-up), gyroscope g-sensitivity
-// 0.05 deg/s/g, gyroscope bias tempco 0.01 deg/s/K, gyroscope bias drift
-// 0.03 deg/s per minute. Each is the standard deviation of a per-axis draw.
-constexpr double kQuadratic = 1.5e-4;
-constexpr double kTemperatureBias = 0.002;
-constexpr double kTemperatureScale = 1e-4;
-constexpr double kBiasDrift = 8e-5;
+// at or below the typical values: the accelerometer's of effect_session.h,
+// gyroscope g-sensitivity 0.05 deg/s/g, gyroscope bias tempco
+// 0.01 deg/s/K, gyroscope bias drift 0.03 deg/s per minute. Each is the
+// standard deviation of a per-axis draw.
+using testing_util::kBiasDrift;
+using testing_util::kQuadratic;
+using testing_util::kTemperatureBias;
+using testing_util::kTemperatureScale;
 constexpr double kGSensitivity = 9e-5;
 constexpr double kGyroTemperatureBias = 1.7e-4;
 constexpr double kGyroDrift = 1e-5;

@@ -16,14 +16,12 @@
 namespace gravcal {
 namespace {
 
-// Typical consumer-MEMS sizes, each the standard deviation of a per-axis
-// draw (the same as discovery_test.cc): k2 1.5e-4 per m/s^2 (1500 ug/g^2),
-// bias tempco 0.2 mg/K, scale tempco 0.01 %/K, bias drift 8e-5 m/s^2/s,
-// non-orthogonality 1.5 mrad per angle.
-constexpr double kQuadratic = 1.5e-4;
-constexpr double kTemperatureBias = 0.002;
-constexpr double kTemperatureScale = 1e-4;
-constexpr double kBiasDrift = 8e-5;
+// Typical consumer-MEMS sizes (effect_session.h) and a non-orthogonality
+// of 1.5 mrad per angle, each the standard deviation of a per-axis draw.
+using testing_util::kBiasDrift;
+using testing_util::kQuadratic;
+using testing_util::kTemperatureBias;
+using testing_util::kTemperatureScale;
 constexpr double kMisalignment = 1.5e-3;
 
 constexpr int kSeeds = 20;

@@ -14,6 +14,15 @@
 namespace gravcal {
 namespace testing_util {
 
+// Typical consumer-MEMS sizes of the accelerometer effects, each the
+// standard deviation of a per-axis draw: k2 1.5e-4 per m/s^2 (about
+// 1500 ug/g^2), bias tempco 0.2 mg/K, scale tempco 0.01 %/K, bias drift
+// 8e-5 m/s^2/s (0.5 mg per minute during warm-up).
+constexpr double kQuadratic = 1.5e-4;
+constexpr double kTemperatureBias = 0.002;
+constexpr double kTemperatureScale = 1e-4;
+constexpr double kBiasDrift = 8e-5;
+
 // The seed's twelve poses held 30 s during a warm-up 20 -> 35 degC (time
 // constant 200 s, so the poses see different temperature rates), with the
 // hand_placed.yaml correlated accelerometer noise on top of the default
