@@ -304,20 +304,6 @@ TEST(Discovery, ReportsTemperatureVersusTimeAmbiguityInMonotonicWarmUp) {
 // accelerometer candidate is scored exactly as on the same positions
 // without the gyroscope (before issue 21 the gyroscope's candidates shared
 // the accelerometer's test family and BIC n, so they differed).
-void AddPoseOffsetsToGyro(double sigmas, uint64_t seed, SimulatedSession* session,
-                          const SimulatorOptions& sim) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> z(0.0, 1.0);
-  const double per_sample = sim.gyro_noise * session->gyro_units_per_si;
-  for (const SimulatedPose& p : session->poses) {
-    const double sigma_of_mean = per_sample / std::sqrt(static_cast<double>(p.end - p.begin));
-    const Eigen::Vector3d offset(z(rng), z(rng), z(rng));
-    for (size_t i = p.begin; i < p.end; ++i) {
-      session->log.gyro[i] += (sigmas * sigma_of_mean * offset).array().round().matrix();
-    }
-  }
-}
-
 // The same static positions as if the log had no gyroscope column.
 std::vector<StaticObservation> WithoutGyroscope(std::vector<StaticObservation> observations) {
   for (StaticObservation& o : observations) o.has_gyro = false;
@@ -337,7 +323,7 @@ TEST(Discovery, GyroscopeExcessDoesNotMaskAccelerometerEffect) {
     SimulatedSession session;
     std::string error;
     ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
-    AddPoseOffsetsToGyro(30.0, seed, &session, sim);
+    testing_util::AddPoseOffsetsToGyro(30.0, seed, &session, sim);
     calibration.gravity.gravity = session.gravity;
     DiscoveryResult with_gyro, without_gyro;
     ASSERT_TRUE(DiscoverEffects(session.log, calibration, {}, DiscoveryOptions(), &with_gyro))

@@ -4,6 +4,8 @@
 #ifndef GRAVCAL_TESTS_EFFECT_SESSION_H_
 #define GRAVCAL_TESTS_EFFECT_SESSION_H_
 
+#include <cmath>
+#include <random>
 #include <vector>
 
 #include "gravcal/detection/static_detector.h"
@@ -59,6 +61,24 @@ inline SimulatorOptions WithHidden(SimulatorOptions o, Effect e, double std) {
       break;
   }
   return o;
+}
+
+// Every pose's gyroscope samples offset by `sigmas` times the standard
+// deviation of the pose's mean, per axis, one draw per pose (rounded to
+// counts): an excess of the static means that no catalogue effect
+// explains, as an AHRS's own processing of its gyroscope output gives.
+inline void AddPoseOffsetsToGyro(double sigmas, uint64_t seed, SimulatedSession* session,
+                                 const SimulatorOptions& sim) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> z(0.0, 1.0);
+  const double per_sample = sim.gyro_noise * session->gyro_units_per_si;
+  for (const SimulatedPose& p : session->poses) {
+    const double sigma_of_mean = per_sample / std::sqrt(static_cast<double>(p.end - p.begin));
+    const Eigen::Vector3d offset(z(rng), z(rng), z(rng));
+    for (size_t i = p.begin; i < p.end; ++i) {
+      session->log.gyro[i] += (sigmas * sigma_of_mean * offset).array().round().matrix();
+    }
+  }
 }
 
 // The simulator's own still periods (so that detection is not under test).

@@ -103,8 +103,10 @@ struct DiscoveryOptions {
   // Issue 21: with a gyroscope, the turns between consecutive poses as
   // rows of the accelerometer's fits (effect_fit.h,
   // use_between_pose_rotations), with the gyroscope's matrix and bias
-  // estimated jointly; left out, with a warning, when they exceed their
-  // noise under the richest accelerometer model.
+  // estimated jointly. Used only where the magnitudes cannot test every
+  // accelerometer candidate (fewer than min_dof residual degrees of freedom
+  // under the richest model), and left out, with a warning, when they
+  // exceed their noise under that model.
   bool use_between_pose_rotations = true;
 
   bool IsValid(std::string* error) const;
