@@ -22,11 +22,6 @@ namespace gravcal {
 namespace internal {
 namespace {
 
-// Batch means per pose for the within-pose trends: 6 s batches on a 30 s
-// hold count the noise correlated over seconds (bias instability) in each
-// batch mean; pooling over the poses gives the degrees of freedom.
-constexpr int kDiscoveryTrendBatches = 5;
-
 // The starting model: the configured calibration (coarse fit and
 // refinement) of the positions, and the discovery context and seed fit
 // from it. False with r->message when it cannot be fitted.
@@ -441,11 +436,8 @@ bool DiscoverEffects(const ImuLog& log, const CalibrationOptions& calibration,
   // between the poses.
   std::vector<StaticObservation> observations;
   if (options.use_within_pose_trends) {
-    WithinPoseTrendOptions trends;
-    trends.batches = internal::kDiscoveryTrendBatches;
-    trends.min_seconds = options.min_trend_seconds;
-    trends.along_gravity_only = true;
-    observations = ObservationsFromIntervals(log, intervals, trends);
+    observations =
+        ObservationsFromIntervals(log, intervals, GravityTrendOptions(options.min_trend_seconds));
   } else {
     observations = ObservationsFromIntervals(intervals, log.has_gyro());
   }
