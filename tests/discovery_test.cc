@@ -9,6 +9,7 @@
 #include <functional>
 #include <random>
 
+#include "effect_session.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
@@ -18,15 +19,14 @@ namespace gravcal {
 namespace {
 
 // Magnitudes a real MEMS sensor shows (simulator.h documents the ranges),
-// at or below the typical values: k2 1.5e-4 per m/s^2 (about 1500 ug/g^2),
-// accelerometer bias tempco 0.2 mg/K, scale tempco 0.01 %/K, bias drift
-// 8e-5 m/s^2/s (0.5 mg per minute during warm-up), gyroscope g-sensitivity
-// 0.05 deg/s/g, gyroscope bias tempco 0.01 deg/s/K, gyroscope bias drift
-// 0.03 deg/s per minute. Each is the standard deviation of a per-axis draw.
-constexpr double kQuadratic = 1.5e-4;
-constexpr double kTemperatureBias = 0.002;
-constexpr double kTemperatureScale = 1e-4;
-constexpr double kBiasDrift = 8e-5;
+// at or below the typical values: the accelerometer's of effect_session.h,
+// gyroscope g-sensitivity 0.05 deg/s/g, gyroscope bias tempco
+// 0.01 deg/s/K, gyroscope bias drift 0.03 deg/s per minute. Each is the
+// standard deviation of a per-axis draw.
+using testing_util::kBiasDrift;
+using testing_util::kQuadratic;
+using testing_util::kTemperatureBias;
+using testing_util::kTemperatureScale;
 constexpr double kGSensitivity = 9e-5;
 constexpr double kGyroTemperatureBias = 1.7e-4;
 constexpr double kGyroDrift = 1e-5;
@@ -304,20 +304,6 @@ TEST(Discovery, ReportsTemperatureVersusTimeAmbiguityInMonotonicWarmUp) {
 // accelerometer candidate is scored exactly as on the same positions
 // without the gyroscope (before issue 21 the gyroscope's candidates shared
 // the accelerometer's test family and BIC n, so they differed).
-void AddPoseOffsetsToGyro(double sigmas, uint64_t seed, SimulatedSession* session,
-                          const SimulatorOptions& sim) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> z(0.0, 1.0);
-  const double per_sample = sim.gyro_noise * session->gyro_units_per_si;
-  for (const SimulatedPose& p : session->poses) {
-    const double sigma_of_mean = per_sample / std::sqrt(static_cast<double>(p.end - p.begin));
-    const Eigen::Vector3d offset(z(rng), z(rng), z(rng));
-    for (size_t i = p.begin; i < p.end; ++i) {
-      session->log.gyro[i] += (sigmas * sigma_of_mean * offset).array().round().matrix();
-    }
-  }
-}
-
 // The same static positions as if the log had no gyroscope column.
 std::vector<StaticObservation> WithoutGyroscope(std::vector<StaticObservation> observations) {
   for (StaticObservation& o : observations) o.has_gyro = false;
@@ -337,7 +323,7 @@ TEST(Discovery, GyroscopeExcessDoesNotMaskAccelerometerEffect) {
     SimulatedSession session;
     std::string error;
     ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
-    AddPoseOffsetsToGyro(30.0, seed, &session, sim);
+    testing_util::AddPoseOffsetsToGyro(30.0, seed, &session, sim);
     calibration.gravity.gravity = session.gravity;
     DiscoveryResult with_gyro, without_gyro;
     ASSERT_TRUE(DiscoverEffects(session.log, calibration, {}, DiscoveryOptions(), &with_gyro))

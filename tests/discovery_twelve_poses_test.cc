@@ -16,14 +16,12 @@
 namespace gravcal {
 namespace {
 
-// Typical consumer-MEMS sizes, each the standard deviation of a per-axis
-// draw (the same as discovery_test.cc): k2 1.5e-4 per m/s^2 (1500 ug/g^2),
-// bias tempco 0.2 mg/K, scale tempco 0.01 %/K, bias drift 8e-5 m/s^2/s,
-// non-orthogonality 1.5 mrad per angle.
-constexpr double kQuadratic = 1.5e-4;
-constexpr double kTemperatureBias = 0.002;
-constexpr double kTemperatureScale = 1e-4;
-constexpr double kBiasDrift = 8e-5;
+// Typical consumer-MEMS sizes (effect_session.h) and a non-orthogonality
+// of 1.5 mrad per angle, each the standard deviation of a per-axis draw.
+using testing_util::kBiasDrift;
+using testing_util::kQuadratic;
+using testing_util::kTemperatureBias;
+using testing_util::kTemperatureScale;
 constexpr double kMisalignment = 1.5e-3;
 
 constexpr int kSeeds = 20;
@@ -31,6 +29,8 @@ constexpr int kSeeds = 20;
 struct Hidden {
   Effect effect;
   double std;
+  // Seeds of kSeeds in which it must be named first.
+  int required;
 };
 
 // The twelve-pose session with `hidden` (none when std is 0), discovered
@@ -77,16 +77,27 @@ TEST_P(DiscoveryTwelvePoses, NamesTheHiddenAccelerometerEffectFirst) {
       }
     }
   }
-  EXPECT_GE(first, 18) << first << " of " << kSeeds;
+  EXPECT_GE(first, hidden.required) << first << " of " << kSeeds;
 }
 
+// Named first in at least 18 of 20 seeds (measured on seeds 1-20: k2 20,
+// bias tempco 18, drift 19, non-orthogonality 20), except the scale
+// tempco: with the magnitudes at 0 residual dof it must be confirmed by
+// the trend and rotation rows, and a typical 0.01 %/K gives those too
+// little signal. Its along-gravity slope c_i g dT/dt, against the slopes'
+// noise, has a noncentrality of 10.9 on average over these seeds (bias
+// tempco 32.8, drift 38.3; the rotation rows add little for it), so the
+// confirmation test (chi2 on 3 dof at 0.01 / 4) passes with probability
+// about 0.37: 7.4 of 20 expected, 8 measured. Its bound is the binomial
+// one for a rate of 0.25.
 INSTANTIATE_TEST_SUITE_P(Effects, DiscoveryTwelvePoses,
-                         ::testing::Values(Hidden{Effect::kAccelQuadratic, kQuadratic},
-                                           Hidden{Effect::kAccelTemperatureBias, kTemperatureBias},
-                                           Hidden{Effect::kAccelTemperatureScale,
-                                                  kTemperatureScale},
-                                           Hidden{Effect::kAccelBiasDrift, kBiasDrift},
-                                           Hidden{Effect::kAccelMisalignment, kMisalignment}),
+                         ::testing::Values(Hidden{Effect::kAccelQuadratic, kQuadratic, 18},
+                                           Hidden{Effect::kAccelTemperatureBias, kTemperatureBias,
+                                                  18},
+                                           Hidden{Effect::kAccelTemperatureScale, kTemperatureScale,
+                                                  testing_util::RequiredSuccesses(kSeeds, 0.25)},
+                                           Hidden{Effect::kAccelBiasDrift, kBiasDrift, 18},
+                                           Hidden{Effect::kAccelMisalignment, kMisalignment, 18}),
                          [](const ::testing::TestParamInfo<Hidden>& info) {
                            return std::string(ToString(info.param.effect));
                          });
@@ -94,11 +105,42 @@ INSTANTIATE_TEST_SUITE_P(Effects, DiscoveryTwelvePoses,
 TEST(DiscoveryTwelvePosesQuiet, NamesNothingWithoutHiddenEffect) {
   int quiet = 0;
   for (int seed = 1; seed <= kSeeds; ++seed) {
-    const DiscoveryResult r = DiscoverTwelve({Effect::kAccelQuadratic, 0.0}, seed);
+    const DiscoveryResult r = DiscoverTwelve({Effect::kAccelQuadratic, 0.0, 0}, seed);
     quiet += r.named().empty() ? 1 : 0;
     if (!r.named().empty()) std::printf("seed %d: %s\n", seed, r.verdict.c_str());
   }
   EXPECT_GE(quiet, 19) << quiet << " of " << kSeeds;
+}
+
+// Each sensor's evidence stands on its own, on twelve poses too: the
+// accelerometer hides a non-orthogonality (scale baseline) while every
+// pose's gyroscope mean sits 30 sigma off any static model. The gyroscope is
+// reported unexplained and the accelerometer effect is still named (the
+// same check on 14 random poses: discovery_test.cc,
+// GyroscopeExcessDoesNotMaskAccelerometerEffect).
+TEST(DiscoveryTwelvePosesGyroExcess, AccelerometerEffectIsStillNamed) {
+  SimulatorOptions sim = testing_util::TwelvePoseWarmUp();
+  sim.accel_misalignment_std = kMisalignment;
+  CalibrationOptions calibration;
+  calibration.refinement.parameterization = AccelParameterization::kScale;
+  const int seeds = 10;
+  int named = 0, gyro_unexplained = 0;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    SimulatedSession session;
+    std::string error;
+    ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
+    testing_util::AddPoseOffsetsToGyro(30.0, seed, &session, sim);
+    calibration.gravity.gravity = session.gravity;
+    DiscoveryResult r;
+    ASSERT_TRUE(DiscoverEffects(session.log, calibration, {}, DiscoveryOptions(), &r)) << r.message;
+    named += !r.steps.empty() && r.steps.front().effect == Effect::kAccelMisalignment ? 1 : 0;
+    ASSERT_EQ(r.sensors.size(), 2u);
+    gyro_unexplained += r.sensors[1].unexplained ? 1 : 0;
+    std::printf("seed %d: %s | accelerometer from the %s\n", seed, r.verdict.c_str(),
+                r.sensors[0].information.c_str());
+  }
+  EXPECT_GE(named, 9) << named << " of " << seeds;
+  EXPECT_GE(gyro_unexplained, 9) << gyro_unexplained << " of " << seeds;
 }
 
 }  // namespace

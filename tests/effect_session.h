@@ -4,6 +4,8 @@
 #ifndef GRAVCAL_TESTS_EFFECT_SESSION_H_
 #define GRAVCAL_TESTS_EFFECT_SESSION_H_
 
+#include <cmath>
+#include <random>
 #include <vector>
 
 #include "gravcal/detection/static_detector.h"
@@ -13,6 +15,15 @@
 
 namespace gravcal {
 namespace testing_util {
+
+// Typical consumer-MEMS sizes of the accelerometer effects, each the
+// standard deviation of a per-axis draw: k2 1.5e-4 per m/s^2 (about
+// 1500 ug/g^2), bias tempco 0.2 mg/K, scale tempco 0.01 %/K, bias drift
+// 8e-5 m/s^2/s (0.5 mg per minute during warm-up).
+constexpr double kQuadratic = 1.5e-4;
+constexpr double kTemperatureBias = 0.002;
+constexpr double kTemperatureScale = 1e-4;
+constexpr double kBiasDrift = 8e-5;
 
 // The seed's twelve poses held 30 s during a warm-up 20 -> 35 degC (time
 // constant 200 s, so the poses see different temperature rates), with the
@@ -50,6 +61,24 @@ inline SimulatorOptions WithHidden(SimulatorOptions o, Effect e, double std) {
       break;
   }
   return o;
+}
+
+// Every pose's gyroscope samples offset by `sigmas` times the standard
+// deviation of the pose's mean, per axis, one draw per pose (rounded to
+// counts): an excess of the static means that no catalogue effect
+// explains, as an AHRS's own processing of its gyroscope output gives.
+inline void AddPoseOffsetsToGyro(double sigmas, uint64_t seed, SimulatedSession* session,
+                                 const SimulatorOptions& sim) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> z(0.0, 1.0);
+  const double per_sample = sim.gyro_noise * session->gyro_units_per_si;
+  for (const SimulatedPose& p : session->poses) {
+    const double sigma_of_mean = per_sample / std::sqrt(static_cast<double>(p.end - p.begin));
+    const Eigen::Vector3d offset(z(rng), z(rng), z(rng));
+    for (size_t i = p.begin; i < p.end; ++i) {
+      session->log.gyro[i] += (sigmas * sigma_of_mean * offset).array().round().matrix();
+    }
+  }
 }
 
 // The simulator's own still periods (so that detection is not under test).

@@ -105,6 +105,16 @@ TEST(AccelTrendResidual, JacobianMatchesNumericDifferences) {
       {1e-2, 1e-9, 1e-6, 1e-6, 1e-7, 1e-8}, 1e-5, &jac);
   // The quadratic term predicts no trend.
   for (double d : jac[2]) EXPECT_EQ(d, 0.0);
+  // The one row along gravity (discover's trends): same parameters, one
+  // residual.
+  AccelTrendResidual::Whitening along(1, 3);
+  along << 0.01, -0.07, 0.99;
+  std::unique_ptr<ceres::CostFunction> one(
+      AccelTrendResidual::Create(raw, slope, along * 30.0, 0.03, 4.0, -50.0));
+  EXPECT_EQ(one->num_residuals(), 1);
+  testing_util::ExpectJacobianMatchesCentralDifferences(
+      *one, {bias, upper, k2, beta, c, delta}, {3, 6, 3, 3, 3, 3},
+      {1e-2, 1e-9, 1e-6, 1e-6, 1e-7, 1e-8}, 1e-5, &jac);
 }
 
 // A still log with a known linear trend and white noise: the slope is

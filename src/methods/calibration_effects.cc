@@ -160,7 +160,10 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
     c.message = (log.source.empty() ? "" : log.source + ": ") + what;
     return false;
   };
-  std::vector<StaticObservation> observations = ObservationsFromIntervals(log, intervals);
+  // The trends along gravity of poses held 10 s or more, as discover reads
+  // them.
+  std::vector<StaticObservation> observations =
+      ObservationsFromIntervals(log, intervals, GravityTrendOptions());
   // Issue 21: with a gyroscope, the turns between the poses link their
   // directions (use_between_pose_rotations).
   const int turns = AddBetweenPoseTurns(log, intervals, &observations);

@@ -736,6 +736,14 @@ std::vector<StaticObservation> ObservationsFromIntervals(
   return out;
 }
 
+WithinPoseTrendOptions GravityTrendOptions(double min_seconds) {
+  WithinPoseTrendOptions o;
+  o.batches = 5;
+  o.along_gravity_only = true;
+  o.min_seconds = min_seconds;
+  return o;
+}
+
 bool EffectFitOptions::IsValid(std::string* error) const {
   if (!(magnitude_variance_prior >= 0.0) || !(magnitude_variance_prior_dof >= 0.0) ||
       !(magnitude_extra_variance >= 0.0) || !std::isfinite(magnitude_extra_variance) ||

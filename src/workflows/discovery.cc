@@ -22,11 +22,6 @@ namespace gravcal {
 namespace internal {
 namespace {
 
-// Batch means per pose for the within-pose trends: 6 s batches on a 30 s
-// hold count the noise correlated over seconds (bias instability) in each
-// batch mean; pooling over the poses gives the degrees of freedom.
-constexpr int kDiscoveryTrendBatches = 5;
-
 // The starting model: the configured calibration (coarse fit and
 // refinement) of the positions, and the discovery context and seed fit
 // from it. False with r->message when it cannot be fitted.
@@ -205,6 +200,15 @@ std::vector<Effect> CandidateEffects(const DiscoveryOptions& options) {
   return candidates;
 }
 
+// "the position magnitudes" (and "the within-pose trends" when a pose has
+// one): what the accelerometer's decisions use without the rotations.
+std::string WhatIsLeft(const std::vector<StaticObservation>& observations) {
+  const bool trends = std::any_of(observations.begin(), observations.end(),
+                                  [](const StaticObservation& o) { return o.has_trend; });
+  return trends ? "the position magnitudes and within-pose trends only"
+                : "the position magnitudes only";
+}
+
 // Whether the rotations between poses stay in the accelerometer's fits:
 // they must fit their noise (chi2 p >= 1e-3 on their rows less the
 // gyroscope's 12 parameters) under the richest accelerometer model this
@@ -232,6 +236,24 @@ void CheckRotations(const std::vector<Effect>& baseline_effects,
     }
     richest.push_back(e);
   }
+  // Only where needed: when the magnitudes keep min_dof residual degrees
+  // of freedom even under the richest model, they test every candidate on
+  // their own, and the rotations (about a hundred times the CPU of the
+  // magnitudes: every fit integrates every turn) are left out. The choice
+  // follows from the design (poses and parameters), not from the data, so
+  // the tests stay honest.
+  int parameters = ctx.parameterization == AccelParameterization::kScale ? 6 : 9;
+  for (Effect e : richest) {
+    if (!IsAccel(e) || (e == Effect::kAccelMisalignment &&
+                        ctx.parameterization != AccelParameterization::kScale)) {
+      continue;
+    }
+    parameters += Info(e).num_parameters;
+  }
+  if (static_cast<int>(ctx.observations->size()) - parameters >= options.min_dof) {
+    ctx.use_rotations = false;
+    return;
+  }
   EffectFitResult fit;
   if (!FitDiscoveryModel(ctx, *ctx.observations, richest, seed, true, false, false, &fit) &&
       !FitDiscoveryModel(ctx, *ctx.observations, baseline_effects, seed, true, false, false,
@@ -249,8 +271,7 @@ void CheckRotations(const std::vector<Effect>& baseline_effects,
   if (f.rotation_residuals == 0) {
     w << "the rotations between poses could not be used";
     for (const std::string& m : fit.warnings) w << ": " << m;
-    w << "; the accelerometer's decisions use the position magnitudes"
-      << " (and within-pose trends)";
+    w << "; the accelerometer's decisions use " << WhatIsLeft(*ctx.observations);
     AddWarning(WarningCode::kRotationSkipped, w.str(), &result->warnings, &result->warning_codes);
     return;
   }
@@ -258,8 +279,8 @@ void CheckRotations(const std::vector<Effect>& baseline_effects,
        "(chi2 "
     << f.rotation_chi2 << " on about " << dof
     << " dof): a gyroscope g-sensitivity or a turn the gyroscope does not integrate; they are "
-       "left out, and the accelerometer's decisions use the position magnitudes (and "
-       "within-pose trends) only";
+       "left out, and the accelerometer's decisions use "
+    << WhatIsLeft(*ctx.observations);
   AddWarning(WarningCode::kRotationsAboveNoise, w.str(), &result->warnings, &result->warning_codes);
 }
 
@@ -376,7 +397,7 @@ bool DiscoverFromObservations(const std::vector<StaticObservation>& observations
                             &scores, &fits);
     internal::CodeNewWarnings(WarningCode::kEffectUntestable, r.warnings, &r.warning_codes);
     internal::ScoreCandidates(ctx, current, fits, &scores);
-    const int best = internal::ChooseCandidate(ctx, current, options, &scores);
+    const int best = internal::ChooseCandidate(ctx, current, options, fits, &scores);
     if (best < 0) {
       r.final_candidates = scores;
       break;
@@ -415,11 +436,8 @@ bool DiscoverEffects(const ImuLog& log, const CalibrationOptions& calibration,
   // between the poses.
   std::vector<StaticObservation> observations;
   if (options.use_within_pose_trends) {
-    WithinPoseTrendOptions trends;
-    trends.batches = internal::kDiscoveryTrendBatches;
-    trends.min_seconds = options.min_trend_seconds;
-    trends.along_gravity_only = true;
-    observations = ObservationsFromIntervals(log, intervals, trends);
+    observations =
+        ObservationsFromIntervals(log, intervals, GravityTrendOptions(options.min_trend_seconds));
   } else {
     observations = ObservationsFromIntervals(intervals, log.has_gyro());
   }

@@ -138,16 +138,15 @@ void TryCandidate(const DiscoveryContext& ctx, const ModelAssessment& current, E
   c->delta_chi2 = now.chi2 - ext.chi2;
   if (accel) {
     c->magnitude_dof = MagnitudeDof(now, static_cast<int>(ctx.observations->size()), e);
-    // The trend and rotation rows' own share of delta chi2, on the
-    // effect's dof: they confirm an effect the magnitudes cannot test.
-    auto part = [&](int rows, double before, double after) {
-      if (rows == 0) return static_cast<double>(NAN);
-      return before - after > 0.0 ? ChiSquareUpperTail(before - after, c->dof) : 1.0;
-    };
-    if (Info(e).regressor != EffectRegressor::kOrientation) {
-      c->trend_p_value = part(ext.trend_residuals, now.trend_chi2, ext.trend_chi2);
+    // The trend and rotation rows' own share of delta chi2: together, on
+    // the effect's dof, they confirm an effect the magnitudes cannot test
+    // (one test, so that two sources do not each get the level).
+    c->trend_delta_chi2 = now.trend_chi2 - ext.trend_chi2;
+    c->rotation_delta_chi2 = now.rotation_chi2 - ext.rotation_chi2;
+    if (ext.trend_residuals + ext.rotation_residuals > 0) {
+      const double beside = c->trend_delta_chi2 + c->rotation_delta_chi2;
+      c->confirmation_p_value = beside > 0.0 ? ChiSquareUpperTail(beside, c->dof) : 1.0;
     }
-    c->rotation_p_value = part(ext.rotation_residuals, now.rotation_chi2, ext.rotation_chi2);
   }
   c->gap = InSampleGap(extended_fit, ctx.has_gyro);
   // The other sensor's part was not refitted: its gap is the current one.
@@ -158,10 +157,13 @@ void TryCandidate(const DiscoveryContext& ctx, const ModelAssessment& current, E
     c->gap.accel = current.gap.accel;
     c->gap.accel_sigma = current.gap.accel_sigma;
   }
+  // Cross-validated only when its tests pass (ChooseCandidate): until then
+  // its sensor's cross-validated gap is unknown.
   c->cv_gap = current.cv_gap;
-  if (!CrossValidate(ctx, extended, extended_fit, Info(e).sensor, &c->cv_gap, nullptr, nullptr)) {
-    c->reason = "cross-validation failed (a fold could not be fitted)";
-    c->tried = false;
+  if (accel) {
+    c->cv_gap.accel = c->cv_gap.accel_sigma = NAN;
+  } else {
+    c->cv_gap.gyro = c->cv_gap.gyro_sigma = NAN;
   }
   *fit = extended_fit;
 }
@@ -324,7 +326,8 @@ void ScoreCandidates(const DiscoveryContext& ctx, const ModelAssessment& current
 }
 
 int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,
-                    const DiscoveryOptions& options, std::vector<CandidateScore>* scores_out) {
+                    const DiscoveryOptions& options, const std::vector<EffectFitResult>& fits,
+                    std::vector<CandidateScore>* scores_out) {
   std::vector<CandidateScore>& scores = *scores_out;
   int best = -1;
   for (size_t i = 0; i < scores.size(); ++i) {
@@ -332,28 +335,39 @@ int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,
     if (!c.tried) continue;
     const bool accel = IsAccel(c.effect);
     const double alpha = SensorAlpha(scores, accel, options);
-    const double before = accel ? current.cv_gap.accel_sigma : current.cv_gap.gyro_sigma;
-    const double after = accel ? c.cv_gap.accel_sigma : c.cv_gap.gyro_sigma;
     std::ostringstream why;
     why.precision(3);
     if (!(c.p_value < alpha)) why << "p = " << c.p_value << " not below " << alpha << "; ";
     if (!(c.delta_bic < -options.min_bic_gain)) {
       why << "delta BIC = " << c.delta_bic << " not below " << -options.min_bic_gain << "; ";
     }
-    if (!(after < before)) {
-      why << "cross-validated gap " << after << " sigma not below " << before << "; ";
-    }
     c.confirmed_by.clear();
     if (accel && c.magnitude_dof < options.min_dof) {
-      if (c.trend_p_value < alpha) {
-        c.confirmed_by = "within-pose trends (p = " + FormatNumber("%.2g", c.trend_p_value) + ")";
-      } else if (c.rotation_p_value < alpha) {
-        c.confirmed_by =
-            "rotations between poses (p = " + FormatNumber("%.2g", c.rotation_p_value) + ")";
+      const std::string beside = "within-pose trends + rotations between poses (delta chi2 " +
+                                 FormatNumber("%.3g", c.trend_delta_chi2) + " + " +
+                                 FormatNumber("%.3g", c.rotation_delta_chi2) +
+                                 ", p = " + FormatNumber("%.2g", c.confirmation_p_value) + ")";
+      if (c.confirmation_p_value < alpha) {
+        c.confirmed_by = beside;
       } else {
         why << "the magnitudes keep " << c.magnitude_dof << " residual dof (needs "
-            << options.min_dof << ") and neither the within-pose trends (p = " << c.trend_p_value
-            << ") nor the rotations between poses (p = " << c.rotation_p_value << ") confirm it; ";
+            << options.min_dof << ") and the " << beside << " do not confirm it; ";
+      }
+    }
+    // Leave-one-position-out cross-validation (a dozen refits) only for a
+    // candidate that passed the tests above.
+    if (why.str().empty()) {
+      std::vector<Effect> extended = current.effects;
+      extended.push_back(c.effect);
+      const double before = accel ? current.cv_gap.accel_sigma : current.cv_gap.gyro_sigma;
+      if (!CrossValidate(ctx, extended, fits[i], Info(c.effect).sensor, &c.cv_gap, nullptr,
+                         nullptr)) {
+        why << "cross-validation failed (a fold could not be fitted); ";
+      } else {
+        const double after = accel ? c.cv_gap.accel_sigma : c.cv_gap.gyro_sigma;
+        if (!(after < before)) {
+          why << "cross-validated gap " << after << " sigma not below " << before << "; ";
+        }
       }
     }
     c.reason = why.str();

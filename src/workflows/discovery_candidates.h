@@ -31,9 +31,13 @@ void ScoreCandidates(const DiscoveryContext& ctx, const ModelAssessment& current
 // Marks the significant candidates (with the reason of each that is not;
 // each sensor's tests at `significance` divided among its own candidates)
 // and returns the index of the one to name, or -1; looks at pairs of
-// candidates masking each other when none is significant alone.
+// candidates masking each other when none is significant alone. A
+// candidate is cross-validated (from fits[i], its extended fit) only when
+// its likelihood-ratio, BIC and confirmation tests pass; the others keep a
+// NaN cross-validated gap for their sensor.
 int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,
-                    const DiscoveryOptions& options, std::vector<CandidateScore>* scores);
+                    const DiscoveryOptions& options, const std::vector<EffectFitResult>& fits,
+                    std::vector<CandidateScore>* scores);
 
 }  // namespace internal
 }  // namespace gravcal

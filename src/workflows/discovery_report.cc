@@ -134,8 +134,9 @@ json CandidatesJson(const std::vector<CandidateScore>& scores) {
       j["cv_gap_after_sigma"] = Number(SigmaOf(c.cv_gap, accel));
       if (accel) {
         j["magnitude_dof"] = c.magnitude_dof;
-        j["trend_p_value"] = Number(c.trend_p_value);
-        j["rotation_p_value"] = Number(c.rotation_p_value);
+        j["trend_delta_chi2"] = Number(c.trend_delta_chi2);
+        j["rotation_delta_chi2"] = Number(c.rotation_delta_chi2);
+        j["confirmation_p_value"] = Number(c.confirmation_p_value);
         j["confirmed_by"] = c.confirmed_by;
       }
     }

@@ -120,6 +120,13 @@ struct WithinPoseTrendOptions {
   bool IsValid(std::string* error) const;
 };
 
+// The trends `discover` and `calibrate --effects` read (issue 21): 5 batch
+// means per pose (6 s batches on a 30 s hold count the noise correlated
+// over seconds in each batch mean; pooling over the poses gives the
+// degrees of freedom), the component along gravity only, poses of
+// min_seconds or more.
+WithinPoseTrendOptions GravityTrendOptions(double min_seconds = 10.0);
+
 // The same observations with each pose's within-pose trend from the samples
 // of `log` (the log the intervals were detected in). An empty result when
 // the options are invalid.

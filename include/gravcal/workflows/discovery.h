@@ -103,8 +103,10 @@ struct DiscoveryOptions {
   // Issue 21: with a gyroscope, the turns between consecutive poses as
   // rows of the accelerometer's fits (effect_fit.h,
   // use_between_pose_rotations), with the gyroscope's matrix and bias
-  // estimated jointly; left out, with a warning, when they exceed their
-  // noise under the richest accelerometer model.
+  // estimated jointly. Used only where the magnitudes cannot test every
+  // accelerometer candidate (fewer than min_dof residual degrees of freedom
+  // under the richest model), and left out, with a warning, when they
+  // exceed their noise under that model.
   bool use_between_pose_rotations = true;
 
   bool IsValid(std::string* error) const;
@@ -207,15 +209,18 @@ struct CandidateScore {
   // Accelerometer effects: the residual degrees of freedom the extended
   // model leaves the position magnitudes (positions minus accelerometer
   // parameters). Below DiscoveryOptions::min_dof the magnitudes cannot
-  // test the effect on their own, and it is named only when the
-  // within-pose trends or the rotations confirm it: the part of delta chi2
-  // from their rows alone, on the effect's dof, with its p-value (NaN when
-  // those rows are not used or do not see the effect).
+  // test the effect on their own (every candidate of its size then fits
+  // them exactly), and it is named only when the rows beside them confirm
+  // it: the part of delta chi2 from the within-pose trend rows and from
+  // the rotation rows (0 when not used), and the p-value of their sum on
+  // the effect's dof, which must be below the candidate's level.
   int magnitude_dof = 0;
-  double trend_p_value = NAN;
-  double rotation_p_value = NAN;
+  double trend_delta_chi2 = 0.0;
+  double rotation_delta_chi2 = 0.0;
+  double confirmation_p_value = NAN;
   // "" when the magnitudes suffice; else what confirmed it, e.g.
-  // "rotations between poses (p = 3e-09)".
+  // "within-pose trends + rotations between poses (delta chi2 3.1 + 41.2,
+  // p = 2e-08)".
   std::string confirmed_by;
 };
 
