@@ -1,6 +1,10 @@
 #include "io/formats/message_log.h"
 
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -23,6 +27,24 @@ std::string Listing(const std::vector<RecordingTopic>& topics, bool imu_only) {
     out += (out.empty() ? "" : ", ") + OneLine(t.name) + " (" + OneLine(t.type) + ")";
   }
   return out.empty() ? std::string("none") : out;
+}
+
+// The least a sensor_msgs/Imu takes serialised, in ROS 1 or CDR: its
+// orientation, three covariances and two vectors are 37 doubles.
+constexpr uint64_t kImuMessageBytes = 37 * 8;
+
+// The samples to reserve for a topic that the file says holds `messages`.
+// That count is the file's own word (an MCAP statistics record, a bag's
+// index), and a damaged one asked for 25.7 GB (fuzz/regressions/mcap), so the
+// reservation is also bounded by the messages the file's size could hold
+// uncompressed. A compressed file may hold more; the vectors then grow as
+// its messages are read.
+size_t SamplesToReserve(int64_t messages, const std::string& path) {
+  std::error_code ec;
+  const uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (messages <= 0 || ec) return 0;
+  return static_cast<size_t>(
+      std::min<uint64_t>(static_cast<uint64_t>(messages), bytes / kImuMessageBytes));
 }
 
 }  // namespace
@@ -92,11 +114,10 @@ bool ReadMessageLog(MessageRecording* recording, const std::string& path,
                                OneLine(topic.md5sum) + ")");
   }
   ImuLog read;
-  if (topic.messages > 0) {
-    read.t.reserve(static_cast<size_t>(topic.messages));
-    read.accel.reserve(static_cast<size_t>(topic.messages));
-    read.gyro.reserve(static_cast<size_t>(topic.messages));
-  }
+  const size_t reserved = SamplesToReserve(topic.messages, path);
+  read.t.reserve(reserved);
+  read.accel.reserve(reserved);
+  read.gyro.reserve(reserved);
   std::vector<bool> wanted(recording->topics().size(), false);
   wanted[index] = true;
   const std::string where = path + ": topic '" + OneLine(topic.name) + "' message ";
