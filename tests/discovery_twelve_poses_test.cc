@@ -59,11 +59,17 @@ class DiscoveryTwelvePoses : public ::testing::TestWithParam<Hidden> {};
 
 TEST_P(DiscoveryTwelvePoses, NamesTheHiddenAccelerometerEffectFirst) {
   const Hidden hidden = GetParam();
-  int first = 0;
+  int first = 0, wrong_preferred = 0;
   for (int seed = 1; seed <= kSeeds; ++seed) {
     const DiscoveryResult r = DiscoverTwelve(hidden, seed);
     const bool ok = !r.steps.empty() && r.steps.front().effect == hidden.effect;
     first += ok ? 1 : 0;
+    // Another effect named first because the trends and rotations preferred
+    // it (not confirmed by them on their own).
+    wrong_preferred +=
+        !ok && !r.steps.empty() && r.steps.front().confirmed_by.find("prefer") != std::string::npos
+            ? 1
+            : 0;
     std::printf("seed %d: %s%s%s\n", seed, r.verdict.c_str(), r.steps.empty() ? "" : " | from the ",
                 r.steps.empty() ? ""
                                 : (r.steps.front().information +
@@ -78,29 +84,28 @@ TEST_P(DiscoveryTwelvePoses, NamesTheHiddenAccelerometerEffectFirst) {
     }
   }
   EXPECT_GE(first, hidden.required) << first << " of " << kSeeds;
+  // The preference test's margin bounds a wrong preference over the true
+  // effect at the sensor's level, 0.01 / 4 per rival (three rivals).
+  EXPECT_LE(wrong_preferred, testing_util::AllowedSuccesses(kSeeds, 3 * 0.01 / 4))
+      << wrong_preferred << " of " << kSeeds;
 }
 
-// Named first in at least 18 of 20 seeds (measured on seeds 1-20: k2 20,
-// bias tempco 18, drift 19, non-orthogonality 20), except the scale
-// tempco: with the magnitudes at 0 residual dof it must be confirmed by
-// the trend and rotation rows, and a typical 0.01 %/K gives those too
-// little signal. Its along-gravity slope c_i g dT/dt, against the slopes'
-// noise, has a noncentrality of 10.9 on average over these seeds (bias
-// tempco 32.8, drift 38.3; the rotation rows add little for it), so the
-// confirmation test (chi2 on 3 dof at 0.01 / 4) passes with probability
-// about 0.37: 7.4 of 20 expected, 8 measured. Its bound is the binomial
-// one for a rate of 0.25.
-INSTANTIATE_TEST_SUITE_P(Effects, DiscoveryTwelvePoses,
-                         ::testing::Values(Hidden{Effect::kAccelQuadratic, kQuadratic, 18},
-                                           Hidden{Effect::kAccelTemperatureBias, kTemperatureBias,
-                                                  18},
-                                           Hidden{Effect::kAccelTemperatureScale, kTemperatureScale,
-                                                  testing_util::RequiredSuccesses(kSeeds, 0.25)},
-                                           Hidden{Effect::kAccelBiasDrift, kBiasDrift, 18},
-                                           Hidden{Effect::kAccelMisalignment, kMisalignment, 18}),
-                         [](const ::testing::TestParamInfo<Hidden>& info) {
-                           return std::string(ToString(info.param.effect));
-                         });
+// Each named first in at least 18 of 20 seeds. The scale tempco leans on
+// the preference test: with the magnitudes at 0 residual dof its trend and
+// rotation rows alone confirm it in only about 8 of 20 seeds (noncentrality
+// 10.9 on average over these seeds, against 32.8 for the bias tempco and
+// 38.3 for the drift), but they single it out among the candidates its
+// size in most of the rest (discovery.h, preference_margin).
+INSTANTIATE_TEST_SUITE_P(
+    Effects, DiscoveryTwelvePoses,
+    ::testing::Values(Hidden{Effect::kAccelQuadratic, kQuadratic, 18},
+                      Hidden{Effect::kAccelTemperatureBias, kTemperatureBias, 18},
+                      Hidden{Effect::kAccelTemperatureScale, kTemperatureScale, 18},
+                      Hidden{Effect::kAccelBiasDrift, kBiasDrift, 18},
+                      Hidden{Effect::kAccelMisalignment, kMisalignment, 18}),
+    [](const ::testing::TestParamInfo<Hidden>& info) {
+      return std::string(ToString(info.param.effect));
+    });
 
 TEST(DiscoveryTwelvePosesQuiet, NamesNothingWithoutHiddenEffect) {
   int quiet = 0;

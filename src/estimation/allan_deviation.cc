@@ -18,36 +18,6 @@ namespace {
 
 constexpr int kTerms = 4;  // quantisation, white noise, bias instability, random walk
 
-// The standard normal quantile by bisection of erfc (for confidence levels:
-// a few calls per curve point).
-double NormalQuantile(double p) {
-  double lo = -40.0, hi = 40.0;
-  for (int i = 0; i < 100; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
-// The chi-square quantile: P(X <= x) = p for X with `dof` degrees of
-// freedom. Up to 100 dof, bisection on the exact tail with dof rounded (the
-// edf is an approximation to begin with); above, Wilson and Hilferty's cube
-// root approximation, accurate to well under 1 % there.
-double ChiSquareQuantile(double p, double dof) {
-  if (dof > 100.0) {
-    const double a = 2.0 / (9.0 * dof);
-    const double c = 1.0 - a + NormalQuantile(p) * std::sqrt(a);
-    return dof * c * c * c;
-  }
-  const int k = std::max(1, static_cast<int>(std::lround(dof)));
-  double lo = 0.0, hi = k + 40.0 * std::sqrt(2.0 * k) + 60.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (1.0 - ChiSquareUpperTail(mid, k) < p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi) * dof / k;
-}
-
 // g_j(tau): the Allan variance per unit coefficient of each term.
 double Shape(int term, double tau) {
   switch (term) {

@@ -15,6 +15,13 @@ double ChiSquareUpperTail(double x, int dof);
 // whole) at x >= 0.
 double ChiSquareDensity(double x, double dof);
 
+// The standard normal quantile: P(Z <= z) = p (bisection of erfc).
+double NormalQuantile(double p);
+
+// The chi-square quantile: P(X <= x) = p for X with `dof` degrees of
+// freedom (need not be whole: an equivalent dof).
+double ChiSquareQuantile(double p, double dof);
+
 // P(X > f) for X ~ F(d1, d2) (regularised incomplete beta function,
 // continued fraction). The degrees of freedom need not be whole (a prior's
 // weight is one).

@@ -179,6 +179,39 @@ double SensorAlpha(const std::vector<CandidateScore>& scores, bool accel,
   return options.significance / std::max(1, tried);
 }
 
+// Whether the rows beside the magnitudes single candidate i out. An
+// accelerometer effect that leaves the magnitudes fewer than min_dof
+// residual dof fits them about as well as any other candidate of its size:
+// what tells the candidates apart is how each predicts the trends within
+// the poses (a temperature bias's slope along gravity flips sign between a
+// pose and its opposite, a scale factor's does not; a drift follows time,
+// not temperature; a nonlinearity has none) and the turns between poses.
+// Fills c's margin over its closest rival of the same size, the rival's
+// delta BIC minus its own (the chi2 gap of the two fits over the
+// dispersion), and the margin needed at level alpha: z^2 with z the normal
+// quantile 1 - alpha. The reason: when the rival B is the true effect, the
+// gap chi2_B - chi2_c is lambda + 2 mu' e to first order, lambda the
+// rival's misfit of the truth, so it exceeds m with probability
+// Phi(-(m + lambda) / (2 sqrt(lambda))), largest at lambda = m: Phi(-sqrt m).
+// (The second-order term, a difference of two fitted chi2 on the same
+// dof, has mean zero and is left out; the twelve-pose tests measure what
+// it leaves.)
+void Prefer(const std::vector<CandidateScore>& scores, int i, double alpha, CandidateScore* c) {
+  c->preference_margin = NAN;
+  c->preference_threshold = std::pow(NormalQuantile(1.0 - alpha), 2);
+  for (size_t j = 0; j < scores.size(); ++j) {
+    const CandidateScore& rival = scores[j];
+    if (static_cast<int>(j) == i || !rival.tried || !IsAccel(rival.effect) || rival.dof != c->dof) {
+      continue;
+    }
+    const double margin = rival.delta_bic - c->delta_bic;
+    if (std::isnan(c->preference_margin) || margin < c->preference_margin) {
+      c->preference_margin = margin;
+      c->runner_up = rival.effect;
+    }
+  }
+}
+
 // When no candidate is significant on its own but some pass the likelihood
 // ratio and BIC and fail only the cross-validation, two effects may be
 // masking each other: each alone leaves the other's large residual, which
@@ -347,11 +380,27 @@ int ChooseCandidate(const DiscoveryContext& ctx, const ModelAssessment& current,
                                  FormatNumber("%.3g", c.trend_delta_chi2) + " + " +
                                  FormatNumber("%.3g", c.rotation_delta_chi2) +
                                  ", p = " + FormatNumber("%.2g", c.confirmation_p_value) + ")";
+      Prefer(scores, static_cast<int>(i), alpha, &c);
+      const std::string preferred =
+          "within-pose trends + rotations between poses, which prefer it to every other "
+          "candidate its size (to " +
+          std::string(ToString(c.runner_up)) + " by delta BIC " +
+          FormatNumber("%.3g", c.preference_margin) + ", needs " +
+          FormatNumber("%.3g", c.preference_threshold) + ")";
       if (c.confirmation_p_value < alpha) {
         c.confirmed_by = beside;
+      } else if (c.preference_margin >= c.preference_threshold) {
+        c.confirmed_by = preferred;
       } else {
         why << "the magnitudes keep " << c.magnitude_dof << " residual dof (needs "
-            << options.min_dof << ") and the " << beside << " do not confirm it; ";
+            << options.min_dof << "), the " << beside << " do not confirm it"
+            << (std::isfinite(c.preference_margin)
+                    ? " and do not single it out (delta BIC " +
+                          FormatNumber("%.3g", c.preference_margin) + " to " +
+                          ToString(c.runner_up) + ", needs " +
+                          FormatNumber("%.3g", c.preference_threshold) + ")"
+                    : "")
+            << "; ";
       }
     }
     // Leave-one-position-out cross-validation (a dozen refits) only for a

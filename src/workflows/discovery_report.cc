@@ -137,6 +137,9 @@ json CandidatesJson(const std::vector<CandidateScore>& scores) {
         j["trend_delta_chi2"] = Number(c.trend_delta_chi2);
         j["rotation_delta_chi2"] = Number(c.rotation_delta_chi2);
         j["confirmation_p_value"] = Number(c.confirmation_p_value);
+        j["preference_margin"] = Number(c.preference_margin);
+        j["runner_up"] = std::isfinite(c.preference_margin) ? json(ToString(c.runner_up)) : json();
+        j["preference_threshold"] = Number(c.preference_threshold);
         j["confirmed_by"] = c.confirmed_by;
       }
     }

@@ -47,8 +47,10 @@
 // likelihood as the magnitudes (effect_fit.h), so the chi2 tests, BIC and
 // cross-validation see them all; an accelerometer effect that leaves the
 // magnitudes fewer than min_dof residual degrees of freedom is named only
-// when the trends' or rotations' own rows confirm it
-// (CandidateScore::confirmed_by). Without a gyroscope, with poses shorter
+// when the trends' or rotations' own rows confirm it, or when they single
+// it out: every other candidate of its size then fits the magnitudes as
+// well, and the whole fit must prefer it over each of them by a margin
+// (CandidateScore::confirmed_by, preference_margin). Without a gyroscope, with poses shorter
 // than min_trend_seconds, or with rotations exceeding their noise, the
 // accelerometer falls back to what is left (down to the magnitudes alone).
 //
@@ -213,11 +215,22 @@ struct CandidateScore {
   // them exactly), and it is named only when the rows beside them confirm
   // it: the part of delta chi2 from the within-pose trend rows and from
   // the rotation rows (0 when not used), and the p-value of their sum on
-  // the effect's dof, which must be below the candidate's level.
+  // the effect's dof: below the candidate's level, they confirm it on
+  // their own. Otherwise they may still single it out among the
+  // candidates that fit the magnitudes equally (preference_margin).
   int magnitude_dof = 0;
   double trend_delta_chi2 = 0.0;
   double rotation_delta_chi2 = 0.0;
   double confirmation_p_value = NAN;
+  // How much better the whole fit (magnitudes, trends and rotations) is
+  // with this candidate than with its closest rival of the same size
+  // (runner_up): the rival's delta BIC minus this one's, the chi2 gap
+  // of the two fits over the dispersion. NaN when no rival of its size
+  // was tried. Checked against preference_threshold, the squared normal
+  // quantile at the candidate's level.
+  double preference_margin = NAN;
+  Effect runner_up = Effect::kAccelQuadratic;
+  double preference_threshold = NAN;
   // "" when the magnitudes suffice; else what confirmed it, e.g.
   // "within-pose trends + rotations between poses (delta chi2 3.1 + 41.2,
   // p = 2e-08)".
