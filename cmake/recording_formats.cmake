@@ -28,8 +28,10 @@ if(GRAVCAL_WITH_ROSBAG)
   find_path(GRAVCAL_ROSBAG_INCLUDE rosbag/bag.h)
   set(_gravcal_rosbag_found TRUE)
   set(_gravcal_rosbag_libraries)
+  # roslz4 and bz2: src/io/formats/ros1_bag_structure.cc uncompresses each
+  # chunk as rosbag will, to check it before rosbag reads it.
   foreach(lib rosbag_storage roscpp_serialization rostime cpp_common console_bridge
-              class_loader ament_index_cpp)
+              class_loader ament_index_cpp roslz4 bz2)
     find_library(GRAVCAL_ROS_${lib}_LIBRARY ${lib})
     if(NOT GRAVCAL_ROS_${lib}_LIBRARY)
       set(_gravcal_rosbag_found FALSE)
@@ -45,9 +47,11 @@ if(GRAVCAL_WITH_ROSBAG)
   endforeach()
   if(GRAVCAL_ROSBAG_INCLUDE AND _gravcal_rosbag_found)
     message(STATUS "ROS 1 bags: librosbag_storage")
-    set_property(SOURCE ${CMAKE_CURRENT_SOURCE_DIR}/src/io/formats/ros1_bag.cc
+    set(_gravcal_rosbag_sources ${CMAKE_CURRENT_SOURCE_DIR}/src/io/formats/ros1_bag.cc
+                                ${CMAKE_CURRENT_SOURCE_DIR}/src/io/formats/ros1_bag_structure.cc)
+    set_property(SOURCE ${_gravcal_rosbag_sources}
       APPEND PROPERTY COMPILE_OPTIONS ${_gravcal_rosbag_flags})
-    set_property(SOURCE ${CMAKE_CURRENT_SOURCE_DIR}/src/io/formats/ros1_bag.cc
+    set_property(SOURCE ${_gravcal_rosbag_sources}
       APPEND PROPERTY COMPILE_DEFINITIONS GRAVCAL_HAVE_ROSBAG)
     target_link_libraries(gravcal PRIVATE ${_gravcal_rosbag_libraries})
   else()

@@ -11,6 +11,7 @@
 // <build>/npm_formats). A test whose writer is absent skips and says why.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -277,6 +278,31 @@ TEST_F(Formats, BrokenDb3IsRefused) {
   ExpectRefused(s, "header_only.db3", bytes.substr(0, 100), "");
 }
 
+// The data offset of the first top-level record of a ROS 1 bag whose
+// header holds `field` ("op=\x04" for an index), or npos.
+size_t Ros1RecordData(const std::string& bag, const std::string& field) {
+  auto u32 = [&bag](size_t at) {
+    uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= uint32_t{static_cast<uint8_t>(bag[at + i])} << (8 * i);
+    return v;
+  };
+  size_t pos = 13;
+  while (pos + 8 <= bag.size()) {
+    const uint32_t header_len = u32(pos);
+    const size_t data = pos + 8 + header_len;
+    if (data > bag.size()) break;
+    if (bag.substr(pos + 4, header_len).find(field) != std::string::npos) return data;
+    pos = data + u32(pos + 4 + header_len);
+  }
+  return std::string::npos;
+}
+
+// Overwrites four bytes at `at` with the little-endian v.
+std::string WithU32(std::string bytes, size_t at, uint32_t v) {
+  for (int i = 0; i < 4; ++i) bytes[at + i] = static_cast<char>((v >> (8 * i)) & 0xFF);
+  return bytes;
+}
+
 TEST_F(Formats, BrokenRos1BagIsRefused) {
   if (!Have("ros1_bz2.bag")) GTEST_SKIP() << Slurp(*scratch_ / "ros1_absent.txt");
   const ScratchDir& s = *scratch_;
@@ -286,6 +312,36 @@ TEST_F(Formats, BrokenRos1BagIsRefused) {
     ExpectRefused(s, std::string("corrupted_") + name, Corrupted(bytes, 13, 32), "ROS 1 bag");
   }
   ExpectRefused(s, "old.bag", "#ROSBAG V1.2\nxxxx", "a ROS 1 bag of version '1.2'");
+  // Offsets librosbag_storage follows without a bounds check, each damaged
+  // in an otherwise valid bag (fuzz/fuzz_ros1_bag found the first: a read
+  // outside the chunk's buffer): refused before rosbag reads them.
+  for (const char* name : {"ros1_none.bag", "ros1_lz4.bag"}) {
+    const std::string bytes = Slurp(s / name);
+    const size_t index = Ros1RecordData(bytes, std::string("op=\x04", 4));
+    ASSERT_NE(index, std::string::npos) << name;
+    // The first index entry's offset (after its 8-byte time) past the chunk.
+    ExpectRefused(s, std::string("index_offset_") + name, WithU32(bytes, index + 8, 0xFFFFFFF0u),
+                  "names no message of its chunk");
+    // The same entry one byte into its message record.
+    const uint32_t first =
+        static_cast<uint8_t>(bytes[index + 8]) | static_cast<uint8_t>(bytes[index + 9]) << 8;
+    ExpectRefused(s, std::string("index_inside_") + name, WithU32(bytes, index + 8, first + 1),
+                  "names no message of its chunk");
+  }
+  {
+    const std::string bytes = Slurp(s / "ros1_lz4.bag");
+    const size_t chunk_pos = bytes.find("chunk_pos=");
+    ASSERT_NE(chunk_pos, std::string::npos);
+    ExpectRefused(s, "chunk_pos_ros1_lz4.bag", WithU32(bytes, chunk_pos + 10, 14), "not a chunk");
+    // The chunk's declared uncompressed size one byte short.
+    const size_t size = bytes.find("size=");
+    ASSERT_NE(size, std::string::npos);
+    const uint32_t declared = static_cast<uint8_t>(bytes[size + 5]) |
+                              static_cast<uint8_t>(bytes[size + 6]) << 8 |
+                              static_cast<uint8_t>(bytes[size + 7]) << 16;
+    ExpectRefused(s, "chunk_size_ros1_lz4.bag", WithU32(bytes, size + 5, declared - 1),
+                  "does not uncompress to its declared size");
+  }
 }
 
 TEST_F(Formats, BrokenEurocIsRefused) {

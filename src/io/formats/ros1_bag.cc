@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "io/formats/byte_cursor.h"
 #include "io/formats/message_recording.h"
+#include "io/formats/ros1_bag_structure.h"
 
 #ifdef GRAVCAL_HAVE_ROSBAG
 #include <ros/serialization.h>
@@ -18,9 +18,7 @@
 #include <rosbag/view.h>
 
 #include <cstdint>
-#include <cstring>
 #include <exception>
-#include <fstream>
 #include <map>
 #endif
 
@@ -30,61 +28,6 @@ namespace {
 
 #ifdef GRAVCAL_HAVE_ROSBAG
 
-// The bag's top-level records (after the "#ROSBAG V2.0\n" line), each
-//   header_len (uint32 LE), header, data_len (uint32 LE), data,
-// must lie inside the file. librosbag_storage allocates what a length field
-// says before reading it, so a damaged length made it ask for gigabytes
-// (found by fuzz/fuzz_rosbag2_db3 on a bag-headed input): checked here first.
-bool RecordsFitInFile(const std::string& path, std::string* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    *what = "cannot open";
-    return false;
-  }
-  in.seekg(0, std::ios::end);
-  const uint64_t size = static_cast<uint64_t>(in.tellg());
-  const uint64_t magic = 13;  // "#ROSBAG V2.0\n"
-  uint64_t pos = magic;
-  auto read_u32 = [&in](uint64_t at, uint32_t* v) {
-    unsigned char b[4];
-    in.seekg(static_cast<std::streamoff>(at));
-    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
-    *v = static_cast<uint32_t>(b[0]) | static_cast<uint32_t>(b[1]) << 8 |
-         static_cast<uint32_t>(b[2]) << 16 | static_cast<uint32_t>(b[3]) << 24;
-    return true;
-  };
-  while (pos < size) {
-    uint32_t header_len = 0;
-    uint32_t data_len = 0;
-    if (pos + 4 > size || !read_u32(pos, &header_len) || pos + 4 + header_len + 4 > size ||
-        !read_u32(pos + 4 + header_len, &data_len) ||
-        pos + 8 + uint64_t{header_len} + data_len > size) {
-      *what = "a record at byte " + std::to_string(pos) + " runs past the end of the file";
-      return false;
-    }
-    // The header's fields, each field_len (uint32 LE) then "name=value",
-    // must fill it exactly: ros::Header::parse trusts them (a damaged one
-    // overflowed its buffer, fuzz/fuzz_ros1_bag).
-    std::string header(header_len, '\0');
-    in.seekg(static_cast<std::streamoff>(pos + 4));
-    if (!in.read(header.data(), header_len)) {
-      *what = "cannot read the record at byte " + std::to_string(pos);
-      return false;
-    }
-    ByteCursor fields(reinterpret_cast<const uint8_t*>(header.data()), header.size());
-    while (fields.ok() && fields.remaining() > 0) {
-      const uint32_t field_len = fields.U32();
-      const uint8_t* field = fields.Bytes(field_len);
-      if (field == nullptr || std::memchr(field, '=', field_len) == nullptr) {
-        *what = "the record at byte " + std::to_string(pos) + " has a damaged header field";
-        return false;
-      }
-    }
-    pos += 8 + uint64_t{header_len} + data_len;
-  }
-  return true;
-}
-
 class Ros1Bag : public MessageRecording {
  public:
   const char* FormatName() const override { return "ROS 1 bag"; }
@@ -93,7 +36,8 @@ class Ros1Bag : public MessageRecording {
   bool Open(const std::string& path, std::string* error) override {
     path_ = path;
     std::string what;
-    if (!RecordsFitInFile(path, &what)) return Fail(error, "not a readable ROS 1 bag: " + what);
+    if (!CheckRos1BagStructure(path, &what))
+      return Fail(error, "not a readable ROS 1 bag: " + what);
     try {
       bag_.open(path, rosbag::bagmode::Read);
       rosbag::View view(bag_);
