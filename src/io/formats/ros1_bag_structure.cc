@@ -163,7 +163,7 @@ bool CheckChunkRecords(const std::vector<uint8_t>& chunk, std::set<uint32_t>* me
                        std::string* what) {
   messages->clear();
   auto read = [&chunk](uint64_t at, uint64_t n, uint8_t* out) {
-    std::memcpy(out, chunk.data() + at, n);
+    if (n > 0) std::memcpy(out, chunk.data() + at, n);
     return true;
   };
   uint64_t pos = 0;
@@ -197,6 +197,7 @@ bool CheckRos1BagStructure(const std::string& path, std::string* what) {
   in.seekg(0, std::ios::end);
   const uint64_t size = static_cast<uint64_t>(in.tellg());
   auto read = [&in](uint64_t at, uint64_t n, uint8_t* out) {
+    if (n == 0) return true;
     in.clear();
     in.seekg(static_cast<std::streamoff>(at));
     return static_cast<bool>(
