@@ -25,25 +25,30 @@ if [ "$which" = all ]; then
 else
   targets=$which
 fi
-status=0
-for t in $targets; do
-  exe="$build/fuzz/fuzz_$t"
-  work="$build/fuzz/corpus_run/$t"
-  crashes="$build/fuzz/crashes/$t"
+# With FUZZ_JOBS=<n>, n targets run at once (CI: 2, one per core); each
+# target's failure leaves a mark in <build dir>/fuzz/failed/.
+failed="$build/fuzz/failed"
+rm -rf "$failed"
+mkdir -p "$failed"
+run_target() {
+  local t=$1
+  local exe="$build/fuzz/fuzz_$t"
+  local work="$build/fuzz/corpus_run/$t"
+  local crashes="$build/fuzz/crashes/$t"
   mkdir -p "$work" "$crashes"
   if [ -d "$here/regressions/$t" ] && [ -n "$(ls -A "$here/regressions/$t")" ]; then
     "$exe" -runs=0 "$here/regressions/$t"/* >/dev/null 2>&1 || {
       echo "fuzz: $t fails on a regression input"
-      status=1
+      touch "$failed/$t"
     }
   fi
   case " ${FUZZ_REGRESSIONS_ONLY:-} " in *" $t "*)
     echo "fuzz: $t ran its regression inputs only"
-    continue
+    return
     ;;
   esac
-  start=$SECONDS
-  budget=(-max_total_time="$seconds")
+  local start=$SECONDS
+  local budget=(-max_total_time="$seconds")
   if [ -n "${FUZZ_SEED:-}" ]; then budget+=(-seed="$FUZZ_SEED"); fi
   if [ -n "${FUZZ_RUNS:-}" ]; then budget=(-runs="$FUZZ_RUNS" -seed=1); fi
   if ! "$exe" "${budget[@]}" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
@@ -51,9 +56,15 @@ for t in $targets; do
     >"$build/fuzz/$t.log" 2>&1; then
     echo "fuzz: $t FOUND A PROBLEM (see $build/fuzz/$t.log, input in $crashes)"
     tail -30 "$build/fuzz/$t.log"
-    status=1
+    touch "$failed/$t"
   fi
+  local runs
   runs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$build/fuzz/$t.log" | awk '{print $2}')
   echo "fuzz: $t ran $((SECONDS - start)) s, ${runs:-?} inputs"
+}
+for t in $targets; do
+  while [ "$(jobs -rp | wc -l)" -ge "${FUZZ_JOBS:-1}" ]; do wait -n || true; done
+  run_target "$t" &
 done
-exit $status
+wait
+[ -z "$(ls -A "$failed")" ]
