@@ -165,8 +165,10 @@ TEST(ReportWarnings, EveryWarningOfEveryMethodIsExplained) {
   for (const std::string& c : seen) list += c + " ";
   ::testing::Test::RecordProperty("codes_seen", list);
   std::printf("%zu warnings, codes seen: %s\n", warnings, list.c_str());
-  // The sessions exercise more than one kind of warning.
-  EXPECT_GE(seen.size(), 5u) << list;
+  // The sessions exercise more than one kind of warning: four kinds from
+  // the simulated sessions alone, a fifth from the real recordings, which
+  // are skipped when ../shared/data/real is absent (a clean clone elsewhere).
+  EXPECT_GE(seen.size(), testing_util::RealDataDir().empty() ? 4u : 5u) << list;
 }
 
 }  // namespace

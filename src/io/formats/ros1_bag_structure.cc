@@ -92,6 +92,10 @@ bool ReadRecord(uint64_t pos, uint64_t size, const Read& read, Record* r, std::s
     *what = where + " runs past the end";
     return false;
   }
+  if (header_len > kMaxRos1ChunkBytes) {
+    *what = where + " has a header of " + std::to_string(header_len) + " bytes";
+    return false;
+  }
   std::vector<uint8_t> header(header_len);
   if (!read(pos + 4, header_len, header.data()) || !read(pos + 4 + header_len, 4, len)) {
     *what = "cannot read " + where;
@@ -217,9 +221,10 @@ bool CheckRos1BagStructure(const std::string& path, std::string* what) {
     if (!ReadRecord(pos, size, read, &r, what)) return false;
     const std::string where = "the record at byte " + std::to_string(pos);
     std::vector<uint8_t> data;
-    // Data read whole only where it is checked (chunks at most
-    // kMaxRos1ChunkBytes, indexes and connections far smaller).
+    // Data read whole only where it is checked, each at most
+    // kMaxRos1ChunkBytes (chunks; indexes and connections are far smaller).
     auto load = [&]() {
+      if (r.data_len > kMaxRos1ChunkBytes) return false;
       data.resize(r.data_len);
       return read(r.data_start, r.data_len, data.data());
     };

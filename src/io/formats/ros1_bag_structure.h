@@ -28,8 +28,9 @@
 namespace gravcal {
 namespace internal {
 
-// A chunk larger than this uncompressed is refused (rosbag writes chunks of
-// 768 kB by default).
+// A chunk larger than this uncompressed, or a record header or checked
+// record data larger than this, is refused (rosbag writes chunks of 768 kB
+// by default).
 constexpr uint32_t kMaxRos1ChunkBytes = 256u << 20;
 
 // True when the bag at `path` is well formed as above; else false and
