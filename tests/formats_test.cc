@@ -278,21 +278,23 @@ TEST_F(Formats, BrokenDb3IsRefused) {
   ExpectRefused(s, "header_only.db3", bytes.substr(0, 100), "");
 }
 
+// The little-endian uint32 at `at`.
+uint32_t U32At(const std::string& bytes, size_t at) {
+  uint32_t v = 0;
+  for (int i = 0; i < 4; ++i) v |= uint32_t{static_cast<uint8_t>(bytes[at + i])} << (8 * i);
+  return v;
+}
+
 // The data offset of the first top-level record of a ROS 1 bag whose
 // header holds `field` ("op=\x04" for an index), or npos.
 size_t Ros1RecordData(const std::string& bag, const std::string& field) {
-  auto u32 = [&bag](size_t at) {
-    uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= uint32_t{static_cast<uint8_t>(bag[at + i])} << (8 * i);
-    return v;
-  };
   size_t pos = 13;
   while (pos + 8 <= bag.size()) {
-    const uint32_t header_len = u32(pos);
+    const uint32_t header_len = U32At(bag, pos);
     const size_t data = pos + 8 + header_len;
     if (data > bag.size()) break;
     if (bag.substr(pos + 4, header_len).find(field) != std::string::npos) return data;
-    pos = data + u32(pos + 4 + header_len);
+    pos = data + U32At(bag, pos + 4 + header_len);
   }
   return std::string::npos;
 }
@@ -323,8 +325,7 @@ TEST_F(Formats, BrokenRos1BagIsRefused) {
     ExpectRefused(s, std::string("index_offset_") + name, WithU32(bytes, index + 8, 0xFFFFFFF0u),
                   "names no message of its chunk");
     // The same entry one byte into its message record.
-    const uint32_t first =
-        static_cast<uint8_t>(bytes[index + 8]) | static_cast<uint8_t>(bytes[index + 9]) << 8;
+    const uint32_t first = U32At(bytes, index + 8);
     ExpectRefused(s, std::string("index_inside_") + name, WithU32(bytes, index + 8, first + 1),
                   "names no message of its chunk");
   }
@@ -336,9 +337,7 @@ TEST_F(Formats, BrokenRos1BagIsRefused) {
     // The chunk's declared uncompressed size one byte short.
     const size_t size = bytes.find("size=");
     ASSERT_NE(size, std::string::npos);
-    const uint32_t declared = static_cast<uint8_t>(bytes[size + 5]) |
-                              static_cast<uint8_t>(bytes[size + 6]) << 8 |
-                              static_cast<uint8_t>(bytes[size + 7]) << 16;
+    const uint32_t declared = U32At(bytes, size + 5);
     ExpectRefused(s, "chunk_size_ros1_lz4.bag", WithU32(bytes, size + 5, declared - 1),
                   "does not uncompress to its declared size");
   }

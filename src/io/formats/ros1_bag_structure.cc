@@ -13,9 +13,7 @@
 #include <vector>
 
 #include "io/formats/byte_cursor.h"
-#endif
 
-#ifdef GRAVCAL_HAVE_ROSBAG
 namespace gravcal {
 namespace internal {
 namespace {
@@ -68,7 +66,6 @@ bool UnsignedField(const Fields& fields, const char* name, int bytes, uint64_t* 
 
 // The records of one level (the file, or one chunk's uncompressed bytes).
 struct Record {
-  uint64_t start = 0;
   Fields header;
   uint8_t op = 0;
   uint64_t data_start = 0;
@@ -102,7 +99,6 @@ bool ReadRecord(uint64_t pos, uint64_t size, const Read& read, Record* r, std::s
     return false;
   }
   ByteCursor data_len_bytes(len, 4);
-  r->start = pos;
   r->data_len = data_len_bytes.U32();
   r->data_start = pos + 8 + header_len;
   if (r->data_start + r->data_len > size) {
