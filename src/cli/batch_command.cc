@@ -35,21 +35,18 @@
 #include "gravcal/workflows/batch_scheduler_shard.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/report.h"
+#include "util/error.h"
 
 namespace gravcal {
 namespace cli {
 namespace {
 
 using Json = nlohmann::json;
+using internal::SetError;
 
 const char kStateFolder[] = "batch_state";
 // Failed units listed by name on stderr; summary.json lists all.
 constexpr size_t kFailuresShown = 10;
-
-bool SetError(std::string* error, const std::string& message) {
-  *error = message;
-  return false;
-}
 
 // mkdir -p.
 bool MakeFolders(const std::string& path, std::string* error) {

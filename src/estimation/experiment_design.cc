@@ -9,12 +9,13 @@
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/position.h"
 #include "gravcal/estimation/refinement.h"
+#include "util/numbers.h"
 
 namespace gravcal {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using internal::kInf;
 
 // Unwhitened scale-free rows of the candidates (sigma 1), via the
 // refinement's own Jacobian at the nominal sensor.

@@ -15,13 +15,14 @@
 #include "gravcal/estimation/experiment_design.h"
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/residuals/gyro_rotation_residual.h"
+#include "util/numbers.h"
 #include "util/units.h"
 
 namespace gravcal {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using internal::kInf;
 // Ambient gyroscope vector: b_g (3), M_g (9, row-major).
 constexpr int kGyroAmbient = 12;
 // Ambient accelerometer vector of the joint residual: b_a (3), U (6).

@@ -4,16 +4,12 @@
 #define GRAVCAL_IO_EXPORT_FORMAT_H_
 
 #include <Eigen/Core>
-#include <charconv>
 #include <string>
+
+#include "util/numbers.h"
 
 namespace gravcal {
 namespace internal {
-
-inline std::string ExactNumber(double v) {
-  char text[32];
-  return std::string(text, std::to_chars(text, text + sizeof(text), v).ptr);
-}
 
 // "[a, b, c]" of one row.
 template <typename Derived>

@@ -15,14 +15,12 @@
 #include <utility>
 
 #include "io/file_text.h"
+#include "util/error.h"
 
 namespace gravcal {
 namespace {
 
-bool SetError(std::string* error, std::string message) {
-  if (error != nullptr) *error = std::move(message);
-  return false;
-}
+using internal::SetError;
 
 std::string ErrnoMessage(int errnum) { return std::generic_category().message(errnum); }
 

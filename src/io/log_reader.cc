@@ -21,6 +21,8 @@
 #include "io/formats/file_format.h"
 #include "io/formats/message_log.h"
 #include "util/cancellation.h"
+#include "util/error.h"
+#include "util/numbers.h"
 
 namespace gravcal {
 namespace {
@@ -47,17 +49,9 @@ std::string_view TrimBlanks(std::string_view s) {
   return s;
 }
 
-bool SetError(std::string* error, std::string message) {
-  if (error != nullptr) *error = std::move(message);
-  return false;
-}
+using internal::SetError;
 
-// Shortest text that reads back to the same double.
-std::string FormatDouble(double x) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
-  return std::string(buffer, result.ptr);
-}
+using internal::ExactNumber;
 
 // Bytes of the file as they appear in a message: at most `max_chars` of
 // them, control bytes and bytes that are not UTF-8 written as \xNN, so a
@@ -437,8 +431,8 @@ class Parser {
         const double t = values[kT] * options_.time_scale;
         const double r = reference_t[index];
         if (!(std::fabs(t - r) <= kTimeTolerance * std::max(std::fabs(t), std::fabs(r)))) {
-          return SetError(error, Where(name_, line) + "time " + FormatDouble(t) +
-                                     " differs from time " + FormatDouble(r) + " of sample " +
+          return SetError(error, Where(name_, line) + "time " + ExactNumber(t) +
+                                     " differs from time " + ExactNumber(r) + " of sample " +
                                      std::to_string(index) + " in " + reference_name_);
         }
       }
@@ -449,15 +443,15 @@ class Parser {
     if (has_[kT]) {
       t = values[kT] * options_.time_scale;
       if (!std::isfinite(t)) {
-        return SetError(error, Where(name_, line) + "time " + FormatDouble(values[kT]) +
+        return SetError(error, Where(name_, line) + "time " + ExactNumber(values[kT]) +
                                    " times time_scale is not finite");
       }
     } else {
       t = static_cast<double>(index) / options_.sample_rate;
     }
     if (index > 0 && !(t > previous_t_)) {
-      return SetError(error, Where(name_, line) + "time " + FormatDouble(t) +
-                                 " does not increase (previous " + FormatDouble(previous_t_) + ")");
+      return SetError(error, Where(name_, line) + "time " + ExactNumber(t) +
+                                 " does not increase (previous " + ExactNumber(previous_t_) + ")");
     }
     previous_t_ = t;
     out->t.push_back(t);
@@ -556,11 +550,10 @@ bool LogReaderOptions::IsValid(std::string* error) const {
   }
   if (!std::isfinite(sample_rate) || sample_rate < 0.0) {
     return SetError(error,
-                    "sample_rate is " + FormatDouble(sample_rate) + ", must be finite and >= 0");
+                    "sample_rate is " + ExactNumber(sample_rate) + ", must be finite and >= 0");
   }
   if (!std::isfinite(time_scale) || time_scale <= 0.0) {
-    return SetError(error,
-                    "time_scale is " + FormatDouble(time_scale) + ", must be finite and > 0");
+    return SetError(error, "time_scale is " + ExactNumber(time_scale) + ", must be finite and > 0");
   }
   if (format == LogFormat::kWhitespace && columns.empty()) {
     return SetError(error, "the whitespace format needs columns");

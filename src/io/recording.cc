@@ -10,14 +10,12 @@
 #include "io/formats/file_format.h"
 #include "io/formats/imu_message.h"
 #include "io/formats/message_log.h"
+#include "util/error.h"
 
 namespace gravcal {
 namespace {
 
-bool SetError(std::string* error, std::string message) {
-  if (error != nullptr) *error = std::move(message);
-  return false;
-}
+using internal::SetError;
 
 // Interval statistics of increasing times (IMU topics and text logs).
 void SummariseTimes(const std::vector<double>& t, TopicSummary* topic) {

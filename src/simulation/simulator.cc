@@ -17,8 +17,6 @@ namespace gravcal {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// Standard gravity: defines the nominal accelerometer scale of "counts per g".
-constexpr double kStandardGravity = 9.80665;
 // Corner frequency of the first-order low-pass that shapes hand tremor, Hz.
 constexpr double kTremorCornerHz = 5.0;
 // Limits that keep a typo from asking for gigabytes.

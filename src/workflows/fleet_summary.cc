@@ -1,7 +1,6 @@
 #include "gravcal/workflows/fleet_summary.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +10,7 @@
 #include "io/csv_table.h"
 #include "io/json_helpers.h"
 #include "util/content_hash.h"
+#include "util/numbers.h"
 #include "util/statistics.h"
 
 namespace gravcal {
@@ -66,11 +66,8 @@ bool IsParameterColumn(const std::string& name) {
   return (name.rfind("accel_", 0) == 0 || name.rfind("gyro_", 0) == 0) && !EndsWith(name, "_std");
 }
 
-std::string Number(double v) {
-  if (!std::isfinite(v)) return "";
-  char buffer[32];
-  return std::string(buffer, std::to_chars(buffer, buffer + sizeof(buffer), v).ptr);
-}
+// A cell of the fleet CSV: empty for a value that is not finite.
+std::string CellText(double v) { return std::isfinite(v) ? internal::ExactNumber(v) : ""; }
 
 std::string Short(double v) {
   char buffer[32];
@@ -180,7 +177,7 @@ std::string SummaryToCsv(const std::vector<SummaryRow>& rows) {
     out += std::to_string(row.index) + "," + CsvField(row.unit) + "," + ToString(row.status) + "," +
            CsvField(row.message);
     for (size_t i = text_columns; i < columns.size(); ++i) {
-      out += "," + Number(ValueOf(row, columns[i]));
+      out += "," + CellText(ValueOf(row, columns[i]));
     }
     out += '\n';
   }

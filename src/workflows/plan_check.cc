@@ -8,13 +8,15 @@
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/workflows/plan.h"
 #include "methods/static_positions.h"
+#include "util/numbers.h"
+#include "util/statistics.h"
 #include "workflows/plan_start.h"
 
 namespace gravcal {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using internal::kInf;
 constexpr double kFaceSnapDeg = 10.0;
 
 // The parameters DeterminedStd held (infinite standard deviation).
@@ -42,11 +44,7 @@ std::pair<int, double> Shortfall(const Eigen::VectorXd& std, const Eigen::Vector
   return {undetermined, worst};
 }
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
+using internal::Median;
 
 }  // namespace
 

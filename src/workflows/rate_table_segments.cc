@@ -1,13 +1,13 @@
 #include "gravcal/workflows/rate_table_segments.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
 
 #include "io/csv_table.h"
+#include "util/numbers.h"
 #include "util/units.h"
 
 namespace gravcal {
@@ -22,10 +22,7 @@ bool ParseNumber(const std::string& text, double* v) {
   return ParseCsvNumber(text, v) && std::isfinite(*v);
 }
 
-std::string Number(double v) {
-  char buffer[32];
-  return std::string(buffer, std::to_chars(buffer, buffer + sizeof(buffer), v).ptr);
-}
+using internal::ExactNumber;
 
 }  // namespace
 
@@ -99,8 +96,8 @@ std::string RateTableSegmentsToCsv(const std::vector<RateTableSegment>& segments
     if (s.end <= s.begin || s.end > log.size()) continue;
     // + 0.0 writes a zero rate as 0, not -0.
     const Eigen::Vector3d dps = (s.rate * internal::kRadToDeg).array() + 0.0;
-    text += Number(log.t[s.begin]) + "," + Number(log.t[s.end - 1]) + "," + Number(dps.x()) + "," +
-            Number(dps.y()) + "," + Number(dps.z()) + "\n";
+    text += ExactNumber(log.t[s.begin]) + "," + ExactNumber(log.t[s.end - 1]) + "," +
+            ExactNumber(dps.x()) + "," + ExactNumber(dps.y()) + "," + ExactNumber(dps.z()) + "\n";
   }
   return text;
 }

@@ -9,15 +9,11 @@
 #include <vector>
 
 #include "io/formats/imu_message.h"
+#include "util/error.h"
 
 namespace gravcal {
 namespace internal {
 namespace {
-
-bool SetError(std::string* error, std::string message) {
-  if (error != nullptr) *error = std::move(message);
-  return false;
-}
 
 // "/imu0 (sensor_msgs/Imu), /cam0 (sensor_msgs/Image)".
 std::string Listing(const std::vector<RecordingTopic>& topics, bool imu_only) {
