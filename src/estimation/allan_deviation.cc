@@ -106,7 +106,7 @@ int DominantTerm(const Coefficients& c, double tau) {
   return best;
 }
 
-std::string Seconds(double tau) {
+std::string TauText(double tau) {
   std::ostringstream s;
   s.precision(3);
   s << tau << " s";
@@ -193,9 +193,9 @@ int ChooseReadingPoint(int j, const Coefficients& c, const FitPoints& p,
     term->reason = std::string(names[j]) +
                    (c[j] > 0.0 ? " never dominates the curve: at most " +
                                      std::to_string(static_cast<int>(100.0 * best_share)) +
-                                     " % of the Allan variance, at tau " + Seconds(best_tau)
-                               : " is not in the fitted curve (tau " + Seconds(p.tau.front()) +
-                                     " to " + Seconds(p.tau.back()) + ")");
+                                     " % of the Allan variance, at tau " + TauText(best_tau)
+                               : " is not in the fitted curve (tau " + TauText(p.tau.front()) +
+                                     " to " + TauText(p.tau.back()) + ")");
   }
   return chosen;
 }
@@ -239,7 +239,7 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
           (2.0 / edf * model[k] * model[k] + rest_variance) / (g * g);
       term->tau = p.tau[k];
       if (!(coefficient > 0.0)) {
-        term->reason = "the reading at tau " + Seconds(p.tau[k]) +
+        term->reason = "the reading at tau " + TauText(p.tau[k]) +
                        " leaves nothing once the other terms are subtracted";
         next[j] = 0.0;
         continue;
@@ -484,7 +484,7 @@ bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, 
   const double min_tau = options.min_tau_samples / curve.rate_hz;
   const internal::FitPoints points = internal::SelectFitPoints(curve, min_tau);
   if (points.used.empty()) {
-    fit->message = "no Allan deviation point at tau >= " + internal::Seconds(min_tau);
+    fit->message = "no Allan deviation point at tau >= " + internal::TauText(min_tau);
     return false;
   }
   std::vector<double> model;
@@ -493,8 +493,8 @@ bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, 
   internal::ReadTerms(c, points, model, options.dominance, fit);
 
   std::ostringstream s;
-  s << "fitted on " << points.used.size() << " taus from " << internal::Seconds(points.tau.front())
-    << " to " << internal::Seconds(points.tau.back()) << ":";
+  s << "fitted on " << points.used.size() << " taus from " << internal::TauText(points.tau.front())
+    << " to " << internal::TauText(points.tau.back()) << ":";
   for (int j = 0; j < kTerms; ++j) {
     const NoiseTerm& term = *internal::TermOf(j, &fit->model);
     s << " " << ToString(internal::TypeOf(j)) << "="

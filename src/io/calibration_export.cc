@@ -8,6 +8,7 @@
 #include "gravcal/io/noise_io.h"
 #include "io/c_corrector_export.h"
 #include "io/export_format.h"
+#include "util/join.h"
 
 namespace gravcal {
 
@@ -70,11 +71,7 @@ std::vector<std::string> EffectNamesOf(const std::vector<Effect>& effects,
   return names;
 }
 
-std::string Join(const std::vector<std::string>& items) {
-  std::string s;
-  for (const std::string& item : items) s += (s.empty() ? "" : ", ") + item;
-  return s;
-}
+using internal::Join;
 
 // The lines of `dropped` for the target, from the full and truncated models.
 void DescribeTruncation(const LoadedCalibration& c, ExportTarget target, ExportResult* result) {

@@ -39,13 +39,13 @@ constexpr size_t kMaxLineBytes = size_t{1} << 16;
 constexpr size_t kMaxColumns = 4096;
 
 // Two times agree when they differ by at most this, relative.
-constexpr double kTimeTolerance = 1e-9;
+constexpr double kRelativeTimeTolerance = 1e-9;
 
-inline bool IsBlank(char c) { return c == ' ' || c == '\t'; }
+inline bool IsSpaceOrTab(char c) { return c == ' ' || c == '\t'; }
 
 std::string_view TrimBlanks(std::string_view s) {
-  while (!s.empty() && IsBlank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && IsBlank(s.back())) s.remove_suffix(1);
+  while (!s.empty() && IsSpaceOrTab(s.front())) s.remove_prefix(1);
+  while (!s.empty() && IsSpaceOrTab(s.back())) s.remove_suffix(1);
   return s;
 }
 
@@ -210,7 +210,7 @@ class Parser {
                                    " (is this a text log? are the line ends newlines?)");
       }
       if (line_end > s && line_end[-1] == '\r') --line_end;
-      while (s < line_end && IsBlank(*s)) ++s;
+      while (s < line_end && IsSpaceOrTab(*s)) ++s;
       if (s == line_end || *s == '#') continue;  // Blank or comment.
       if (!have_layout) {
         if (!BuildLayout(s, line_end, line, error)) return false;
@@ -335,7 +335,7 @@ class Parser {
       if (slot >= 0) {
         const char* number = p;
         if (kCsv) {
-          while (number < end && IsBlank(*number)) ++number;
+          while (number < end && IsSpaceOrTab(*number)) ++number;
         }
         // from_chars takes no leading '+'.
         if (number + 1 < end && number[0] == '+' && number[1] != '-' && number[1] != '+') {
@@ -350,10 +350,10 @@ class Parser {
         }
         bool ok = result.ec == std::errc();
         if (kCsv) {
-          while (after < end && IsBlank(*after)) ++after;
+          while (after < end && IsSpaceOrTab(*after)) ++after;
           ok = ok && (after == end || *after == ',');
         } else {
-          ok = ok && (after == end || IsBlank(*after));
+          ok = ok && (after == end || IsSpaceOrTab(*after));
         }
         if (!ok || !std::isfinite(x)) {
           return CellError<kCsv>(p, end, line, field, ok, result.ec, error);
@@ -364,14 +364,14 @@ class Parser {
         const char* comma = static_cast<const char*>(std::memchr(p, ',', end - p));
         p = comma != nullptr ? comma : end;
       } else {
-        while (p < end && !IsBlank(*p)) ++p;
+        while (p < end && !IsSpaceOrTab(*p)) ++p;
       }
       ++field;
       if (kCsv) {
         if (p == end) break;
         ++p;  // The comma.
       } else {
-        while (p < end && IsBlank(*p)) ++p;
+        while (p < end && IsSpaceOrTab(*p)) ++p;
         if (p == end) break;
       }
     }
@@ -386,10 +386,10 @@ class Parser {
       fields = 1 + static_cast<size_t>(std::count(begin, end, ','));
     } else {
       for (const char* p = begin; p < end;) {
-        while (p < end && IsBlank(*p)) ++p;
+        while (p < end && IsSpaceOrTab(*p)) ++p;
         if (p == end) break;
         ++fields;
-        while (p < end && !IsBlank(*p)) ++p;
+        while (p < end && !IsSpaceOrTab(*p)) ++p;
       }
     }
     return SetError(error, Where(name_, line) + std::to_string(fields) + " fields, expected " +
@@ -403,7 +403,7 @@ class Parser {
     if (kCsv) {
       while (cell_end < end && *cell_end != ',') ++cell_end;
     } else {
-      while (cell_end < end && !IsBlank(*cell_end)) ++cell_end;
+      while (cell_end < end && !IsSpaceOrTab(*cell_end)) ++cell_end;
     }
     const std::string_view cell = TrimBlanks(std::string_view(cell_begin, cell_end - cell_begin));
     std::string what = Where(name_, line) + "column " + field_label_[field];
@@ -430,7 +430,7 @@ class Parser {
       if (has_[kT]) {
         const double t = values[kT] * options_.time_scale;
         const double r = reference_t[index];
-        if (!(std::fabs(t - r) <= kTimeTolerance * std::max(std::fabs(t), std::fabs(r)))) {
+        if (!(std::fabs(t - r) <= kRelativeTimeTolerance * std::max(std::fabs(t), std::fabs(r)))) {
           return SetError(error, Where(name_, line) + "time " + ExactNumber(t) +
                                      " differs from time " + ExactNumber(r) + " of sample " +
                                      std::to_string(index) + " in " + reference_name_);

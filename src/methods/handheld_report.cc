@@ -8,7 +8,7 @@ namespace gravcal {
 namespace internal {
 namespace {
 
-constexpr const char* kAxes = "xyz";
+constexpr const char* kAxisLetters = "xyz";
 
 // The motion that excites a sensor error, for the warning.
 std::string MissingMotion(const std::string& name) {
@@ -16,8 +16,9 @@ std::string MissingMotion(const std::string& name) {
   const char axis = name.back();
   std::string others;
   for (int i = 0; i < 3; ++i) {
-    if (kAxes[i] != axis)
-      others += others.empty() ? std::string(1, kAxes[i]) : std::string(" or ") + kAxes[i];
+    if (kAxisLetters[i] != axis)
+      others +=
+          others.empty() ? std::string(1, kAxisLetters[i]) : std::string(" or ") + kAxisLetters[i];
   }
   std::ostringstream s;
   if (name.rfind("lever_arm", 0) == 0) {
@@ -116,12 +117,12 @@ SensorResult ToCalibrationModel(const HandheldSensorEstimate& est, double scale,
   }
   std::vector<std::pair<int, int>> outputs;
   out.names.clear();
-  for (int i = 0; i < 3; ++i) out.names.push_back(std::string("bias_") + kAxes[i]);
+  for (int i = 0; i < 3; ++i) out.names.push_back(std::string("bias_") + kAxisLetters[i]);
   for (int i = 0; i < 3; ++i) {
     for (int k = 0; k < 3; ++k) {
       if (moves[i][k]) {
         outputs.emplace_back(i, k);
-        out.names.push_back(std::string("m_") + kAxes[i] + kAxes[k]);
+        out.names.push_back(std::string("m_") + kAxisLetters[i] + kAxisLetters[k]);
       }
     }
   }

@@ -31,7 +31,7 @@ using internal::MakeLoss;
 namespace {
 
 // Twelve unknowns, three equations per position.
-constexpr int kMinPositions = 4;
+constexpr int kMinKnownPositions = 4;
 
 // Gravity in the body frame of roll r, pitch p (static_alignment.h):
 //   u(r, p) = (-sin p, sin r cos p, cos r cos p).
@@ -127,10 +127,10 @@ bool CheckInputs(const std::vector<Position>& positions,
     return false;
   }
   const int n = static_cast<int>(positions.size());
-  if (n < kMinPositions) {
+  if (n < kMinKnownPositions) {
     std::ostringstream s;
     s << "found " << n << " static positions; the known-attitude method needs at least "
-      << kMinPositions << " (twelve unknowns)";
+      << kMinKnownPositions << " (twelve unknowns)";
     c->message = s.str();
     return false;
   }

@@ -17,7 +17,7 @@ namespace gravcal {
 namespace {
 
 // Fewest positions: step 4 has six unknowns (bias and three scales).
-constexpr int kMinPositions = 6;
+constexpr int kMinTenPositions = 6;
 
 // Aligns every position on the specific force f = transform(raw) of its
 // samples. Returns false with a message naming the position.
@@ -184,7 +184,7 @@ bool TenPositionOptions::IsValid(std::string* error) const {
     *error = "gyro_nominal_scale: must be positive (rad/s per raw gyroscope unit)";
     return false;
   }
-  if (recommended_positions < kMinPositions) {
+  if (recommended_positions < kMinTenPositions) {
     *error = "recommended_positions: must be at least 6";
     return false;
   }
@@ -207,10 +207,10 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
   if (!internal::DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
   const std::string where = log.source.empty() ? "" : log.source + ": ";
   const int n = static_cast<int>(positions.size());
-  if (n < kMinPositions) {
+  if (n < kMinTenPositions) {
     std::ostringstream s;
     s << where << "found " << n << " static positions; the ten-position method needs at least "
-      << kMinPositions << " (the patent uses 10 with different roll and pitch)";
+      << kMinTenPositions << " (the patent uses 10 with different roll and pitch)";
     c.message = s.str();
     return false;
   }

@@ -25,8 +25,6 @@ constexpr double kRamp = 1.0;
 constexpr double kPause = 1.0;
 // The 90-degree tilts that bring z horizontal and back, s.
 constexpr double kTiltSeconds = 2.5;
-// Limit against typos asking for gigabytes.
-constexpr double kMaxSamples = 1e8;
 
 // One sinusoid: amplitude * sin(2 pi f t + phase).
 struct Sine {
@@ -361,7 +359,7 @@ bool SimulateMotion(const SimulatorOptions& sensor, const MotionOptions& motion,
   out.lever_arm = lever;
 
   const double samples = std::floor(total_seconds * sensor.sample_rate) + 1.0;
-  if (!(samples <= kMaxSamples)) {
+  if (!(samples <= internal::kMaxSimulatedSamples)) {
     *error = "the motion session is too long (" + std::to_string(samples) + " samples)";
     return false;
   }

@@ -24,6 +24,9 @@
 namespace gravcal {
 namespace internal {
 
+// Limit on a simulated log's samples, against a typo asking for gigabytes.
+constexpr double kMaxSimulatedSamples = 1e8;
+
 // Three axes of bias instability B (sensor units) flat over [tau_low,
 // tau_high] seconds at rate_hz; B = 0 gives zero forever. `stream` tells the
 // accelerometer's from the gyroscope's processes of the same seed.

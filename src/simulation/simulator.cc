@@ -21,7 +21,6 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kTremorCornerHz = 5.0;
 // Limits that keep a typo from asking for gigabytes.
 constexpr long kMaxRandomPoses = 100000;
-constexpr double kMaxSamples = 1e8;
 // Above these the random truth models can become singular.
 constexpr double kMaxScaleStd = 0.25;
 constexpr double kMaxMisalignmentStd = 0.25;
@@ -303,7 +302,7 @@ bool PlanTimeline(const SimulatorOptions& options, uint64_t seed,
   plan->total = static_cast<size_t>(plan->first_still);
   for (size_t k = 1; k < pose_count; ++k) plan->total += static_cast<size_t>(plan->hold[k]);
   for (long r : plan->rotation) plan->total += static_cast<size_t>(r);
-  if (static_cast<double>(plan->total) > kMaxSamples) {
+  if (static_cast<double>(plan->total) > internal::kMaxSimulatedSamples) {
     if (error) *error = "the session is too long (" + std::to_string(plan->total) + " samples)";
     return false;
   }
@@ -691,7 +690,7 @@ bool CheckEnvironmentAndEffects(const SimulatorOptions& o, const FieldCheck& c) 
          c.Finite("effect_reference_temperature", o.effect_reference_temperature);
 }
 
-// The session's length against kMaxSamples.
+// The session's length against internal::kMaxSimulatedSamples.
 bool CheckLength(const SimulatorOptions& o, long pose_count, const FieldCheck& c) {
   double hold_total = o.hold_seconds * static_cast<double>(pose_count);
   if (!o.planned_poses.empty()) {
@@ -703,9 +702,10 @@ bool CheckLength(const SimulatorOptions& o, long pose_count, const FieldCheck& c
        static_cast<double>(pose_count - 1) *
            (o.rotation_profile == "hand" ? o.hand_max_seconds : o.rotation_seconds)) *
       o.sample_rate;
-  if (samples <= kMaxSamples) return true;
+  if (samples <= internal::kMaxSimulatedSamples) return true;
   std::ostringstream msg;
-  msg << "SimulatorOptions: the session would have " << samples << " samples (limit " << kMaxSamples
+  msg << "SimulatorOptions: the session would have " << samples << " samples (limit "
+      << internal::kMaxSimulatedSamples
       << "); shorten hold_seconds, rotation_seconds or sample_rate";
   c.Say(msg.str());
   return false;

@@ -16,11 +16,11 @@ using internal::Median;
 
 namespace {
 
-using json = nlohmann::ordered_json;
+using OrderedJson = nlohmann::ordered_json;
 
-json Number(double v) { return internal::JsonNumber<json>(v); }
-json Vector(const Eigen::Vector3d& v) { return internal::JsonVector<json>(v); }
-json Matrix(const Eigen::Matrix3d& m) { return internal::JsonMatrix<json>(m); }
+OrderedJson Number(double v) { return internal::JsonNumber<OrderedJson>(v); }
+OrderedJson Vector(const Eigen::Vector3d& v) { return internal::JsonVector<OrderedJson>(v); }
+OrderedJson Matrix(const Eigen::Matrix3d& m) { return internal::JsonMatrix<OrderedJson>(m); }
 
 bool IsAccel(Effect e) { return Info(e).sensor == EffectSensor::kAccelerometer; }
 
@@ -33,7 +33,7 @@ const char* GapUnit(Effect e) { return IsAccel(e) ? "m/s^2" : "raw gyro units"; 
 double Of(const Gap& g, bool accel) { return accel ? g.accel : g.gyro; }
 double SigmaOf(const Gap& g, bool accel) { return accel ? g.accel_sigma : g.gyro_sigma; }
 
-json GapJson(const Gap& g) {
+OrderedJson GapJson(const Gap& g) {
   return {{"accel", Number(g.accel)},
           {"accel_unit", "m/s^2"},
           {"accel_sigma", Number(g.accel_sigma)},
@@ -50,7 +50,7 @@ std::string ModelName(const ModelAssessment& m) {
   return name;
 }
 
-json PositionJson(const PositionDisagreement& p) {
+OrderedJson PositionJson(const PositionDisagreement& p) {
   return {{"position", p.index},
           {"time", p.time},
           {"temperature", Number(p.temperature)},
@@ -64,10 +64,10 @@ json PositionJson(const PositionDisagreement& p) {
 
 // `where`: the summary, the worst positions of each sensor and the groups;
 // with every position (measured, simulated) when `detail`.
-json WhereJson(const Disagreement& d, bool detail) {
-  json w;
+OrderedJson WhereJson(const Disagreement& d, bool detail) {
+  OrderedJson w;
   w["summary"] = d.summary;
-  json worst_a = json::array(), worst_g = json::array();
+  OrderedJson worst_a = OrderedJson::array(), worst_g = OrderedJson::array();
   for (int k : d.worst_accel) worst_a.push_back(PositionJson(d.positions[k]));
   for (int k : d.worst_gyro) worst_g.push_back(PositionJson(d.positions[k]));
   w["accel"] = {{"chi2", d.accel_chi2},
@@ -80,7 +80,7 @@ json WhereJson(const Disagreement& d, bool detail) {
                  {"p_value", d.gyro_p},
                  {"worst_positions", worst_g}};
   }
-  json groups = json::array();
+  OrderedJson groups = OrderedJson::array();
   for (const GroupDisagreement& g : d.groups) {
     groups.push_back({{"by", g.by},
                       {"group", g.group},
@@ -90,9 +90,9 @@ json WhereJson(const Disagreement& d, bool detail) {
   }
   w["groups"] = groups;
   if (detail) {
-    json all = json::array();
+    OrderedJson all = OrderedJson::array();
     for (const PositionDisagreement& p : d.positions) {
-      json j = PositionJson(p);
+      OrderedJson j = PositionJson(p);
       j["accel_measured"] = Vector(p.accel_measured);
       j["accel_simulated"] = Vector(p.accel_simulated);
       if (d.gyro_dof > 0) {
@@ -106,8 +106,8 @@ json WhereJson(const Disagreement& d, bool detail) {
   return w;
 }
 
-json ParametersJson(const EffectEstimate& e) {
-  json params = json::array();
+OrderedJson ParametersJson(const EffectEstimate& e) {
+  OrderedJson params = OrderedJson::array();
   for (size_t i = 0; i < e.names.size(); ++i) {
     params.push_back({{"name", e.names[i]},
                       {"value", Number(i < e.values.size() ? e.values[i] : NAN)},
@@ -117,11 +117,12 @@ json ParametersJson(const EffectEstimate& e) {
   return params;
 }
 
-json CandidatesJson(const std::vector<CandidateScore>& scores) {
-  json out = json::array();
+OrderedJson CandidatesJson(const std::vector<CandidateScore>& scores) {
+  OrderedJson out = OrderedJson::array();
   for (const CandidateScore& c : scores) {
     const bool accel = IsAccel(c.effect);
-    json j = {{"effect", ToString(c.effect)}, {"tried", c.tried}, {"significant", c.significant}};
+    OrderedJson j = {
+        {"effect", ToString(c.effect)}, {"tried", c.tried}, {"significant", c.significant}};
     if (c.tried) {
       j["information"] = c.information;
       j["dof"] = c.dof;
@@ -138,7 +139,8 @@ json CandidatesJson(const std::vector<CandidateScore>& scores) {
         j["rotation_delta_chi2"] = Number(c.rotation_delta_chi2);
         j["confirmation_p_value"] = Number(c.confirmation_p_value);
         j["preference_margin"] = Number(c.preference_margin);
-        j["runner_up"] = std::isfinite(c.preference_margin) ? json(ToString(c.runner_up)) : json();
+        j["runner_up"] =
+            std::isfinite(c.preference_margin) ? OrderedJson(ToString(c.runner_up)) : OrderedJson();
         j["preference_threshold"] = Number(c.preference_threshold);
         j["confirmed_by"] = c.confirmed_by;
       }
@@ -149,8 +151,8 @@ json CandidatesJson(const std::vector<CandidateScore>& scores) {
   return out;
 }
 
-json ModelJson(const ModelAssessment& m) {
-  json j;
+OrderedJson ModelJson(const ModelAssessment& m) {
+  OrderedJson j;
   j["model"] = ModelName(m);
   j["parameterization"] = ToString(m.parameterization);
   j["effects"] = EffectNames(m.effects);
@@ -170,7 +172,7 @@ json ModelJson(const ModelAssessment& m) {
                  {"dof", f.gyro_fit.dof()},
                  {"information", f.gyro_fit.information}};
   }
-  json params = json::object();
+  OrderedJson params = OrderedJson::object();
   for (const EffectEstimate& e : f.estimates) params[ToString(e.effect)] = ParametersJson(e);
   j["parameters"] = params;
   j["reference_temperature"] = Number(f.parameters.reference_temperature);
@@ -322,11 +324,11 @@ std::vector<Series> BeforeAfter(const DiscoveryStep& s, bool accel, bool against
 }  // namespace
 
 std::string DiscoveryToJson(const DiscoveryResult& r) {
-  json out;
+  OrderedJson out;
   out["source"] = r.source;
   out["gravity"] = {{"value", r.gravity}, {"source", r.gravity_source}};
   std::vector<double> sa, sg;
-  json positions = json::array();
+  OrderedJson positions = OrderedJson::array();
   for (size_t k = 0; k < r.observations.size(); ++k) {
     const StaticObservation& o = r.observations[k];
     positions.push_back({{"position", k},
@@ -342,37 +344,37 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
                   {"accel_unit", "m/s^2 (|a| of a position mean)"},
                   {"gyro_sigma_median", Number(sg.empty() ? NAN : Median(sg))},
                   {"gyro_unit", "raw gyro units (one axis of a position mean)"}};
-  json baseline = ModelJson(r.baseline);
+  OrderedJson baseline = ModelJson(r.baseline);
   baseline["disagreement"] = WhereJson(r.baseline_where, true);
   out["baseline"] = baseline;
-  json steps = json::array();
+  OrderedJson steps = OrderedJson::array();
   for (const DiscoveryStep& s : r.steps) {
     const bool accel = IsAccel(s.effect);
-    json j = {{"effect", ToString(s.effect)},
-              {"description", Info(s.effect).description},
-              {"sensor", accel ? "accelerometer" : "gyroscope"},
-              {"information", s.information},
-              {"confirmed_by", s.confirmed_by},
-              {"parameters", ParametersJson(s.estimate)},
-              {"p_value", Number(s.p_value)},
-              {"delta_bic", Number(s.delta_bic)},
-              {"dof", s.dof},
-              {"gap_unit", GapUnit(s.effect)},
-              {"gap_before", Number(Of(s.gap_before, accel))},
-              {"gap_after", Number(Of(s.gap_after, accel))},
-              {"cv_gap_before", Number(Of(s.cv_gap_before, accel))},
-              {"cv_gap_after", Number(Of(s.cv_gap_after, accel))},
-              {"gap_before_sigma", Number(SigmaOf(s.gap_before, accel))},
-              {"gap_after_sigma", Number(SigmaOf(s.gap_after, accel))},
-              {"cv_gap_before_sigma", Number(SigmaOf(s.cv_gap_before, accel))},
-              {"cv_gap_after_sigma", Number(SigmaOf(s.cv_gap_after, accel))},
-              {"where", WhereJson(s.where, false)},
-              {"ambiguous_with", EffectNames(s.ambiguous_with)},
-              {"candidates", CandidatesJson(s.candidates)}};
+    OrderedJson j = {{"effect", ToString(s.effect)},
+                     {"description", Info(s.effect).description},
+                     {"sensor", accel ? "accelerometer" : "gyroscope"},
+                     {"information", s.information},
+                     {"confirmed_by", s.confirmed_by},
+                     {"parameters", ParametersJson(s.estimate)},
+                     {"p_value", Number(s.p_value)},
+                     {"delta_bic", Number(s.delta_bic)},
+                     {"dof", s.dof},
+                     {"gap_unit", GapUnit(s.effect)},
+                     {"gap_before", Number(Of(s.gap_before, accel))},
+                     {"gap_after", Number(Of(s.gap_after, accel))},
+                     {"cv_gap_before", Number(Of(s.cv_gap_before, accel))},
+                     {"cv_gap_after", Number(Of(s.cv_gap_after, accel))},
+                     {"gap_before_sigma", Number(SigmaOf(s.gap_before, accel))},
+                     {"gap_after_sigma", Number(SigmaOf(s.gap_after, accel))},
+                     {"cv_gap_before_sigma", Number(SigmaOf(s.cv_gap_before, accel))},
+                     {"cv_gap_after_sigma", Number(SigmaOf(s.cv_gap_after, accel))},
+                     {"where", WhereJson(s.where, false)},
+                     {"ambiguous_with", EffectNames(s.ambiguous_with)},
+                     {"candidates", CandidatesJson(s.candidates)}};
     steps.push_back(j);
   }
   out["steps"] = steps;
-  json ambiguous = json::array();
+  OrderedJson ambiguous = OrderedJson::array();
   for (const Ambiguity& a : r.ambiguous) {
     ambiguous.push_back({{"effects", EffectNames(a.effects)},
                          {"delta_bic", a.delta_bic},
@@ -380,12 +382,12 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
                          {"advice", a.advice}});
   }
   out["ambiguous"] = ambiguous;
-  json final_model = ModelJson(r.final_model);
+  OrderedJson final_model = ModelJson(r.final_model);
   final_model["disagreement"] = WhereJson(r.final_where, true);
   if (!r.final_candidates.empty()) final_model["candidates"] = CandidatesJson(r.final_candidates);
   out["final_model"] = final_model;
   out["verdict"] = r.verdict;
-  json sensors = json::array();
+  OrderedJson sensors = OrderedJson::array();
   for (const SensorVerdict& v : r.sensors) {
     sensors.push_back({{"sensor", SensorName(v.sensor)},
                        {"information", v.information},
@@ -397,7 +399,7 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
   }
   out["sensors"] = sensors;
   out["warnings"] = r.warnings;
-  json codes = json::array();
+  OrderedJson codes = OrderedJson::array();
   for (size_t i = 0; i < r.warnings.size(); ++i) {
     codes.push_back(
         ToString(i < r.warning_codes.size() ? r.warning_codes[i] : WarningCode::kUnclassified));
@@ -405,7 +407,7 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
   out["warning_codes"] = codes;
   out["message"] = r.message;
   out["time_s"] = r.seconds;
-  return out.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+  return out.dump(2, ' ', false, OrderedJson::error_handler_t::replace) + "\n";
 }
 
 std::string DiscoveryToHtml(const DiscoveryResult& r) {

@@ -11,6 +11,7 @@
 #include "gravcal/core/gravity.h"
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/simulation/simulator.h"
+#include "util/join.h"
 #include "util/units.h"
 #include "workflows/plan_start.h"
 
@@ -63,11 +64,7 @@ std::vector<int> TargetColumns(const std::string& name, const std::vector<std::s
   return columns;
 }
 
-std::string Join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
+using internal::Join;
 
 // The sensor-frame up direction of each pose of a seed scheme.
 std::vector<Eigen::Vector3d> SchemeUps(const std::string& scheme) {

@@ -16,7 +16,7 @@ namespace {
 constexpr const char* kColumns[] = {"t_begin", "t_end", "rate_x_dps", "rate_y_dps", "rate_z_dps"};
 // Times equal to a sample's within this are that sample's (printed times
 // round-trip exactly; hand-written ones may not).
-constexpr double kTimeTolerance = 1e-6;
+constexpr double kSegmentTimeTolerance = 1e-6;
 
 bool ParseNumber(const std::string& text, double* v) {
   return ParseCsvNumber(text, v) && std::isfinite(*v);
@@ -62,8 +62,10 @@ bool ParseRateTableSegments(std::string_view text, const std::string& name, cons
     }
     if (!(v[1] > v[0])) return fail("t_end must be after t_begin");
     RateTableSegment s;
-    s.begin = std::lower_bound(log.t.begin(), log.t.end(), v[0] - kTimeTolerance) - log.t.begin();
-    s.end = std::upper_bound(log.t.begin(), log.t.end(), v[1] + kTimeTolerance) - log.t.begin();
+    s.begin =
+        std::lower_bound(log.t.begin(), log.t.end(), v[0] - kSegmentTimeTolerance) - log.t.begin();
+    s.end =
+        std::upper_bound(log.t.begin(), log.t.end(), v[1] + kSegmentTimeTolerance) - log.t.begin();
     if (s.end < s.begin + 2) {
       std::ostringstream m;
       m << "the segment " << v[0] << " .. " << v[1] << " s holds fewer than 2 samples of "

@@ -20,13 +20,13 @@ namespace {
 
 // Record kinds (the header's "op" field) of format 2.0.
 enum RecordOp : uint8_t {
-  kMessageDefinition = 0x01,
-  kMessageData,
-  kBagHeader,
-  kIndexData,
-  kChunk,
-  kChunkInfo,
-  kConnection,
+  kOpMessageDefinition = 0x01,
+  kOpMessageData,
+  kOpBagHeader,
+  kOpIndexData,
+  kOpChunk,
+  kOpChunkInfo,
+  kOpConnection,
 };
 
 constexpr uint64_t kMagicBytes = 13;  // "#ROSBAG V2.0\n"
@@ -170,14 +170,14 @@ bool CheckChunkRecords(const std::vector<uint8_t>& chunk, std::set<uint32_t>* me
   while (pos < chunk.size()) {
     Record r;
     if (!ReadRecord(pos, chunk.size(), read, &r, what)) return false;
-    if (r.op == kMessageData) {
+    if (r.op == kOpMessageData) {
       messages->insert(static_cast<uint32_t>(pos));
-    } else if (r.op == kConnection) {
+    } else if (r.op == kOpConnection) {
       if (!ConnectionDataValid(chunk.data() + r.data_start, r.data_len)) {
         *what = "the connection record at byte " + std::to_string(pos) + " is damaged";
         return false;
       }
-    } else if (r.op != kMessageDefinition) {
+    } else if (r.op != kOpMessageDefinition) {
       *what = "the record at byte " + std::to_string(pos) + " may not be inside a chunk";
       return false;
     }
@@ -226,13 +226,13 @@ bool CheckRos1BagStructure(const std::string& path, std::string* what) {
     };
     uint64_t value = 0;
     switch (r.op) {
-      case kBagHeader:
+      case kOpBagHeader:
         if (pos != kMagicBytes || !UnsignedField(r.header, "index_pos", 8, &index_pos)) {
           *what = where + " is a misplaced or damaged bag header";
           return false;
         }
         break;
-      case kChunk: {
+      case kOpChunk: {
         const auto compression = r.header.find("compression");
         if (compression == r.header.end() || !UnsignedField(r.header, "size", 4, &value)) {
           *what = where + " is a damaged chunk header";
@@ -255,7 +255,7 @@ bool CheckRos1BagStructure(const std::string& path, std::string* what) {
         after_chunk = true;
         break;
       }
-      case kIndexData: {
+      case kOpIndexData: {
         uint64_t version = 0, connection = 0, count = 0;
         if (!after_chunk || !UnsignedField(r.header, "ver", 4, &version) || version != 1 ||
             !UnsignedField(r.header, "conn", 4, &connection) ||
@@ -275,7 +275,7 @@ bool CheckRos1BagStructure(const std::string& path, std::string* what) {
         index_connections.emplace_back(pos, connection);
         break;
       }
-      case kChunkInfo: {
+      case kOpChunkInfo: {
         uint64_t version = 0, count = 0;
         if (!UnsignedField(r.header, "ver", 4, &version) ||
             !UnsignedField(r.header, "chunk_pos", 8, &value) ||
@@ -287,7 +287,7 @@ bool CheckRos1BagStructure(const std::string& path, std::string* what) {
         chunk_refs.push_back(value);
         break;
       }
-      case kConnection:
+      case kOpConnection:
         if (!UnsignedField(r.header, "conn", 4, &value) || r.header.count("topic") == 0 ||
             !load() || !ConnectionDataValid(data.data(), r.data_len)) {
           *what = where + " is a damaged connection";
@@ -295,8 +295,8 @@ bool CheckRos1BagStructure(const std::string& path, std::string* what) {
         }
         connections.insert(value);
         break;
-      case kMessageData:
-      case kMessageDefinition:
+      case kOpMessageData:
+      case kOpMessageDefinition:
         break;
       default:
         *what = where + " is of an unknown kind (op " + std::to_string(r.op) + ")";
