@@ -49,9 +49,8 @@ std::string_view TrimBlanks(std::string_view s) {
   return s;
 }
 
-using internal::SetError;
-
 using internal::ExactNumber;
+using internal::SetError;
 
 // Bytes of the file as they appear in a message: at most `max_chars` of
 // them, control bytes and bytes that are not UTF-8 written as \xNN, so a

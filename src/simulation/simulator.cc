@@ -19,7 +19,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 // Corner frequency of the first-order low-pass that shapes hand tremor, Hz.
 constexpr double kTremorCornerHz = 5.0;
-// Limits that keep a typo from asking for gigabytes.
+// Limit that keeps a typo from asking for gigabytes of poses.
 constexpr long kMaxRandomPoses = 100000;
 // Above these the random truth models can become singular.
 constexpr double kMaxScaleStd = 0.25;
