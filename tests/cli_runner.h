@@ -69,6 +69,13 @@ class ScratchDir {
   std::string path_;
 };
 
+// How many times `needle` occurs in `text` (overlapping ones counted).
+inline size_t Count(const std::string& text, const std::string& needle) {
+  size_t n = 0;
+  for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
+  return n;
+}
+
 inline bool FileExists(const std::string& path) {
   std::error_code ec;
   return std::filesystem::exists(path, ec);

@@ -7,11 +7,9 @@
 namespace gravcal {
 namespace {
 
+using testing_util::kCountScale;
 using testing_util::MakePositions;
 using testing_util::TwelveDirections;
-
-constexpr double kG = 9.80665;
-constexpr double kCountScale = kG / 16384.0;
 
 std::vector<Eigen::Vector3d> SixDirections() {
   auto d = TwelveDirections();
@@ -23,13 +21,14 @@ TEST(CoarseFit, SixPositionExactWithPerfectPlacement) {
   std::mt19937_64 rng(1);
   const AccelModel truth =
       AccelModel::Random(AccelParameterization::kAffine, kCountScale, 0.02, 0.01, 400, &rng);
-  const auto positions = MakePositions(truth, SixDirections(), kG, 0.0, 0.0, 100, true, &rng);
+  const auto positions =
+      MakePositions(truth, SixDirections(), kStandardGravity, 0.0, 0.0, 100, true, &rng);
   std::vector<int> up;
   for (const Position& p : positions) up.push_back(p.nominal_up);
   Eigen::Vector3d b;
   Eigen::Matrix3d m;
   std::string error;
-  ASSERT_TRUE(SixPositionFit(positions, up, kG, &b, &m, &error)) << error;
+  ASSERT_TRUE(SixPositionFit(positions, up, kStandardGravity, &b, &m, &error)) << error;
   EXPECT_LT((b - truth.bias).norm(), 1e-6);
   EXPECT_LT((m - truth.matrix()).norm() / truth.matrix().norm(), 1e-10);
 }
@@ -40,10 +39,11 @@ TEST(CoarseFit, EllipsoidExactOnNoiseFreeArbitraryPoses) {
                                               kCountScale, 0.02, 0.01, 400, &rng);
   std::vector<Eigen::Vector3d> directions;
   for (int k = 0; k < 15; ++k) directions.push_back(testing_util::RandomDirection(&rng));
-  const auto positions = MakePositions(truth, directions, kG, 0.0, 0.0, 100, false, &rng);
+  const auto positions =
+      MakePositions(truth, directions, kStandardGravity, 0.0, 0.0, 100, false, &rng);
   AccelModel fit;
   std::string error;
-  ASSERT_TRUE(EllipsoidFit(positions, false, kG, &fit, &error)) << error;
+  ASSERT_TRUE(EllipsoidFit(positions, false, kStandardGravity, &fit, &error)) << error;
   EXPECT_LT((fit.bias - truth.bias).norm(), 1e-6 * truth.bias.norm() + 1e-6);
   EXPECT_LT((fit.upper - truth.upper).norm() / truth.upper.norm(), 1e-9);
 }
@@ -54,14 +54,14 @@ TEST(CoarseFit, DiagonalEllipsoidNeedsSixPositions) {
       AccelModel::Random(AccelParameterization::kScale, 1.0, 0.02, 0.0, 0.3, &rng);
   std::vector<Eigen::Vector3d> directions;
   for (int k = 0; k < 8; ++k) directions.push_back(testing_util::RandomDirection(&rng));
-  auto positions = MakePositions(truth, directions, kG, 0.0, 0.0, 100, false, &rng);
+  auto positions = MakePositions(truth, directions, kStandardGravity, 0.0, 0.0, 100, false, &rng);
   AccelModel fit;
   std::string error;
-  ASSERT_TRUE(EllipsoidFit(positions, true, kG, &fit, &error)) << error;
+  ASSERT_TRUE(EllipsoidFit(positions, true, kStandardGravity, &fit, &error)) << error;
   EXPECT_LT((fit.upper - truth.upper).norm(), 1e-9);
   EXPECT_LT((fit.bias - truth.bias).norm(), 1e-9);
   positions.resize(5);
-  EXPECT_FALSE(EllipsoidFit(positions, true, kG, &fit, &error));
+  EXPECT_FALSE(EllipsoidFit(positions, true, kStandardGravity, &fit, &error));
   EXPECT_NE(error.find("at least 6 positions, found 5"), std::string::npos) << error;
 }
 
@@ -70,8 +70,8 @@ TEST(CoarseFit, AssignsNominalAxesInAnyUnits) {
     std::mt19937_64 rng(4);
     const AccelModel truth =
         AccelModel::Random(AccelParameterization::kAffine, scale, 0.02, 0.01, 0.3 / scale, &rng);
-    const auto positions =
-        MakePositions(truth, TwelveDirections(), kG, 3.0 * M_PI / 180.0, 0.02, 500, false, &rng);
+    const auto positions = MakePositions(truth, TwelveDirections(), kStandardGravity,
+                                         3.0 * M_PI / 180.0, 0.02, 500, false, &rng);
     std::vector<int> up;
     AssignNominalAxes(positions, nullptr, 20.0, &up);
     for (int k = 0; k < 6; ++k) EXPECT_EQ(up[k], k) << "scale " << scale;
@@ -83,18 +83,20 @@ TEST(CoarseFit, ChoosesSixPositionWhenAllFacesPresentElseEllipsoid) {
   std::mt19937_64 rng(5);
   const AccelModel truth =
       AccelModel::Random(AccelParameterization::kAffine, kCountScale, 0.02, 0.01, 400, &rng);
-  const auto twelve = MakePositions(truth, TwelveDirections(), kG, 0.02, 0.02, 500, false, &rng);
+  const auto twelve =
+      MakePositions(truth, TwelveDirections(), kStandardGravity, 0.02, 0.02, 500, false, &rng);
   CoarseFitResult result;
-  ASSERT_TRUE(
-      CoarseFit(twelve, kG, AccelParameterization::kScaleMisalignment, CoarseFitOptions(), &result))
+  ASSERT_TRUE(CoarseFit(twelve, kStandardGravity, AccelParameterization::kScaleMisalignment,
+                        CoarseFitOptions(), &result))
       << result.message;
   EXPECT_EQ(result.method, CoarseMethod::kSixPosition);
   EXPECT_EQ(result.axis_positions, 6);
   std::vector<Eigen::Vector3d> directions;
   for (int k = 0; k < 12; ++k) directions.push_back(testing_util::RandomDirection(&rng));
-  const auto random = MakePositions(truth, directions, kG, 0.0, 0.02, 500, false, &rng);
-  ASSERT_TRUE(
-      CoarseFit(random, kG, AccelParameterization::kScaleMisalignment, CoarseFitOptions(), &result))
+  const auto random =
+      MakePositions(truth, directions, kStandardGravity, 0.0, 0.02, 500, false, &rng);
+  ASSERT_TRUE(CoarseFit(random, kStandardGravity, AccelParameterization::kScaleMisalignment,
+                        CoarseFitOptions(), &result))
       << result.message;
   EXPECT_EQ(result.method, CoarseMethod::kEllipsoid);
   // A useful start: scale within 1 %.
@@ -107,15 +109,16 @@ TEST(CoarseFit, TooFewPositionsIsAnError) {
   std::mt19937_64 rng(6);
   const AccelModel truth =
       AccelModel::Random(AccelParameterization::kAffine, kCountScale, 0.02, 0.01, 400, &rng);
-  auto positions = MakePositions(truth, TwelveDirections(), kG, 0.0, 0.02, 500, false, &rng);
+  auto positions =
+      MakePositions(truth, TwelveDirections(), kStandardGravity, 0.0, 0.02, 500, false, &rng);
   positions.resize(3);
   CoarseFitResult result;
-  EXPECT_FALSE(CoarseFit(positions, kG, AccelParameterization::kScaleMisalignment,
+  EXPECT_FALSE(CoarseFit(positions, kStandardGravity, AccelParameterization::kScaleMisalignment,
                          CoarseFitOptions(), &result));
   EXPECT_FALSE(result.message.empty());
   CoarseFitOptions bad;
   bad.axis_tolerance_deg = 50;
-  EXPECT_FALSE(CoarseFit(positions, kG, AccelParameterization::kScale, bad, &result));
+  EXPECT_FALSE(CoarseFit(positions, kStandardGravity, AccelParameterization::kScale, bad, &result));
   EXPECT_NE(result.message.find("axis_tolerance_deg"), std::string::npos);
 }
 

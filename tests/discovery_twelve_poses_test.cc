@@ -24,12 +24,12 @@ using testing_util::kTemperatureBias;
 using testing_util::kTemperatureScale;
 constexpr double kMisalignment = 1.5e-3;
 
-constexpr int kSeeds = 20;
+constexpr int kTwelvePoseSeeds = 20;
 
 struct Hidden {
   Effect effect;
   double std;
-  // Seeds of kSeeds in which it must be named first.
+  // Seeds of kTwelvePoseSeeds in which it must be named first.
   int required;
 };
 
@@ -60,7 +60,7 @@ class DiscoveryTwelvePoses : public ::testing::TestWithParam<Hidden> {};
 TEST_P(DiscoveryTwelvePoses, NamesTheHiddenAccelerometerEffectFirst) {
   const Hidden hidden = GetParam();
   int first = 0, wrong_preferred = 0;
-  for (int seed = 1; seed <= kSeeds; ++seed) {
+  for (int seed = 1; seed <= kTwelvePoseSeeds; ++seed) {
     const DiscoveryResult r = DiscoverTwelve(hidden, seed);
     const bool ok = !r.steps.empty() && r.steps.front().effect == hidden.effect;
     first += ok ? 1 : 0;
@@ -83,11 +83,11 @@ TEST_P(DiscoveryTwelvePoses, NamesTheHiddenAccelerometerEffectFirst) {
       }
     }
   }
-  EXPECT_GE(first, hidden.required) << first << " of " << kSeeds;
+  EXPECT_GE(first, hidden.required) << first << " of " << kTwelvePoseSeeds;
   // The preference test's margin bounds a wrong preference over the true
   // effect at the sensor's level, 0.01 / 4 per rival (three rivals).
-  EXPECT_LE(wrong_preferred, testing_util::AllowedSuccesses(kSeeds, 3 * 0.01 / 4))
-      << wrong_preferred << " of " << kSeeds;
+  EXPECT_LE(wrong_preferred, testing_util::AllowedSuccesses(kTwelvePoseSeeds, 3 * 0.01 / 4))
+      << wrong_preferred << " of " << kTwelvePoseSeeds;
 }
 
 // Each named first in at least 18 of 20 seeds. The scale tempco leans on
@@ -109,12 +109,12 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(DiscoveryTwelvePosesQuiet, NamesNothingWithoutHiddenEffect) {
   int quiet = 0;
-  for (int seed = 1; seed <= kSeeds; ++seed) {
+  for (int seed = 1; seed <= kTwelvePoseSeeds; ++seed) {
     const DiscoveryResult r = DiscoverTwelve({Effect::kAccelQuadratic, 0.0, 0}, seed);
     quiet += r.named().empty() ? 1 : 0;
     if (!r.named().empty()) std::printf("seed %d: %s\n", seed, r.verdict.c_str());
   }
-  EXPECT_GE(quiet, 19) << quiet << " of " << kSeeds;
+  EXPECT_GE(quiet, 19) << quiet << " of " << kTwelvePoseSeeds;
 }
 
 // Each sensor's evidence stands on its own, on twelve poses too: the

@@ -26,6 +26,7 @@ namespace gravcal {
 namespace {
 
 using internal::ChiSquareUpperTail;
+using testing_util::kCandidateLevel;
 using testing_util::Nominal;
 using testing_util::References;
 using testing_util::SessionIntervals;
@@ -33,7 +34,7 @@ using testing_util::TwelvePoseWarmUp;
 using testing_util::WithHidden;
 
 // The session's observations with trends and the turns between the poses.
-std::vector<StaticObservation> SessionObservations(const SimulatedSession& session) {
+std::vector<StaticObservation> ObservationsWithTurns(const SimulatedSession& session) {
   const std::vector<StaticInterval> intervals = SessionIntervals(session);
   std::vector<StaticObservation> obs = ObservationsFromIntervals(session.log, intervals);
   AddBetweenPoseTurns(session.log, intervals, &obs);
@@ -57,16 +58,12 @@ EffectFitResult Fit(const std::vector<StaticObservation>& obs, const SimulatedSe
   return fit;
 }
 
-// The family-wise level of discovery (discovery_significance 0.01) divided
-// over the eight candidates of the catalogue.
-constexpr double kLevel = 0.01 / 8.0;
-
 // Typical consumer-MEMS sizes (tests/effect_trends_test.cc).
-struct HiddenEffect {
+struct HiddenAccelEffect {
   Effect effect;
   double std;
 };
-const HiddenEffect kHidden[] = {
+const HiddenAccelEffect kHiddenAccel[] = {
     {Effect::kAccelQuadratic, 1.5e-4},
     {Effect::kAccelTemperatureBias, 2e-3},
     {Effect::kAccelTemperatureScale, 1e-4},
@@ -130,7 +127,7 @@ TEST(EffectRotations, RowsAreCountedAndTheGyroscopeIsRecovered) {
   SimulatedSession session;
   std::string error;
   ASSERT_TRUE(Simulate(TwelvePoseWarmUp(), 1, &session, &error)) << error;
-  std::vector<StaticObservation> obs = SessionObservations(session);
+  std::vector<StaticObservation> obs = ObservationsWithTurns(session);
   const EffectFitResult with =
       Fit(obs, session, AccelParameterization::kScaleMisalignment, {Effect::kAccelQuadratic}, true);
   EXPECT_EQ(with.accel_fit.information,
@@ -189,7 +186,7 @@ TEST(EffectRotations, RotationsDetermineWhatMagnitudesCannot) {
   SimulatedSession session;
   std::string error;
   ASSERT_TRUE(Simulate(TwelvePoseWarmUp(), 1, &session, &error)) << error;
-  const std::vector<StaticObservation> obs = SessionObservations(session);
+  const std::vector<StaticObservation> obs = ObservationsWithTurns(session);
   const EffectFitResult before = Fit(obs, session, AccelParameterization::kScaleMisalignment,
                                      {Effect::kAccelQuadratic}, false);
   const EffectFitResult after =
@@ -241,7 +238,7 @@ TEST(EffectRotations, RotationWeightsMatchTheScatter) {
     SimulatedSession session;
     std::string error;
     ASSERT_TRUE(Simulate(TwelvePoseWarmUp(), seed, &session, &error)) << error;
-    const std::vector<StaticObservation> obs = SessionObservations(session);
+    const std::vector<StaticObservation> obs = ObservationsWithTurns(session);
     sum += Fit(obs, session, AccelParameterization::kScaleMisalignment, {}, true)
                .accel_fit.rotation_chi2;
   }
@@ -261,21 +258,21 @@ TEST(EffectRotations, NoFalseEffectWithoutAHiddenOne) {
     SimulatedSession session;
     std::string error;
     ASSERT_TRUE(Simulate(TwelvePoseWarmUp(), seed, &session, &error)) << error;
-    const std::vector<StaticObservation> obs = SessionObservations(session);
+    const std::vector<StaticObservation> obs = ObservationsWithTurns(session);
     const SensorFitSummary base =
         Fit(obs, session, AccelParameterization::kScaleMisalignment, {}, true).accel_fit;
     for (int i = 0; i < 4; ++i) {
-      const SensorFitSummary ext =
-          Fit(obs, session, AccelParameterization::kScaleMisalignment, {kHidden[i].effect}, true)
-              .accel_fit;
+      const SensorFitSummary ext = Fit(obs, session, AccelParameterization::kScaleMisalignment,
+                                       {kHiddenAccel[i].effect}, true)
+                                       .accel_fit;
       const double p =
           ChiSquareUpperTail(base.chi2 - ext.chi2, ext.num_parameters - base.num_parameters);
-      if (p >= kLevel) ++quiet[i];
+      if (p >= kCandidateLevel) ++quiet[i];
     }
   }
   for (int i = 0; i < 4; ++i) {
-    std::printf("%s: not significant in %d of 20\n", ToString(kHidden[i].effect), quiet[i]);
-    EXPECT_GE(quiet[i], 19) << ToString(kHidden[i].effect);
+    std::printf("%s: not significant in %d of 20\n", ToString(kHiddenAccel[i].effect), quiet[i]);
+    EXPECT_GE(quiet[i], 19) << ToString(kHiddenAccel[i].effect);
   }
 }
 
@@ -286,14 +283,14 @@ TEST(EffectRotations, NoFalseEffectWithoutAHiddenOne) {
 // seeds, rms in [0.8, 1.25] and within the honest band, k2_z among them.
 TEST(EffectRotations, CalibrateEstimatesAllFourEffectsWithHonestSigmas) {
   SimulatorOptions sim = TwelvePoseWarmUp();
-  for (const HiddenEffect& h : kHidden) sim = WithHidden(sim, h.effect, h.std);
+  for (const HiddenAccelEffect& h : kHiddenAccel) sim = WithHidden(sim, h.effect, h.std);
   testing_util::SigmaCheck check;
   for (int seed = 1; seed <= 30; ++seed) {
     SimulatedSession session;
     std::string error;
     ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
     std::vector<Effect> effects;
-    for (const HiddenEffect& h : kHidden) effects.push_back(h.effect);
+    for (const HiddenAccelEffect& h : kHiddenAccel) effects.push_back(h.effect);
     Calibration calibration;
     ASSERT_TRUE(CalibrateWithEffects(session, effects, true, &calibration)) << calibration.message;
     EXPECT_NE(calibration.message.find("rotations between poses"), std::string::npos)
@@ -310,7 +307,7 @@ TEST(EffectRotations, CalibrateEstimatesAllFourEffectsWithHonestSigmas) {
   }
   std::printf("%s", check.Table().c_str());
   EXPECT_EQ(check.Count("all"), 360);
-  for (const HiddenEffect& h : kHidden) {
+  for (const HiddenAccelEffect& h : kHiddenAccel) {
     EXPECT_GT(check.Rms(ToString(h.effect)), 0.8) << ToString(h.effect);
     EXPECT_LT(check.Rms(ToString(h.effect)), 1.25) << ToString(h.effect);
   }
@@ -334,15 +331,15 @@ TEST(EffectRotations, HiddenGyroscopeEffectsAreNotTakenForAccelerometerOnes) {
       SimulatedSession session;
       std::string error;
       ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
-      const std::vector<StaticObservation> obs = SessionObservations(session);
+      const std::vector<StaticObservation> obs = ObservationsWithTurns(session);
       const EffectFitResult base =
           Fit(obs, session, AccelParameterization::kScaleMisalignment, {}, true);
       if (!base.warnings.empty()) ++warned;
-      for (const HiddenEffect& h : kHidden) {
+      for (const HiddenAccelEffect& h : kHiddenAccel) {
         const SensorFitSummary ext =
             Fit(obs, session, AccelParameterization::kScaleMisalignment, {h.effect}, true)
                 .accel_fit;
-        if (ChiSquareUpperTail(base.accel_fit.chi2 - ext.chi2, 3) < kLevel) ++significant;
+        if (ChiSquareUpperTail(base.accel_fit.chi2 - ext.chi2, 3) < kCandidateLevel) ++significant;
       }
       if (which == 2 && seed == 1) {
         Calibration calibration;

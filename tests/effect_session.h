@@ -25,6 +25,10 @@ constexpr double kTemperatureBias = 0.002;
 constexpr double kTemperatureScale = 1e-4;
 constexpr double kBiasDrift = 8e-5;
 
+// The family-wise level of discovery (discovery_significance 0.01) divided
+// over the eight candidates of the catalogue.
+constexpr double kCandidateLevel = 0.01 / 8.0;
+
 // The seed's twelve poses held 30 s during a warm-up 20 -> 35 degC (time
 // constant 200 s, so the poses see different temperature rates), with the
 // hand_placed.yaml correlated accelerometer noise on top of the default

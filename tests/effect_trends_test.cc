@@ -27,15 +27,12 @@ namespace gravcal {
 namespace {
 
 using internal::ChiSquareUpperTail;
+using testing_util::kCandidateLevel;
 using testing_util::Nominal;
 using testing_util::References;
 using testing_util::SessionIntervals;
 using testing_util::TwelvePoseWarmUp;
 using testing_util::WithHidden;
-
-// The family-wise level of discovery (discovery_significance 0.01) divided
-// over the eight candidates of the catalogue.
-constexpr double kLevel = 0.01 / 8.0;
 
 struct HiddenEffect {
   Effect effect;
@@ -192,7 +189,7 @@ TEST(EffectTrends, TwelvePositionsDetectEveryAccelEffect) {
       std::string error;
       ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
       const std::vector<StaticObservation> obs = SessionObservations(session);
-      if (LikelihoodRatioP(obs, session, h) < kLevel) ++significant;
+      if (LikelihoodRatioP(obs, session, h) < kCandidateLevel) ++significant;
       if (seed == 1) {
         const SensorFitSummary f = AccelFit(obs, session, h.baseline, {h.effect});
         EXPECT_EQ(f.information, "position magnitudes + within-pose trends");
@@ -217,7 +214,7 @@ TEST(EffectTrends, TwelvePositionsWithoutHiddenEffectShowNone) {
     ASSERT_TRUE(Simulate(sim, seed, &session, &error)) << error;
     const std::vector<StaticObservation> obs = SessionObservations(session);
     for (int i = 0; i < 4; ++i) {
-      if (LikelihoodRatioP(obs, session, kHidden[i]) >= kLevel) ++quiet[i];
+      if (LikelihoodRatioP(obs, session, kHidden[i]) >= kCandidateLevel) ++quiet[i];
     }
   }
   for (int i = 0; i < 4; ++i) {

@@ -14,10 +14,14 @@
 #include <string>
 #include <vector>
 
+#include "cli_runner.h"
 #include "test_util.h"
 
 namespace gravcal {
 namespace {
+
+using testing_util::FileExists;
+using testing_util::Slurp;
 
 // True when `text` contains `part`; gtest prints both on failure.
 ::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
@@ -35,15 +39,6 @@ void WriteText(const std::string& path, const std::string& text) {
   out << text;
   ASSERT_TRUE(out.good()) << path;
 }
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
-bool FileExists(const std::string& path) { return access(path.c_str(), F_OK) == 0; }
 
 bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
 
@@ -113,7 +108,7 @@ TEST(LogReader, WriteThenReadIsBitExact) {
       ASSERT_TRUE(ReadImuLog(path, LogReaderOptions(), &read, &error)) << error;
       EXPECT_EQ(read.source, path);
       ExpectSameBits(log, read);
-      const std::string text = ReadText(path);
+      const std::string text = Slurp(path);
       std::string header = "t,ax,ay,az";
       if (gyro) header += ",gx,gy,gz";
       if (temperature) header += ",temp";
@@ -416,7 +411,7 @@ TEST(LogReader, WriteFileAtomically) {
   std::string error;
   ASSERT_TRUE(WriteFileAtomically(path, "first", &error)) << error;
   ASSERT_TRUE(WriteFileAtomically(path, "second\n", &error)) << error;
-  EXPECT_EQ(ReadText(path), "second\n");
+  EXPECT_EQ(Slurp(path), "second\n");
   EXPECT_FALSE(FileExists(path + ".tmp." + std::to_string(getpid())));
   std::remove(path.c_str());
 

@@ -17,7 +17,7 @@
 namespace gravcal {
 namespace {
 
-constexpr double kRate = 100.0;
+constexpr double kSampleRate = 100.0;
 // Raw units: counts of 1/1000 g.
 constexpr double kScale = kStandardGravity / 1000.0;
 
@@ -25,7 +25,7 @@ constexpr double kScale = kStandardGravity / 1000.0;
 // counts; the interval and the white-noise position.
 void Pose(const NoiseProcessOptions& o, uint64_t seed, double seconds, ImuLog* log,
           std::vector<StaticInterval>* intervals) {
-  const size_t n = static_cast<size_t>(seconds * kRate);
+  const size_t n = static_cast<size_t>(seconds * kSampleRate);
   const size_t begin = log->size();
   StaticInterval s;
   s.begin = begin;
@@ -33,7 +33,7 @@ void Pose(const NoiseProcessOptions& o, uint64_t seed, double seconds, ImuLog* l
   std::vector<NoiseProcess> axes;
   for (int a = 0; a < 3; ++a) axes.emplace_back(o, seed * 4 + a);
   for (size_t i = 0; i < n; ++i) {
-    log->t.push_back((begin + i) / kRate);
+    log->t.push_back((begin + i) / kSampleRate);
     Eigen::Vector3d v(0.0, 0.0, kStandardGravity);
     for (int a = 0; a < 3; ++a) v[a] += axes[a].Next();
     log->accel.push_back(v / kScale);

@@ -18,11 +18,10 @@ namespace {
 
 using testing_util::FreeParameters;
 
+using testing_util::kCountScale;
 using testing_util::MakePositions;
 using testing_util::TwelveDirections;
 
-constexpr double kG = 9.80665;
-constexpr double kCountScale = kG / 16384.0;
 constexpr double kTilt = 2.0 * M_PI / 180.0;
 
 AccelModel Truth(std::mt19937_64* rng, double scale = kCountScale) {
@@ -31,7 +30,8 @@ AccelModel Truth(std::mt19937_64* rng, double scale = kCountScale) {
 
 AccelModel Coarse(const std::vector<Position>& positions, AccelParameterization p) {
   CoarseFitResult coarse;
-  EXPECT_TRUE(CoarseFit(positions, kG, p, CoarseFitOptions(), &coarse)) << coarse.message;
+  EXPECT_TRUE(CoarseFit(positions, kStandardGravity, p, CoarseFitOptions(), &coarse))
+      << coarse.message;
   return coarse.model;
 }
 
@@ -39,7 +39,7 @@ TEST(Refinement, AnalyticJacobianMatchesAutodiffResidual) {
   std::mt19937_64 rng(11);
   const AccelModel truth = Truth(&rng);
   const auto positions =
-      MakePositions(truth, TwelveDirections(), kG, kTilt, 0.02, 1000, false, &rng);
+      MakePositions(truth, TwelveDirections(), kStandardGravity, kTilt, 0.02, 1000, false, &rng);
   AccelModel at = truth;
   at.bias += Eigen::Vector3d(5, -3, 2);
   const std::vector<double> sigmas = MagnitudeSigmas(positions, at);
@@ -49,7 +49,7 @@ TEST(Refinement, AnalyticJacobianMatchesAutodiffResidual) {
   at.GetUpper(upper);
   for (size_t k = 0; k < positions.size(); ++k) {
     std::unique_ptr<ceres::CostFunction> cost(
-        GravityMagnitudeResidual::Create(positions[k].raw_mean, kG, sigmas[k]));
+        GravityMagnitudeResidual::Create(positions[k].raw_mean, kStandardGravity, sigmas[k]));
     double residual;
     double jb[3], ju[6];
     double* jacobians[2] = {jb, ju};
@@ -77,7 +77,7 @@ TEST(Refinement, TwelveColumnJacobianHasRankNine) {
   for (int trial = 0; trial < 5; ++trial) {
     const AccelModel truth = Truth(&rng);
     const auto positions =
-        MakePositions(truth, TwelveDirections(), kG, kTilt, 0.02, 1000, false, &rng);
+        MakePositions(truth, TwelveDirections(), kStandardGravity, kTilt, 0.02, 1000, false, &rng);
     const std::vector<double> sigmas(positions.size(), 1.0);
     // At the truth and at a point away from it.
     for (double offset : {0.0, 20.0}) {
@@ -110,19 +110,19 @@ TEST(Refinement, CeresAndNewtonReachTheSameOptimum) {
   for (int trial = 0; trial < 10; ++trial) {
     const AccelModel truth = Truth(&rng);
     for (double noise : {0.0, 0.02}) {
-      auto positions =
-          MakePositions(truth, TwelveDirections(), kG, kTilt, noise, 1000, false, &rng);
+      auto positions = MakePositions(truth, TwelveDirections(), kStandardGravity, kTilt, noise,
+                                     1000, false, &rng);
       if (noise == 0.0) {
         // The sigmas must still be positive: give the clean positions a nominal covariance.
         for (Position& p : positions) p.raw_mean_cov = 1e-4 * Eigen::Matrix3d::Identity();
       }
       const AccelModel start = Coarse(positions, AccelParameterization::kScaleMisalignment);
       RefinementResult ceres_result, newton_result;
-      ASSERT_TRUE(Refine(positions, start, kG, RefinementOptions(), &ceres_result));
+      ASSERT_TRUE(Refine(positions, start, kStandardGravity, RefinementOptions(), &ceres_result));
       NewtonOptions newton;
       newton.residual =
           noise == 0.0 ? NewtonResidual::kSquaredMagnitude : NewtonResidual::kMagnitude;
-      ASSERT_TRUE(NewtonRefine(positions, start, kG, newton, &newton_result));
+      ASSERT_TRUE(NewtonRefine(positions, start, kStandardGravity, newton, &newton_result));
       ASSERT_TRUE(ceres_result.converged) << ceres_result.message;
       ASSERT_TRUE(newton_result.converged) << newton_result.message;
       ASSERT_TRUE(ceres_result.covariance_available);
@@ -162,12 +162,12 @@ void CheckCalibratedUncertainty(AccelParameterization p, double unit_scale) {
         AccelModel::Random(p == AccelParameterization::kScale ? p : AccelParameterization::kAffine,
                            unit_scale, 0.02, 0.01, 0.3 / unit_scale, &rng);
     const auto positions =
-        MakePositions(truth, TwelveDirections(), kG, kTilt, 0.02, 1000, false, &rng);
+        MakePositions(truth, TwelveDirections(), kStandardGravity, kTilt, 0.02, 1000, false, &rng);
     const AccelModel start = Coarse(positions, p);
     RefinementOptions options;
     options.parameterization = p;
     RefinementResult result;
-    ASSERT_TRUE(Refine(positions, start, kG, options, &result));
+    ASSERT_TRUE(Refine(positions, start, kStandardGravity, options, &result));
     ASSERT_TRUE(result.converged);
     ASSERT_TRUE(result.covariance_available);
     const Eigen::VectorXd err = FreeParameters(result.model, p) - FreeParameters(truth, p);
@@ -205,7 +205,8 @@ TEST(Refinement, RobustLossResistsDisturbedPositions) {
     const AccelModel truth = Truth(&rng);
     auto directions = TwelveDirections();
     for (int k = 0; k < 6; ++k) directions.push_back(testing_util::RandomDirection(&rng));
-    auto positions = MakePositions(truth, directions, kG, kTilt, 0.02, 1000, false, &rng);
+    auto positions =
+        MakePositions(truth, directions, kStandardGravity, kTilt, 0.02, 1000, false, &rng);
     // An unmodelled 0.3 m/s^2 push on two of the eighteen positions, along
     // the specific force (a push across it barely changes the magnitude).
     // Neither is a position that alone pins a direction of the model (a
@@ -221,7 +222,7 @@ TEST(Refinement, RobustLossResistsDisturbedPositions) {
       RefinementOptions options;
       options.loss = loss;
       RefinementResult result;
-      ASSERT_TRUE(Refine(positions, start, kG, options, &result));
+      ASSERT_TRUE(Refine(positions, start, kStandardGravity, options, &result));
       const Eigen::VectorXd err = FreeParameters(result.model, options.parameterization) -
                                   FreeParameters(truth, options.parameterization);
       bool within = result.covariance_available;
@@ -247,9 +248,10 @@ TEST(Refinement, RankDeficientPositionsWarnInsteadOfCrashing) {
     const double a = 2 * M_PI * k / 12;
     directions.emplace_back(std::cos(a), std::sin(a), 0.0);
   }
-  const auto positions = MakePositions(truth, directions, kG, 0.0, 0.02, 1000, false, &rng);
+  const auto positions =
+      MakePositions(truth, directions, kStandardGravity, 0.0, 0.02, 1000, false, &rng);
   RefinementResult result;
-  ASSERT_TRUE(Refine(positions, truth, kG, RefinementOptions(), &result));
+  ASSERT_TRUE(Refine(positions, truth, kStandardGravity, RefinementOptions(), &result));
   bool warned = false;
   for (const std::string& w : result.warnings)
     warned |= w.find("do not determine") != std::string::npos;
@@ -263,14 +265,15 @@ TEST(Refinement, RankDeficientPositionsWarnInsteadOfCrashing) {
 TEST(Refinement, InvalidOptionsAndTooFewPositions) {
   std::mt19937_64 rng(15);
   const AccelModel truth = Truth(&rng);
-  auto positions = MakePositions(truth, TwelveDirections(), kG, kTilt, 0.02, 1000, false, &rng);
+  auto positions =
+      MakePositions(truth, TwelveDirections(), kStandardGravity, kTilt, 0.02, 1000, false, &rng);
   RefinementOptions options;
   options.loss_scale = -1;
   RefinementResult result;
-  EXPECT_FALSE(Refine(positions, truth, kG, options, &result));
+  EXPECT_FALSE(Refine(positions, truth, kStandardGravity, options, &result));
   EXPECT_NE(result.message.find("loss_scale"), std::string::npos);
   positions.resize(8);
-  EXPECT_FALSE(Refine(positions, truth, kG, RefinementOptions(), &result));
+  EXPECT_FALSE(Refine(positions, truth, kStandardGravity, RefinementOptions(), &result));
   EXPECT_NE(result.message.find("at least 9"), std::string::npos) << result.message;
   EXPECT_NE(result.message.find("found 8"), std::string::npos) << result.message;
 }

@@ -32,6 +32,7 @@
 namespace gravcal {
 namespace {
 
+using testing_util::Count;
 using testing_util::RunCli;
 using testing_util::ScratchDir;
 using testing_util::Slurp;
@@ -111,12 +112,6 @@ LoadedPage Load(const std::string& html, const ScratchDir& dir) {
     if (line.find(":CONSOLE") != std::string::npos) page.console.push_back(line);
   }
   return page;
-}
-
-size_t Count(const std::string& text, const std::string& needle) {
-  size_t n = 0;
-  for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
-  return n;
 }
 
 // The value of attribute `name` of the first element after `from`.

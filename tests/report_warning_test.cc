@@ -21,15 +21,10 @@
 namespace gravcal {
 namespace {
 
+using testing_util::Count;
 using testing_util::RunCli;
 using testing_util::ScratchDir;
 using testing_util::Slurp;
-
-size_t Count(const std::string& text, const std::string& needle) {
-  size_t n = 0;
-  for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
-  return n;
-}
 
 // The codes of the report's warning rows, in order.
 std::vector<std::string> RowCodes(const std::string& html) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gravcal/core/accel_model.h"
+#include "gravcal/core/gravity.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/position.h"
 #include "gravcal/estimation/refinement.h"
@@ -24,6 +25,9 @@
 
 namespace gravcal {
 namespace testing_util {
+
+// A 16-bit accelerometer at +-2 g full scale: m/s^2 per count.
+constexpr double kCountScale = kStandardGravity / 16384.0;
 
 // The free magnitude parameters (b, free entries of U) of a model, in the
 // order of the refinement's covariance.

@@ -161,7 +161,7 @@ TEST_P(HandPlaced, ErrorOverSigmaRmsIsNearOne) {
   }
 }
 
-std::string CaseName(const ::testing::TestParamInfo<int>& info) {
+std::string HandPlacedCaseName(const ::testing::TestParamInfo<int>& info) {
   std::string name = HandPlacedCases(false)[info.param].name;
   for (char& c : name) {
     if (!isalnum(static_cast<unsigned char>(c))) c = '_';
@@ -171,7 +171,7 @@ std::string CaseName(const ::testing::TestParamInfo<int>& info) {
 
 INSTANTIATE_TEST_SUITE_P(Methods, HandPlaced,
                          ::testing::Range(0, static_cast<int>(HandPlacedCases(false).size())),
-                         CaseName);
+                         HandPlacedCaseName);
 
 }  // namespace
 }  // namespace testing_util

@@ -240,7 +240,7 @@ TEST_P(MethodProperty, ErrorOverSigmaIsStandardNormal) {
   }
 }
 
-std::string CaseName(const ::testing::TestParamInfo<int>& info) {
+std::string MethodCaseName(const ::testing::TestParamInfo<int>& info) {
   std::string name = AllCases()[info.param].name;
   for (char& c : name) {
     if (!isalnum(static_cast<unsigned char>(c))) c = '_';
@@ -249,7 +249,7 @@ std::string CaseName(const ::testing::TestParamInfo<int>& info) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, MethodProperty,
-                         ::testing::Range(0, static_cast<int>(AllCases().size())), CaseName);
+                         ::testing::Range(0, static_cast<int>(AllCases().size())), MethodCaseName);
 
 }  // namespace
 }  // namespace testing_util
