@@ -10,11 +10,14 @@
 // tests/formats/write_mcap.mjs (Node with @mcap/core installed by .ci/run into
 // <build>/npm_formats). A test whose writer is absent skips and says why.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -66,12 +69,74 @@ nlohmann::json StripTimes(const nlohmann::json& j) {
   return j;
 }
 
-// The session in every format, written once for the suite.
+// What the suite's files are made from, as text: the tool (its size and
+// modification time), the writers' and the config's modification times, and
+// whether the MCAP writer is installed. Files written from the same sources
+// are the same files.
+std::string SourcesKey() {
+  namespace fs = std::filesystem;
+  std::string key;
+  for (const std::string& path :
+       {std::string(GRAVCAL_CLI_PATH),
+        std::string(GRAVCAL_SOURCE_DIR) + "/tests/formats/write_formats.py",
+        std::string(GRAVCAL_SOURCE_DIR) + "/tests/formats/write_mcap.mjs", kConfig}) {
+    std::error_code ec;
+    const auto size = fs::file_size(path, ec);
+    const auto time = fs::last_write_time(path, ec);
+    key += path + ":" + std::to_string(ec ? 0 : size) + ":" +
+           std::to_string(ec ? 0 : time.time_since_epoch().count()) + ";";
+  }
+  key += FileExists(NpmModules() + "/@mcap/core") ? "mcap" : "no-mcap";
+  return key;
+}
+
+// <build>/formats_cache/<hash of SourcesKey()>: the suite's input files and
+// the contract CSV's calibration, kept once they are written. ctest starts
+// every test in its own process, so without it each of them simulated the
+// session and ran both writers again (about 4 s of a test's 5).
+std::string CacheDir() {
+  char hash[32];
+  std::snprintf(hash, sizeof(hash), "%016zx", std::hash<std::string>()(SourcesKey()));
+  return std::filesystem::path(GRAVCAL_CLI_PATH).parent_path().string() + "/formats_cache/" + hash;
+}
+
+// The session in every format, written once per build (CacheDir) and copied
+// into the suite's scratch folder, where the tests write their outputs.
 class Formats : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
+    namespace fs = std::filesystem;
     scratch_ = new ScratchDir();
     const ScratchDir& s = *scratch_;
+    const std::string cache = CacheDir();
+    std::error_code ec;
+    if (fs::is_directory(cache, ec)) {
+      fs::copy(cache, s.path(), fs::copy_options::recursive | fs::copy_options::overwrite_existing,
+               ec);
+      ASSERT_FALSE(ec) << cache << ": " << ec.message();
+    } else {
+      WriteEveryFormat(s);
+      if (HasFatalFailure()) return;
+      // Published whole or not at all: a copy renamed into place. A process
+      // that loses the race to another writer drops its copy; the files of
+      // an earlier build's tool are removed.
+      const fs::path root = fs::path(cache).parent_path();
+      const std::string staging = cache + ".staging." + std::to_string(getpid());
+      fs::create_directories(root, ec);
+      fs::copy(s.path(), staging, fs::copy_options::recursive, ec);
+      if (!ec) fs::rename(staging, cache, ec);
+      if (ec) fs::remove_all(staging, ec);
+      for (const fs::directory_entry& e : fs::directory_iterator(root, ec)) {
+        const std::string name = e.path().filename().string();
+        if (name.size() == 16 && e.path() != fs::path(cache)) fs::remove_all(e.path(), ec);
+      }
+    }
+    reference_ = new nlohmann::json(StripTimes(nlohmann::json::parse(Slurp(s / "contract.json"))));
+  }
+
+  // Simulates the session into `s` and writes it in every format, with the
+  // contract CSV's calibration beside it (contract.json).
+  static void WriteEveryFormat(const ScratchDir& s) {
     const auto simulated =
         RunCli({"simulate", "--config", kConfig, "--seed", "3", "--output-dir", s / "sim"}, s);
     ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
@@ -89,7 +154,6 @@ class Formats : public ::testing::Test {
                                    "--output", s / "contract.json"},
                                   s);
     ASSERT_EQ(reference.exit_code, 0) << reference.err;
-    reference_ = new nlohmann::json(StripTimes(nlohmann::json::parse(Slurp(s / "contract.json"))));
   }
   static void TearDownTestSuite() {
     delete reference_;

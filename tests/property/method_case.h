@@ -130,23 +130,34 @@ inline SeedOutcome RunSeed(const MethodCase& method, uint64_t seed) {
   return out;
 }
 
+// run(seed) for the seeds [first, first + count) on `threads` threads; the
+// results in seed order, so what the caller makes of them does not depend
+// on the number of threads. `run` must not use gtest's ASSERT_* (a failed
+// one would end only its thread's call); it returns what went wrong.
+template <typename Run>
+auto RunSeeds(int first, int count, int threads, const Run& run)
+    -> std::vector<decltype(run(first))> {
+  std::vector<decltype(run(first))> outcomes(std::max(count, 0));
+  std::atomic<int> next{0};
+  auto work = [&]() {
+    for (int i = next++; i < count; i = next++) outcomes[i] = run(first + i);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  return outcomes;
+}
+
 // Runs seeds [first, first + count) on `threads` threads and adds every
 // seed's errors to `check` in seed order (the result does not depend on the
 // number of threads), those of method.known_failures to `known` instead.
 // Returns the seeds that failed to simulate or calibrate.
 inline std::vector<SeedOutcome> RunMethodCase(const MethodCase& method, int first, int count,
                                               int threads, SigmaCheck* check, SigmaCheck* known) {
-  std::vector<SeedOutcome> outcomes(count);
-  std::atomic<int> next{0};
-  auto work = [&]() {
-    for (int i = next++; i < count; i = next++) {
-      outcomes[i] = RunSeed(method, static_cast<uint64_t>(first + i));
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+  const std::vector<SeedOutcome> outcomes = RunSeeds(first, count, threads, [&](int seed) {
+    return RunSeed(method, static_cast<uint64_t>(seed));
+  });
   std::vector<SeedOutcome> failed;
   for (const SeedOutcome& o : outcomes) {
     if (!o.ok) {

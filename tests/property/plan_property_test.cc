@@ -41,22 +41,36 @@ void CheckSpread(const Config& config, size_t poses, const std::string& label,
   const SensorPrediction& s = p.sensor;
   int first = 1, count = kDefaultSeeds;
   PropertySeeds(&first, &count);
-  SigmaCheck check;
-  std::vector<double> sum_squares(s.parameter_names.size(), 0.0);
-  std::string error;
-  for (int seed = first; seed < first + count; ++seed) {
+  // Each seed's parameter errors, or what went wrong with it.
+  struct Seed {
+    std::string failure;
+    std::vector<double> errors;
+  };
+  const std::vector<Seed> seeds = RunSeeds(first, count, PropertyThreads(), [&](int seed) {
+    Seed out;
     SimulatedSession session;
-    ASSERT_TRUE(Simulate(config.simulation, seed, &session, &error)) << error;
+    if (!Simulate(config.simulation, seed, &session, &out.failure)) return out;
     PipelineInput input;
     input.log = session.log;
     input.source = "seed " + std::to_string(seed);
     Calibration calibration;
-    ASSERT_TRUE(RunCalibration(config, input, &calibration)) << calibration.message;
-    ASSERT_EQ(calibration.positions.size(), poses) << "seed " << seed;
-    const std::vector<double> errors = p.errors(session, calibration);
+    if (!RunCalibration(config, input, &calibration)) {
+      out.failure = "seed " + std::to_string(seed) + ": " + calibration.message;
+    } else if (calibration.positions.size() != poses) {
+      out.failure = "seed " + std::to_string(seed) + ": " +
+                    std::to_string(calibration.positions.size()) + " positions";
+    } else {
+      out.errors = p.errors(session, calibration);
+    }
+    return out;
+  });
+  SigmaCheck check;
+  std::vector<double> sum_squares(s.parameter_names.size(), 0.0);
+  for (const Seed& seed : seeds) {
+    ASSERT_TRUE(seed.failure.empty()) << seed.failure;
     for (size_t i = 0; i < s.parameter_names.size(); ++i) {
-      check.Add(s.parameter_names[i], errors[i], s.predicted_std(i));
-      sum_squares[i] += errors[i] * errors[i];
+      check.Add(s.parameter_names[i], seed.errors[i], s.predicted_std(i));
+      sum_squares[i] += seed.errors[i] * seed.errors[i];
     }
   }
   std::printf("%s: %zu poses\n%s", label.c_str(), poses, check.Table().c_str());
