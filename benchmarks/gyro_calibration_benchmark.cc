@@ -4,12 +4,14 @@
 // timed loop.
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/methods/gyro_calibration.h"
 #include "gravcal/methods/twelve_position.h"
+#include "gravcal/residuals/gyro_rotation_residual.h"
 #include "gravcal/simulation/simulator.h"
 
 namespace gravcal {
@@ -64,6 +66,44 @@ void BM_GyroCalibration(benchmark::State& state) {
   state.counters["failures"] = failures;
 }
 BENCHMARK(BM_GyroCalibration)->ArgsProduct({{12, 40}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
+
+// The derivatives of one turn's attitude change (300 samples at 100 Hz, a
+// rate up to 2 rad/s sweeping its axis) with respect to b_g, M_g and G, as
+// the rotation residuals need them at every solver iteration. range(0): 0 =
+// dual numbers carried through every sample (IntegrateGyroRotation with
+// ceres::Jet<double, 21>), 1 = IntegrateGyroRotationJacobian (what the
+// residuals use).
+void BM_TurnDerivatives(benchmark::State& state) {
+  GyroRotationData turn;
+  for (int k = 0; k < 300; ++k) {
+    const double t = 0.01 * k;
+    const double s = std::sin(M_PI * k / 300.0);
+    turn.t.push_back(t);
+    turn.gyro.push_back(Eigen::Vector3d(std::cos(3.0 * t), std::sin(2.0 * t), 0.5) * 2.0 * s /
+                        0.01);
+    turn.force.push_back(Eigen::Vector3d(0.5, -2.0, 9.5));
+  }
+  double b[3] = {1.0, -2.0, 0.5}, m[9] = {0.01, 1e-4, 0.0, -1e-4, 0.01, 2e-4, 0.0, 0.0, 0.01};
+  double g[9] = {1e-4, 0.0, 0.0, 0.0, -1e-4, 0.0, 0.0, 0.0, 2e-4};
+  using Dual = ceres::Jet<double, 21>;
+  Dual db[3], dm[9], dg[9];
+  for (int i = 0; i < 3; ++i) db[i] = Dual(b[i], i);
+  for (int i = 0; i < 9; ++i) dm[i] = Dual(m[i], 3 + i);
+  for (int i = 0; i < 9; ++i) dg[i] = Dual(g[i], 12 + i);
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      Dual dq[4];
+      IntegrateGyroRotation<Dual>(turn, db, dm, dg, dq);
+      benchmark::DoNotOptimize(dq);
+    } else {
+      double dq[4];
+      Eigen::Matrix<double, 4, 21> jacobian;
+      IntegrateGyroRotationJacobian(turn, b, m, g, dq, &jacobian);
+      benchmark::DoNotOptimize(jacobian);
+    }
+  }
+}
+BENCHMARK(BM_TurnDerivatives)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace gravcal

@@ -1,18 +1,25 @@
 // Issue 17: every HTML report (calibrate, batch, noise, discover, plan --report)
-// opened in a real browser. Headless Chromium loads the file (file://, no
-// network); a test fails on any console message (the reports log nothing, so
+// opened in a real browser. Headless Chromium, driven over its DevTools
+// protocol, loads the file (file://, no network); a test fails on any
+// console message or uncaught exception (the reports log nothing, so
 // any message is an error or a warning), checks the sections in the DOM the
 // browser built (for example one shaded interval per position of the
 // calibration JSON), checks that every axis's tick labels are round numbers,
 // and saves a full-page screenshot into <build>/report_screenshots/. Skipped
 // with a message when no Chromium is installed (.ci/run installs the Debian
 // package `chromium`).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <poll.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <set>
@@ -62,37 +69,205 @@ std::string Browser() {
                     "does): the reports are not opened in a browser";                      \
   }
 
-// Runs the browser with `args` (no shell); stdout and stderr into files.
-int RunBrowser(std::vector<std::string> args, const std::string& out, const std::string& err) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int null = open("/dev/null", O_RDWR);
-    const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(null, 0);
-    dup2(o, 1);
-    dup2(e, 2);
-    std::string program = Browser();
-    std::vector<char*> argv = {program.data()};
-    for (std::string& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(program.c_str(), argv.data());
-    _exit(127);
+// Bytes of base64 `text` (the DevTools protocol's encoding of a screenshot).
+std::string DecodeBase64(const std::string& text) {
+  std::string out;
+  int bits = 0, value = 0;
+  for (char ch : text) {
+    int v = -1;
+    if (ch >= 'A' && ch <= 'Z') v = ch - 'A';
+    if (ch >= 'a' && ch <= 'z') v = ch - 'a' + 26;
+    if (ch >= '0' && ch <= '9') v = ch - '0' + 52;
+    if (ch == '+') v = 62;
+    if (ch == '/') v = 63;
+    if (v < 0) continue;
+    value = (value << 6) | v;
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<char>((value >> bits) & 0xff));
+    }
   }
-  return testing_util::WaitForExit(pid);
+  return out;
 }
 
-std::vector<std::string> HeadlessFlags() {
-  // --no-sandbox: CI runs as root; no GPU in a container.
-  return {
-      "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--enable-logging=stderr",
-      "--v=0"};
-}
+// Headless Chromium driven over the DevTools protocol on a pipe
+// (--remote-debugging-pipe: it reads commands on its fd 3 and writes replies
+// and events on its fd 4, each a JSON text ended by a NUL), so one start of
+// the browser loads a page, reads its DOM and takes the screenshot (two
+// starts with --dump-dom and --screenshot took twice as long). Every console
+// message and uncaught exception of the page is collected.
+class DevToolsBrowser {
+ public:
+  // Starts the browser on about:blank with a 1280-pixel-wide window and
+  // attaches to its page; false with *error when that fails.
+  bool Start(const std::string& log, std::string* error) {
+    std::signal(SIGPIPE, SIG_IGN);  // a browser that died is a read error
+    int commands[2], replies[2];
+    if (pipe(commands) != 0 || pipe(replies) != 0) return Fail("pipe", error);
+    pid_ = fork();
+    if (pid_ == 0) {
+      // Above the fds the child ends up with, then onto 3 and 4.
+      const int in = fcntl(commands[0], F_DUPFD, 10);
+      const int out = fcntl(replies[1], F_DUPFD, 10);
+      const int null = open("/dev/null", O_RDWR);
+      const int err = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(null, 0);
+      dup2(null, 1);
+      dup2(err, 2);
+      dup2(in, 3);
+      dup2(out, 4);
+      for (int fd = 5; fd < 64; ++fd) close(fd);
+      std::string program = Browser();
+      std::vector<std::string> args = {program,
+                                       "--headless",
+                                       "--no-sandbox",
+                                       "--disable-gpu",
+                                       "--hide-scrollbars",
+                                       "--remote-debugging-pipe",
+                                       "--window-size=1280,800",
+                                       "about:blank"};
+      std::vector<char*> argv;
+      for (std::string& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(program.c_str(), argv.data());
+      _exit(127);
+    }
+    close(commands[0]);
+    close(replies[1]);
+    to_ = commands[1];
+    from_ = replies[0];
+    if (pid_ < 0) return Fail("fork", error);
+    nlohmann::json targets;
+    if (!Call("Target.getTargets", {}, false, &targets, error)) return false;
+    std::string target;
+    for (const auto& t : targets["targetInfos"]) {
+      if (t.value("type", "") == "page") target = t.value("targetId", "");
+    }
+    if (target.empty()) return Fail("no page target", error);
+    nlohmann::json attached;
+    if (!Call("Target.attachToTarget", {{"targetId", target}, {"flatten", true}}, false, &attached,
+              error)) {
+      return false;
+    }
+    session_ = attached.value("sessionId", "");
+    nlohmann::json ignored;
+    return Call("Runtime.enable", {}, true, &ignored, error) &&
+           Call("Page.enable", {}, true, &ignored, error);
+  }
+
+  ~DevToolsBrowser() {
+    if (pid_ <= 0) return;
+    std::string error;
+    nlohmann::json ignored;
+    if (from_ >= 0) Call("Browser.close", {}, false, &ignored, &error);
+    if (to_ >= 0) close(to_);
+    if (from_ >= 0) close(from_);
+    // Up to 10 s to exit on its own.
+    bool exited = false;
+    for (int i = 0; i < 100 && !exited; ++i) {
+      exited = waitpid(pid_, nullptr, WNOHANG) == pid_;
+      if (!exited) usleep(100000);
+    }
+    if (!exited) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+
+  // Sends `method` (to the page's session when `page`) and waits for its
+  // reply; *result is the reply's result. Events that arrive meanwhile are
+  // kept: console messages in console(), and whether the load event fired.
+  bool Call(const std::string& method, const nlohmann::json& params, bool page,
+            nlohmann::json* result, std::string* error) {
+    nlohmann::json message = {{"id", ++id_}, {"method", method}, {"params", params}};
+    if (page) message["sessionId"] = session_;
+    const std::string text = message.dump() + std::string(1, '\0');
+    for (size_t sent = 0; sent < text.size();) {
+      const ssize_t n = write(to_, text.data() + sent, text.size() - sent);
+      if (n <= 0) return Fail(method + ": the browser closed its pipe", error);
+      sent += static_cast<size_t>(n);
+    }
+    nlohmann::json reply;
+    while (true) {
+      if (!Next(&reply, error)) return Fail(method + ": " + *error, error);
+      if (reply.value("id", -1) == id_) break;
+    }
+    if (reply.contains("error")) return Fail(method + ": " + reply["error"].dump(), error);
+    *result = reply.value("result", nlohmann::json::object());
+    return true;
+  }
+
+  // Waits for the page's load event (events since the last navigation).
+  bool WaitForLoad(std::string* error) {
+    nlohmann::json event;
+    while (!loaded_) {
+      if (!Next(&event, error)) return Fail("waiting for the load event: " + *error, error);
+    }
+    return true;
+  }
+
+  void ExpectLoad() { loaded_ = false; }
+  const std::vector<std::string>& console() const { return console_; }
+
+ private:
+  static bool Fail(const std::string& what, std::string* error) {
+    *error = what;
+    return false;
+  }
+
+  // The next message from the browser (within 60 s), noting events.
+  bool Next(nlohmann::json* message, std::string* error) {
+    while (true) {
+      const size_t end = buffer_.find('\0');
+      if (end != std::string::npos) {
+        *message = nlohmann::json::parse(buffer_.substr(0, end), nullptr, false);
+        buffer_.erase(0, end + 1);
+        Note(*message);
+        return true;
+      }
+      pollfd p = {from_, POLLIN, 0};
+      if (poll(&p, 1, 60000) <= 0) return Fail("no reply from the browser in 60 s", error);
+      char chunk[65536];
+      const ssize_t n = read(from_, chunk, sizeof(chunk));
+      if (n <= 0) return Fail("the browser closed its pipe", error);
+      buffer_.append(chunk, static_cast<size_t>(n));
+    }
+  }
+
+  void Note(const nlohmann::json& m) {
+    const std::string method = m.is_object() ? m.value("method", "") : "";
+    if (method == "Page.loadEventFired") loaded_ = true;
+    if (method == "Runtime.consoleAPICalled") {
+      std::string line = "console." + m["params"].value("type", "");
+      for (const auto& a : m["params"].value("args", nlohmann::json::array())) {
+        line += " " + (a.contains("value") ? a["value"].dump() : a.value("description", ""));
+      }
+      console_.push_back(line);
+    }
+    if (method == "Runtime.exceptionThrown") {
+      const nlohmann::json& d = m["params"]["exceptionDetails"];
+      console_.push_back("uncaught: " + d.value("text", "") + " " +
+                         d.value("exception", nlohmann::json::object()).value("description", ""));
+    }
+  }
+
+  pid_t pid_ = -1;
+  int to_ = -1;
+  int from_ = -1;
+  int id_ = 0;
+  std::string session_;
+  std::string buffer_;
+  bool loaded_ = false;
+  std::vector<std::string> console_;
+};
 
 struct LoadedPage {
-  int exit_code = -1;
+  // Empty when the browser loaded the page (and took the screenshot);
+  // otherwise what failed.
+  std::string error;
   std::string dom;
-  // Every console line the page produced.
+  // Every console message and uncaught exception of the page.
   std::vector<std::string> console;
 };
 
@@ -100,17 +275,46 @@ std::string FileUrl(const std::string& path) {
   return "file://" + std::filesystem::absolute(path).string();
 }
 
-LoadedPage Load(const std::string& html, const ScratchDir& dir) {
-  std::vector<std::string> args = HeadlessFlags();
-  args.push_back("--dump-dom");
-  args.push_back(FileUrl(html));
+// Loads `html` in a 1280-pixel-wide window and returns the DOM once the
+// load event has run; with `png`, also saves a screenshot of the whole page
+// (its height from the page's data-height attribute, 600-16000 px).
+LoadedPage Load(const std::string& html, const ScratchDir& dir, const std::string& png = "") {
   LoadedPage page;
-  page.exit_code = RunBrowser(args, dir / "dom.html", dir / "browser.log");
-  page.dom = Slurp(dir / "dom.html");
-  std::istringstream log(Slurp(dir / "browser.log"));
-  for (std::string line; std::getline(log, line);) {
-    if (line.find(":CONSOLE") != std::string::npos) page.console.push_back(line);
+  DevToolsBrowser browser;
+  nlohmann::json r;
+  std::string& error = page.error;
+  if (!browser.Start(dir / "browser.log", &error)) return page;
+  browser.ExpectLoad();
+  if (!browser.Call("Page.navigate", {{"url", FileUrl(html)}}, true, &r, &error) ||
+      !browser.WaitForLoad(&error)) {
+    return page;
   }
+  // After the tasks the load handlers queued.
+  const std::string dom_after_load =
+      "new Promise(done => setTimeout(() => done(document.documentElement.outerHTML), 0))";
+  if (!browser.Call(
+          "Runtime.evaluate",
+          {{"expression", dom_after_load}, {"awaitPromise", true}, {"returnByValue", true}}, true,
+          &r, &error)) {
+    return page;
+  }
+  page.dom = r["result"].value("value", "");
+  if (!png.empty()) {
+    const std::string key = "data-height=\"";
+    const size_t at = page.dom.find(key);
+    const int height = std::max(
+        600, std::min(16000,
+                      at == std::string::npos ? 0 : std::atoi(page.dom.c_str() + at + key.size())));
+    if (!browser.Call(
+            "Emulation.setDeviceMetricsOverride",
+            {{"width", 1280}, {"height", height}, {"deviceScaleFactor", 1}, {"mobile", false}},
+            true, &r, &error) ||
+        !browser.Call("Page.captureScreenshot", {{"format", "png"}}, true, &r, &error)) {
+      return page;
+    }
+    std::ofstream(png, std::ios::binary) << DecodeBase64(r.value("data", ""));
+  }
+  page.console = browser.console();
   return page;
 }
 
@@ -223,22 +427,17 @@ std::string ScreenshotDir() {
 std::string OpenReport(const std::string& html, const std::string& name, const ScratchDir& dir,
                        size_t min_axes) {
   EXPECT_EQ(ExternalReference(Slurp(html)), "") << "the report is not self-contained";
-  const LoadedPage page = Load(html, dir);
-  EXPECT_EQ(page.exit_code, 0) << Slurp(dir / "browser.log");
+  const std::string png = ScreenshotDir() + "/" + name + ".png";
+  std::filesystem::remove(png);
+  const LoadedPage page = Load(html, dir, png);
+  EXPECT_EQ(page.error, "") << Slurp(dir / "browser.log");
   EXPECT_TRUE(page.console.empty()) << "console: " << page.console[0];
   EXPECT_NE(page.dom.find("data-load-ms"), std::string::npos) << "the load event did not run";
   ExpectRoundTicks(page.dom, min_axes);
   // Every warning has its explanation (report_warning_test.cc checks more).
   EXPECT_EQ(Count(page.dom, "warning unexplained"), 0u);
-  const int height =
-      std::max(600, std::min(16000, std::atoi(Attribute(page.dom, "data-height").c_str())));
-  std::vector<std::string> args = HeadlessFlags();
-  const std::string png = ScreenshotDir() + "/" + name + ".png";
-  args.push_back("--window-size=1280," + std::to_string(height));
-  args.push_back("--screenshot=" + png);
-  args.push_back(FileUrl(html));
-  EXPECT_EQ(RunBrowser(args, dir / "shot.out", dir / "shot.log"), 0);
-  EXPECT_TRUE(testing_util::FileExists(png));
+  // A PNG file: its signature.
+  EXPECT_EQ(Slurp(png).substr(0, 8), "\x89PNG\r\n\x1a\n") << png;
   ::testing::Test::RecordProperty("screenshot", png);
   ::testing::Test::RecordProperty("load_ms", Attribute(page.dom, "data-load-ms"));
   const size_t bytes = Slurp(html).size();

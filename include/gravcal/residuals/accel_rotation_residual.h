@@ -89,7 +89,7 @@ struct AccelRotationResidual {
       return false;
     }
     T dq[4];
-    IntegrateTurn(data_.turn, gyro_bias, gyro_matrix, dq);
+    IntegrateGyroTurn(data_.turn, gyro_bias, gyro_matrix, static_cast<const T*>(nullptr), dq);
     WhitenedTurnError<T>(dq, start, end, data_.tangent, data_.sqrt_information, residual);
     return true;
   }
@@ -100,33 +100,6 @@ struct AccelRotationResidual {
   }
 
  private:
-  // The turn dq (IntegrateGyroRotation) at plain values.
-  static void IntegrateTurn(const GyroRotationData& turn, const double* bias, const double* matrix,
-                            double* dq) {
-    IntegrateGyroRotation<double>(turn, bias, matrix, nullptr, dq);
-  }
-
-  // The same for automatic differentiation: dq depends on b_g and M_g
-  // only, so it is integrated with 12-dimensional dual numbers and chained
-  // into the N of the residual's parameters (about 90 % of the fit's time
-  // went into integrating every sample with all N = 33).
-  template <int N>
-  static void IntegrateTurn(const GyroRotationData& turn, const ceres::Jet<double, N>* bias,
-                            const ceres::Jet<double, N>* matrix, ceres::Jet<double, N>* dq) {
-    using Small = ceres::Jet<double, 12>;
-    Small b[3], m[9];
-    for (int i = 0; i < 3; ++i) b[i] = Small(bias[i].a, i);
-    for (int i = 0; i < 9; ++i) m[i] = Small(matrix[i].a, 3 + i);
-    Small q[4];
-    IntegrateGyroRotation<Small>(turn, b, m, nullptr, q);
-    for (int k = 0; k < 4; ++k) {
-      dq[k].a = q[k].a;
-      dq[k].v.setZero();
-      for (int i = 0; i < 3; ++i) dq[k].v += q[k].v[i] * bias[i].v;
-      for (int i = 0; i < 9; ++i) dq[k].v += q[k].v[3 + i] * matrix[i].v;
-    }
-  }
-
   // d = a / |a| of one pose; false when the quadratic term has no root.
   template <typename T>
   static bool Direction(const Eigen::Vector3d& raw, double temperature_offset, double time_offset,

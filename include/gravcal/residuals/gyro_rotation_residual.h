@@ -156,6 +156,167 @@ void IntegrateGyroRotation(const GyroRotationData& data, const T* bias, const T*
   }
 }
 
+// The turn dq of IntegrateGyroRotation (same values, same order of
+// operations) and its Jacobian with respect to the parameters: columns 0-2
+// b_g, 3-11 M_g and 12-20 G (both row-major; the G columns are zero when
+// g_sensitivity is null).
+//
+// Automatic differentiation would carry every parameter through every
+// sample. Instead, with S_i = exp(phi_{i+1}) * ... * exp(phi_{n-2}) the
+// part of the turn after step i and J_r the right Jacobian of the
+// exponential (exp(phi + d) = exp(phi) * exp(J_r(phi) d)),
+//
+//   d dq = dq * (0, e / 2),   e = sum_i R(S_i)^T J_r(phi_i) d phi_i,
+//
+// because S^* * (0, v) * S = (0, R(S)^T v). d phi_i is linear in the
+// changes of the rates of the step's samples (weights c of GyroStepWeights,
+// kappa = h^2 / 12 for the coning term):
+//
+//   d phi_i = sum_j c_j d w_{i-1+j} + kappa (d w_i x w_{i+1} + w_i x d w_{i+1}),
+//
+// so e = sum_k H_k d w_k, with H_k gathered from the steps that use sample
+// k, and d w_k = -M_g d b_g + (d M_g)(u_k - b_g) - (d G) f_k. One pass
+// forward for the steps, one backward for S_i and the H_k.
+//
+//   J_r(phi) = I - (1 - cos t) / t^2 [phi]x + (t - sin t) / t^3 [phi]x^2,  t = |phi|
+inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const double* bias,
+                                          const double* matrix, const double* g_sensitivity,
+                                          double* dq, Eigen::Matrix<double, 4, 21>* jacobian) {
+  jacobian->setZero();
+  dq[0] = 1.0;
+  dq[1] = dq[2] = dq[3] = 0.0;
+  const size_t n = data.t.size();
+  if (n < 2) return;
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(matrix);
+  // The rates w_k, as IntegrateGyroRotation<double> computes them.
+  std::vector<Eigen::Vector3d> w(n), d(n);
+  for (size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d& u = data.gyro[k];
+    for (int j = 0; j < 3; ++j) d[k](j) = u(j) - bias[j];
+    for (int r = 0; r < 3; ++r) {
+      w[k](r) = matrix[3 * r] * d[k](0) + matrix[3 * r + 1] * d[k](1) + matrix[3 * r + 2] * d[k](2);
+      if (g_sensitivity != nullptr) {
+        const Eigen::Vector3d& f = data.force[k];
+        w[k](r) -= g_sensitivity[3 * r] * f(0) + g_sensitivity[3 * r + 1] * f(1) +
+                   g_sensitivity[3 * r + 2] * f(2);
+      }
+    }
+  }
+  auto cross = [](const Eigen::Vector3d& v) {
+    Eigen::Matrix3d x;
+    x << 0.0, -v(2), v(1), v(2), 0.0, -v(0), -v(1), v(0), 0.0;
+    return x;
+  };
+  // Forward: the steps phi_i and the turn.
+  std::vector<Eigen::Vector3d> phi(n - 1);
+  std::vector<Eigen::Vector4d> steps(n - 1);
+  for (size_t i = 0; i + 1 < n; ++i) {
+    const double h = data.t[i + 1] - data.t[i];
+    double c[4];
+    GyroStepWeights(data.t, i, c);
+    const double coning = h * h / 12.0;
+    const Eigen::Vector3d& a = w[i];
+    const Eigen::Vector3d& b = w[i + 1];
+    double p[3];
+    for (int j = 0; j < 3; ++j) p[j] = c[1] * a(j) + c[2] * b(j);
+    if (c[0] != 0.0) {
+      for (int j = 0; j < 3; ++j) p[j] += c[0] * w[i - 1](j) + c[3] * w[i + 2](j);
+    }
+    p[0] += coning * (a(1) * b(2) - a(2) * b(1));
+    p[1] += coning * (a(2) * b(0) - a(0) * b(2));
+    p[2] += coning * (a(0) * b(1) - a(1) * b(0));
+    phi[i] = Eigen::Vector3d(p[0], p[1], p[2]);
+    double next[4];
+    ceres::AngleAxisToQuaternion(p, steps[i].data());
+    ceres::QuaternionProduct(dq, steps[i].data(), next);
+    for (int j = 0; j < 4; ++j) dq[j] = next[j];
+  }
+  // Backward: S_i and H_k.
+  std::vector<Eigen::Matrix3d> h_k(n, Eigen::Matrix3d::Zero());
+  double s[4] = {1.0, 0.0, 0.0, 0.0};
+  for (size_t i = n - 1; i-- > 0;) {
+    const double t2 = phi[i].squaredNorm();
+    double alpha, beta;
+    if (t2 < 1e-4) {
+      alpha = 0.5 - t2 / 24.0 + t2 * t2 / 720.0;
+      beta = 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0;
+    } else {
+      const double t = std::sqrt(t2);
+      const double half = std::sin(0.5 * t);
+      alpha = 2.0 * half * half / t2;
+      beta = (t - std::sin(t)) / (t2 * t);
+    }
+    const Eigen::Matrix3d k = cross(phi[i]);
+    const Eigen::Matrix3d right = Eigen::Matrix3d::Identity() - alpha * k + beta * k * k;
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rotation;
+    ceres::QuaternionToRotation(s, rotation.data());
+    const Eigen::Matrix3d g = rotation.transpose() * right;
+    const double step = data.t[i + 1] - data.t[i];
+    double c[4];
+    GyroStepWeights(data.t, i, c);
+    const double coning = step * step / 12.0;
+    h_k[i] += g * (c[1] * Eigen::Matrix3d::Identity() - coning * cross(w[i + 1]));
+    h_k[i + 1] += g * (c[2] * Eigen::Matrix3d::Identity() + coning * cross(w[i]));
+    if (c[0] != 0.0) {
+      h_k[i - 1] += c[0] * g;
+      h_k[i + 2] += c[3] * g;
+    }
+    double next[4];
+    ceres::QuaternionProduct(steps[i].data(), s, next);
+    for (int j = 0; j < 4; ++j) s[j] = next[j];
+  }
+  // e = E dp, then d dq = dq * (0, e / 2).
+  Eigen::Matrix<double, 3, 21> e = Eigen::Matrix<double, 3, 21>::Zero();
+  Eigen::Matrix3d h_sum = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < n; ++k) {
+    h_sum += h_k[k];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        e.col(3 + 3 * r + c) += h_k[k].col(r) * d[k](c);
+        if (g_sensitivity != nullptr) e.col(12 + 3 * r + c) -= h_k[k].col(r) * data.force[k](c);
+      }
+    }
+  }
+  e.leftCols<3>() = -h_sum * m;
+  const Eigen::Vector3d v(dq[1], dq[2], dq[3]);
+  for (int j = 0; j < 21; ++j) {
+    const Eigen::Vector3d half = 0.5 * e.col(j);
+    (*jacobian)(0, j) = -v.dot(half);
+    jacobian->block<3, 1>(1, j) = dq[0] * half + v.cross(half);
+  }
+}
+
+// IntegrateGyroRotation for Ceres: at plain values, or for automatic
+// differentiation with the derivatives of dq chained from
+// IntegrateGyroRotationJacobian into the N of the residual's parameters.
+inline void IntegrateGyroTurn(const GyroRotationData& data, const double* bias,
+                              const double* matrix, const double* g_sensitivity, double* dq) {
+  IntegrateGyroRotation<double>(data, bias, matrix, g_sensitivity, dq);
+}
+template <int N>
+void IntegrateGyroTurn(const GyroRotationData& data, const ceres::Jet<double, N>* bias,
+                       const ceres::Jet<double, N>* matrix,
+                       const ceres::Jet<double, N>* g_sensitivity, ceres::Jet<double, N>* dq) {
+  double b[3], m[9], g[9];
+  for (int i = 0; i < 3; ++i) b[i] = bias[i].a;
+  for (int i = 0; i < 9; ++i) {
+    m[i] = matrix[i].a;
+    g[i] = g_sensitivity != nullptr ? g_sensitivity[i].a : 0.0;
+  }
+  double q[4];
+  Eigen::Matrix<double, 4, 21> jacobian;
+  IntegrateGyroRotationJacobian(data, b, m, g_sensitivity != nullptr ? g : nullptr, q, &jacobian);
+  for (int k = 0; k < 4; ++k) {
+    dq[k].a = q[k];
+    dq[k].v.setZero();
+    for (int i = 0; i < 3; ++i) dq[k].v += jacobian(k, i) * bias[i].v;
+    for (int i = 0; i < 9; ++i) dq[k].v += jacobian(k, 3 + i) * matrix[i].v;
+    if (g_sensitivity != nullptr) {
+      for (int i = 0; i < 9; ++i) dq[k].v += jacobian(k, 12 + i) * g_sensitivity[i].v;
+    }
+  }
+}
+
 // r = W E (R(dq)^T d_s - d_e), the whitened direction error of a turn dq
 // (w, x, y, z) from start direction d_s to end direction d_e.
 template <typename T>
@@ -244,7 +405,7 @@ struct GyroRotationResidual {
       }
     }
     T dq[4];
-    IntegrateGyroRotation<T>(data_, bias, matrix, g_sensitivity, dq);
+    IntegrateGyroTurn(data_, bias, matrix, g_sensitivity, dq);
     WhitenedTurnError<T>(dq, start, end, data_.tangent, data_.sqrt_information, residual);
     return true;
   }
