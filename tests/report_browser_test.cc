@@ -69,6 +69,15 @@ std::string Browser() {
                     "does): the reports are not opened in a browser";                      \
   }
 
+// The value of attribute `name` of the first element after `from`.
+std::string Attribute(const std::string& dom, const std::string& name, size_t from = 0) {
+  const std::string key = name + "=\"";
+  const size_t at = dom.find(key, from);
+  if (at == std::string::npos) return "";
+  const size_t begin = at + key.size();
+  return dom.substr(begin, dom.find('"', begin) - begin);
+}
+
 // Bytes of base64 `text` (the DevTools protocol's encoding of a screenshot).
 std::string DecodeBase64(const std::string& text) {
   std::string out;
@@ -300,11 +309,8 @@ LoadedPage Load(const std::string& html, const ScratchDir& dir, const std::strin
   }
   page.dom = r["result"].value("value", "");
   if (!png.empty()) {
-    const std::string key = "data-height=\"";
-    const size_t at = page.dom.find(key);
-    const int height = std::max(
-        600, std::min(16000,
-                      at == std::string::npos ? 0 : std::atoi(page.dom.c_str() + at + key.size())));
+    const int height =
+        std::max(600, std::min(16000, std::atoi(Attribute(page.dom, "data-height").c_str())));
     if (!browser.Call(
             "Emulation.setDeviceMetricsOverride",
             {{"width", 1280}, {"height", height}, {"deviceScaleFactor", 1}, {"mobile", false}},
@@ -316,15 +322,6 @@ LoadedPage Load(const std::string& html, const ScratchDir& dir, const std::strin
   }
   page.console = browser.console();
   return page;
-}
-
-// The value of attribute `name` of the first element after `from`.
-std::string Attribute(const std::string& dom, const std::string& name, size_t from = 0) {
-  const std::string key = name + "=\"";
-  const size_t at = dom.find(key, from);
-  if (at == std::string::npos) return "";
-  const size_t begin = at + key.size();
-  return dom.substr(begin, dom.find('"', begin) - begin);
 }
 
 struct AxisTicks {

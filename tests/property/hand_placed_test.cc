@@ -162,11 +162,7 @@ TEST_P(HandPlaced, ErrorOverSigmaRmsIsNearOne) {
 }
 
 std::string HandPlacedCaseName(const ::testing::TestParamInfo<int>& info) {
-  std::string name = HandPlacedCases(false)[info.param].name;
-  for (char& c : name) {
-    if (!isalnum(static_cast<unsigned char>(c))) c = '_';
-  }
-  return name;
+  return TestParameterName(HandPlacedCases(false)[info.param].name);
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, HandPlaced,

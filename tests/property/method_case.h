@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cstdint>
 #include <cstdlib>
 #include <functional>
@@ -81,6 +82,15 @@ struct MethodCase {
 inline int EnvInt(const char* name, int fallback) {
   const char* value = std::getenv(name);
   return value != nullptr && *value != '\0' ? std::atoi(value) : fallback;
+}
+
+// `name` as a gtest parameter name: every character that is not a letter
+// or a digit becomes '_'.
+inline std::string TestParameterName(std::string name) {
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
 }
 
 // The first seed and the number of seeds of GRAVCAL_PROPERTY_SEEDS.

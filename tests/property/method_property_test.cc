@@ -241,11 +241,7 @@ TEST_P(MethodProperty, ErrorOverSigmaIsStandardNormal) {
 }
 
 std::string MethodCaseName(const ::testing::TestParamInfo<int>& info) {
-  std::string name = AllCases()[info.param].name;
-  for (char& c : name) {
-    if (!isalnum(static_cast<unsigned char>(c))) c = '_';
-  }
-  return name;
+  return TestParameterName(AllCases()[info.param].name);
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, MethodProperty,

@@ -92,6 +92,40 @@ inline void GyroStepWeights(const std::vector<double>& t, size_t i, double weigh
   weights[3] = edge;
 }
 
+// w = M_g (u_i - b_g) - G f_i of sample i (G = 0 when g_sensitivity is null).
+template <typename T>
+void CalibratedGyroRate(const GyroRotationData& data, size_t i, const T* bias, const T* matrix,
+                        const T* g_sensitivity, T* w) {
+  const Eigen::Vector3d& u = data.gyro[i];
+  const T d[3] = {T(u(0)) - bias[0], T(u(1)) - bias[1], T(u(2)) - bias[2]};
+  for (int r = 0; r < 3; ++r) {
+    w[r] = matrix[3 * r] * d[0] + matrix[3 * r + 1] * d[1] + matrix[3 * r + 2] * d[2];
+    if (g_sensitivity != nullptr) {
+      const Eigen::Vector3d& f = data.force[i];
+      w[r] -= g_sensitivity[3 * r] * f(0) + g_sensitivity[3 * r + 1] * f(1) +
+              g_sensitivity[3 * r + 2] * f(2);
+    }
+  }
+}
+
+// phi_i of step i (the scheme above) from the rates of samples i - 1 .. i + 2
+// (before and after are read only at inner steps).
+template <typename T>
+void GyroStepRotation(const std::vector<double>& t, size_t i, const T* before, const T* a,
+                      const T* b, const T* after, T* phi) {
+  const double h = t[i + 1] - t[i];
+  double c[4];
+  GyroStepWeights(t, i, c);
+  const T coning(h * h / 12.0);
+  for (int j = 0; j < 3; ++j) phi[j] = c[1] * a[j] + c[2] * b[j];
+  if (c[0] != 0.0) {
+    for (int j = 0; j < 3; ++j) phi[j] += c[0] * before[j] + c[3] * after[j];
+  }
+  phi[0] += coning * (a[1] * b[2] - a[2] * b[1]);
+  phi[1] += coning * (a[2] * b[0] - a[0] * b[2]);
+  phi[2] += coning * (a[0] * b[1] - a[1] * b[0]);
+}
+
 // Integrates the calibrated rate over the samples (the scheme above) into
 // dq = (w, x, y, z). bias, matrix and g_sensitivity as in the parameter
 // blocks; g_sensitivity may be null (G = 0). When path is not null it
@@ -108,16 +142,7 @@ void IntegrateGyroRotation(const GyroRotationData& data, const T* bias, const T*
   }
   if (n < 2) return;
   auto rate = [&](size_t i, T* w) {
-    const Eigen::Vector3d& u = data.gyro[i];
-    const T d[3] = {T(u(0)) - bias[0], T(u(1)) - bias[1], T(u(2)) - bias[2]};
-    for (int r = 0; r < 3; ++r) {
-      w[r] = matrix[3 * r] * d[0] + matrix[3 * r + 1] * d[1] + matrix[3 * r + 2] * d[2];
-      if (g_sensitivity != nullptr) {
-        const Eigen::Vector3d& f = data.force[i];
-        w[r] -= g_sensitivity[3 * r] * f(0) + g_sensitivity[3 * r + 1] * f(1) +
-                g_sensitivity[3 * r + 2] * f(2);
-      }
-    }
+    CalibratedGyroRate<T>(data, i, bias, matrix, g_sensitivity, w);
   };
   // w[k] holds the rate of sample i - 1 + k (k = 0..3), a window that
   // slides by one sample per step.
@@ -127,20 +152,8 @@ void IntegrateGyroRotation(const GyroRotationData& data, const T* bias, const T*
   if (n > 2) rate(2, w[3]);
   for (int j = 0; j < 3; ++j) w[0][j] = w[1][j];
   for (size_t i = 0; i + 1 < n; ++i) {
-    const double h = data.t[i + 1] - data.t[i];
-    double c[4];
-    GyroStepWeights(data.t, i, c);
-    const T coning(h * h / 12.0);
-    const T* a = w[1];
-    const T* b = w[2];
     T phi[3];
-    for (int j = 0; j < 3; ++j) phi[j] = c[1] * a[j] + c[2] * b[j];
-    if (c[0] != 0.0) {
-      for (int j = 0; j < 3; ++j) phi[j] += c[0] * w[0][j] + c[3] * w[3][j];
-    }
-    phi[0] += coning * (a[1] * b[2] - a[2] * b[1]);
-    phi[1] += coning * (a[2] * b[0] - a[0] * b[2]);
-    phi[2] += coning * (a[0] * b[1] - a[1] * b[0]);
+    GyroStepRotation<T>(data.t, i, w[0], w[1], w[2], w[3], phi);
     T step[4], next[4];
     ceres::AngleAxisToQuaternion(phi, step);
     ceres::QuaternionProduct(dq, step, next);
@@ -189,18 +202,9 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
   if (n < 2) return;
   const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(matrix);
   // The rates w_k, as IntegrateGyroRotation<double> computes them.
-  std::vector<Eigen::Vector3d> w(n), d(n);
+  std::vector<Eigen::Vector3d> w(n);
   for (size_t k = 0; k < n; ++k) {
-    const Eigen::Vector3d& u = data.gyro[k];
-    for (int j = 0; j < 3; ++j) d[k](j) = u(j) - bias[j];
-    for (int r = 0; r < 3; ++r) {
-      w[k](r) = matrix[3 * r] * d[k](0) + matrix[3 * r + 1] * d[k](1) + matrix[3 * r + 2] * d[k](2);
-      if (g_sensitivity != nullptr) {
-        const Eigen::Vector3d& f = data.force[k];
-        w[k](r) -= g_sensitivity[3 * r] * f(0) + g_sensitivity[3 * r + 1] * f(1) +
-                   g_sensitivity[3 * r + 2] * f(2);
-      }
-    }
+    CalibratedGyroRate<double>(data, k, bias, matrix, g_sensitivity, w[k].data());
   }
   auto cross = [](const Eigen::Vector3d& v) {
     Eigen::Matrix3d x;
@@ -211,23 +215,12 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
   std::vector<Eigen::Vector3d> phi(n - 1);
   std::vector<Eigen::Vector4d> steps(n - 1);
   for (size_t i = 0; i + 1 < n; ++i) {
-    const double h = data.t[i + 1] - data.t[i];
-    double c[4];
-    GyroStepWeights(data.t, i, c);
-    const double coning = h * h / 12.0;
-    const Eigen::Vector3d& a = w[i];
-    const Eigen::Vector3d& b = w[i + 1];
-    double p[3];
-    for (int j = 0; j < 3; ++j) p[j] = c[1] * a(j) + c[2] * b(j);
-    if (c[0] != 0.0) {
-      for (int j = 0; j < 3; ++j) p[j] += c[0] * w[i - 1](j) + c[3] * w[i + 2](j);
-    }
-    p[0] += coning * (a(1) * b(2) - a(2) * b(1));
-    p[1] += coning * (a(2) * b(0) - a(0) * b(2));
-    p[2] += coning * (a(0) * b(1) - a(1) * b(0));
-    phi[i] = Eigen::Vector3d(p[0], p[1], p[2]);
+    // Samples i - 1 and i + 2 exist (and are read) only at inner steps.
+    const double* before = w[i > 0 ? i - 1 : i].data();
+    const double* after = w[i + 2 < n ? i + 2 : i + 1].data();
+    GyroStepRotation<double>(data.t, i, before, w[i].data(), w[i + 1].data(), after, phi[i].data());
     double next[4];
-    ceres::AngleAxisToQuaternion(p, steps[i].data());
+    ceres::AngleAxisToQuaternion(phi[i].data(), steps[i].data());
     ceres::QuaternionProduct(dq, steps[i].data(), next);
     for (int j = 0; j < 4; ++j) dq[j] = next[j];
   }
@@ -268,11 +261,13 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
   // e = E dp, then d dq = dq * (0, e / 2).
   Eigen::Matrix<double, 3, 21> e = Eigen::Matrix<double, 3, 21>::Zero();
   Eigen::Matrix3d h_sum = Eigen::Matrix3d::Zero();
+  const Eigen::Vector3d b_g(bias[0], bias[1], bias[2]);
   for (size_t k = 0; k < n; ++k) {
     h_sum += h_k[k];
+    const Eigen::Vector3d d = data.gyro[k] - b_g;
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) {
-        e.col(3 + 3 * r + c) += h_k[k].col(r) * d[k](c);
+        e.col(3 + 3 * r + c) += h_k[k].col(r) * d(c);
         if (g_sensitivity != nullptr) e.col(12 + 3 * r + c) -= h_k[k].col(r) * data.force[k](c);
       }
     }
