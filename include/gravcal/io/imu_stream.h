@@ -8,8 +8,8 @@
 // (Other layouts and renamings: log_reader.h, which loads the whole log.)
 // Errors name the file and line, like log_reader.h.
 //
-// The writer writes to a temporary file beside the output and renames it on
-// Commit(), so a failure leaves no partial file; on standard output it writes
+// The writer writes through AtomicFile (files.h: the destination contract),
+// so a failure leaves no partial file; on standard output it writes
 // as it goes (callers check everything they can before the first sample).
 #ifndef GRAVCAL_IO_IMU_STREAM_H_
 #define GRAVCAL_IO_IMU_STREAM_H_
@@ -19,6 +19,8 @@
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include "gravcal/io/files.h"
 
 namespace gravcal {
 
@@ -92,9 +94,11 @@ class ImuCsvStreamWriter {
  private:
   bool Flush(std::string* error);
 
-  std::FILE* file_ = nullptr;
+  // Standard output, or nullptr when writing to `file_`.
+  std::FILE* stdout_ = nullptr;
+  AtomicFile file_;
+  bool open_ = false;
   std::string path_;
-  std::string temporary_;
   bool gyro_ = false;
   bool temperature_ = false;
   std::string buffer_;
