@@ -319,6 +319,16 @@ TEST_F(DestinationTest, CleanupRemovesOnlyProvablyStaleTemporaries) {
   expected.insert(".gravcal-tmp." + dead + ".89abcdef.u2.json");
   EXPECT_EQ(Names(work_), expected);
   for (const std::string& name : kept) EXPECT_EQ(Slurp(Work(name)), "mine") << name;
+
+  // The batch cleans its output folder on start the same way: the lock now
+  // free, that temporary goes; every other name stays.
+  ASSERT_EQ(mkdir(Work("in").c_str(), 0755), 0);
+  Plant("in/u1.csv", Slurp(raw_));
+  const CliResult r = Run("batch --config " + ConfigPath() + " --input-dir " + Work("in") +
+                          " --output-dir " + work_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const std::string& name : kept) EXPECT_EQ(Slurp(Work(name)), "mine") << name;
+  EXPECT_FALSE(testing_util::FileExists(locked));
 }
 
 // merge-summaries refuses an output folder that is one of its shard
@@ -349,6 +359,10 @@ TEST_F(DestinationTest, BatchInItsOwnInputFolder) {
   Plant("u2.csv", log);
   Plant("._u1.csv", std::string("\0\5\26\7\0\2\0\0Mac OS X", 16));
   Plant(".hidden.csv", "not a log");
+  // Names that merely look like temporaries: not the batch's to remove.
+  const std::vector<std::string> others = {"notes.tmp.2023", "thesis.tmp.99999",
+                                           "u1.json.tmp." + std::to_string(DeadPid())};
+  for (const std::string& name : others) Plant(name, "mine");
   const std::string batch =
       "batch --config " + ConfigPath() + " --input-dir " + work_ + " --output-dir " + work_;
   CliResult r = Run(batch);
@@ -360,6 +374,7 @@ TEST_F(DestinationTest, BatchInItsOwnInputFolder) {
   EXPECT_NE(r.err.find("2 units"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("skipped 2 (stored results up to date)"), std::string::npos) << r.err;
   EXPECT_EQ(Slurp(Work("._u1.csv")).size(), 16u);
+  for (const std::string& name : others) EXPECT_EQ(Slurp(Work(name)), "mine") << name;
 
   // A user's own summary.csv among the logs is not overwritten.
   ASSERT_EQ(mkdir(Work("mine").c_str(), 0755), 0);

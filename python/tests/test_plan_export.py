@@ -33,10 +33,11 @@ def test_plan_equals_cli(cli_plan, tmp_path):
     assert result["poses"] and result["meets_targets"]
 
 
-def test_plan_error_is_the_cli_message():
+def test_plan_error_is_the_cli_message(tmp_path):
+    # A writable output: the CLI checks its destinations before the work.
     _, error = run_cli("plan", "--config", TWELVE, "--target", TARGET, "--output",
-                       "/nonexistent/plan.json", ok=False)
-    assert error
+                       tmp_path / "plan.json", ok=False)
+    assert error and not (tmp_path / "plan.json").exists()
     with pytest.raises(gravcal.Error) as e:
         gravcal.plan(TWELVE, target=TARGET)
     assert str(e.value) == error
@@ -124,9 +125,10 @@ def test_export_equals_cli(target, si_calibration, still_noise, tmp_path):
     assert (result["dropped"] == []) == (target not in ("px4", "ardupilot"))
 
 
-def test_export_errors_are_the_cli_messages(cli_calibration):
+def test_export_errors_are_the_cli_messages(cli_calibration, tmp_path):
     _, error = run_cli("export", "--calibration", cli_calibration, "--to", "kalibr", "--output",
-                       "/nonexistent/imu.yaml", ok=False)
+                       tmp_path / "imu.yaml", ok=False)
+    assert error and not (tmp_path / "imu.yaml").exists()
     with pytest.raises(gravcal.Error) as e:
         gravcal.export(str(cli_calibration), "kalibr")
     assert str(e.value) == error
