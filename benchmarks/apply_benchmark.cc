@@ -11,6 +11,7 @@
 #include "gravcal/core/imu_corrector.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/imu_stream.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace {
@@ -19,7 +20,8 @@ namespace {
 const std::string& InputFile() {
   static std::string path;
   if (!path.empty()) return path;
-  path = "/tmp/gravcal_apply_benchmark_" + std::to_string(getpid()) + ".csv";
+  path = testing_util::ScratchFolder() + "gravcal_apply_benchmark_" + std::to_string(getpid()) +
+         ".csv";
   std::string text = "t,ax,ay,az,gx,gy,gz,temp\n";
   const size_t target = size_t{60} * 1000 * 1000;
   text.reserve(target + 256);

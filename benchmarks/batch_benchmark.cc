@@ -17,6 +17,7 @@
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/config.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace {
@@ -38,7 +39,8 @@ const std::vector<BatchUnit>& Units() {
     sim.scheme = "twelve";
     sim.hold_seconds = 30.0;
     sim.sample_rate = 100.0;
-    const std::string prefix = "/tmp/gravcal_batch_benchmark_" + std::to_string(getpid()) + "_";
+    const std::string prefix =
+        testing_util::ScratchFolder() + "gravcal_batch_benchmark_" + std::to_string(getpid()) + "_";
     for (int k = 0; k < kUnits; ++k) {
       SimulatedSession s;
       std::string error;

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "gravcal/io/log_reader.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace {
@@ -25,7 +26,8 @@ const std::string& Folder() {
   static const std::string folder = [] {
     // GRAVCAL_FORMATS_DIR: a folder already written (the writers take minutes).
     if (const char* ready = std::getenv("GRAVCAL_FORMATS_DIR")) return std::string(ready);
-    const std::string dir = "/tmp/gravcal_formats_benchmark_" + std::to_string(getpid());
+    const std::string dir =
+        testing_util::ScratchFolder() + "gravcal_formats_benchmark_" + std::to_string(getpid());
     std::filesystem::create_directories(dir);
     ImuLog log;
     for (int i = 0; i < kSamples; ++i) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "gravcal/io/log_reader.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace {
@@ -18,8 +19,8 @@ const std::string& TestFile(int megabytes) {
   static std::string paths[2];
   std::string& path = paths[megabytes > 50 ? 1 : 0];
   if (!path.empty()) return path;
-  path = "/tmp/gravcal_log_reader_benchmark_" + std::to_string(getpid()) + "_" +
-         std::to_string(megabytes) + "mb.csv";
+  path = testing_util::ScratchFolder() + "gravcal_log_reader_benchmark_" +
+         std::to_string(getpid()) + "_" + std::to_string(megabytes) + "mb.csv";
   std::string text = "t,ax,ay,az,gx,gy,gz\n";
   const size_t target = static_cast<size_t>(megabytes) * 1000 * 1000;
   text.reserve(target + 256);
@@ -102,8 +103,9 @@ BENCHMARK(BM_WriteImuLogCsv)->Unit(benchmark::kMillisecond);
 struct Cleanup {
   ~Cleanup() {
     for (int megabytes : {10, 100}) {
-      const std::string path = "/tmp/gravcal_log_reader_benchmark_" + std::to_string(getpid()) +
-                               "_" + std::to_string(megabytes) + "mb.csv";
+      const std::string path = testing_util::ScratchFolder() + "gravcal_log_reader_benchmark_" +
+                               std::to_string(getpid()) + "_" + std::to_string(megabytes) +
+                               "mb.csv";
       std::remove(path.c_str());
     }
   }

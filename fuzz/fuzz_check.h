@@ -16,6 +16,15 @@
 namespace gravcal {
 namespace fuzz {
 
+// A scratch path of this process under $TMPDIR (/tmp when unset):
+// "<dir>/gravcal_fuzz_<pid><suffix>".
+inline std::string ScratchPath(const std::string& suffix) {
+  const char* dir = std::getenv("TMPDIR");
+  std::string folder = dir != nullptr && *dir != '\0' ? dir : "/tmp";
+  if (folder.back() != '/') folder += '/';
+  return folder + "gravcal_fuzz_" + std::to_string(getpid()) + suffix;
+}
+
 inline void Require(bool condition, const char* what) {
   if (condition) return;
   std::fprintf(stderr, "fuzz invariant broken: %s\n", what);
@@ -30,7 +39,7 @@ inline void RequireOutcome(bool ok, const std::string& error) {
 // A scratch file of this process, rewritten with `bytes` for readers that
 // take a path.
 inline std::string WriteScratch(const std::string& suffix, const uint8_t* data, size_t size) {
-  const std::string path = "/tmp/gravcal_fuzz_" + std::to_string(getpid()) + suffix;
+  const std::string path = ScratchPath(suffix);
   std::ofstream(path, std::ios::binary | std::ios::trunc)
       .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path;

@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "fuzz_check.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/io/log_reader.h"
 
@@ -29,7 +30,7 @@ namespace fuzz {
 
 inline int CheckReader(const uint8_t* data, size_t size, const std::string& prefix,
                        const std::string& extension) {
-  const std::string path = "/tmp/gravcal_fuzz_" + std::to_string(getpid()) + extension;
+  const std::string path = ScratchPath(extension);
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (f == nullptr) return 0;
   std::fwrite(prefix.data(), 1, prefix.size(), f);

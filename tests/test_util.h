@@ -27,13 +27,18 @@
 namespace gravcal {
 namespace testing_util {
 
-// A mkstemp() template for a scratch file under $TMPDIR (/tmp when unset):
-// "<dir>/<stem>XXXXXX". Tests never hard-code /tmp.
-inline std::string ScratchFileTemplate(const std::string& stem) {
+// The folder for scratch files, $TMPDIR (/tmp when unset), with a trailing
+// '/'. Tests and benchmarks never hard-code /tmp.
+inline std::string ScratchFolder() {
   const char* dir = std::getenv("TMPDIR");
   std::string folder = dir != nullptr && *dir != '\0' ? dir : "/tmp";
   if (folder.back() != '/') folder += '/';
-  return folder + stem + "XXXXXX";
+  return folder;
+}
+
+// A mkstemp() template for a scratch file: "<ScratchFolder()><stem>XXXXXX".
+inline std::string ScratchFileTemplate(const std::string& stem) {
+  return ScratchFolder() + stem + "XXXXXX";
 }
 
 // A 16-bit accelerometer at +-2 g full scale: m/s^2 per count.
