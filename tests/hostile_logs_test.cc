@@ -205,5 +205,66 @@ TEST(HostileLogs, LineEndVariantsGiveIdenticalResults) {
   }
 }
 
+// A `nan` temperature with a calibration that has a temperature term: the
+// same error naming the line (today's main skipped the term silently).
+TEST(HostileLogs, ANanTemperatureWithATemperatureTermNamesTheLine) {
+  const ScratchDir scratch;
+  nlohmann::json j = nlohmann::json::parse(Slurp(WriteCalibration(scratch)));
+  j["effects"] = {{"reference_time", 0.0},
+                  {"reference_temperature", 25.0},
+                  {"accel_temperature_bias", {{"value", {0.01, 0.02, 0.03}}}}};
+  const std::string calib = scratch.Write("calib.json", j.dump());
+  const std::string path = HostileDir() + "/nan_temperature.csv";
+  const CliResult r = RunCli(
+      {"apply", "--calibration", calib, "--input", path, "--output", scratch / "out.csv"}, scratch);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(CliError(r), path + ":3: column 'temp': 'nan' is not finite") << r.err;
+  EXPECT_EQ(LeftBehind(scratch, "calib.json"), std::vector<std::string>());
+}
+
+// apply streams every layout calibrate reads, with the same input keys: a
+// whitespace file without a header (its first line is a row), metadata lines
+// to skip, renamed columns, a sample rate for a log without time.
+TEST(HostileLogs, ApplyStreamsOtherLayoutsAsCalibrateReadsThem) {
+  const ScratchDir scratch;
+  const std::string calib = WriteCalibration(scratch);
+  struct Layout {
+    std::string config;
+    std::string text;
+  };
+  const std::vector<Layout> layouts = {
+      {"format: whitespace\ncolumns: [t, ax, ay, az, extra]\n",
+       "0 1 2 3 9\n0.5 4 5 6 9\n1 7 8 9 9\n"},
+      {"skip_lines: 2\nrename: {ax: acc_x}\n",
+       "Fs,2\nmeta\nt,acc_x,ay,az\r\n0,1,2,3\r\n0.5,4,5,6\r\n1,7,8,9\r\n"},
+      {"sample_rate: 2\n", "ax,ay,az\n1,2,3\n4,5,6\n7,8,9"},
+  };
+  std::string first;
+  for (size_t k = 0; k < layouts.size(); ++k) {
+    SCOPED_TRACE(layouts[k].config);
+    const std::string config = scratch.Write("layout.yaml", layouts[k].config);
+    const std::string input = scratch.Write("in.txt", layouts[k].text);
+    for (const std::string& via : {std::string("file"), std::string("-")}) {
+      const std::string out = scratch / "out.csv";
+      const std::string script = scratch.Write(
+          "run.sh", std::string(GRAVCAL_CLI_PATH) + " apply --config " + config +
+                        " --calibration " + calib + " --input " + (via == "-" ? "-" : input) +
+                        " --output " + out + " < " + input + " 2> " + (scratch / "err.txt") + "\n");
+      ASSERT_EQ(std::system(("bash " + script).c_str()), 0) << Slurp(scratch / "err.txt");
+      ImuLog corrected;
+      std::string error;
+      ASSERT_TRUE(ReadImuLog(out, LogReaderOptions(), &corrected, &error)) << error;
+      ASSERT_EQ(corrected.size(), 3u);
+      EXPECT_EQ(corrected.t, std::vector<double>({0.0, 0.5, 1.0}));
+      // M (v - b): diag(1e-3, 2e-3, 3e-3), b = (1, 2, 3).
+      EXPECT_DOUBLE_EQ(corrected.accel[2].x(), 0.006);
+      EXPECT_DOUBLE_EQ(corrected.accel[2].z(), 0.018);
+      const std::string body = Slurp(out).substr(Slurp(out).find("\nt,") + 1);
+      if (first.empty()) first = body;
+      EXPECT_EQ(body, first);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace gravcal
