@@ -206,9 +206,8 @@ TEST_F(BatchFaultsTest, OutputFolderBecomingUnwritableLosesNothingWritten) {
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find(root ? "Read-only file system" : "Permission denied"), std::string::npos)
       << r.err;
-  // The destination contract (io/files.h) checks the folder before any
-  // work: refused up front, naming it (the disk-full test above covers a
-  // store failing mid-run).
+  // The destination contract checks the output folder before any unit is
+  // calibrated, so the refusal names the folder, not a result.
   EXPECT_NE(r.err.find(out + ": cannot write in the folder"), std::string::npos) << r.err;
   if (root) {
     ASSERT_TRUE(tmpfs.RemountWritable());
