@@ -4,6 +4,7 @@
 // situation; every refusal is a non-zero exit, one error line naming the
 // destination, and nothing written.
 #include <dirent.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/file.h>
@@ -290,6 +291,25 @@ TEST_F(DestinationTest, DashIsStandardOutputOrRefused) {
   }
   EXPECT_TRUE(Names(work_).empty());
   ASSERT_EQ(chdir(cwd), 0);
+
+  // Standard output appended to the input itself: refused before a byte.
+  const std::string log = Plant("s.csv", Slurp(raw_));
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int out = open(log.c_str(), O_WRONLY | O_APPEND);
+    const int err = open((scratch_ / "append_err.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(out, 1);
+    dup2(err, 2);
+    const std::string calibration = calibration_;
+    execl(GRAVCAL_CLI_PATH, GRAVCAL_CLI_PATH, "apply", "--calibration", calibration.c_str(),
+          "--input", log.c_str(), "--output", "-", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  CliResult appended;
+  appended.exit_code = testing_util::WaitForExit(pid);
+  appended.err = Slurp(scratch_ / "append_err.txt");
+  ExpectRefused(appended, "-: --output is standard output, which is the input --input", log);
+  EXPECT_EQ(Slurp(log), Slurp(raw_));
 }
 
 // The batch removes only temporaries of its own form whose process is gone
@@ -324,11 +344,21 @@ TEST_F(DestinationTest, CleanupRemovesOnlyProvablyStaleTemporaries) {
   // free, that temporary goes; every other name stays.
   ASSERT_EQ(mkdir(Work("in").c_str(), 0755), 0);
   Plant("in/u1.csv", Slurp(raw_));
+  // Units that fail: the stale result of u3 (a calibration JSON) goes, the
+  // user's own u2.json stays.
+  Plant("in/u2.csv", "t,ax,ay,az\n");
+  Plant("in/u3.csv", "t,ax,ay,az\n");
+  Plant("u2.json", "mine");
+  Plant("u3.json", Slurp(calibration_));
   const CliResult r = Run("batch --config " + ConfigPath() + " --input-dir " + Work("in") +
                           " --output-dir " + work_);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("2 of 3 units failed"), std::string::npos) << r.err;
   for (const std::string& name : kept) EXPECT_EQ(Slurp(Work(name)), "mine") << name;
   EXPECT_FALSE(testing_util::FileExists(locked));
+  EXPECT_EQ(Slurp(Work("u2.json")), "mine");
+  EXPECT_FALSE(testing_util::FileExists(Work("u3.json")));
+  EXPECT_TRUE(testing_util::FileExists(Work("u1.json")));
 }
 
 // merge-summaries refuses an output folder that is one of its shard

@@ -75,6 +75,17 @@ bool FileExists(const std::string& path) {
   return stat(path.c_str(), &st) == 0;
 }
 
+// True when `path` holds a calibration JSON (a result of an earlier run,
+// stale once its unit fails): a file of that name the batch did not write
+// is never removed.
+bool IsOwnResult(const std::string& path) {
+  std::string text;
+  std::string error;
+  if (!ReadFileBytes(path, &text, &error)) return false;
+  const Json j = Json::parse(text, nullptr, false);
+  return j.is_object() && j.contains("accel") && j.contains("method") && j.contains("provenance");
+}
+
 Json RowToJson(const SummaryRow& row) {
   Json values = Json::object();
   for (const auto& [name, value] : row.values) {
@@ -418,7 +429,7 @@ class BatchStore {
           !WriteCalibrationJson(r.calibration, config.output_covariance, result_path, why)) {
         return false;
       }
-    } else if (unlink(result_path.c_str()) != 0 && errno != ENOENT) {
+    } else if (IsOwnResult(result_path) && unlink(result_path.c_str()) != 0 && errno != ENOENT) {
       *why = result_path +
              ": cannot remove the stale result: " + std::generic_category().message(errno);
       return false;

@@ -401,6 +401,18 @@ bool CheckDestinations(const std::vector<Destination>& destinations,
                                      " cannot both be standard output");
         }
         standard_output = &d;
+        // `gravcal apply --input s.csv --output - >> s.csv` would read what
+        // it appends.
+        struct stat out;
+        if (fstat(STDOUT_FILENO, &out) == 0 && S_ISREG(out.st_mode)) {
+          for (const auto& [id, source] : read) {
+            if (id == FileId{out.st_dev, out.st_ino}) {
+              return SetError(error, "-: " + flag + " is standard output, which is the input " +
+                                         named(source->flag, source->path) +
+                                         ": gravcal never overwrites its input");
+            }
+          }
+        }
         continue;
       }
       std::string target;
