@@ -414,6 +414,15 @@ TEST_F(DestinationTest, BatchInItsOwnInputFolder) {
   ExpectRefused(Run(mine), "summary.csv", "did not write");
   EXPECT_EQ(Slurp(Work("mine/summary.csv")), log);
   EXPECT_EQ(Names(Work("mine")), std::set<std::string>({"summary.csv"}));
+
+  // A unit whose log has the name of its own result.
+  ASSERT_EQ(mkdir(Work("own").c_str(), 0755), 0);
+  Plant("own/u1.json", log);
+  ExpectRefused(Run("batch --config " + ConfigPath() + " --input-dir " + Work("own") +
+                    " --output-dir " + Work("own") + " --pattern *.json"),
+                "u1.json: the batch would overwrite", "unit u1");
+  EXPECT_EQ(Slurp(Work("own/u1.json")), log);
+  EXPECT_EQ(Names(Work("own")), std::set<std::string>({"u1.json"}));
 }
 
 }  // namespace

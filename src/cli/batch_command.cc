@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -362,6 +363,41 @@ bool ListShardUnits(const CommandArgs& args, const Shard& shard, ShardUnits* out
   return true;
 }
 
+// No output of the batch (summary.csv, summary.json, the report, each
+// unit's result and state file) is the log or side file of one of its units
+// (a manifest naming out/u2.json as u1's log, --pattern '*' in its own output
+// folder): refused before any unit runs.
+bool CheckUnitsAgainstOutputs(const CommandArgs& args, const std::vector<BatchUnit>& units,
+                              std::string* error) {
+  std::map<std::pair<dev_t, ino_t>, std::pair<const BatchUnit*, std::string>> inputs;
+  for (const BatchUnit& u : units) {
+    for (const std::string& path : {u.path, u.attitudes_path}) {
+      struct stat st;
+      if (!path.empty() && stat(path.c_str(), &st) == 0) {
+        inputs.emplace(std::make_pair(st.st_dev, st.st_ino), std::make_pair(&u, path));
+      }
+    }
+  }
+  if (inputs.empty()) return true;
+  const std::string& out = args.output_dir;
+  std::vector<std::string> outputs = {out + "/summary.csv", out + "/summary.json", args.report};
+  for (const BatchUnit& u : units) {
+    outputs.push_back(out + "/" + u.id + ".json");
+    outputs.push_back(out + "/" + kStateFolder + "/" + u.id + ".json");
+  }
+  for (const std::string& path : outputs) {
+    struct stat st;
+    if (path.empty() || stat(path.c_str(), &st) != 0) continue;
+    const auto it = inputs.find(std::make_pair(st.st_dev, st.st_ino));
+    if (it != inputs.end()) {
+      return SetError(error, path + ": the batch would overwrite " + it->second.second +
+                                 ", an input of unit " + it->second.first->id +
+                                 ": gravcal never overwrites its input");
+    }
+  }
+  return true;
+}
+
 // The batch's files: the state of each unit (resume), its calibration JSON,
 // and its summary row. A result that cannot be stored (disk full, folder
 // unwritable) stops the batch: the units after it would fail the same way.
@@ -523,6 +559,7 @@ int RunBatch(const CommandArgs& args) {
   if (!ReadBatchSettings(args, &settings, &error)) return Fail(error);
   ShardUnits shard;
   if (!ListShardUnits(args, settings.shard, &shard, &error)) return Fail(error);
+  if (!CheckUnitsAgainstOutputs(args, shard.units, &error)) return Fail(error);
   BatchStore store(args, shard);
   if (!store.Prepare(&error)) return Fail(error);
 
