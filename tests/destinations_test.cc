@@ -150,6 +150,8 @@ TEST_F(DestinationTest, NeverOverwritesAnInput) {
        "--history is the same file as --output"},
       {"apply --calibration " + calib + " --input " + log + " --output " + calib, calib,
        "same file as the input --calibration"},
+      {calibrate + " --gyro_path " + Work("c.json") + " --output " + calib, calib,
+       "same file as the input gyro_path"},
       {"noise --input " + log + " --output " + Work("n.json") + " --report " + log, log,
        "same file as the input"},
       {"discover --input " + log + " --output " + Work("d.json") + " --report " + log, log,

@@ -23,7 +23,9 @@ std::string In(const std::string& folder, const char* name) {
 bool CheckCommandDestinations(const std::string& command, const CommandArgs& args,
                               std::string* error) {
   std::vector<Destination> out;
-  std::vector<Source> in = {{args.config_path, "--config"}};
+  // The config and the gyroscope file it may name (input: gyro_path).
+  std::vector<Source> in = {{args.config_path, "--config"},
+                            {args.config.input.gyro_path, "gyro_path"}};
   auto folder_files = [&](const char* flag, const std::vector<const char*>& names) {
     out.push_back({args.output_dir, flag, false, true});
     for (const char* name : names) out.push_back({In(args.output_dir, name), flag});
