@@ -365,13 +365,17 @@ bool ListShardUnits(const CommandArgs& args, const Shard& shard, ShardUnits* out
 
 // No output of the batch (summary.csv, summary.json, the report, each
 // unit's result and state file) is the log or side file of one of its units
-// (a manifest naming out/u2.json as u1's log, --pattern '*' in its own output
-// folder): refused before any unit runs.
+// (a manifest naming out/u2.json as u1's log or gyro_path, --pattern '*' in
+// its own output folder): refused before any unit runs.
 bool CheckUnitsAgainstOutputs(const CommandArgs& args, const std::vector<BatchUnit>& units,
                               std::string* error) {
   std::map<std::pair<dev_t, ino_t>, std::pair<const BatchUnit*, std::string>> inputs;
   for (const BatchUnit& u : units) {
-    for (const std::string& path : {u.path, u.attitudes_path}) {
+    std::vector<std::string> paths = {u.path, u.attitudes_path};
+    for (const auto& [key, value] : u.overrides) {
+      if (key == "gyro_path") paths.push_back(value);
+    }
+    for (const std::string& path : paths) {
       struct stat st;
       if (!path.empty() && stat(path.c_str(), &st) == 0) {
         inputs.emplace(std::make_pair(st.st_dev, st.st_ino), std::make_pair(&u, path));
