@@ -264,6 +264,24 @@ TEST(HostileLogs, ANanTemperatureWithATemperatureTermNamesTheLine) {
   EXPECT_EQ(LeftBehind(scratch, "calib.json"), std::vector<std::string>());
 }
 
+// Finite readings times a checked calibration can overflow: apply writes no
+// inf, names the line and leaves no file.
+TEST(HostileLogs, ACorrectedSampleThatOverflowsIsRefusedByLine) {
+  const ScratchDir scratch;
+  nlohmann::json j = nlohmann::json::parse(Slurp(WriteCalibration(scratch)));
+  j["accel"]["matrix"] = {{1e100, 0.0, 0.0}, {0.0, 1e100, 0.0}, {0.0, 0.0, 1e100}};
+  const std::string calib = scratch.Write("calib.json", j.dump());
+  const std::string log = scratch.Write("raw.csv", "t,ax,ay,az\n0,1,2,3\n0.01,1e300,2,3\n");
+  const CliResult r = RunCli(
+      {"apply", "--calibration", calib, "--input", log, "--output", scratch / "out.csv"}, scratch);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(CliError(r), log +
+                             ":3: the corrected sample is not finite (the reading times the "
+                             "calibration overflows)")
+      << r.err;
+  EXPECT_FALSE(testing_util::FileExists(scratch / "out.csv"));
+}
+
 // apply streams every layout calibrate reads, with the same input keys: a
 // whitespace file without a header (its first line is a row), metadata lines
 // to skip, renamed columns, a sample rate for a log without time.
