@@ -45,7 +45,7 @@ constexpr int kUnits = 6;
 // temporary file is left.
 void ExpectIntactFolder(const std::string& folder) {
   for (const std::string& f : {folder, folder + "/batch_state"}) {
-    EXPECT_EQ(testing_util::CountNames(f, ".tmp."), 0u) << f;
+    EXPECT_EQ(testing_util::CountNames(f, ".gravcal-tmp."), 0u) << f;
     for (const auto& [name, id] : testing_util::JsonFiles(f)) {
       const std::string text = Slurp(f + "/" + name);
       EXPECT_TRUE(nlohmann::json::accept(text)) << f << "/" << name << " is not whole JSON";

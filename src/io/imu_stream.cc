@@ -155,28 +155,16 @@ ImuCsvStreamWriter::~ImuCsvStreamWriter() { Abort(); }
 
 bool ImuCsvStreamWriter::Open(const std::string& path, bool gyro, bool temperature,
                               const std::vector<std::string>& comment, std::string* error) {
+  Abort();
   path_ = path;
   gyro_ = gyro;
   temperature_ = temperature;
   if (path == "-") {
-    file_ = stdout;
-  } else {
-    temporary_ = path + ".tmp.XXXXXX";
-    const int fd = mkstemp(&temporary_[0]);
-    if (fd < 0) {
-      *error = path + ": cannot write: " + ErrnoText();
-      temporary_.clear();
-      return false;
-    }
-    fchmod(fd, 0644);
-    file_ = fdopen(fd, "wb");
-    if (file_ == nullptr) {
-      *error = path + ": cannot write: " + ErrnoText();
-      close(fd);
-      Abort();
-      return false;
-    }
+    stdout_ = stdout;
+  } else if (!file_.Open(path, error)) {
+    return false;
   }
+  open_ = true;
   buffer_.reserve(kBufferSize + 4096);
   for (const std::string& line : comment) buffer_ += "# " + line + "\n";
   buffer_ += "t,ax,ay,az";
@@ -187,9 +175,11 @@ bool ImuCsvStreamWriter::Open(const std::string& path, bool gyro, bool temperatu
 }
 
 bool ImuCsvStreamWriter::Flush(std::string* error) {
-  if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
-    *error =
-        (path_ == "-" ? std::string("standard output") : path_) + ": cannot write: " + ErrnoText();
+  if (stdout_ == nullptr) {
+    if (!file_.Write(buffer_.data(), buffer_.size(), error)) return false;
+  } else if (!buffer_.empty() &&
+             std::fwrite(buffer_.data(), 1, buffer_.size(), stdout_) != buffer_.size()) {
+    *error = "standard output: cannot write: " + ErrnoText();
     return false;
   }
   buffer_.clear();
@@ -219,7 +209,7 @@ bool ImuCsvStreamWriter::Write(const ImuSample& s, std::string* error) {
 }
 
 bool ImuCsvStreamWriter::Commit(std::string* error) {
-  if (file_ == nullptr) {
+  if (!open_) {
     *error = path_ + ": not open";
     return false;
   }
@@ -227,28 +217,21 @@ bool ImuCsvStreamWriter::Commit(std::string* error) {
     Abort();
     return false;
   }
-  if (path_ == "-") {
-    const bool ok = std::fflush(file_) == 0;
-    file_ = nullptr;
+  open_ = false;
+  if (stdout_ != nullptr) {
+    const bool ok = std::fflush(stdout_) == 0;
+    stdout_ = nullptr;
     if (!ok) *error = "standard output: cannot write: " + ErrnoText();
     return ok;
   }
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!closed || std::rename(temporary_.c_str(), path_.c_str()) != 0) {
-    *error = path_ + ": cannot write: " + ErrnoText();
-    Abort();
-    return false;
-  }
-  temporary_.clear();
-  return true;
+  return file_.Commit(error);
 }
 
 void ImuCsvStreamWriter::Abort() {
-  if (file_ != nullptr && path_ != "-") std::fclose(file_);
-  file_ = nullptr;
-  if (!temporary_.empty()) std::remove(temporary_.c_str());
-  temporary_.clear();
+  file_.Abort();
+  stdout_ = nullptr;
+  open_ = false;
+  buffer_.clear();
 }
 
 }  // namespace gravcal

@@ -11,8 +11,8 @@
 // with a second gyroscope file (gyro_path) are read whole by log_reader.h
 // and served from memory.
 //
-// The writer writes to a temporary file beside the output and renames it on
-// Commit(), so a failure leaves no partial file; on standard output it writes
+// The writer writes through AtomicFile (files.h: the destination contract),
+// so a failure leaves no partial file; on standard output it writes
 // as it goes (callers check everything they can before the first sample).
 #ifndef GRAVCAL_IO_IMU_STREAM_H_
 #define GRAVCAL_IO_IMU_STREAM_H_
@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 
 namespace gravcal {
@@ -91,9 +92,11 @@ class ImuCsvStreamWriter {
  private:
   bool Flush(std::string* error);
 
-  std::FILE* file_ = nullptr;
+  // Standard output, or nullptr when writing to `file_`.
+  std::FILE* stdout_ = nullptr;
+  AtomicFile file_;
+  bool open_ = false;
   std::string path_;
-  std::string temporary_;
   bool gyro_ = false;
   bool temperature_ = false;
   std::string buffer_;
