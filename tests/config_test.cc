@@ -141,6 +141,7 @@ TEST(Config, APathThatIsNotARegularFileIsRefused) {
 TEST(Config, ContradictionsAndIgnoredKeysNameBothKeys) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
       {"gravity: 9.81\nlatitude: 45\n", {"'gravity'", "'latitude'"}},
+      {"sample_rate: 100\ntime_scale: 1e-9\n", {"'sample_rate'", "'time_scale'"}},
       {"height: 300\n", {"'height'", "latitude"}},
       {"gravity: 9.81\nlatitude: 45\nheight: 300\n", {"'gravity'", "'latitude'"}},
       {"solver: newton\nloss: cauchy\n", {"'solver'", "'loss'"}},

@@ -270,6 +270,31 @@ TEST(EffectFit, RobustLossResistsADisturbedPoseAsThePlainFitDoes) {
   }
 }
 
+// covariance: false holds with effects too: the same estimates, and no
+// standard deviations or covariance (they were computed and written).
+TEST(EffectFit, CovarianceFalseHoldsForTheFitWithEffects) {
+  SimulatorOptions sim = testing_util::WarmUpSession();
+  sim.accel_temperature_bias_std = 0.005;
+  SimulatedSession session;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, 2, &session, &error)) << error;
+  Config config;
+  config.effects = {Effect::kAccelTemperatureBias};
+  config.calibration.gravity.gravity = session.gravity;
+  PipelineInput input;
+  input.log = session.log;
+  Calibration with, without;
+  ASSERT_TRUE(RunCalibration(config, input, &with)) << with.message;
+  config.calibration.refinement.compute_covariance = false;
+  ASSERT_TRUE(RunCalibration(config, input, &without)) << without.message;
+  EXPECT_TRUE(with.accel.bias_std.allFinite());
+  EXPECT_GT(with.accel.covariance.size(), 0);
+  EXPECT_FALSE(without.accel.bias_std.array().isFinite().any()) << without.accel.bias_std;
+  EXPECT_EQ(without.accel.covariance.size(), 0);
+  EXPECT_LT((with.accel.model.bias - without.accel.model.bias).norm(),
+            1e-6 * with.accel.model.bias.norm() + 1e-9);
+}
+
 TEST(EffectFit, EffectsTheLogCannotSupportFailWithTheirName) {
   SimulatorOptions sim;
   SimulatedSession session;

@@ -111,6 +111,11 @@ bool CheckConsistency(const Config& c, const std::function<bool(const char*)>& r
     *error = std::string("key '") + key + "' is ignored " + when + " (remove it)";
     return false;
   };
+  if (c.input.sample_rate > 0.0 && KeySet(c, "time_scale")) {
+    return contradict("sample_rate", "time_scale",
+                      "sample_rate makes the time of a log without a time column, time_scale "
+                      "scales the time column of a log with one: one of them is ignored");
+  }
   if (reads("gravity") && o.gravity.gravity > 0.0 && std::isfinite(o.gravity.latitude)) {
     return contradict("gravity", "latitude",
                       "a measured gravity replaces normal gravity at a latitude; set one");
