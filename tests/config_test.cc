@@ -151,6 +151,7 @@ TEST(Config, ContradictionsAndIgnoredKeysNameBothKeys) {
       {"gyro_model: none\ngyro_joint: true\n", {"'gyro_model'", "'gyro_joint'"}},
       {"gyro_edge: 0.5\n", {"'gyro_edge'", "gyro_model: none"}},
       {"pose_disturbance_prior: 0.004\n", {"'pose_disturbance_prior'", "pose_variance: true"}},
+      {"pose_noise_batches: 8\n", {"'pose_noise_batches'", "pose_noise: batch_means"}},
       {"covariance: false\noutput_covariance: true\n", {"'covariance'", "'output_covariance'"}},
   };
   for (const auto& [text, names] : cases) {
@@ -168,6 +169,7 @@ TEST(Config, ContradictionsAndIgnoredKeysNameBothKeys) {
         "solver: newton\nnewton_residual: magnitude\n", "gyro_model: full\ngyro_joint: true\n",
         "gyro_model: bias\ngyro_g_sensitivity: true\ngyro_edge: 0.5\n",
         "pose_variance: true\npose_disturbance_prior: 0.004\n",
+        "pose_noise: batch_means\npose_noise_batches: 8\n",
         "covariance: false\noutput_covariance: false\n", "effects: [accel_bias_drift]\n"}) {
     Config config;
     std::string error;

@@ -216,6 +216,10 @@ bool PrintHelp(const std::string& command) {
         "'gravcal --version' prints the versions of gravcal, Ceres and Eigen.\n");
     return true;
   }
+  if (command == "version" || command == "--version") {
+    std::printf("gravcal version (or --version): the versions of gravcal, Ceres and Eigen\n");
+    return true;
+  }
   for (const CommandInfo& c : Commands()) {
     if (command != c.name) continue;
     std::printf("gravcal %s: %s\n\nflags:\n", c.name, c.summary);

@@ -144,6 +144,10 @@ bool CheckConsistency(const Config& c, const std::function<bool(const char*)>& r
     return contradict("covariance", "output_covariance",
                       "no covariance is computed with covariance: false, so none can be written");
   }
+  if (reads("pose_noise_batches") && KeySet(c, "pose_noise_batches") &&
+      o.pose_noise.method != PoseNoise::kBatchMeans) {
+    return ignored("pose_noise_batches", "unless pose_noise: batch_means");
+  }
   if (reads("pose_variance") && !o.refinement.estimate_pose_variance) {
     for (const char* key :
          {"pose_disturbance_prior", "pose_disturbance_prior_dof", "prior_conflict_level",
