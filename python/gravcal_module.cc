@@ -747,6 +747,17 @@ PYBIND11_MODULE(_gravcal, m) {
       },
       py::arg("config"), py::arg("log"), py::arg("kalibr"), py::arg("handheld"), py::arg("report"));
   m.def("discover", &Discover, py::arg("config"), py::arg("log"));
+  // The destination contract (io/files.h), checked before any work:
+  // outputs and inputs as (path, name in messages) pairs.
+  m.def("check_destinations", [](const std::vector<std::pair<std::string, std::string>>& outputs,
+                                 const std::vector<std::pair<std::string, std::string>>& inputs) {
+    std::vector<Destination> destinations;
+    for (const auto& [path, name] : outputs) destinations.push_back({path, name});
+    std::vector<Source> sources;
+    for (const auto& [path, name] : inputs) sources.push_back({path, name});
+    std::string error;
+    Check(CheckDestinations(destinations, sources, &error), error);
+  });
   m.def("write_file", [](const std::string& path, const std::string& text) {
     std::string error;
     Check(WriteFileAtomically(path, text, &error), error);

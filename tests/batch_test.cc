@@ -408,13 +408,14 @@ TEST_F(BatchTest, KilledRunResumesWithoutRecomputing) {
   std::ofstream(pipe) << Slurp(*dir_ + "/u00.csv");
 
   // As if the kill had caught a write half way.
-  std::ofstream(out + "/r1000.json.tmp." + std::to_string(pid)) << "{";
+  std::ofstream(out + "/.gravcal-tmp." + std::to_string(pid) + ".0badcafe.r1000.json") << "{";
   const Process resumed = Run(args(out));
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   EXPECT_NE(resumed.err.find("skipped " + std::to_string(state.size()) + " "), std::string::npos)
       << resumed.err;
   // No temporary file of the killed run is left.
-  EXPECT_EQ(CountNames(out, ".tmp.") + CountNames(out + "/batch_state", ".tmp."), 0u);
+  EXPECT_EQ(CountNames(out, ".gravcal-tmp.") + CountNames(out + "/batch_state", ".gravcal-tmp."),
+            0u);
   const std::map<std::string, FileId> state_after = JsonFiles(out + "/batch_state");
   const std::map<std::string, FileId> results_after = JsonFiles(out);
   EXPECT_EQ(state_after.size(), static_cast<size_t>(kUnits));

@@ -50,7 +50,10 @@ inline std::map<std::string, FileId> JsonFiles(const std::string& folder) {
   if (dir == nullptr) return files;
   while (const dirent* e = readdir(dir)) {
     const std::string name = e->d_name;
-    if (name.size() < 5 || name.compare(name.size() - 5, 5, ".json") != 0) continue;
+    // Hidden names: gravcal's temporaries (io/files.h).
+    if (name[0] == '.' || name.size() < 5 || name.compare(name.size() - 5, 5, ".json") != 0) {
+      continue;
+    }
     struct stat st;
     if (stat((folder + "/" + name).c_str(), &st) != 0) continue;
     files[name] = {st.st_ino,

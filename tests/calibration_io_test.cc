@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -174,6 +175,188 @@ TEST(CalibrationJsonReader, ANumberBeyondDoubleIsAnErrorNotACrash) {
   error.clear();
   EXPECT_FALSE(ReadCalibrationJson(regression, &loaded, &error));
   EXPECT_FALSE(error.empty());
+}
+
+// --- Issue 32: calibrations checked on load -----------------------------
+
+// A consistent calibration: M = R U with a small rotation, a gyroscope.
+json GoodCalibration() {
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.01, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+  Eigen::Matrix3d upper;
+  upper << 6.0e-4, 2e-7, -1e-7, 0.0, 5.9e-4, 3e-7, 0.0, 0.0, 6.1e-4;
+  auto matrix = [](const Eigen::Matrix3d& m) {
+    json rows = json::array();
+    for (int r = 0; r < 3; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2)});
+    return rows;
+  };
+  json j;
+  j["method"] = "twelve_position";
+  j["accel"] = {{"model", "affine"},
+                {"bias", {10.0, -20.0, 5.0}},
+                {"matrix", matrix(rotation * upper)},
+                {"upper", matrix(upper)},
+                {"rotation", matrix(rotation)}};
+  j["gyro"] = {{"bias", {1.0, 2.0, 3.0}}, {"matrix", matrix(1.3e-4 * Eigen::Matrix3d::Identity())}};
+  j["gravity"] = {{"value", 9.81}};
+  return j;
+}
+
+// The error CalibrationFromJson gives for `j` ("" when it loads).
+std::string LoadError(const json& j, LoadedCalibration* loaded = nullptr) {
+  LoadedCalibration scratch;
+  std::string error;
+  const bool ok = CalibrationFromJson(j.dump(), "c.json", loaded ? loaded : &scratch, &error);
+  EXPECT_EQ(ok, error.empty()) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  return ok ? std::string() : error;
+}
+
+json Diagonal(double a, double b, double c) {
+  return json::array(
+      {json::array({a, 0.0, 0.0}), json::array({0.0, b, 0.0}), json::array({0.0, 0.0, c})});
+}
+
+TEST(CalibrationChecksOnLoad, AConsistentCalibrationLoadsAsWritten) {
+  LoadedCalibration loaded;
+  ASSERT_EQ(LoadError(GoodCalibration(), &loaded), "");
+  const json j = GoodCalibration();
+  EXPECT_LT((loaded.corrector.accel.matrix() - JsonMatrix(j["accel"]["matrix"])).norm(),
+            1e-15 * JsonMatrix(j["accel"]["matrix"]).norm());
+  std::string error;
+  EXPECT_TRUE(CheckCalibrationModels(loaded, "c.json", &error)) << error;
+}
+
+// Today's main rebuilt the model from upper and rotation and ignored an edited
+// matrix: apply and every export gave the unedited output.
+TEST(CalibrationChecksOnLoad, AnEditedMatrixIsRefusedNamingBothKeys) {
+  for (double factor : {1.01, 1.0 + 1e-6, -1.0}) {
+    json j = GoodCalibration();
+    j["accel"]["matrix"][1][1] = j["accel"]["matrix"][1][1].get<double>() * factor;
+    const std::string error = LoadError(j);
+    EXPECT_NE(error.find("c.json: key 'accel.matrix'"), std::string::npos) << error;
+    EXPECT_NE(error.find("'accel.rotation'"), std::string::npos) << error;
+    EXPECT_NE(error.find("'accel.upper'"), std::string::npos) << error;
+  }
+  // An edit below the tolerance (rounding in another writer) is accepted.
+  json j = GoodCalibration();
+  j["accel"]["matrix"][1][1] = j["accel"]["matrix"][1][1].get<double>() * (1.0 + 1e-13);
+  EXPECT_EQ(LoadError(j), "");
+  // An edited upper (matrix left) disagrees the same way.
+  j = GoodCalibration();
+  j["accel"]["upper"][0][1] = 1e-5;
+  EXPECT_NE(LoadError(j).find("key 'accel.matrix': disagrees with key 'accel.rotation' * "
+                              "'accel.upper'"),
+            std::string::npos);
+  // effects.accel_misalignment repeats upper's off-diagonal.
+  j = GoodCalibration();
+  j["effects"] = {{"reference_time", 0.0},
+                  {"reference_temperature", nullptr},
+                  {"accel_misalignment", {{"value", {2e-7, -1e-7, 3e-7}}}}};
+  EXPECT_EQ(LoadError(j), "");
+  j["effects"]["accel_misalignment"]["value"][2] = 4e-7;
+  const std::string error = LoadError(j);
+  EXPECT_NE(error.find("key 'effects.accel_misalignment.value'"), std::string::npos) << error;
+  EXPECT_NE(error.find("'accel.upper'"), std::string::npos) << error;
+}
+
+TEST(CalibrationChecksOnLoad, ARotationThatIsNotOneIsRefused) {
+  struct Case {
+    json rotation;
+    const char* what;
+  };
+  const std::vector<Case> cases = {
+      {Diagonal(1.0, 1.0, -1.0), "reflection"},
+      {Diagonal(0.0, 0.0, 0.0), "not a rotation"},
+      {Diagonal(2.0, 2.0, 2.0), "not a rotation"},
+  };
+  for (const Case& k : cases) {
+    json j = GoodCalibration();
+    j["accel"]["rotation"] = k.rotation;
+    // matrix kept consistent, so that the rotation check is what refuses.
+    j["accel"]["matrix"] = j["accel"]["upper"];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        j["accel"]["matrix"][r][c] =
+            k.rotation[r][r].get<double>() * j["accel"]["upper"][r][c].get<double>();
+      }
+    }
+    const std::string error = LoadError(j);
+    EXPECT_NE(error.find("c.json: key 'accel.rotation'"), std::string::npos) << error;
+    EXPECT_NE(error.find(k.what), std::string::npos) << error;
+  }
+  json j = GoodCalibration();
+  j["accel"]["upper"][2][0] = 1e-4;
+  EXPECT_NE(LoadError(j).find("key 'accel.upper': is not upper triangular"), std::string::npos);
+}
+
+TEST(CalibrationChecksOnLoad, SensorMatricesAreCheckedByConditioningNotDeterminant) {
+  struct Case {
+    json matrix;
+    const char* what;  // "" = accepted
+  };
+  const std::vector<Case> cases = {
+      {Diagonal(0.0, 0.0, 0.0), "all zeros"},
+      {Diagonal(1e308, 1e308, 1e308), "singular values"},
+      {Diagonal(1e-3, 1e-3, -1e-3), "reflection"},
+      {Diagonal(1e-3, 1e-3, 1e-10), "ill-conditioned"},
+      {Diagonal(1.0, 1.0, 0.0), "singular"},
+      // det = 1e-360 underflows to 0; the matrix is perfectly conditioned.
+      {Diagonal(1e-120, 1e-120, 1e-120), ""},
+      {Diagonal(1e-3, 1e-3, 1e-8), ""},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.matrix.dump());
+    json j = GoodCalibration();
+    j["gyro"]["matrix"] = k.matrix;
+    std::string error = LoadError(j);
+    if (*k.what == '\0') {
+      EXPECT_EQ(error, "");
+    } else {
+      EXPECT_NE(error.find("c.json: key 'gyro.matrix': "), std::string::npos) << error;
+      EXPECT_NE(error.find(k.what), std::string::npos) << error;
+    }
+    // The same for an accelerometer given by its matrix alone (older files).
+    j = GoodCalibration();
+    j["accel"].erase("upper");
+    j["accel"].erase("rotation");
+    j["accel"]["matrix"] = k.matrix;
+    LoadedCalibration loaded;
+    error = LoadError(j, &loaded);
+    if (*k.what == '\0') {
+      ASSERT_EQ(error, "");
+      const Eigen::Matrix3d expected = JsonMatrix(k.matrix);
+      EXPECT_LT((loaded.corrector.accel.matrix() - expected).norm(), 1e-15 * expected.norm());
+      const Eigen::Vector3d raw(1.0, 2.0, 3.0);
+      const Eigen::Vector3d bias = JsonVector(j["accel"]["bias"]);
+      EXPECT_LT((loaded.corrector.accel.Apply(raw) - expected * (raw - bias)).norm(),
+                1e-14 * (expected * (raw - bias)).norm());
+    } else {
+      EXPECT_NE(error.find("c.json: key 'accel.matrix': "), std::string::npos) << error;
+    }
+  }
+}
+
+// apply, export and the Python package read the file the same way; the CLI
+// refuses before writing anything.
+TEST(CalibrationChecksOnLoad, ApplyAndExportRefuseAnEditedCalibration) {
+  const testing_util::ScratchDir scratch;
+  json j = GoodCalibration();
+  j["accel"]["matrix"][0][0] = 1e-3;
+  const std::string calib = scratch.Write("edited.json", j.dump(2));
+  const std::string log = scratch.Write("raw.csv", "t,ax,ay,az\n0,1,2,3\n0.01,1,2,3\n");
+  const std::string out = scratch / "out.csv";
+  testing_util::CliResult r = testing_util::RunCli(
+      "apply --calibration " + calib + " --input " + log + " --output " + out, scratch);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(calib + ": key 'accel.matrix': disagrees with key 'accel.rotation'"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(testing_util::FileExists(out));
+  r = testing_util::RunCli("export --calibration " + calib + " --to px4 --output " + out, scratch);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(calib + ": key 'accel.matrix'"), std::string::npos) << r.err;
+  EXPECT_FALSE(testing_util::FileExists(out));
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
+#include "test_util.h"
 
 namespace gravcal {
 namespace testing_util {
@@ -56,8 +57,8 @@ inline ImuNoise SimulatedNoiseModel(const SimulatorOptions& o) {
 // written to a temporary file and removed after.
 inline bool CalibrateWithSimulatedNoise(const Config& config, const ImuLog& log,
                                         const std::string& source, Calibration* calibration) {
-  char path[] = "/tmp/gravcal_noise_XXXXXX";
-  const int fd = mkstemp(path);
+  std::string path = testing_util::ScratchFileTemplate("gravcal_noise_");
+  const int fd = mkstemp(path.data());
   if (fd < 0) {
     calibration->message = "cannot create a temporary noise.json";
     return false;
@@ -65,7 +66,7 @@ inline bool CalibrateWithSimulatedNoise(const Config& config, const ImuLog& log,
   close(fd);
   std::string error;
   if (!WriteNoiseJson(SimulatedNoiseModel(config.simulation), path, &error)) {
-    std::remove(path);
+    std::remove(path.c_str());
     calibration->message = error;
     return false;
   }
@@ -74,7 +75,7 @@ inline bool CalibrateWithSimulatedNoise(const Config& config, const ImuLog& log,
   pipeline.source = source;
   pipeline.noise_path = path;
   const bool ok = RunCalibration(config, pipeline, calibration);
-  std::remove(path);
+  std::remove(path.c_str());
   return ok;
 }
 

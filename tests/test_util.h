@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -25,6 +26,15 @@
 
 namespace gravcal {
 namespace testing_util {
+
+// A mkstemp() template for a scratch file under $TMPDIR (/tmp when unset):
+// "<dir>/<stem>XXXXXX". Tests never hard-code /tmp.
+inline std::string ScratchFileTemplate(const std::string& stem) {
+  const char* dir = std::getenv("TMPDIR");
+  std::string folder = dir != nullptr && *dir != '\0' ? dir : "/tmp";
+  if (folder.back() != '/') folder += '/';
+  return folder + stem + "XXXXXX";
+}
 
 // A 16-bit accelerometer at +-2 g full scale: m/s^2 per count.
 constexpr double kCountScale = kStandardGravity / 16384.0;

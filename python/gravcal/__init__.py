@@ -455,12 +455,23 @@ def batch(units, config=None, threads=0, *, pattern="*.csv", **keys):
     return results
 
 
+def _check_outputs(outputs, inputs=()):
+    """The destination contract (docs/data_contract.md#destinations), before
+    any work: ``outputs`` and ``inputs`` as (path or None, name) pairs; an
+    input that is not a path (a Log, arrays) is not compared."""
+    _gravcal.check_destinations(
+        [(_os.fsdecode(p), n) for p, n in outputs if p is not None],
+        [(_os.fsdecode(p), n) for p, n in inputs if isinstance(p, (str, bytes, _os.PathLike))])
+
+
 def noise(log=None, *, config=None, kalibr=None, handheld=None, report=None, t=None, accel=None,
           gyro=None, temp=None, **keys):
     """The noise model of a still log (Allan deviation), as ``gravcal noise``
     writes noise.json: a dict. ``kalibr``, ``handheld`` and ``report`` write
     Kalibr's imu.yaml, the handheld filter's keys and the HTML report there
     (the CLI's --kalibr, --handheld, --report; the same library call)."""
+    _check_outputs([(kalibr, "kalibr"), (handheld, "handheld"), (report, "report")],
+                   [(log, "log"), (config, "config")])
     cfg = _config(config, **keys)
     paths = ["" if p is None else _os.fspath(p) for p in (kalibr, handheld, report)]
     return _result(_gravcal.noise(cfg, _as_log(log, cfg, t, accel, gyro, temp), *paths))
@@ -470,6 +481,7 @@ def discover(log=None, *, config=None, report=None, t=None, accel=None, gyro=Non
              **keys):
     """The effects the model misses, as ``gravcal discover`` writes
     discovery.json: a dict. ``report`` writes the HTML report there."""
+    _check_outputs([(report, "report")], [(log, "log"), (config, "config")])
     cfg = _config(config, **keys)
     text, html = _gravcal.discover(cfg, _as_log(log, cfg, t, accel, gyro, temp))
     if report is not None:
@@ -527,6 +539,7 @@ def plan(config=None, *, noise=None, output=None, **keys):
     path or the dict :func:`noise` returns); also ``max_poses``. Other
     keywords are config keys. ``output`` writes plan.json there (the CLI's
     file, byte for byte); ``simulate(plan=...)`` reads it."""
+    _check_outputs([(output, "output")], [(noise, "noise"), (config, "config")])
     request, rest = _split_request(keys)
     text = _gravcal.plan(_config(config, **rest), request, *_noise_source(noise))
     if output is not None:

@@ -1,4 +1,8 @@
 """Every bad input raises gravcal.Error with the CLI's message (issue 18)."""
+import json
+import os
+import stat
+
 import numpy as np
 import pytest
 
@@ -134,3 +138,34 @@ def test_apply_refuses_bad_arrays(py_calibration):
         py_calibration.apply(np.array([[0.0, 0, 0], [np.nan, 0, 0]]))
     with pytest.raises(gravcal.Error, match="^t: 2 samples, but accel has 1$"):
         py_calibration.apply(np.zeros((1, 3)), t=np.zeros(2))
+
+
+def test_destinations_are_checked_before_the_work(tmp_path):
+    """The destination contract (docs/data_contract.md#destinations): an
+    input is never overwritten, a FIFO never replaced, '-' never a file; a
+    symbolic link's target is replaced."""
+    log = tmp_path / "s.csv"
+    log.write_text("precious")
+    with pytest.raises(gravcal.Error) as e:
+        gravcal.discover(log, report=log)
+    assert str(e.value).startswith(str(log) + ": report is the same file as the input log")
+    with pytest.raises(gravcal.Error) as e:
+        gravcal.noise(log, report=tmp_path / "." / "s.csv")
+    assert "same file as the input log" in str(e.value)
+    assert log.read_text() == "precious"
+    fifo = tmp_path / "plan.json"
+    os.mkfifo(fifo)
+    with pytest.raises(gravcal.Error) as e:
+        gravcal.plan(config_path("twelve_position.yaml"), output=fifo)
+    assert str(e.value) == str(fifo) + ": exists and is a FIFO: gravcal replaces only regular files"
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+    with pytest.raises(gravcal.Error):
+        gravcal.plan(config_path("twelve_position.yaml"), output="-")
+    (tmp_path / "real").mkdir()
+    link = tmp_path / "link.json"
+    link.symlink_to("real/plan.json")
+    gravcal.plan(config_path("twelve_position.yaml"), output=link,
+                 target="accel_bias=0.5mg accel_scale=100ppm", accel_noise_density=0.002)
+    assert link.is_symlink()
+    assert json.loads((tmp_path / "real" / "plan.json").read_text())["poses"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.json", "plan.json", "real", "s.csv"]

@@ -1,12 +1,10 @@
-// gravcal apply: every term of a calibration applied to a contract CSV log,
-// sample by sample in constant memory (io/imu_stream.h), "-" for standard
-// input and output. Logs in another layout (the config's input keys) are
-// read whole by log_reader.h and written the same way. Exit 0 written; 1 bad input (no output file;
-// on standard output nothing is written when the problem shows before the first sample).
+// gravcal apply: every term of a calibration applied to a raw log, sample by
+// sample (io/imu_stream.h: the log reader's layouts, rules and messages; text
+// in constant memory), "-" for standard input and output. Exit 0 written; 1
+// bad input (no output file; on standard output nothing is written when the
+// problem shows before the first sample).
 #include <cmath>
 #include <cstdio>
-#include <functional>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -34,56 +32,6 @@ std::vector<std::string> OutputComment(const std::string& calibration_path,
   return lines;
 }
 
-// True when the config's input keys describe the contract CSV layout, which
-// streams; any other layout (log_reader.h) is read whole.
-bool ContractLayout(const LogReaderOptions& o) {
-  return o.format == LogFormat::kCsv && o.columns.empty() && o.rename.empty() &&
-         o.skip_lines == 0 && o.sample_rate == 0.0 && o.time_scale == 1.0 && o.gyro_path.empty();
-}
-
-// The samples of the input: streamed for the contract layout, from the whole
-// log otherwise.
-struct SampleSource {
-  std::string name;
-  bool has_gyro = false;
-  bool has_temperature = false;
-  std::function<bool(ImuSample*, std::string*)> next;
-};
-
-bool OpenSource(const CommandArgs& args, ImuCsvStreamReader* reader, ImuLog* log,
-                SampleSource* source, std::string* error) {
-  if (ContractLayout(args.config.input)) {
-    if (!reader->Open(args.input, error)) return false;
-    source->name = reader->name();
-    source->has_gyro = reader->has_gyro();
-    source->has_temperature = reader->has_temperature();
-    source->next = [reader](ImuSample* s, std::string* e) { return reader->Next(s, e); };
-    return true;
-  }
-  if (args.input == "-") {
-    *error =
-        "apply: standard input takes the contract CSV layout only (the config's input keys "
-        "describe another layout)";
-    return false;
-  }
-  if (!ReadImuLog(args.input, args.config.input, log, error)) return false;
-  source->name = args.input;
-  source->has_gyro = log->has_gyro();
-  source->has_temperature = !log->temperature.empty();
-  auto index = std::make_shared<size_t>(0);
-  source->next = [log, index](ImuSample* s, std::string* e) {
-    e->clear();
-    if (*index >= log->size()) return false;
-    const size_t i = (*index)++;
-    s->t = log->t[i];
-    s->accel = log->accel[i];
-    s->gyro = log->has_gyro() ? log->gyro[i] : Eigen::Vector3d::Zero();
-    s->temperature = log->temperature.empty() ? NAN : log->temperature[i];
-    return true;
-  };
-  return true;
-}
-
 }  // namespace
 
 int RunApply(const CommandArgs& args) {
@@ -101,35 +49,34 @@ int RunApply(const CommandArgs& args) {
   }
   const ImuCorrector& corrector = calibration.corrector;
   if (!args.config.IsValid(&error)) return Fail(error);
-  ImuCsvStreamReader stream;
-  ImuLog log;
-  SampleSource reader;
-  if (!OpenSource(args, &stream, &log, &reader, &error)) return Fail(error);
-  if (corrector.RequiresTemperature() && !reader.has_temperature) {
-    return Fail(reader.name +
+  // Every layout through the one checked reader (io/imu_stream.h): text in
+  // constant memory, the same rules and messages as calibrate.
+  ImuCsvStreamReader reader;
+  if (!reader.Open(args.input, args.config.input, &error)) return Fail(error);
+  if (corrector.RequiresTemperature() && !reader.has_temperature()) {
+    return Fail(reader.name() +
                 ": the calibration has temperature effects and needs a 'temp' column");
   }
-  if (corrector.has_gyro && !reader.has_gyro) {
+  if (corrector.has_gyro && !reader.has_gyro()) {
     std::fprintf(stderr,
                  "gravcal: warning: %s has no gx, gy, gz: only the accelerometer is corrected\n",
-                 reader.name.c_str());
+                 reader.name().c_str());
   }
   // The first sample is read before the output is opened, so that a bad
-  // first row writes nothing.
+  // first row writes nothing (a log without one is an error).
   ImuSample sample;
-  const bool any = reader.next(&sample, &error);
-  if (!any && !error.empty()) return Fail(error);
+  if (!reader.Next(&sample, &error)) return Fail(error);
   ImuCsvStreamWriter writer;
-  if (!writer.Open(args.output, reader.has_gyro, reader.has_temperature,
-                   OutputComment(args.calibration, calibration, reader.has_gyro), &error)) {
+  if (!writer.Open(args.output, reader.has_gyro(), reader.has_temperature(),
+                   OutputComment(args.calibration, calibration, reader.has_gyro()), &error)) {
     return Fail(error);
   }
   size_t count = 0;
-  for (bool more = any; more; more = reader.next(&sample, &error)) {
+  for (bool more = true; more; more = reader.Next(&sample, &error)) {
     if (!corrector.CorrectRow(sample.temperature, sample.t, &sample.accel,
-                              reader.has_gyro ? &sample.gyro : nullptr)) {
+                              reader.has_gyro() ? &sample.gyro : nullptr)) {
       writer.Abort();
-      return Fail(reader.name + ": sample at t = " + std::to_string(sample.t) +
+      return Fail(reader.name() + ": sample at t = " + std::to_string(sample.t) +
                   ": the quadratic term has no real root (reading outside the calibrated range)");
     }
     if (!writer.Write(sample, &error)) return Fail(error);

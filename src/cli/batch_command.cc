@@ -8,7 +8,9 @@
 // has the unit's current content hash (and, if it calibrated, <unit>.json
 // exists): its summary row is taken from the state file. Units whose input
 // could not be read get no state file, so they are tried again. Temporary
-// files a killed run left behind are removed when their process is gone.
+// files a killed run left behind (io/files.h names them) are removed when
+// provably stale; no other file is ever removed. --input-dir may be the
+// output folder: the batch's own files there are not units.
 #include <dirent.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -22,6 +24,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -29,6 +32,7 @@
 
 #include "cli/commands.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/batch_manifest.h"
@@ -64,24 +68,6 @@ bool MakeFolders(const std::string& path, std::string* error) {
     return false;
   }
   return true;
-}
-
-// Removes the temporary files (<name>.tmp.<pid>) that a killed run left in
-// `folder`, when their process is gone.
-void RemoveStaleTemporaries(const std::string& folder) {
-  DIR* dir = opendir(folder.c_str());
-  if (dir == nullptr) return;
-  while (const dirent* entry = readdir(dir)) {
-    const std::string name = entry->d_name;
-    const size_t tmp = name.rfind(".tmp.");
-    if (tmp == std::string::npos) continue;
-    const std::string pid = name.substr(tmp + 5);
-    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
-    if (kill(static_cast<pid_t>(std::atol(pid.c_str())), 0) != 0 && errno == ESRCH) {
-      unlink((folder + "/" + name).c_str());
-    }
-  }
-  closedir(dir);
 }
 
 bool FileExists(const std::string& path) {
@@ -277,14 +263,82 @@ struct ShardUnits {
   std::vector<size_t> positions;
 };
 
+// True when `a` and `b` name the same existing file.
+bool SameFile(const std::string& a, const std::string& b) {
+  struct stat sa, sb;
+  return stat(a.c_str(), &sa) == 0 && stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev &&
+         sa.st_ino == sb.st_ino;
+}
+
+// The batch's own files (summary.csv, summary.json, the report) that are in
+// its input folder (--input-dir equal to --output-dir, or the report written
+// there), to leave out of the units. A file there that is not what this
+// batch writes is a unit log the batch would overwrite: refused.
+bool OwnFilesInInput(const CommandArgs& args, std::vector<std::string>* own, std::string* error) {
+  const std::string summary_json = args.output_dir + "/summary.json";
+  std::vector<std::pair<std::string, std::function<bool(const std::string&)>>> outputs = {
+      {args.output_dir + "/summary.csv",
+       [&](const std::string& text) {
+         std::vector<SummaryRow> rows;
+         std::string why;
+         return ParseSummaryCsv(text, "", &rows, &why);
+       }},
+      {summary_json,
+       [&](const std::string& text) {
+         FleetInfo info;
+         std::string why;
+         return ParseFleetInfo(text, "", &info, &why);
+       }},
+      {args.report, [](const std::string& text) {
+         return text.compare(0, 15, "<!DOCTYPE html>") == 0 || text.compare(0, 5, "<html") == 0;
+       }}};
+  DIR* dir = opendir(args.input_dir.c_str());
+  if (dir == nullptr) return true;  // UnitsFromDirectory says why.
+  std::vector<std::string> names;
+  while (const dirent* entry = readdir(dir)) names.push_back(entry->d_name);
+  closedir(dir);
+  for (const auto& [path, ours] : outputs) {
+    if (path.empty()) continue;
+    for (const std::string& name : names) {
+      const std::string input = args.input_dir + "/" + name;
+      if (name[0] == '.' || !SameFile(path, input)) continue;
+      std::string text;
+      if (!ReadFileBytes(input, &text, error)) return false;
+      if (!ours(text)) {
+        return SetError(error, path + ": the batch would overwrite " + input +
+                                   ", a file of --input-dir that it did not write; choose "
+                                   "another --output-dir or --report");
+      }
+      own->push_back(name);
+    }
+  }
+  return true;
+}
+
 bool ListShardUnits(const CommandArgs& args, const Shard& shard, ShardUnits* out,
                     std::string* error) {
   std::vector<BatchUnit> fleet;
-  const bool listed = !args.topics.empty() ? UnitsFromTopics(args.input, &fleet, error)
-                      : args.manifest.empty()
-                          ? UnitsFromDirectory(args.input_dir, args.pattern, &fleet, error)
-                          : ReadBatchManifest(args.manifest, args.config, &fleet, error);
+  std::vector<std::string> own;
+  std::vector<std::string> hidden;
+  if (!args.input_dir.empty() && !OwnFilesInInput(args, &own, error)) return false;
+  const bool listed =
+      !args.topics.empty() ? UnitsFromTopics(args.input, &fleet, error)
+      : args.manifest.empty()
+          ? UnitsFromDirectory(args.input_dir, args.pattern, &fleet, error, own, &hidden)
+          : ReadBatchManifest(args.manifest, args.config, &fleet, error);
   if (!listed) return false;
+  if (!hidden.empty()) {
+    std::string names;
+    for (size_t i = 0; i < hidden.size() && i < 5; ++i) {
+      names += (i == 0 ? "" : ", ") + hidden[i];
+    }
+    if (hidden.size() > 5) names += ", ...";
+    std::fprintf(stderr,
+                 "gravcal: note: %s: skipped %zu hidden file%s (%s): hidden and AppleDouble "
+                 "'._' files are never units\n",
+                 args.input_dir.c_str(), hidden.size(), hidden.size() == 1 ? "" : "s",
+                 names.c_str());
+  }
   std::vector<std::string> ids;
   for (const BatchUnit& u : fleet) ids.push_back(u.id);
   out->info.fleet = FleetHash(ids);

@@ -153,13 +153,16 @@ int RunCalibrate(const CommandArgs& args) {
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
   if (!args.history.empty() && !WriteHistoryCsv(c, args.history, &error)) return Fail(error);
-  if (!WriteCalibrationJson(c, args.config.output_covariance,
-                            CalibrationCheckSections(args, input.log), args.output, &error)) {
+  if (!WriteOutput(args.output,
+                   CalibrationToJson(c, args.config.output_covariance,
+                                     CalibrationCheckSections(args, input.log)),
+                   &error)) {
     if (!args.history.empty()) std::remove(args.history.c_str());
     return Fail(error);
   }
   std::fprintf(stderr, "gravcal: %s; %s; wrote %s\n", c.message.c_str(),
-               ResidualLine(c, args.config.calibration.nominal_scale).c_str(), args.output.c_str());
+               ResidualLine(c, args.config.calibration.nominal_scale).c_str(),
+               args.output == "-" ? "standard output" : args.output.c_str());
   return 0;
 }
 

@@ -89,6 +89,15 @@ int RunCheck(const CommandArgs& args);
 // none or when the check cannot be made.
 JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log);
 
+// destinations.cc: the command's destinations checked against the
+// destination contract (io/files.h) before it runs: false with a one-line
+// message naming the destination.
+bool CheckCommandDestinations(const std::string& command, const CommandArgs& args,
+                              std::string* error);
+// Writes `text` to `path` atomically, or to standard output for "-" (the
+// outputs CheckCommandDestinations lets stream).
+bool WriteOutput(const std::string& path, const std::string& text, std::string* error);
+
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);
 

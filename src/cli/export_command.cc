@@ -49,14 +49,15 @@ int RunExport(const CommandArgs& args) {
       mkdir(args.output_dir.c_str(), 0755);
       path = args.output_dir + "/" + file.name;
     }
-    if (!WriteFileAtomically(path, file.text, &error)) {
+    if (!WriteOutput(path, file.text, &error)) {
       for (const std::string& w : written) std::remove(w.c_str());
       return Fail(error);
     }
     written.push_back(path);
   }
   std::string names;
-  for (const std::string& w : written) names += (names.empty() ? "" : " and ") + w;
+  for (const std::string& w : written)
+    names += (names.empty() ? "" : " and ") + (w == "-" ? "standard output" : w);
   std::fprintf(stderr, "gravcal: %s; wrote %s\n", result.message.c_str(), names.c_str());
   return 0;
 }

@@ -464,5 +464,6 @@ int main(int argc, char** argv) {
   if (!LoadCommandConfig(split, &args.config, &error)) return Fail(error);
   CopyFlags(&args);
   args.positional = split.positional;
+  if (!gravcal::cli::CheckCommandDestinations(command, args, &error)) return Fail(error);
   return info->run(args);
 }

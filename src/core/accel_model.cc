@@ -46,7 +46,12 @@ void AccelModel::SetUpper(const double* u6) {
 
 bool AccelModel::FromMatrix(const Eigen::Vector3d& bias, const Eigen::Matrix3d& m,
                             AccelParameterization p, AccelModel* model) {
-  if (!m.allFinite() || !bias.allFinite() || m.determinant() <= 0.0) return false;
+  // The sign of det(M) from M / max|m_ij|, which does not underflow for a
+  // well-conditioned M of tiny scale (det(1e-120 I) is 0 in double).
+  const double scale = m.cwiseAbs().maxCoeff();
+  if (!m.allFinite() || !bias.allFinite() || !(scale > 0.0) || (m / scale).determinant() <= 0.0) {
+    return false;
+  }
   const Eigen::HouseholderQR<Eigen::Matrix3d> qr(m);
   Eigen::Matrix3d q = qr.householderQ();
   Eigen::Matrix3d r = qr.matrixQR().triangularView<Eigen::Upper>();

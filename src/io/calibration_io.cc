@@ -1,5 +1,6 @@
 #include "gravcal/io/calibration_io.h"
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -9,6 +10,8 @@
 #include "gravcal/io/log_reader.h"
 #include "io/json_helpers.h"
 #include "util/content_hash.h"
+#include "util/error.h"
+#include "util/numbers.h"
 #include "util/units.h"
 
 namespace gravcal {
@@ -283,6 +286,48 @@ class JsonReader {
   std::string* error_;
 };
 
+// True when `r` is a rotation (orthonormal, det +1); else sets `why`.
+bool CheckRotation(const Eigen::Matrix3d& r, std::string* why) {
+  if (!r.allFinite()) return internal::SetError(why, "is not finite");
+  const double off = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(off <= kCalibrationRelativeTolerance)) {
+    return internal::SetError(why, "is not a rotation: R^T R differs from I by " +
+                                       internal::ExactNumber(off) + " (at most " +
+                                       internal::ExactNumber(kCalibrationRelativeTolerance) + ")");
+  }
+  const double det = r.determinant();
+  if (!(det > 0.0)) {
+    return internal::SetError(why,
+                              "is a reflection (det = " + internal::ExactNumber(det) + ", not +1)");
+  }
+  return true;
+}
+
+// True when `u` is upper triangular with a positive diagonal; else sets
+// `why`.
+bool CheckUpperTriangular(const Eigen::Matrix3d& u, std::string* why) {
+  if (!u.allFinite()) return internal::SetError(why, "is not finite");
+  const double scale = u.cwiseAbs().maxCoeff();
+  const double lower = std::max({std::abs(u(1, 0)), std::abs(u(2, 0)), std::abs(u(2, 1))});
+  if (!(lower <= kCalibrationRelativeTolerance * scale)) {
+    return internal::SetError(why, "is not upper triangular (an entry below the diagonal is " +
+                                       internal::ExactNumber(lower) + ")");
+  }
+  if (!(u.diagonal().minCoeff() > 0.0)) {
+    return internal::SetError(
+        why, "has a diagonal entry <= 0 (" + internal::ExactNumber(u.diagonal().minCoeff()) + ")");
+  }
+  return true;
+}
+
+// |a - b| / |b| in the Frobenius norm (|a - b| when b is 0).
+double RelativeDifference(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  const double norm = b.norm();
+  return (a - b).norm() / (norm > 0.0 ? norm : 1.0);
+}
+
+// The accelerometer: accel.upper and accel.rotation are authoritative and
+// accel.matrix must be their product; without them accel.matrix is.
 bool ReadAccel(const json& j, JsonReader* r, AccelModel* model) {
   if (!r->Object(j, "accel", "accel")) return false;
   const json& a = j["accel"];
@@ -297,19 +342,36 @@ bool ReadAccel(const json& j, JsonReader* r, AccelModel* model) {
       return r->Fail("accel.model", "must be one of the accelerometer parameterisations");
     }
   }
-  if (!AccelModel::FromMatrix(b, m, p, model)) {
-    return r->Fail("accel.matrix", "is singular or a reflection");
-  }
-  // The file's upper and rotation, when present, are the decomposition the
-  // effects were fitted in; the QR of M gives the same up to rounding.
+  std::string why;
+  if (!b.allFinite()) return r->Fail("accel.bias", "is not finite");
+  if (!m.allFinite()) return r->Fail("accel.matrix", "is not finite");
   if (a.contains("upper") || a.contains("rotation")) {
     Eigen::Matrix3d upper, rotation;
     if (!r->Matrix(a, "upper", "accel.upper", &upper) ||
         !r->Matrix(a, "rotation", "accel.rotation", &rotation)) {
       return false;
     }
+    if (!CheckRotation(rotation, &why)) return r->Fail("accel.rotation", why);
+    if (!CheckUpperTriangular(upper, &why)) return r->Fail("accel.upper", why);
+    const Eigen::Matrix3d product = rotation * upper;
+    if (!product.allFinite()) return r->Fail("accel.upper", "times accel.rotation is not finite");
+    const double difference = RelativeDifference(m, product);
+    if (!(difference <= kCalibrationRelativeTolerance)) {
+      return r->Fail("accel.matrix",
+                     "disagrees with key 'accel.rotation' * 'accel.upper' (relative difference " +
+                         internal::ExactNumber(difference) + ", at most " +
+                         internal::ExactNumber(kCalibrationRelativeTolerance) +
+                         "); upper and rotation are authoritative, matrix must be their product");
+    }
+    model->parameterization = p;
+    model->bias = b;
     model->upper = upper;
     model->rotation = rotation;
+  } else {
+    if (!CheckSensorMatrix(m, &why)) return r->Fail("accel.matrix", why);
+    if (!AccelModel::FromMatrix(b, m, p, model)) {
+      return r->Fail("accel.matrix", "has no QR decomposition with a positive diagonal");
+    }
   }
   return true;
 }
@@ -325,6 +387,26 @@ bool ReadGyro(const json& j, JsonReader* r, ImuCorrector* c) {
   return true;
 }
 
+// effects.accel_misalignment.value repeats accel.upper's (0,1), (0,2), (1,2).
+bool CheckMisalignment(const json& values, const std::string& key, JsonReader* r,
+                       const AccelModel& accel) {
+  if (values.size() != 3) return r->Fail(key + ".value", "must have 3 numbers");
+  const Eigen::Matrix3d& u = accel.upper;
+  const double in_upper[3] = {u(0, 1), u(0, 2), u(1, 2)};
+  const double scale = u.cwiseAbs().maxCoeff();
+  for (int i = 0; i < 3; ++i) {
+    double v = 0.0;
+    if (!r->Number(values[i], key + ".value", false, &v)) return false;
+    if (!(std::abs(v - in_upper[i]) <= kCalibrationRelativeTolerance * scale)) {
+      return r->Fail(key + ".value", "[" + std::to_string(i) + "] = " + internal::ExactNumber(v) +
+                                         " disagrees with key 'accel.upper' (" +
+                                         internal::ExactNumber(in_upper[i]) +
+                                         "), which is authoritative");
+    }
+  }
+  return true;
+}
+
 // effects.<name>.value into the parameter the name stands for.
 bool ReadEffect(const json& entry, Effect effect, const std::string& key, JsonReader* r,
                 LoadedCalibration* out) {
@@ -334,7 +416,9 @@ bool ReadEffect(const json& entry, Effect effect, const std::string& key, JsonRe
   }
   const json& values = entry["value"];
   const int n = Info(effect).num_parameters;
-  if (effect == Effect::kAccelMisalignment) return true;  // lives in accel.upper
+  if (effect == Effect::kAccelMisalignment) {  // lives in accel.upper
+    return CheckMisalignment(values, key, r, out->corrector.accel);
+  }
   if (static_cast<int>(values.size()) != n) {
     return r->Fail(key + ".value", "must have " + std::to_string(n) + " numbers");
   }
@@ -482,7 +566,71 @@ bool CalibrationFromJson(const std::string& text, const std::string& name,
     if (!(out.gravity > 0.0)) return r.Fail("gravity.value", "must be positive");
   }
   if (j.contains("method") && j["method"].is_string()) out.method = j["method"].get<std::string>();
+  if (!CheckCalibrationModels(out, name, error)) return false;
   *calibration = std::move(out);
+  return true;
+}
+
+bool CheckSensorMatrix(const Eigen::Matrix3d& m, std::string* why) {
+  using internal::ExactNumber;
+  using internal::SetError;
+  if (!m.allFinite()) return SetError(why, "is not finite");
+  // m / max|m_ij|: its determinant and singular values neither overflow
+  // (1e300 entries) nor underflow (det(1e-120 I) = 1e-360 is 0 in double).
+  const double scale = m.cwiseAbs().maxCoeff();
+  if (!(scale > 0.0)) return SetError(why, "is all zeros");
+  const double det = (m / scale).determinant();
+  if (det < 0.0) return SetError(why, "is a reflection (det < 0: the axes would be mirrored)");
+  const Eigen::Vector3d s = Eigen::JacobiSVD<Eigen::Matrix3d>(m / scale).singularValues();
+  const double largest = s(0) * scale, smallest = s(2) * scale;
+  if (!(largest <= kCalibrationMaxSingularValue) || !(smallest >= kCalibrationMinSingularValue)) {
+    return SetError(why, "has singular values from " + ExactNumber(smallest) + " to " +
+                             ExactNumber(largest) + ", outside [" +
+                             ExactNumber(kCalibrationMinSingularValue) + ", " +
+                             ExactNumber(kCalibrationMaxSingularValue) +
+                             "] (singular, or beyond double arithmetic)");
+  }
+  const double condition = s(0) / s(2);
+  if (!(condition <= kCalibrationMaxConditionNumber)) {
+    return SetError(why, "is ill-conditioned: condition number " + ExactNumber(condition) + " > " +
+                             ExactNumber(kCalibrationMaxConditionNumber));
+  }
+  if (!(det > 0.0)) return SetError(why, "is singular");
+  return true;
+}
+
+bool CheckCalibrationModels(const LoadedCalibration& c, const std::string& name,
+                            std::string* error) {
+  auto fail = [&](const std::string& key, const std::string& what) {
+    return internal::SetError(error, name + ": key '" + key + "': " + what);
+  };
+  std::string why;
+  const AccelModel& accel = c.corrector.accel;
+  if (!accel.bias.allFinite()) return fail("accel.bias", "is not finite");
+  if (!CheckRotation(accel.rotation, &why)) return fail("accel.rotation", why);
+  if (!CheckUpperTriangular(accel.upper, &why)) return fail("accel.upper", why);
+  if (!CheckSensorMatrix(accel.matrix(), &why)) return fail("accel.matrix", why);
+  if (c.corrector.has_gyro) {
+    if (!c.corrector.gyro.bias.allFinite()) return fail("gyro.bias", "is not finite");
+    if (!CheckSensorMatrix(c.corrector.gyro.matrix, &why)) return fail("gyro.matrix", why);
+  }
+  const EffectParameters& e = c.corrector.effects;
+  const std::pair<const char*, bool> effects[] = {
+      {"effects.accel_quadratic_nonlinearity", e.accel_quadratic.allFinite()},
+      {"effects.accel_temperature_bias", e.accel_temperature_bias.allFinite()},
+      {"effects.accel_temperature_scale", e.accel_temperature_scale.allFinite()},
+      {"effects.accel_bias_drift", e.accel_bias_drift.allFinite()},
+      {"effects.gyro_temperature_bias", e.gyro_temperature_bias.allFinite()},
+      {"effects.gyro_bias_drift", e.gyro_bias_drift.allFinite()},
+      {"effects.gyro_g_sensitivity", e.gyro_g_sensitivity.allFinite()},
+      {"effects.reference_time", std::isfinite(e.reference_time)},
+      {"effects.reference_temperature", std::isfinite(e.reference_temperature)}};
+  for (const auto& [key, finite] : effects) {
+    if (!finite) return fail(key, "is not finite");
+  }
+  if (!(c.gravity > 0.0) || !std::isfinite(c.gravity)) {
+    return fail("gravity.value", "must be positive and finite");
+  }
   return true;
 }
 

@@ -10,6 +10,11 @@
 #include <cstring>
 #include <system_error>
 
+#include "gravcal/core/imu_log.h"
+#include "io/formats/file_format.h"
+#include "io/log_text.h"
+#include "util/error.h"
+
 namespace gravcal {
 
 namespace {
@@ -18,185 +23,123 @@ constexpr size_t kBufferSize = size_t{1} << 20;
 
 std::string ErrnoText() { return std::generic_category().message(errno); }
 
-// [begin, end) without spaces, tabs and a carriage return at either end.
-void Trim(const char** begin, const char** end) {
-  while (*begin < *end && (**begin == ' ' || **begin == '\t')) ++*begin;
-  while (*end > *begin && ((*end)[-1] == ' ' || (*end)[-1] == '\t' || (*end)[-1] == '\r')) --*end;
-}
-
-bool ParseNumber(const char* begin, const char* end, double* value) {
-  Trim(&begin, &end);
-  if (begin < end && *begin == '+') ++begin;
-  if (begin == end) return false;
-  const std::from_chars_result r = std::from_chars(begin, end, *value);
-  return r.ec == std::errc() && r.ptr == end;
-}
-
 }  // namespace
 
-ImuCsvStreamReader::~ImuCsvStreamReader() {
-  if (owns_file_ && file_ != nullptr) std::fclose(file_);
-}
-
-bool ImuCsvStreamReader::Fail(const std::string& message, std::string* error) const {
-  *error = name_ + ":" + std::to_string(line_) + ": " + message;
-  return false;
-}
-
-bool ImuCsvStreamReader::ReadLine(const char** begin, const char** end, std::string* error) {
-  for (;;) {
-    const char* start = buffer_.data() + begin_;
-    const char* newline = static_cast<const char*>(std::memchr(start, '\n', end_ - begin_));
-    if (newline != nullptr) {
-      *begin = start;
-      *end = newline;
-      begin_ = static_cast<size_t>(newline - buffer_.data()) + 1;
-      ++line_;
-      return true;
-    }
-    if (eof_) {
-      if (begin_ == end_) return false;
-      // The last line has no end of line.
-      *begin = start;
-      *end = buffer_.data() + end_;
-      begin_ = end_;
-      ++line_;
-      return true;
-    }
-    // Move the partial line to the front (grow for a line longer than the
-    // buffer) and read more.
-    std::memmove(buffer_.data(), start, end_ - begin_);
-    end_ -= begin_;
-    begin_ = 0;
-    if (end_ == buffer_.size()) buffer_.resize(buffer_.size() * 2);
-    const size_t n = std::fread(buffer_.data() + end_, 1, buffer_.size() - end_, file_);
-    if (n == 0) {
-      if (std::ferror(file_)) {
-        *error = name_ + ": cannot read: " + ErrnoText();
-        return false;
-      }
-      eof_ = true;
-    }
-    end_ += n;
+struct ImuCsvStreamReader::State {
+  ~State() {
+    if (owns_file && file != nullptr) std::fclose(file);
   }
-}
+  std::FILE* file = nullptr;
+  bool owns_file = false;
+  std::unique_ptr<internal::LogLines> lines;
+  std::unique_ptr<internal::LogRowParser> parser;
+  // A row read while looking for the layout (`columns` given: no header).
+  bool pending = false;
+  // A log read whole (bags, MCAP, gyro_path), served from memory.
+  bool whole = false;
+  ImuLog log;
+  size_t next = 0;
+};
+
+ImuCsvStreamReader::ImuCsvStreamReader() = default;
+ImuCsvStreamReader::~ImuCsvStreamReader() = default;
 
 bool ImuCsvStreamReader::Open(const std::string& path, std::string* error) {
+  return Open(path, LogReaderOptions(), error);
+}
+
+bool ImuCsvStreamReader::Open(const std::string& path, const LogReaderOptions& options,
+                              std::string* error) {
+  using internal::SetError;
   name_ = path == "-" ? "standard input" : path;
-  if (path == "-") {
-    file_ = stdin;
-  } else {
-    file_ = std::fopen(path.c_str(), "rb");
-    if (file_ == nullptr) {
-      *error = path + ": cannot open: " + ErrnoText();
-      return false;
-    }
-    owns_file_ = true;
-  }
-  buffer_.resize(kBufferSize);
-  const char* begin;
-  const char* end;
-  for (;;) {
-    error->clear();
-    if (!ReadLine(&begin, &end, error)) {
-      if (error->empty()) *error = name_ + ": no header row (empty log)";
-      return false;
-    }
-    const char* first = begin;
-    Trim(&first, &end);
-    if (first != end && *first != '#') break;
-  }
-  columns_.clear();
-  for (const char* field = begin;;) {
-    const char* comma = static_cast<const char*>(std::memchr(field, ',', end - field));
-    const char* field_end = comma != nullptr ? comma : end;
-    const char* a = field;
-    const char* b = field_end;
-    Trim(&a, &b);
-    columns_.emplace_back(a, b);
-    if (comma == nullptr) break;
-    field = comma + 1;
-  }
-  auto find = [&](const char* name) {
-    const auto it = std::find(columns_.begin(), columns_.end(), name);
-    return it == columns_.end() ? -1 : static_cast<int>(it - columns_.begin());
+  state_ = std::make_unique<State>();
+  State& s = *state_;
+  std::string why;
+  if (!options.IsValid(&why)) return SetError(error, name_ + ": invalid options: " + why);
+  auto read_whole = [&]() {
+    if (!ReadImuLog(path, options, &s.log, error)) return false;
+    s.whole = true;
+    has_gyro_ = s.log.has_gyro();
+    has_temperature_ = !s.log.temperature.empty();
+    return true;
   };
-  time_column_ = find("t");
-  const char* accel_names[3] = {"ax", "ay", "az"};
-  const char* gyro_names[3] = {"gx", "gy", "gz"};
-  for (int i = 0; i < 3; ++i) {
-    accel_column_[i] = find(accel_names[i]);
-    gyro_column_[i] = find(gyro_names[i]);
+  if (!options.gyro_path.empty()) {
+    if (path == "-") return SetError(error, "standard input: gyro_path needs the log in a file");
+    return read_whole();
   }
-  temperature_column_ = find("temp");
-  for (const char* required : {"t", "ax", "ay", "az"}) {
-    if (find(required) < 0) {
-      return Fail(std::string("the header has no column '") + required +
-                      "' (needs t, ax, ay, az; optional gx, gy, gz, temp)",
-                  error);
+  if (path == "-") {
+    s.file = stdin;
+  } else {
+    s.file = std::fopen(path.c_str(), "rb");
+    if (s.file == nullptr) return SetError(error, path + ": cannot open: " + ErrnoText());
+    s.owns_file = true;
+  }
+  s.lines = std::make_unique<internal::LogLines>(s.file, name_);
+  why.clear();
+  const std::string_view head = s.lines->Head(4096, &why);
+  if (!why.empty()) return SetError(error, why);
+  internal::FileFormat format = internal::FileFormat::kText;
+  if (!internal::DetectFileFormat(head, &format, &why)) return SetError(error, name_ + ": " + why);
+  if (internal::NewMessageRecording(format) != nullptr) {
+    if (path == "-") {
+      return SetError(error, name_ + ": a " + internal::FileFormatName(format) +
+                                 " is read from its file, not from standard input");
     }
+    s.lines.reset();
+    std::fclose(s.file);
+    s.file = nullptr;
+    return read_whole();
   }
-  const int gyro_count = (gyro_column_[0] >= 0) + (gyro_column_[1] >= 0) + (gyro_column_[2] >= 0);
-  if (gyro_count != 0 && gyro_count != 3) {
-    return Fail("the header names only some of gx, gy, gz", error);
+  // An EuRoC / TUM-VI header is the header row once its '#' is dropped.
+  const bool euroc = format == internal::FileFormat::kEuroc && internal::LayoutFromFile(options);
+  s.parser = std::make_unique<internal::LogRowParser>(
+      name_, euroc ? internal::EurocOptions(options) : options, false);
+  std::string_view line;
+  while (!s.parser->has_layout()) {
+    if (!s.lines->Next(&line, &why)) {
+      return SetError(error, why.empty() ? name_ + ": no samples" : why);
+    }
+    if (euroc && s.lines->number() == 1 && !line.empty() && line[0] == '#') line.remove_prefix(1);
+    if (!s.parser->Line(line, s.lines->number(), &s.pending, error)) return false;
   }
-  last_needed_column_ =
-      std::max({time_column_, accel_column_[0], accel_column_[1], accel_column_[2], gyro_column_[0],
-                gyro_column_[1], gyro_column_[2], temperature_column_});
+  has_gyro_ = s.parser->has(internal::kGx);
+  has_temperature_ = s.parser->has(internal::kTemp);
   return true;
 }
 
 bool ImuCsvStreamReader::Next(ImuSample* sample, std::string* error) {
   error->clear();
-  const char* begin;
-  const char* end;
-  for (;;) {
-    if (!ReadLine(&begin, &end, error)) return false;
-    const char* first = begin;
-    const char* last = end;
-    Trim(&first, &last);
-    if (first != last && *first != '#') break;
+  if (state_ == nullptr) return internal::SetError(error, name_ + ": not open");
+  State& s = *state_;
+  if (s.whole) {
+    if (s.next >= s.log.size()) return false;
+    const size_t i = s.next++;
+    sample->t = s.log.t[i];
+    sample->accel = s.log.accel[i];
+    sample->gyro = has_gyro_ ? s.log.gyro[i] : Eigen::Vector3d::Zero();
+    sample->temperature = has_temperature_ ? s.log.temperature[i] : NAN;
+    return true;
   }
-  double values[16];
-  std::vector<double> wide;
-  double* value = values;
-  if (last_needed_column_ >= 16) {
-    wide.resize(last_needed_column_ + 1);
-    value = wide.data();
-  }
-  int column = 0;
-  for (const char* field = begin; column <= last_needed_column_; ++column) {
-    const char* comma = static_cast<const char*>(std::memchr(field, ',', end - field));
-    const char* field_end = comma != nullptr ? comma : end;
-    const bool needed = column == time_column_ || column == temperature_column_ ||
-                        std::count(accel_column_, accel_column_ + 3, column) > 0 ||
-                        std::count(gyro_column_, gyro_column_ + 3, column) > 0;
-    if (needed && !ParseNumber(field, field_end, &value[column])) {
-      const char* a = field;
-      const char* b = field_end;
-      Trim(&a, &b);
-      return Fail("column '" + columns_[column] + "': '" + std::string(a, b) + "' is not a number",
-                  error);
-    }
-    if (comma == nullptr) {
-      ++column;
-      break;
-    }
-    field = comma + 1;
-  }
-  if (column <= last_needed_column_) {
-    return Fail("the row has " + std::to_string(column) + " fields, the header names " +
-                    std::to_string(columns_.size()),
-                error);
-  }
-  sample->t = value[time_column_];
-  for (int i = 0; i < 3; ++i) sample->accel(i) = value[accel_column_[i]];
-  if (has_gyro()) {
-    for (int i = 0; i < 3; ++i) sample->gyro(i) = value[gyro_column_[i]];
+  if (s.pending) {
+    s.pending = false;
   } else {
-    sample->gyro.setZero();
+    std::string_view line;
+    for (bool row = false; !row;) {
+      if (!s.lines->Next(&line, error)) {
+        if (error->empty() && s.parser->rows() == 0) *error = name_ + ": no samples";
+        return false;
+      }
+      if (!s.parser->Line(line, s.lines->number(), &row, error)) return false;
+    }
   }
-  sample->temperature = has_temperature() ? value[temperature_column_] : NAN;
+  const internal::LogRowParser& p = *s.parser;
+  sample->t = p.value(internal::kT);
+  sample->accel =
+      Eigen::Vector3d(p.value(internal::kAx), p.value(internal::kAy), p.value(internal::kAz));
+  sample->gyro = has_gyro_ ? Eigen::Vector3d(p.value(internal::kGx), p.value(internal::kGy),
+                                             p.value(internal::kGz))
+                           : Eigen::Vector3d::Zero();
+  sample->temperature = has_temperature_ ? p.value(internal::kTemp) : NAN;
   return true;
 }
 
@@ -204,28 +147,16 @@ ImuCsvStreamWriter::~ImuCsvStreamWriter() { Abort(); }
 
 bool ImuCsvStreamWriter::Open(const std::string& path, bool gyro, bool temperature,
                               const std::vector<std::string>& comment, std::string* error) {
+  Abort();
   path_ = path;
   gyro_ = gyro;
   temperature_ = temperature;
   if (path == "-") {
-    file_ = stdout;
-  } else {
-    temporary_ = path + ".tmp.XXXXXX";
-    const int fd = mkstemp(&temporary_[0]);
-    if (fd < 0) {
-      *error = path + ": cannot write: " + ErrnoText();
-      temporary_.clear();
-      return false;
-    }
-    fchmod(fd, 0644);
-    file_ = fdopen(fd, "wb");
-    if (file_ == nullptr) {
-      *error = path + ": cannot write: " + ErrnoText();
-      close(fd);
-      Abort();
-      return false;
-    }
+    stdout_ = stdout;
+  } else if (!file_.Open(path, error)) {
+    return false;
   }
+  open_ = true;
   buffer_.reserve(kBufferSize + 4096);
   for (const std::string& line : comment) buffer_ += "# " + line + "\n";
   buffer_ += "t,ax,ay,az";
@@ -236,9 +167,11 @@ bool ImuCsvStreamWriter::Open(const std::string& path, bool gyro, bool temperatu
 }
 
 bool ImuCsvStreamWriter::Flush(std::string* error) {
-  if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
-    *error =
-        (path_ == "-" ? std::string("standard output") : path_) + ": cannot write: " + ErrnoText();
+  if (stdout_ == nullptr) {
+    if (!file_.Write(buffer_.data(), buffer_.size(), error)) return false;
+  } else if (!buffer_.empty() &&
+             std::fwrite(buffer_.data(), 1, buffer_.size(), stdout_) != buffer_.size()) {
+    *error = "standard output: cannot write: " + ErrnoText();
     return false;
   }
   buffer_.clear();
@@ -268,7 +201,7 @@ bool ImuCsvStreamWriter::Write(const ImuSample& s, std::string* error) {
 }
 
 bool ImuCsvStreamWriter::Commit(std::string* error) {
-  if (file_ == nullptr) {
+  if (!open_) {
     *error = path_ + ": not open";
     return false;
   }
@@ -276,28 +209,21 @@ bool ImuCsvStreamWriter::Commit(std::string* error) {
     Abort();
     return false;
   }
-  if (path_ == "-") {
-    const bool ok = std::fflush(file_) == 0;
-    file_ = nullptr;
+  open_ = false;
+  if (stdout_ != nullptr) {
+    const bool ok = std::fflush(stdout_) == 0;
+    stdout_ = nullptr;
     if (!ok) *error = "standard output: cannot write: " + ErrnoText();
     return ok;
   }
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!closed || std::rename(temporary_.c_str(), path_.c_str()) != 0) {
-    *error = path_ + ": cannot write: " + ErrnoText();
-    Abort();
-    return false;
-  }
-  temporary_.clear();
-  return true;
+  return file_.Commit(error);
 }
 
 void ImuCsvStreamWriter::Abort() {
-  if (file_ != nullptr && path_ != "-") std::fclose(file_);
-  file_ = nullptr;
-  if (!temporary_.empty()) std::remove(temporary_.c_str());
-  temporary_.clear();
+  file_.Abort();
+  stdout_ = nullptr;
+  open_ = false;
+  buffer_.clear();
 }
 
 }  // namespace gravcal

@@ -11,6 +11,7 @@
 #include <set>
 #include <system_error>
 
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/recording.h"
 #include "io/csv_table.h"
@@ -168,7 +169,8 @@ bool ReadBatchManifest(const std::string& path, const Config& base, std::vector<
 }
 
 bool UnitsFromDirectory(const std::string& folder, const std::string& pattern,
-                        std::vector<BatchUnit>* units, std::string* error) {
+                        std::vector<BatchUnit>* units, std::string* error,
+                        const std::vector<std::string>& exclude, std::vector<std::string>* hidden) {
   DIR* dir = opendir(folder.c_str());
   if (dir == nullptr) {
     *error = folder + ": cannot open the folder: " + std::generic_category().message(errno);
@@ -178,6 +180,11 @@ bool UnitsFromDirectory(const std::string& folder, const std::string& pattern,
   while (const dirent* entry = readdir(dir)) {
     const std::string file = entry->d_name;
     if (file == "." || file == ".." || fnmatch(pattern.c_str(), file.c_str(), 0) != 0) continue;
+    if (std::find(exclude.begin(), exclude.end(), file) != exclude.end()) continue;
+    if (file[0] == '.') {
+      if (hidden != nullptr && !IsGravcalTemporaryName(file)) hidden->push_back(file);
+      continue;
+    }
     struct stat st;
     if (stat((folder + "/" + file).c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
       names.push_back(file);
@@ -185,6 +192,7 @@ bool UnitsFromDirectory(const std::string& folder, const std::string& pattern,
   }
   closedir(dir);
   std::sort(names.begin(), names.end());
+  if (hidden != nullptr) std::sort(hidden->begin(), hidden->end());
   if (names.empty()) {
     *error = folder + ": no file matches '" + pattern + "'";
     return false;

@@ -46,6 +46,13 @@ bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoi
 
 bool WriteNoiseFiles(const ImuNoise& noise, const std::string& source, const NoiseFiles& files,
                      std::vector<std::string>* written, std::string* error) {
+  if (!CheckDestinations({{files.json, "noise.json"},
+                          {files.kalibr, "kalibr"},
+                          {files.handheld, "handheld"},
+                          {files.report, "report"}},
+                         {{source, "log"}}, error)) {
+    return false;
+  }
   std::vector<std::pair<std::string, std::string>> texts;  // path, text
   if (!files.json.empty()) texts.emplace_back(files.json, NoiseToJson(noise));
   if (!files.kalibr.empty()) {

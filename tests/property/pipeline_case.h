@@ -67,8 +67,8 @@ inline bool CalibrateAsCli(const Config& config, const SimulatedInput& input, ui
   pipeline.source = "seed " + std::to_string(seed);
   std::string attitudes;
   if (config.method == "known_attitude") {
-    char path[] = "/tmp/gravcal_property_XXXXXX";
-    const int fd = mkstemp(path);
+    std::string path = testing_util::ScratchFileTemplate("gravcal_property_");
+    const int fd = mkstemp(path.data());
     if (fd < 0) {
       calibration->message = "cannot create a temporary attitudes file";
       return false;

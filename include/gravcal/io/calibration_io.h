@@ -63,10 +63,47 @@ struct LoadedCalibration {
   std::vector<std::string> undetermined;
 };
 
+// The checks every calibration is held to when it is read
+// (docs/data_contract.md, "Calibration JSON: checks on load"):
+// - accel.upper and accel.rotation are authoritative; accel.matrix must equal
+//   rotation * upper to kCalibrationRelativeTolerance (Frobenius norm of the
+//   difference over that of the product), and effects.accel_misalignment.value
+//   must equal upper's (0,1), (0,2), (1,2) to the same tolerance relative to
+//   the largest entry of upper. A file without upper and rotation has
+//   accel.matrix authoritative (decomposed by QR).
+// - rotation is orthonormal (|R^T R - I| <= kCalibrationRelativeTolerance per
+//   entry) with det +1; upper is upper triangular with a positive diagonal.
+// - accel.matrix and gyro.matrix pass CheckSensorMatrix.
+constexpr double kCalibrationRelativeTolerance = 1e-9;
+// Singular values of a sensor matrix lie in [min, max]: beyond these double
+// arithmetic, not physics, breaks (M and M^-1 applied to readings of up to
+// 1e150 stay finite). A well-conditioned 1e-120 * I is accepted.
+constexpr double kCalibrationMinSingularValue = 1e-150;
+constexpr double kCalibrationMaxSingularValue = 1e150;
+// The largest condition number (largest / smallest singular value) of a
+// sensor matrix: a triad whose axes differ in gain by more than this has
+// lost an axis (a real sensor is near 1).
+constexpr double kCalibrationMaxConditionNumber = 1e6;
+
+// Checks a sensor matrix (raw units -> calibrated units): finite, det > 0 (a
+// reflection is refused), singular values and condition number within the
+// limits above. On failure sets `why` to what is wrong, without a key ("is a
+// reflection (det = -1)").
+bool CheckSensorMatrix(const Eigen::Matrix3d& m, std::string* why);
+
+// Checks the models a calibration file was read into (CalibrationFromJson
+// runs it; a future `verify` runs it on any LoadedCalibration): the
+// accelerometer's rotation, upper and matrix and the gyroscope's matrix as
+// above, every bias and effect finite. `error` names the file and key.
+bool CheckCalibrationModels(const LoadedCalibration& calibration, const std::string& name,
+                            std::string* error);
+
 // Parses calibration JSON text; `name` is used in messages. Every error is
 // one line naming the file and the key ("calib.json: key 'accel.bias': must
 // be an array of 3 numbers"). Keys added after version 0.2.0 (provenance,
-// positions[].temperature) are optional.
+// positions[].temperature) are optional. The file is held to the checks
+// above: a calibration that fails one is refused, naming the key (both keys
+// when two redundant fields disagree).
 bool CalibrationFromJson(const std::string& text, const std::string& name,
                          LoadedCalibration* calibration, std::string* error);
 // The same for a file.

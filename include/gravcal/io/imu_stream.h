@@ -2,14 +2,17 @@
 // log") read and written one sample at a time, in constant memory, for logs
 // larger than memory. "-" names standard input / standard output.
 //
-// The reader takes the contract layout only: a header row naming the columns,
-// `t`, `ax`, `ay`, `az` required, `gx`, `gy`, `gz`, `temp` optional, other
-// columns ignored, `#` lines and blank lines skipped, commas between fields.
-// (Other layouts and renamings: log_reader.h, which loads the whole log.)
-// Errors name the file and line, like log_reader.h.
+// The reader holds every text log to the same rules as log_reader.h (one
+// checked line reader, src/io/log_text.h): the same layouts and input keys,
+// finite values, strictly increasing time, a byte order mark dropped, "\n",
+// "\r\n" or "\r" line ends, lines of at most 64 KiB (a file without line
+// ends costs one buffer), the same messages naming the file and line. Text
+// is read in constant memory; a ROS bag, rosbag2 or MCAP file and a layout
+// with a second gyroscope file (gyro_path) are read whole by log_reader.h
+// and served from memory.
 //
-// The writer writes to a temporary file beside the output and renames it on
-// Commit(), so a failure leaves no partial file; on standard output it writes
+// The writer writes through AtomicFile (files.h: the destination contract),
+// so a failure leaves no partial file; on standard output it writes
 // as it goes (callers check everything they can before the first sample).
 #ifndef GRAVCAL_IO_IMU_STREAM_H_
 #define GRAVCAL_IO_IMU_STREAM_H_
@@ -17,8 +20,12 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "gravcal/io/files.h"
+#include "gravcal/io/log_reader.h"
 
 namespace gravcal {
 
@@ -33,15 +40,18 @@ struct ImuSample {
 
 class ImuCsvStreamReader {
  public:
-  ImuCsvStreamReader() = default;
+  ImuCsvStreamReader();
   ~ImuCsvStreamReader();
   ImuCsvStreamReader(const ImuCsvStreamReader&) = delete;
   ImuCsvStreamReader& operator=(const ImuCsvStreamReader&) = delete;
 
-  // Opens `path` ("-" = standard input) and reads up to the header row.
+  // Opens `path` ("-" = standard input) and reads up to the header row
+  // (contract CSV, or the layout `options` describe). A log without a row
+  // is "log.csv: no samples", as for ReadImuLog.
   bool Open(const std::string& path, std::string* error);
-  bool has_gyro() const { return gyro_column_[0] >= 0; }
-  bool has_temperature() const { return temperature_column_ >= 0; }
+  bool Open(const std::string& path, const LogReaderOptions& options, std::string* error);
+  bool has_gyro() const { return has_gyro_; }
+  bool has_temperature() const { return has_temperature_; }
   // The next sample. False at the end of the file (error left empty) or on
   // a bad row (error set: "log.csv:17: column 'ay': 'abc' is not a number").
   bool Next(ImuSample* sample, std::string* error);
@@ -49,24 +59,11 @@ class ImuCsvStreamReader {
   const std::string& name() const { return name_; }
 
  private:
-  // The next line without its end of line; false at the end of the file.
-  bool ReadLine(const char** begin, const char** end, std::string* error);
-  bool Fail(const std::string& message, std::string* error) const;
-
-  std::FILE* file_ = nullptr;
-  bool owns_file_ = false;
+  struct State;
+  std::unique_ptr<State> state_;
   std::string name_;
-  std::vector<char> buffer_;
-  size_t begin_ = 0;
-  size_t end_ = 0;
-  bool eof_ = false;
-  long line_ = 0;
-  std::vector<std::string> columns_;
-  int time_column_ = -1;
-  int accel_column_[3] = {-1, -1, -1};
-  int gyro_column_[3] = {-1, -1, -1};
-  int temperature_column_ = -1;
-  int last_needed_column_ = -1;
+  bool has_gyro_ = false;
+  bool has_temperature_ = false;
 };
 
 class ImuCsvStreamWriter {
@@ -92,9 +89,11 @@ class ImuCsvStreamWriter {
  private:
   bool Flush(std::string* error);
 
-  std::FILE* file_ = nullptr;
+  // Standard output, or nullptr when writing to `file_`.
+  std::FILE* stdout_ = nullptr;
+  AtomicFile file_;
+  bool open_ = false;
   std::string path_;
-  std::string temporary_;
   bool gyro_ = false;
   bool temperature_ = false;
   std::string buffer_;

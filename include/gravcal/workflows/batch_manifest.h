@@ -40,9 +40,14 @@ bool ParseBatchManifest(std::string_view text, const std::string& name, const st
 
 // Every regular file in `folder` whose name matches the shell `pattern`
 // ("*.csv") is a unit with id = the file name without its last extension,
-// in sorted order of file names (the same on every machine).
+// in sorted order of file names (the same on every machine). Hidden files
+// (".name", also AppleDouble "._name" files and gravcal's temporaries) are
+// never units: their names go to *hidden when given. Names in `exclude`
+// (a batch's own files in its input folder) are left out.
 bool UnitsFromDirectory(const std::string& folder, const std::string& pattern,
-                        std::vector<BatchUnit>* units, std::string* error);
+                        std::vector<BatchUnit>* units, std::string* error,
+                        const std::vector<std::string>& exclude = {},
+                        std::vector<std::string>* hidden = nullptr);
 
 // One unit per sensor_msgs/Imu topic of the bag or MCAP file at `path`
 // (batch --topics all): id = the topic without its leading '/', other '/'
