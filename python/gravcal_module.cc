@@ -284,6 +284,7 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
   DoubleArray a_out({n, static_cast<py::ssize_t>(3)});
   DoubleArray w_out({static_cast<py::ssize_t>(w.size()), static_cast<py::ssize_t>(3)});
   size_t bad_row = a.size();
+  bool overflow = false;
   {
     py::gil_scoped_release release;
     double* ao = a_out.mutable_data();
@@ -293,13 +294,22 @@ py::tuple ApplyCalibration(const PyCalibration& c, const py::object& accel, cons
         bad_row = i;
         break;
       }
+      // As `gravcal apply`: nothing that is not a number is returned.
+      if (!a[i].allFinite() || (!w.empty() && !w[i].allFinite())) {
+        bad_row = i;
+        overflow = true;
+        break;
+      }
       Eigen::Map<Eigen::Vector3d>(ao + 3 * i) = a[i];
       if (!w.empty()) Eigen::Map<Eigen::Vector3d>(wo + 3 * i) = w[i];
     }
   }
   Check(bad_row == a.size(),
         "accel: row " + std::to_string(bad_row) +
-            ": the quadratic term has no real root (reading outside the calibrated range)");
+            (overflow ? ": the corrected sample is not finite (the reading times the calibration "
+                        "overflows)"
+                      : ": the quadratic term has no real root (reading outside the calibrated "
+                        "range)"));
   return py::make_tuple(a_out, gyro.is_none() ? py::object(py::none()) : py::object(w_out));
 }
 

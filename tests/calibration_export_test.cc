@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -632,6 +633,78 @@ TEST(Export, CCorrectorEqualsApply) {
   EXPECT_LT(worst_float, 1e-5);
   std::printf("C corrector vs apply over %zu samples: double %.3g, float %.3g (largest relative)\n",
               n, worst_double, worst_float);
+}
+
+// Issue 32: the C corrector compiles warning-free (-std=c99 -Wall -Wextra
+// -Werror -pedantic), in both precisions, for every subset of the model's
+// optional terms: the four accelerometer effects, the gyroscope, and with
+// it its three effects (temperature and drift terms bring the reference
+// temperature and time). 16 + 16 * 8 = 144 models, compiled by gcc and by
+// clang (when installed) with -fsyntax-only, one compiler run each.
+TEST(Export, CCorrectorCompilesWithoutWarningsForEveryModelSubset) {
+  const Effect kAccel[] = {Effect::kAccelQuadratic, Effect::kAccelTemperatureBias,
+                           Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift};
+  const Effect kGyro[] = {Effect::kGyroGSensitivity, Effect::kGyroTemperatureBias,
+                          Effect::kGyroBiasDrift};
+  const Calibration full = FullCalibration(true);
+  const ScratchDir scratch;
+  int models = 0;
+  for (int gyro = 0; gyro < 2; ++gyro) {
+    for (int accel_mask = 0; accel_mask < 16; ++accel_mask) {
+      for (int gyro_mask = 0; gyro_mask < (gyro ? 8 : 1); ++gyro_mask) {
+        Calibration c = full;
+        c.gyro.estimated = gyro == 1;
+        if (!gyro) c.gyro = Calibration().gyro;
+        c.effects.estimates.clear();
+        std::string name = gyro ? "g" : "a";
+        for (const EffectEstimate& e : full.effects.estimates) {
+          bool keep = false;
+          for (int b = 0; b < 4; ++b) keep |= (accel_mask >> b & 1) && e.effect == kAccel[b];
+          for (int b = 0; b < 3; ++b) keep |= (gyro_mask >> b & 1) && e.effect == kGyro[b];
+          if (keep) {
+            c.effects.estimates.push_back(e);
+            name += std::string("_") + ToString(e.effect);
+          }
+        }
+        // Without a temperature term the log may have had no temperature
+        // column: the reference is NaN, as calibrate writes it.
+        bool temperature = false;
+        for (const EffectEstimate& e : c.effects.estimates) {
+          temperature |= Info(e.effect).regressor == EffectRegressor::kTemperature;
+        }
+        if (!temperature) c.effects.reference_temperature = NAN;
+        ExportOptions options;
+        options.target = ExportTarget::kC;
+        ExportResult result;
+        std::string error;
+        ASSERT_TRUE(ExportCalibration(Loaded(c), options, &result, &error))
+            << name << ": " << error;
+        ASSERT_EQ(result.files.size(), 2u) << name;
+        std::filesystem::create_directories(scratch / ("models/" + name));
+        for (const ExportedFile& f : result.files) {
+          scratch.Write("models/" + name + "/" + f.name, f.text);
+        }
+        ++models;
+      }
+    }
+  }
+  EXPECT_EQ(models, 16 + 16 * 8);
+  int compilers = 0;
+  for (const char* compiler : {"gcc", "clang"}) {
+    if (std::system((std::string(compiler) + " --version > /dev/null 2>&1").c_str()) != 0) {
+      std::printf("%s is not installed: not compiled with it\n", compiler);
+      continue;
+    }
+    ++compilers;
+    // Every model in one compiler run (each file is its own translation
+    // unit; the messages name the model's folder).
+    const std::string log = scratch / (std::string(compiler) + ".txt");
+    const std::string run = std::string("cd ") + (scratch / "models") + " && " + compiler +
+                            " -std=c99 -Wall -Wextra -Werror -pedantic -fsyntax-only */*.c > " +
+                            log + " 2>&1";
+    EXPECT_EQ(std::system(run.c_str()), 0) << compiler << ":\n" << Slurp(log);
+  }
+  if (compilers == 0) GTEST_SKIP() << "neither gcc nor clang is installed";
 }
 
 }  // namespace

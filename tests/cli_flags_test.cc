@@ -4,6 +4,7 @@
 
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli_runner.h"
 #include "test_util.h"
@@ -110,6 +111,58 @@ TEST_F(CliFlagsTest, BinaryHeaderBytesAreEscaped) {
   EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find('\xff'), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("\\x1b[31m\\x01\\xff\\xfe"), std::string::npos) << r.err;
+}
+
+// Issue 32, strict configuration at the command line: help on an unknown
+// command fails, --version names gravcal, Ceres and Eigen, a --config that
+// is a folder, a flag given twice and contradictory settings are one-line
+// errors naming what is wrong, and nothing is written.
+TEST_F(CliFlagsTest, StrictConfigurationSaysNo) {
+  CliResult r = Run("help bogus");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("unknown command 'bogus'"), std::string::npos) << r.err;
+  EXPECT_EQ(Run("help calibrate").exit_code, 0);
+  for (const char* version : {"--version", "version"}) {
+    r = Run(version);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out.rfind("gravcal 0.", 0), 0u) << r.out;
+    EXPECT_NE(r.out.find("Ceres Solver 2."), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Eigen 3."), std::string::npos) << r.out;
+  }
+  const std::string out = scratch_ / "out.json";
+  const std::string missing = scratch_ / "never_read.csv";
+  struct Case {
+    std::string args;
+    std::vector<std::string> named;
+  };
+  const Case cases[] = {
+      {"--config " + testing_util::SourceDir() + "/configs", {"not a regular file", "configs"}},
+      {"--config " + Config() + " --gravity 9.81 --latitude 45", {"'gravity'", "'latitude'"}},
+      {"--config " + Config() + " --solver newton --loss cauchy", {"'solver'", "'loss'"}},
+      {"--config " + Config() + " --gyro-g-sensitivity true", {"'gyro_model'", "'gyro_g_sens"}},
+      {"--config " + Config() + " --gyro-model none --gyro-joint true",
+       {"'gyro_model'", "'gyro_joint'"}},
+      {"--config " + Config() + " --gravity 9.81 --gravity 9.79", {"--gravity is given twice"}},
+      {"--config " + Config() + " --output " + out, {"--output is given twice"}},
+  };
+  for (const Case& c : cases) {
+    r = Run("calibrate --input " + missing + " --output " + out + " " + c.args);
+    EXPECT_EQ(r.exit_code, 1) << c.args;
+    EXPECT_EQ(Count(r.err, "\n"), 1u) << r.err;
+    for (const std::string& name : c.named) {
+      EXPECT_NE(r.err.find(name), std::string::npos) << c.args << ": " << r.err;
+    }
+    EXPECT_FALSE(testing_util::FileExists(out)) << c.args;
+  }
+  const std::string twice =
+      scratch_.Write("twice.yaml", "gravity: 9.81\nloss: cauchy\ngravity: 9.7\n");
+  r = Run("calibrate --input " + missing + " --output " + out + " --config " + twice);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("twice.yaml:3: duplicate key 'gravity'"), std::string::npos) << r.err;
+  const std::string two = scratch_.Write("two.yaml", "gravity: 9.81\n---\nloss: cauchy\n");
+  r = Run("calibrate --input " + missing + " --output " + out + " --config " + two);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("second YAML document"), std::string::npos) << r.err;
 }
 
 }  // namespace

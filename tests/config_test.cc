@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "gravcal/workflows/method_registry.h"
 #include "test_util.h"
@@ -92,6 +94,88 @@ TEST(Config, MalformedYamlAndMissingFile) {
   EXPECT_NE(error.find("list.yaml"), std::string::npos) << error;
   EXPECT_FALSE(LoadConfigFile("/nonexistent/gravcal.yaml", &config, &error));
   EXPECT_NE(error.find("/nonexistent/gravcal.yaml"), std::string::npos) << error;
+}
+
+// Issue 32: a key set twice, in any map of the file, is an error naming the
+// key and both lines (yaml-cpp keeps both, and the loader took the last).
+TEST(Config, DuplicateKeyNamesTheKeyAndBothLines) {
+  Config config;
+  std::string error;
+  EXPECT_FALSE(
+      LoadConfigText("gravity: 9.81\nloss: cauchy\ngravity: 9.79\n", "dup.yaml", &config, &error));
+  EXPECT_NE(error.find("dup.yaml:3: duplicate key 'gravity'"), std::string::npos) << error;
+  EXPECT_NE(error.find("line 1"), std::string::npos) << error;
+  EXPECT_DOUBLE_EQ(config.calibration.gravity.gravity, Config().calibration.gravity.gravity);
+  EXPECT_FALSE(
+      LoadConfigText("rename:\n  ax: acc_x\n  ax: acc_y\n", "nested.yaml", &config, &error));
+  EXPECT_NE(error.find("nested.yaml:3: duplicate key 'ax'"), std::string::npos) << error;
+  // The same name in two different maps is no duplicate.
+  EXPECT_TRUE(LoadConfigText("rename: {ax: t}\nformat: csv\n", "ok.yaml", &config, &error))
+      << error;
+}
+
+TEST(Config, ASecondDocumentIsAnError) {
+  Config config;
+  std::string error;
+  EXPECT_FALSE(LoadConfigText("gravity: 9.81\n---\nloss: cauchy\n", "two.yaml", &config, &error));
+  EXPECT_NE(error.find("two.yaml:"), std::string::npos) << error;
+  EXPECT_NE(error.find("second YAML document"), std::string::npos) << error;
+  EXPECT_FALSE(LoadConfigText("gravity: 9.81\n---\n", "empty_second.yaml", &config, &error));
+  EXPECT_NE(error.find("second YAML document"), std::string::npos) << error;
+  // One document with its markers is one document.
+  EXPECT_TRUE(LoadConfigText("---\ngravity: 9.81\n...\n", "one.yaml", &config, &error)) << error;
+}
+
+TEST(Config, APathThatIsNotARegularFileIsRefused) {
+  Config config;
+  std::string error;
+  const std::string folder = std::string(GRAVCAL_SOURCE_DIR) + "/configs";
+  EXPECT_FALSE(LoadConfigFile(folder, &config, &error));
+  EXPECT_NE(error.find(folder + ": not a regular file"), std::string::npos) << error;
+  EXPECT_FALSE(LoadConfigFile("/dev/null", &config, &error));
+  EXPECT_NE(error.find("/dev/null: not a regular file"), std::string::npos) << error;
+}
+
+// Settings that contradict each other, and keys the chosen solver or model
+// path ignores: errors naming both keys (each loads; IsValid refuses).
+TEST(Config, ContradictionsAndIgnoredKeysNameBothKeys) {
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"gravity: 9.81\nlatitude: 45\n", {"'gravity'", "'latitude'"}},
+      {"sample_rate: 100\ntime_scale: 1e-9\n", {"'sample_rate'", "'time_scale'"}},
+      {"height: 300\n", {"'height'", "latitude"}},
+      {"gravity: 9.81\nlatitude: 45\nheight: 300\n", {"'gravity'", "'latitude'"}},
+      {"solver: newton\nloss: cauchy\n", {"'solver'", "'loss'"}},
+      {"solver: newton\neffects: [accel_bias_drift]\n", {"'solver'", "'effects'"}},
+      {"newton_residual: magnitude\n", {"'newton_residual'", "solver: newton"}},
+      {"gyro_g_sensitivity: true\n", {"'gyro_model'", "'gyro_g_sensitivity'"}},
+      {"gyro_model: none\ngyro_joint: true\n", {"'gyro_model'", "'gyro_joint'"}},
+      {"gyro_edge: 0.5\n", {"'gyro_edge'", "gyro_model: none"}},
+      {"pose_disturbance_prior: 0.004\n", {"'pose_disturbance_prior'", "pose_variance: true"}},
+      {"pose_noise_batches: 8\n", {"'pose_noise_batches'", "pose_noise: batch_means"}},
+      {"covariance: false\noutput_covariance: true\n", {"'covariance'", "'output_covariance'"}},
+  };
+  for (const auto& [text, names] : cases) {
+    Config config;
+    std::string error;
+    ASSERT_TRUE(LoadConfigText(text, "c.yaml", &config, &error)) << text << error;
+    EXPECT_FALSE(config.IsValid(&error)) << text;
+    for (const std::string& name : names) {
+      EXPECT_NE(error.find(name), std::string::npos) << text << ": " << error;
+    }
+  }
+  // Their consistent forms are valid.
+  for (const char* text :
+       {"latitude: 45\nheight: 300\n", "gravity: 9.81\n", "solver: newton\nloss: none\n",
+        "solver: newton\nnewton_residual: magnitude\n", "gyro_model: full\ngyro_joint: true\n",
+        "gyro_model: bias\ngyro_g_sensitivity: true\ngyro_edge: 0.5\n",
+        "pose_variance: true\npose_disturbance_prior: 0.004\n",
+        "pose_noise: batch_means\npose_noise_batches: 8\n",
+        "covariance: false\noutput_covariance: false\n", "effects: [accel_bias_drift]\n"}) {
+    Config config;
+    std::string error;
+    ASSERT_TRUE(LoadConfigText(text, "c.yaml", &config, &error)) << text << error;
+    EXPECT_TRUE(config.IsValid(&error)) << text << ": " << error;
+  }
 }
 
 TEST(Config, InvalidValuesAreCaughtByValidation) {

@@ -205,6 +205,48 @@ TEST(HostileLogs, LineEndVariantsGiveIdenticalResults) {
   }
 }
 
+// The streamed reader reads through a 1 MiB buffer: every alignment of a
+// line end ("\r\n" split across the refill, a lone '\r' as the buffer's
+// last byte) gives the samples the whole-file reader gives.
+TEST(HostileLogs, StreamedLineEndsAcrossTheBufferMatchTheWholeReader) {
+  const ScratchDir scratch;
+  constexpr size_t kBuffer = size_t{1} << 20;
+  for (const std::string end : {"\n", "\r\n", "\r"}) {
+    for (size_t shift = 0; shift < 3; ++shift) {
+      SCOPED_TRACE(testing::PrintToString(end) + " shift " + std::to_string(shift));
+      std::string text = "t,ax,ay,az" + end;
+      size_t rows = 0;
+      while (text.size() < kBuffer - 200) {
+        text += std::to_string(rows) + "," + std::to_string(rows % 977) + ",2,3" + end;
+        ++rows;
+      }
+      // A comment line whose last byte is the buffer's byte kBuffer - shift:
+      // "\r|\n" across the refill (shift 0), a lone '\r' as its last (1).
+      text += "#" + std::string(kBuffer - shift - text.size() - end.size(), 'c') + end;
+      for (size_t i = 0; i < 1000; ++i, ++rows) {
+        text += std::to_string(rows) + "," + std::to_string(rows % 977) + ",2,3" + end;
+      }
+      const std::string path = scratch.Write("log.csv", text);
+      ImuLog whole;
+      std::string error;
+      ASSERT_TRUE(ReadImuLog(path, LogReaderOptions(), &whole, &error)) << error;
+      ASSERT_EQ(whole.size(), rows);
+      ImuCsvStreamReader reader;
+      ASSERT_TRUE(reader.Open(path, &error)) << error;
+      ImuSample sample;
+      size_t n = 0;
+      while (reader.Next(&sample, &error)) {
+        ASSERT_LT(n, whole.size());
+        ASSERT_EQ(sample.t, whole.t[n]);
+        ASSERT_EQ(sample.accel, whole.accel[n]);
+        ++n;
+      }
+      EXPECT_EQ(error, "");
+      EXPECT_EQ(n, rows);
+    }
+  }
+}
+
 // A `nan` temperature with a calibration that has a temperature term: the
 // same error naming the line (today's main skipped the term silently).
 TEST(HostileLogs, ANanTemperatureWithATemperatureTermNamesTheLine) {
@@ -220,6 +262,24 @@ TEST(HostileLogs, ANanTemperatureWithATemperatureTermNamesTheLine) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(CliError(r), path + ":3: column 'temp': 'nan' is not finite") << r.err;
   EXPECT_EQ(LeftBehind(scratch, "calib.json"), std::vector<std::string>());
+}
+
+// Finite readings times a checked calibration can overflow: apply writes no
+// inf, names the line and leaves no file.
+TEST(HostileLogs, ACorrectedSampleThatOverflowsIsRefusedByLine) {
+  const ScratchDir scratch;
+  nlohmann::json j = nlohmann::json::parse(Slurp(WriteCalibration(scratch)));
+  j["accel"]["matrix"] = {{1e100, 0.0, 0.0}, {0.0, 1e100, 0.0}, {0.0, 0.0, 1e100}};
+  const std::string calib = scratch.Write("calib.json", j.dump());
+  const std::string log = scratch.Write("raw.csv", "t,ax,ay,az\n0,1,2,3\n0.01,1e300,2,3\n");
+  const CliResult r = RunCli(
+      {"apply", "--calibration", calib, "--input", log, "--output", scratch / "out.csv"}, scratch);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(CliError(r), log +
+                             ":3: the corrected sample is not finite (the reading times the "
+                             "calibration overflows)")
+      << r.err;
+  EXPECT_FALSE(testing_util::FileExists(scratch / "out.csv"));
 }
 
 // apply streams every layout calibrate reads, with the same input keys: a

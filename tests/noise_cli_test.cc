@@ -186,6 +186,78 @@ TEST(NoiseCli, BadInputWritesNothing) {
   expect_nothing();
 }
 
+// Issue 32: every value of a noise.json is checked for range and sign on
+// reading, with the message naming the file and the value's path (a
+// negative white noise used to surface as "positions do not determine all 9
+// parameters").
+TEST(NoiseCli, EveryNoiseJsonValueIsCheckedForRangeAndSign) {
+  ImuNoise noise;
+  noise.model.rate_hz = kRate;
+  noise.model.still_begin = 0;
+  noise.model.still_end = 1000;
+  noise.model.still_t_begin = 0.0;
+  noise.model.still_t_end = 10.0;
+  for (auto* axes : {&noise.model.accel, &noise.model.gyro}) {
+    for (AxisNoiseModel& axis : *axes) {
+      axis.white_noise.value = 2e-3;
+      axis.white_noise.std = 1e-5;
+      axis.white_noise.tau = 1.0;
+      axis.white_noise.tau_min = 0.01;
+      axis.white_noise.tau_max = 3.0;
+      axis.random_walk.value = 1e-3;
+    }
+  }
+  for (auto* curves : {&noise.accel_curves, &noise.gyro_curves}) {
+    for (AllanDeviation& c : *curves) {
+      for (double tau : {0.01, 0.1, 1.0}) {
+        AllanPoint p;
+        p.tau = tau;
+        p.adev = 2e-3 / std::sqrt(tau);
+        p.lo = 0.9 * p.adev;
+        p.hi = 1.1 * p.adev;
+        p.edf = 100.0 / tau;
+        c.points.push_back(p);
+      }
+      c.confidence = 0.683;
+    }
+  }
+  const nlohmann::json good = nlohmann::json::parse(NoiseToJson(noise));
+  ImuNoise read;
+  std::string error;
+  ASSERT_TRUE(NoiseFromJson(good.dump(), "noise.json", &read, &error)) << error;
+  EXPECT_DOUBLE_EQ(read.model.accel[1].white_noise.value, 2e-3);
+  // JSON pointer, bad value, what the message must name.
+  struct Case {
+    const char* pointer;
+    nlohmann::json value;
+    const char* named;
+  };
+  const Case cases[] = {
+      {"/accel/x/white_noise/value", -0.01, "accel.x.white_noise.value must be a positive number"},
+      {"/accel/y/random_walk/value", 0.0, "accel.y.random_walk.value"},
+      {"/gyro/z/white_noise/std", -1e-5, "gyro.z.white_noise.std must be a number >= 0"},
+      {"/gyro/x/white_noise/tau", 0.0, "gyro.x.white_noise.tau"},
+      {"/accel/z/white_noise/tau_range/0", -1.0, "accel.z.white_noise.tau_range[0]"},
+      {"/accel/z/white_noise/tau_range/0", 5.0, "accel.z.white_noise.tau_range: max is below min"},
+      {"/accel/z/white_noise/value", "2e-3", "accel.z.white_noise.value must be a number"},
+      {"/rate_hz", -100.0, "rate_hz must be a positive number"},
+      {"/rate_hz", 0.0, "rate_hz"},
+      {"/confidence", 1.5, "confidence must be a number between 0 and 1"},
+      {"/still/t_end", -5.0, "still.t_end is before still.t_begin"},
+      {"/accel/x/allan/tau/1", 0.001, "accel.x.allan.tau[1] must be larger"},
+      {"/gyro/y/allan/adev/2", -1.0, "gyro.y.allan.adev[2] must be a number >= 0"},
+      {"/accel/y/allan/lo/0", 1.0, "accel.y.allan[0]: lo <= adev <= hi"},
+      {"/accel/y/allan/edf/0", 0.0, "accel.y.allan.edf[0] must be a positive number"},
+  };
+  for (const Case& c : cases) {
+    nlohmann::json bad = good;
+    bad[nlohmann::json::json_pointer(c.pointer)] = c.value;
+    EXPECT_FALSE(NoiseFromJson(bad.dump(), "bad_noise.json", &read, &error)) << c.pointer;
+    EXPECT_EQ(error.rfind("bad_noise.json: ", 0), 0u) << error;
+    EXPECT_NE(error.find(c.named), std::string::npos) << c.pointer << ": " << error;
+  }
+}
+
 // calibrate --noise: a bad noise file or a method that uses none is one
 // line naming it and no calibration; a good one is used by the
 // twelve-position poses (a random-walk bias makes the model's pose

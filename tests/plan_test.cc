@@ -489,5 +489,49 @@ TEST(PlanIo, TurnIndicesOutsideThePosesAreRefusedNotWrapped) {
   }
 }
 
+// Issue 32: every value simulate --plan reads from a plan.json is checked
+// for range and sign, with a message naming the entry and the value.
+TEST(PlanIo, EveryValueReadIsCheckedWithAMessageNamingIt) {
+  const auto plan = [](const std::string& pose, const std::string& turn) {
+    return R"({"poses": [{"up": [0, 0, 1], "hold_s": 10}, )" + pose +
+           R"(], "rotations": [)" + turn + "]}";
+  };
+  const std::string good_pose = R"({"up": [1, 0, 0], "hold_s": 10})";
+  const std::string good_turn = R"({"from": 0, "to": 1, "axis": [0, 1, 0], "angle_deg": 90})";
+  std::vector<PlannedPose> poses;
+  std::vector<PlannedRotation> turns;
+  std::string error;
+  ASSERT_TRUE(PlanPosesFromJson(plan(good_pose, good_turn), "plan.json", &poses, &error)) << error;
+  ASSERT_TRUE(PlanRotationsFromJson(plan(good_pose, good_turn), "plan.json", 2, &turns, &error))
+      << error;
+  const std::pair<std::string, std::string> bad_poses[] = {
+      {R"({"up": [1, 0, 0], "hold_s": -10})", "poses[1]: 'hold_s'"},
+      {R"({"up": [1, 0, 0], "hold_s": "10"})", "poses[1]: 'hold_s'"},
+      {R"({"up": [3, 0, 0], "hold_s": 10})", "poses[1]: 'up'"},
+      {R"({"up": [1, 0], "hold_s": 10})", "poses[1]: 'up'"},
+  };
+  for (const auto& [pose, named] : bad_poses) {
+    EXPECT_FALSE(PlanPosesFromJson(plan(pose, good_turn), "plan.json", &poses, &error)) << pose;
+    EXPECT_NE(error.find("plan.json: " + named), std::string::npos) << pose << ": " << error;
+  }
+  const std::pair<std::string, std::string> bad_turns[] = {
+      {R"({"from": 0, "to": 1, "axis": [0, 1, 0], "angle_deg": -90})", "'angle_deg'"},
+      {R"({"from": 0, "to": 1, "axis": [0, 1, 0], "angle_deg": 270})", "'angle_deg'"},
+      {R"({"from": 0, "to": 1, "axis": [0, 0.2, 0], "angle_deg": 90})", "'axis'"},
+      {R"({"from": 0, "to": 1, "axis": [0, 1, 0], "angle_deg": 90, "duration_s": -3})",
+       "'duration_s'"},
+      {R"({"from": 0, "to": 1, "axis": [0, 1, 0], "angle_deg": 90, "duration_s": "3"})",
+       "'duration_s'"},
+      {R"({"from": 0.5, "to": 1, "axis": [0, 1, 0], "angle_deg": 90})", "'from'"},
+      {R"({"from": 0, "axis": [0, 1, 0], "angle_deg": 90})", "'to'"},
+  };
+  for (const auto& [turn, named] : bad_turns) {
+    EXPECT_FALSE(PlanRotationsFromJson(plan(good_pose, turn), "plan.json", 2, &turns, &error))
+        << turn;
+    EXPECT_NE(error.find("plan.json: rotations[0]: " + named), std::string::npos)
+        << turn << ": " << error;
+  }
+}
+
 }  // namespace
 }  // namespace gravcal

@@ -87,3 +87,12 @@ def test_tiny_but_well_conditioned_matrix_is_applied(tmp_path):
     calib.write_text(json.dumps(j))
     a = gravcal.Calibration.from_json(calib).apply(np.array([[2.0, 4.0, 6.0]]))
     np.testing.assert_allclose(a, [[1e-120, 2e-120, 3e-120]], rtol=1e-14, atol=0)
+
+
+def test_overflowing_correction_is_refused_by_row(tmp_path):
+    j = json.loads(json.dumps(CALIBRATION))
+    j["accel"]["matrix"] = [[1e100, 0, 0], [0, 1e100, 0], [0, 0, 1e100]]
+    calib = tmp_path / "calib.json"
+    calib.write_text(json.dumps(j))
+    with pytest.raises(gravcal.Error, match=r"^accel: row 1: the corrected sample is not finite"):
+        gravcal.Calibration.from_json(calib).apply(np.array([[1.0, 2.0, 3.0], [1e300, 2.0, 3.0]]))

@@ -76,8 +76,16 @@ int RunApply(const CommandArgs& args) {
     if (!corrector.CorrectRow(sample.temperature, sample.t, &sample.accel,
                               reader.has_gyro() ? &sample.gyro : nullptr)) {
       writer.Abort();
-      return Fail(reader.name() + ": sample at t = " + std::to_string(sample.t) +
+      return Fail(reader.where() +
                   ": the quadratic term has no real root (reading outside the calibrated range)");
+    }
+    // Finite readings and a checked calibration can still overflow (a
+    // reading of 1e300 counts): nothing that is not a number is written.
+    if (!sample.accel.allFinite() || !sample.gyro.allFinite()) {
+      writer.Abort();
+      return Fail(reader.where() +
+                  ": the corrected sample is not finite (the reading times the "
+                  "calibration overflows)");
     }
     if (!writer.Write(sample, &error)) return Fail(error);
     ++count;

@@ -4,15 +4,18 @@
 // Config keys (config.h) can be given as flags of the same name; they are
 // taken out of argv here and applied on top of --config, and the rest goes to
 // gflags.
+#include <ceres/version.h>
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
+#include <Eigen/Core>
 #include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "cli/commands.h"
+#include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/method_registry.h"
@@ -201,14 +204,21 @@ std::string SectionReaders(const std::string& section) {
   return text;
 }
 
-void PrintHelp(const std::string& command) {
+// False for a command that does not exist (nothing printed then).
+bool PrintHelp(const std::string& command) {
   gravcal::Config defaults;
   if (command.empty()) {
     std::printf("gravcal: IMU calibration with gravity as the only reference\n\n");
     std::printf("usage: gravcal <command> [--flag value ...]\n\ncommands:\n");
     for (const CommandInfo& c : Commands()) std::printf("  %-10s %s\n", c.name, c.summary);
-    std::printf("\n'gravcal <command> --help' lists that command's flags and the config keys.\n");
-    return;
+    std::printf(
+        "\n'gravcal <command> --help' lists that command's flags and the config keys;\n"
+        "'gravcal --version' prints the versions of gravcal, Ceres and Eigen.\n");
+    return true;
+  }
+  if (command == "version" || command == "--version") {
+    std::printf("gravcal version (or --version): the versions of gravcal, Ceres and Eigen\n");
+    return true;
   }
   for (const CommandInfo& c : Commands()) {
     if (command != c.name) continue;
@@ -232,9 +242,15 @@ void PrintHelp(const std::string& command) {
       std::printf("    --%-26s %s [%s]\n", k.name.c_str(), k.help.c_str(),
                   gravcal::ConfigValueText(defaults, k.name).c_str());
     }
-    return;
+    return true;
   }
-  std::printf("unknown command '%s'\n", command.c_str());
+  return false;
+}
+
+// gravcal's version and the versions of Ceres and Eigen it was built with.
+void PrintVersion() {
+  std::printf("gravcal %s\nCeres Solver %s\nEigen %d.%d.%d\n", gravcal::GravcalVersion(),
+              CERES_VERSION_STRING, EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION);
 }
 
 // The command line split: config keys (--key value) become overrides, the
@@ -309,6 +325,18 @@ bool SplitCommandLine(int argc, char** argv, const CommandInfo& command, SplitAr
 bool CheckFlagsOfCommand(const CommandInfo& command, const SplitArguments& split,
                          std::string* error) {
   const std::string listed = std::string("('gravcal ") + command.name + " --help' lists its flags)";
+  // A flag or config key given twice: which one was meant is not known.
+  std::vector<std::string> names;
+  for (const auto& [key, value] : split.overrides) names.push_back(key);
+  for (const std::string& flag : split.flags) names.push_back(flag.substr(2, flag.find('=') - 2));
+  for (size_t i = 0; i < names.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (names[i] == names[j]) {
+        *error = "flag --" + DashedName(names[i]) + " is given twice";
+        return false;
+      }
+    }
+  }
   for (const std::string& flag : split.flags) {
     const std::string name = flag.substr(2, flag.find('=') - 2);
     gflags::CommandLineFlagInfo info;
@@ -407,7 +435,12 @@ int main(int argc, char** argv) {
   }
   const std::string command = argv[1];
   if (command == "help" || command == "--help" || command == "-h") {
-    PrintHelp(argc > 2 ? argv[2] : "");
+    const std::string topic = argc > 2 ? argv[2] : "";
+    if (!PrintHelp(topic)) return Fail("unknown command '" + topic + "' (gravcal help lists them)");
+    return 0;
+  }
+  if (command == "--version" || command == "version") {
+    PrintVersion();
     return 0;
   }
   const CommandInfo* info = FindCommand(command);

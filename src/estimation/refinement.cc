@@ -109,16 +109,11 @@ namespace {
 // whitened residual (the first stage is then close to least squares) down to
 // the requested one. Just loss_scale without a loss.
 std::vector<double> LossScales(const RefinementOptions& options, const RefinementResult& result) {
-  std::vector<double> scales = {options.loss_scale};
-  if (options.loss != LossType::kNone) {
-    const int n = static_cast<int>(result.residuals_before.size());
-    std::vector<double> whitened(n);
-    for (int k = 0; k < n; ++k)
-      whitened[k] = std::fabs(result.residuals_before[k] / result.sigmas[k]);
-    const double start_scale = *std::max_element(whitened.begin(), whitened.end());
-    while (scales.back() * 2.0 < start_scale) scales.push_back(scales.back() * 2.0);
+  double largest = 0.0;
+  for (size_t k = 0; k < result.residuals_before.size(); ++k) {
+    largest = std::max(largest, std::fabs(result.residuals_before[k] / result.sigmas[k]));
   }
-  return scales;
+  return internal::GraduatedLossScales(options.loss, options.loss_scale, largest);
 }
 
 // The Ceres problem of the magnitude fit in normalised units, with its

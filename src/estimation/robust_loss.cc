@@ -21,5 +21,12 @@ ceres::LossFunction* MakeLoss(LossType type, double scale) {
   return nullptr;
 }
 
+std::vector<double> GraduatedLossScales(LossType type, double loss_scale, double largest_whitened) {
+  std::vector<double> scales = {loss_scale};
+  if (type == LossType::kNone) return scales;
+  while (scales.back() * 2.0 < largest_whitened) scales.push_back(scales.back() * 2.0);
+  return scales;
+}
+
 }  // namespace internal
 }  // namespace gravcal

@@ -5,6 +5,8 @@
 
 #include <ceres/loss_function.h>
 
+#include <vector>
+
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
@@ -12,6 +14,12 @@ namespace internal {
 
 // A new loss with the given scale (in whitened units), or nullptr for kNone.
 ceres::LossFunction* MakeLoss(LossType type, double scale);
+
+// The graduated loss scales of a robust solve, narrowest first: loss_scale,
+// then doubled while the double stays below `largest_whitened` (the largest
+// initial whitened residual), so the widest stage holds every residual and is
+// close to least squares. Just {loss_scale} for kNone.
+std::vector<double> GraduatedLossScales(LossType type, double loss_scale, double largest_whitened);
 
 }  // namespace internal
 }  // namespace gravcal

@@ -46,7 +46,8 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
   array("ACCEL_BIAS", c.accel.bias);
   array("ACCEL_UPPER", c.accel.upper);
   array("ACCEL_ROTATION", c.accel.rotation);
-  array("ACCEL_QUADRATIC", on(Effect::kAccelQuadratic, e.accel_quadratic));
+  // Only a term the functions below use (-Wunused-const-variable).
+  if (quadratic) array("ACCEL_QUADRATIC", e.accel_quadratic);
   array("ACCEL_TEMP_BIAS", on(Effect::kAccelTemperatureBias, e.accel_temperature_bias));
   array("ACCEL_TEMP_SCALE", on(Effect::kAccelTemperatureScale, e.accel_temperature_scale));
   array("ACCEL_DRIFT", on(Effect::kAccelBiasDrift, e.accel_bias_drift));
@@ -55,10 +56,12 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
   array("GYRO_G_SENSITIVITY", on(Effect::kGyroGSensitivity, e.gyro_g_sensitivity));
   array("GYRO_TEMP_BIAS", on(Effect::kGyroTemperatureBias, e.gyro_temperature_bias));
   array("GYRO_DRIFT", on(Effect::kGyroBiasDrift, e.gyro_bias_drift));
-  s << "static const " << real << " " << p
-    << "REFERENCE_TEMPERATURE = " << CNumber(e.reference_temperature, f) << ";\n"
-    << "static const " << real << " " << p << "REFERENCE_TIME = " << CNumber(e.reference_time, f)
-    << ";\n\n";
+  // A reference the model has no term for is unused, and may be NaN (no
+  // temperature column), which is no C literal: 0 then.
+  s << "static const " << real << " " << p << "REFERENCE_TEMPERATURE = "
+    << CNumber(c.RequiresTemperature() ? e.reference_temperature : 0.0, f) << ";\n"
+    << "static const " << real << " " << p
+    << "REFERENCE_TIME = " << CNumber(c.RequiresTime() ? e.reference_time : 0.0, f) << ";\n\n";
   const std::string zero = f ? "0.0f" : "0.0";
   const std::string one = f ? "1.0f" : "1.0";
   // dT and dt: zero when the model has no such term (the argument is

@@ -143,6 +143,14 @@ bool ImuCsvStreamReader::Next(ImuSample* sample, std::string* error) {
   return true;
 }
 
+std::string ImuCsvStreamReader::where() const {
+  if (state_ == nullptr) return name_;
+  if (state_->whole) {
+    return name_ + ": sample " + std::to_string(state_->next > 0 ? state_->next - 1 : 0);
+  }
+  return name_ + ":" + std::to_string(state_->lines != nullptr ? state_->lines->number() : 0);
+}
+
 ImuCsvStreamWriter::~ImuCsvStreamWriter() { Abort(); }
 
 bool ImuCsvStreamWriter::Open(const std::string& path, bool gyro, bool temperature,

@@ -19,9 +19,45 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-double NumberOr(const json& j, const char* key) {
-  if (!j.contains(key) || j.at(key).is_null()) return kNaN;
-  return j.at(key).get<double>();
+// The rule a value read must meet, for Checked.
+enum class Range { kPositive, kNonNegative, kFinite, kProbability };
+
+// `v` checked against `range`, or a runtime_error naming `where` (the key's
+// path in the file, e.g. accel.x.white_noise.value) and the value.
+double Checked(double v, Range range, const std::string& where) {
+  const bool ok =
+      std::isfinite(v) && (range == Range::kFinite || (range == Range::kPositive && v > 0.0) ||
+                           (range == Range::kNonNegative && v >= 0.0) ||
+                           (range == Range::kProbability && v > 0.0 && v < 1.0));
+  if (ok) return v;
+  const char* rule = range == Range::kPositive      ? "a positive number"
+                     : range == Range::kNonNegative ? "a number >= 0"
+                     : range == Range::kProbability ? "a number between 0 and 1"
+                                                    : "a finite number";
+  std::ostringstream s;
+  s.precision(9);
+  s << where << " must be " << rule << " (it is " << v << ")";
+  throw std::runtime_error(s.str());
+}
+
+// A number of `j` (null = NaN, not shown) checked against `range`.
+double NumberAt(const json& j, const std::string& where, Range range) {
+  if (j.is_null()) return kNaN;
+  if (!j.is_number()) throw std::runtime_error(where + " must be a number or null");
+  return Checked(j.get<double>(), range, where);
+}
+
+// A number that must be there: `key` of `j`, at path `where`.
+double Required(const json& j, const char* key, const std::string& where, Range range) {
+  if (!j.contains(key)) throw std::runtime_error(where + " is missing");
+  const double v = NumberAt(j.at(key), where, range);
+  if (std::isnan(v)) throw std::runtime_error(where + " must be a number");
+  return v;
+}
+
+double NumberOr(const json& j, const char* key, const std::string& where, Range range) {
+  if (!j.contains(key)) return kNaN;
+  return NumberAt(j.at(key), where + "." + key, range);
 }
 
 struct TermKey {
@@ -43,14 +79,20 @@ json TermJson(const NoiseTerm& t) {
   return j;
 }
 
-NoiseTerm TermFromJson(const json& j) {
+// One term; `where` is its path (accel.x.white_noise). Every coefficient
+// is a positive density or level, or null where the log does not show it.
+NoiseTerm TermFromJson(const json& j, const std::string& where) {
   NoiseTerm t;
-  t.value = NumberOr(j, "value");
-  t.std = NumberOr(j, "std");
-  t.tau = NumberOr(j, "tau");
+  t.value = NumberOr(j, "value", where, Range::kPositive);
+  t.std = NumberOr(j, "std", where, Range::kNonNegative);
+  t.tau = NumberOr(j, "tau", where, Range::kPositive);
   const json& range = j.at("tau_range");
-  t.tau_min = range.at(0).is_null() ? kNaN : range.at(0).get<double>();
-  t.tau_max = range.at(1).is_null() ? kNaN : range.at(1).get<double>();
+  if (!range.is_array() || range.size() != 2) {
+    throw std::runtime_error(where + ".tau_range must be [min, max]");
+  }
+  t.tau_min = NumberAt(range.at(0), where + ".tau_range[0]", Range::kPositive);
+  t.tau_max = NumberAt(range.at(1), where + ".tau_range[1]", Range::kPositive);
+  if (t.tau_max < t.tau_min) throw std::runtime_error(where + ".tau_range: max is below min");
   if (j.contains("reason")) t.reason = j.at("reason").get<std::string>();
   return t;
 }
@@ -68,20 +110,41 @@ json CurveJson(const AllanDeviation& c) {
   return {{"tau", tau}, {"adev", adev}, {"lo", lo}, {"hi", hi}, {"edf", edf}};
 }
 
-AllanDeviation CurveFromJson(const json& j, double rate_hz, size_t samples, double confidence) {
+// An Allan curve; `where` is its path (accel.x.allan): increasing positive
+// taus, deviations and bounds >= 0 with lo <= adev <= hi, positive edf.
+AllanDeviation CurveFromJson(const json& j, double rate_hz, size_t samples, double confidence,
+                             const std::string& where) {
   AllanDeviation c;
   c.rate_hz = rate_hz;
   c.samples = samples;
   c.confidence = confidence;
   const json& tau = j.at("tau");
+  for (const char* key : {"tau", "adev", "lo", "hi", "edf"}) {
+    if (j.contains(key) && (!j.at(key).is_array() || j.at(key).size() != tau.size())) {
+      throw std::runtime_error(where + "." + key + " must be an array as long as " + where +
+                               ".tau");
+    }
+  }
   for (size_t i = 0; i < tau.size(); ++i) {
+    const std::string at = "[" + std::to_string(i) + "]";
+    const auto number = [&](const char* key, Range range) {
+      const std::string path = where + "." + key + at;
+      if (!j.at(key).at(i).is_number()) throw std::runtime_error(path + " must be a number");
+      return Checked(j.at(key).at(i).get<double>(), range, path);
+    };
     AllanPoint p;
-    p.tau = tau.at(i).get<double>();
+    p.tau = number("tau", Range::kPositive);
+    if (!c.points.empty() && !(p.tau > c.points.back().tau)) {
+      throw std::runtime_error(where + ".tau" + at + " must be larger than the tau before it");
+    }
     p.m = static_cast<size_t>(std::llround(p.tau * rate_hz));
-    p.adev = j.at("adev").at(i).get<double>();
-    p.lo = j.at("lo").at(i).get<double>();
-    p.hi = j.at("hi").at(i).get<double>();
-    if (j.contains("edf")) p.edf = j.at("edf").at(i).get<double>();
+    p.adev = number("adev", Range::kNonNegative);
+    p.lo = number("lo", Range::kNonNegative);
+    p.hi = number("hi", Range::kNonNegative);
+    if (!(p.lo <= p.adev && p.adev <= p.hi)) {
+      throw std::runtime_error(where + at + ": lo <= adev <= hi does not hold");
+    }
+    if (j.contains("edf")) p.edf = number("edf", Range::kPositive);
     c.points.push_back(p);
   }
   c.message = "read from noise.json";
@@ -100,15 +163,20 @@ json SensorJson(const std::array<AxisNoiseModel, 3>& axes,
   return sensor;
 }
 
-void SensorFromJson(const json& sensor, double rate_hz, size_t samples, double confidence,
-                    std::array<AxisNoiseModel, 3>* axes, std::array<AllanDeviation, 3>* curves) {
+void SensorFromJson(const json& sensor, const std::string& name, double rate_hz, size_t samples,
+                    double confidence, std::array<AxisNoiseModel, 3>* axes,
+                    std::array<AllanDeviation, 3>* curves) {
   for (int a = 0; a < 3; ++a) {
     const json& axis = sensor.at(kAxes[a]);
+    const std::string where = name + "." + kAxes[a];
     for (const TermKey& k : kTermKeys) {
-      if (axis.contains(k.name)) (*axes)[a].*(k.term) = TermFromJson(axis.at(k.name));
+      if (axis.contains(k.name)) {
+        (*axes)[a].*(k.term) = TermFromJson(axis.at(k.name), where + "." + k.name);
+      }
     }
     if (axis.contains("allan")) {
-      (*curves)[a] = CurveFromJson(axis.at("allan"), rate_hz, samples, confidence);
+      (*curves)[a] =
+          CurveFromJson(axis.at("allan"), rate_hz, samples, confidence, where + ".allan");
     }
   }
 }
@@ -170,21 +238,28 @@ bool NoiseFromJson(const std::string& text, const std::string& name, ImuNoise* n
   try {
     const json in = json::parse(text);
     ImuNoiseModel& m = parsed.model;
-    m.rate_hz = in.at("rate_hz").get<double>();
+    using internal::Range;
+    using internal::Required;
+    m.rate_hz = Required(in, "rate_hz", "rate_hz", Range::kPositive);
     const json& still = in.at("still");
     m.still_begin = internal::StillIndex(still, "begin");
     m.still_end = internal::StillIndex(still, "end");
     if (m.still_end < m.still_begin) {
       throw std::runtime_error("still.end is before still.begin");
     }
-    m.still_t_begin = still.at("t_begin").get<double>();
-    m.still_t_end = still.at("t_end").get<double>();
-    const double confidence = in.value("confidence", 0.683);
+    m.still_t_begin = Required(still, "t_begin", "still.t_begin", Range::kFinite);
+    m.still_t_end = Required(still, "t_end", "still.t_end", Range::kFinite);
+    if (m.still_t_end < m.still_t_begin) {
+      throw std::runtime_error("still.t_end is before still.t_begin");
+    }
+    const double confidence = in.contains("confidence")
+                                  ? Required(in, "confidence", "confidence", Range::kProbability)
+                                  : 0.683;
     const size_t samples = m.still_end - m.still_begin;
-    internal::SensorFromJson(in.at("accel"), m.rate_hz, samples, confidence, &m.accel,
+    internal::SensorFromJson(in.at("accel"), "accel", m.rate_hz, samples, confidence, &m.accel,
                              &parsed.accel_curves);
     if (in.contains("gyro")) {
-      internal::SensorFromJson(in.at("gyro"), m.rate_hz, samples, confidence, &m.gyro,
+      internal::SensorFromJson(in.at("gyro"), "gyro", m.rate_hz, samples, confidence, &m.gyro,
                                &parsed.gyro_curves);
     } else {
       NoiseTerm missing;
@@ -192,8 +267,8 @@ bool NoiseFromJson(const std::string& text, const std::string& name, ImuNoise* n
       for (AxisNoiseModel& axis : m.gyro) axis = {missing, missing, missing, missing};
     }
     if (in.contains("temperature")) {
-      parsed.temperature_curve =
-          internal::CurveFromJson(in.at("temperature").at("allan"), m.rate_hz, samples, confidence);
+      parsed.temperature_curve = internal::CurveFromJson(
+          in.at("temperature").at("allan"), m.rate_hz, samples, confidence, "temperature.allan");
     }
   } catch (const std::exception& e) {
     *error = name + ": not a noise.json: " + e.what();

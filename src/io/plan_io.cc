@@ -187,35 +187,47 @@ bool PlanRotationsFromJson(const std::string& text, const std::string& name, siz
     const nlohmann::json& r = j["rotations"][k];
     const std::string where = name + ": rotations[" + std::to_string(k) + "]";
     PlannedRotation turn;
-    bool ok = r.is_object() && r.contains("from") && r["from"].is_number_integer() &&
-              r.contains("to") && r["to"].is_number_integer() && r.contains("axis") &&
-              r["axis"].is_array() && r["axis"].size() == 3 && r.contains("angle_deg") &&
-              r["angle_deg"].is_number();
-    for (int i = 0; ok && i < 3; ++i) {
-      ok = r["axis"][i].is_number();
-      if (ok) turn.axis(i) = r["axis"][i].get<double>();
-    }
-    if (ok) {
-      // Read wide and range-check before narrowing, so 2^32 + 1 is refused
-      // rather than read as pose 1.
-      const int64_t from = r["from"].get<int64_t>();
-      const int64_t to = r["to"].get<int64_t>();
-      ok = from >= 0 && to >= 0 && static_cast<uint64_t>(to) < pose_count;
-      turn.from = ok ? static_cast<int>(from) : -1;
-      turn.to = ok ? static_cast<int>(to) : -1;
-      turn.angle_deg = r["angle_deg"].get<double>();
-      if (r.contains("duration_s") && r["duration_s"].is_number()) {
-        turn.seconds = r["duration_s"].get<double>();
+    // Each field checked on its own, so the message names the one that is
+    // wrong.
+    const auto fail = [&](const std::string& what) {
+      *error = where + ": " + what;
+      return false;
+    };
+    if (!r.is_object()) return fail("must be an object with from, to, axis and angle_deg");
+    for (const char* key : {"from", "to"}) {
+      if (!r.contains(key) || !r[key].is_number_integer()) {
+        return fail(std::string("'") + key + "' must be a pose index (an integer)");
       }
     }
-    if (!ok || !(turn.axis.norm() > 0.5 && turn.axis.norm() < 1.5) ||
-        !(turn.angle_deg >= 0.0 && turn.angle_deg <= 180.0) || turn.from < 0 ||
-        turn.to != turn.from + 1 || static_cast<size_t>(turn.to) >= pose_count ||
-        !(turn.seconds >= 0.0 && std::isfinite(turn.seconds))) {
-      *error = where +
-               ": expected from, to = from + 1 (pose indices), a unit 'axis', 'angle_deg' in "
-               "[0, 180] and an optional positive 'duration_s'";
-      return false;
+    // Read wide and range-check before narrowing, so 2^32 + 1 is refused
+    // rather than read as pose 1.
+    const int64_t from = r["from"].get<int64_t>();
+    const int64_t to = r["to"].get<int64_t>();
+    if (from < 0 || to != from + 1 || static_cast<uint64_t>(to) >= pose_count) {
+      return fail("'from' and 'to' must be consecutive pose indices (to = from + 1 < " +
+                  std::to_string(pose_count) + ")");
+    }
+    turn.from = static_cast<int>(from);
+    turn.to = static_cast<int>(to);
+    bool axis_ok = r.contains("axis") && r["axis"].is_array() && r["axis"].size() == 3;
+    for (int i = 0; axis_ok && i < 3; ++i) {
+      axis_ok = r["axis"][i].is_number();
+      if (axis_ok) turn.axis(i) = r["axis"][i].get<double>();
+    }
+    if (!axis_ok || !turn.axis.allFinite() || !(turn.axis.norm() > 0.5 && turn.axis.norm() < 1.5)) {
+      return fail("'axis' must be a unit vector of 3 numbers");
+    }
+    if (!r.contains("angle_deg") || !r["angle_deg"].is_number() ||
+        !(r["angle_deg"].get<double>() >= 0.0 && r["angle_deg"].get<double>() <= 180.0)) {
+      return fail("'angle_deg' must be a number in [0, 180]");
+    }
+    turn.angle_deg = r["angle_deg"].get<double>();
+    if (r.contains("duration_s")) {
+      if (!r["duration_s"].is_number() || !(r["duration_s"].get<double>() >= 0.0) ||
+          !std::isfinite(r["duration_s"].get<double>())) {
+        return fail("'duration_s' must be a number of seconds >= 0");
+      }
+      turn.seconds = r["duration_s"].get<double>();
     }
     turn.axis.normalize();
     if (r.contains("instruction") && r["instruction"].is_string()) {

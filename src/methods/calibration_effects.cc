@@ -183,6 +183,14 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
   EffectFitOptions fit_options;
   fit_options.parameterization = options.refinement.parameterization;
   fit_options.effects = effects;
+  // The solver section holds for the fit with effects as for the one
+  // without: the robust loss and its scale, the iteration limit, and whether
+  // a covariance is computed. (The Newton solver has no effect fit: the
+  // config refuses solver newton with effects.)
+  fit_options.loss = options.refinement.loss;
+  fit_options.loss_scale = options.refinement.loss_scale;
+  fit_options.solver.max_iterations = options.refinement.solver.max_iterations;
+  fit_options.compute_covariance = options.refinement.compute_covariance;
   // The refinement's pose variance (pose_variance: true) carries over: the
   // magnitudes' extra variance by REML, with the same prior.
   fit_options.magnitude_variance_component = options.refinement.estimate_pose_variance;

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "estimation/normalization.h"
+#include "estimation/robust_loss.h"
 #include "estimation/solver_settings.h"
 #include "estimation/variance_component.h"
 #include "gravcal/estimation/observability.h"
@@ -308,6 +309,38 @@ std::vector<AccelBlock> AccelBlocks(const std::vector<StaticObservation>& observ
   return blocks;
 }
 
+// The largest whitened norm |r| of the blocks at `params` (the widest scale
+// of a graduated robust solve).
+double LargestBlockNorm(const std::vector<AccelBlock>& blocks, const double* const params[8]) {
+  double largest = 0.0;
+  for (const AccelBlock& b : blocks) {
+    double r[3];
+    if (!b.cost->Evaluate(params, r, nullptr)) continue;
+    largest = std::max(largest, Eigen::Map<const Eigen::VectorXd>(r, b.rows).norm());
+  }
+  return largest;
+}
+
+// With a robust loss rho at the final scale: each block's whitened rows
+// (Jacobian and residual, block order) times sqrt(rho'(|r|^2)), the weight
+// iteratively reweighted least squares gives the block at the optimum, so
+// the covariance counts a block the loss set aside as the solve did.
+void WeightRowsByLoss(const std::vector<AccelBlock>& blocks, const EffectFitOptions& options,
+                      Eigen::MatrixXd* jacobian, Eigen::VectorXd* residual_rows) {
+  const std::unique_ptr<ceres::LossFunction> rho(
+      internal::MakeLoss(options.loss, options.loss_scale));
+  int row0 = 0;
+  for (const AccelBlock& b : blocks) {
+    const double s = residual_rows->segment(row0, b.rows).squaredNorm();
+    double values[3];
+    rho->Evaluate(s, values);
+    const double w = std::sqrt(std::max(0.0, values[1]));
+    jacobian->middleRows(row0, b.rows) *= w;
+    residual_rows->segment(row0, b.rows) *= w;
+    row0 += b.rows;
+  }
+}
+
 // The accelerometer part. Works in normalised raw units (normalization.h).
 bool FitAccel(const std::vector<StaticObservation>& observations, const AccelModel& initial,
               const EffectParameters& initial_parameters, double gravity,
@@ -374,18 +407,35 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
       residuals.push_back(std::move(b));
     }
   }
+  const double* params[8] = {bias,
+                             upper,
+                             blocks[0],
+                             blocks[1],
+                             blocks[2],
+                             blocks[3],
+                             rotation_rows.gyro_bias,
+                             rotation_rows.gyro_matrix};
+  const std::vector<double> scales = internal::GraduatedLossScales(
+      options.loss, options.loss_scale,
+      options.loss == LossType::kNone ? 0.0 : LargestBlockNorm(residuals, params));
   ceres::Problem::Options keep;
   keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  keep.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(keep);
+  std::unique_ptr<ceres::LossFunctionWrapper> loss;
+  if (options.loss != LossType::kNone) {
+    loss = std::make_unique<ceres::LossFunctionWrapper>(
+        internal::MakeLoss(options.loss, scales.back()), ceres::TAKE_OWNERSHIP);
+  }
   int num_rows = 0, trend_rows = 0, rotation_rows_count = 0;
   for (const AccelBlock& b : residuals) {
     if (b.rotation) {
       std::vector<double*> with_gyro = parameter_blocks;
       with_gyro.push_back(rotation_rows.gyro_bias);
       with_gyro.push_back(rotation_rows.gyro_matrix);
-      problem.AddResidualBlock(b.cost.get(), nullptr, with_gyro);
+      problem.AddResidualBlock(b.cost.get(), loss.get(), with_gyro);
     } else {
-      problem.AddResidualBlock(b.cost.get(), nullptr, parameter_blocks);
+      problem.AddResidualBlock(b.cost.get(), loss.get(), parameter_blocks);
     }
     num_rows += b.rows;
     if (b.trend) trend_rows += b.rows;
@@ -397,14 +447,21 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   for (int b = 0; b < 4; ++b) {
     if (!on[b]) problem.SetParameterBlockConstant(blocks[b]);
   }
+  // Once per loss scale, widest first (one solve without a loss).
   ceres::Solver::Summary summary;
-  ceres::Solve(SolverOptions(options), &problem, &summary);
   SensorFitSummary& fit = result->accel_fit;
+  fit.iterations = 0;
+  for (auto it = scales.rbegin(); it != scales.rend(); ++it) {
+    if (loss) loss->Reset(internal::MakeLoss(options.loss, *it), ceres::TAKE_OWNERSHIP);
+    ceres::Solve(SolverOptions(options), &problem, &summary);
+    fit.iterations += static_cast<int>(summary.iterations.size()) - 1;
+    if (!summary.IsSolutionUsable()) break;
+  }
   fit.fitted = true;
   fit.information =
       trend_rows > 0 ? "position magnitudes + within-pose trends" : "position magnitudes";
   if (rotations) fit.information += " + rotations between poses";
-  fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  if (loss) fit.information += std::string(" (") + ToString(options.loss) + " loss)";
   fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {
     result->message = "accelerometer effect fit failed: " + summary.message;
@@ -416,20 +473,15 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   const int np = static_cast<int>(fit.parameter_names.size());
   Eigen::MatrixXd jacobian(num_rows, np);
   Eigen::VectorXd residual_rows(num_rows);
-  const double* params[8] = {bias,
-                             upper,
-                             blocks[0],
-                             blocks[1],
-                             blocks[2],
-                             blocks[3],
-                             rotation_rows.gyro_bias,
-                             rotation_rows.gyro_matrix};
   result->accel_trend_residuals.assign(observations.size(), Eigen::Vector3d::Zero());
   if (!EvaluateAccelFit(residuals, params, upper_free, on, rotations, options.compute_covariance,
                         &jacobian, &residual_rows, &fit, &result->accel_trend_residuals,
                         &result->rotation_residuals)) {
     result->message = "accelerometer effect fit: the model has no value at a position";
     return false;
+  }
+  if (loss && options.compute_covariance) {
+    WeightRowsByLoss(residuals, options, &jacobian, &residual_rows);
   }
   fit.num_residuals = num_rows;
   fit.trend_residuals = trend_rows;
@@ -751,6 +803,10 @@ bool EffectFitOptions::IsValid(std::string* error) const {
     *error =
         "effect fit: magnitude_extra_variance, magnitude_variance_prior and its dof and "
         "rotation_gyro_bias_variance must be >= 0";
+    return false;
+  }
+  if (!(loss_scale > 0.0) || !std::isfinite(loss_scale)) {
+    *error = "effect fit: loss_scale must be positive";
     return false;
   }
   std::string solver_error;

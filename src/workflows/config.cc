@@ -3,8 +3,12 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
+#include <utility>
 
 #include "gravcal/workflows/method_registry.h"
 #include "workflows/config/config_key.h"
@@ -57,6 +61,116 @@ bool SetNode(const std::string& key, const YAML::Node& node, Config* config, std
   return true;
 }
 
+// Duplicate keys of every map in the tree (yaml-cpp keeps both entries and
+// the loader would silently take the last): false with "<name>:<line>: ..."
+// naming the key and both lines.
+bool CheckDuplicateKeys(const YAML::Node& node, const std::string& name, std::string* error) {
+  if (node.IsSequence()) {
+    for (const YAML::Node& item : node) {
+      if (!CheckDuplicateKeys(item, name, error)) return false;
+    }
+    return true;
+  }
+  if (!node.IsMap()) return true;
+  std::vector<std::pair<std::string, int>> seen;
+  for (const auto& kv : node) {
+    const int line = kv.first.Mark().line + 1;
+    if (kv.first.IsScalar()) {
+      const std::string& key = kv.first.Scalar();
+      for (const auto& [other, other_line] : seen) {
+        if (other != key) continue;
+        std::ostringstream s;
+        s << name << ":" << line << ": duplicate key '" << key << "' (first set on line "
+          << other_line << "; a key may be set once)";
+        *error = s.str();
+        return false;
+      }
+      seen.emplace_back(key, line);
+    }
+    if (!CheckDuplicateKeys(kv.second, name, error)) return false;
+  }
+  return true;
+}
+
+bool KeySet(const Config& c, const std::string& key) {
+  return std::find(c.keys_set.begin(), c.keys_set.end(), key) != c.keys_set.end();
+}
+
+// Settings that contradict each other, and keys set that the chosen solver
+// or model path ignores (as a key the method ignores is an error): false
+// with a message naming both keys. `reads` says whether the method reads a
+// key (a rule about keys it does not read does not apply).
+bool CheckConsistency(const Config& c, const std::function<bool(const char*)>& reads,
+                      std::string* error) {
+  const CalibrationOptions& o = c.calibration;
+  const auto contradict = [&](const char* a, const char* b, const std::string& why) {
+    *error = std::string("keys '") + a + "' and '" + b + "' contradict: " + why;
+    return false;
+  };
+  const auto ignored = [&](const char* key, const std::string& when) {
+    *error = std::string("key '") + key + "' is ignored " + when + " (remove it)";
+    return false;
+  };
+  if (c.input.sample_rate > 0.0 && KeySet(c, "time_scale")) {
+    return contradict("sample_rate", "time_scale",
+                      "sample_rate makes the time of a log without a time column, time_scale "
+                      "scales the time column of a log with one: one of them is ignored");
+  }
+  if (reads("gravity") && o.gravity.gravity > 0.0 && std::isfinite(o.gravity.latitude)) {
+    return contradict("gravity", "latitude",
+                      "a measured gravity replaces normal gravity at a latitude; set one");
+  }
+  if (reads("height") && KeySet(c, "height") &&
+      !(o.gravity.gravity <= 0.0 && std::isfinite(o.gravity.latitude))) {
+    return ignored("height",
+                   "without 'latitude' or with 'gravity' (it is the height of "
+                   "normal gravity at a latitude)");
+  }
+  if (reads("solver") && o.solver == RefinementSolver::kNewton) {
+    if (reads("loss") && o.refinement.loss != LossType::kNone) {
+      return contradict("solver", "loss", "the Newton solver has no robust loss (solver: ceres)");
+    }
+    if (reads("effects") && !c.effects.empty()) {
+      return contradict("solver", "effects",
+                        "the fit with effects is by Ceres only (solver: ceres)");
+    }
+  }
+  if (reads("newton_residual") && KeySet(c, "newton_residual") &&
+      o.solver != RefinementSolver::kNewton) {
+    return ignored("newton_residual", "unless solver: newton");
+  }
+  if (reads("covariance") && reads("output_covariance") && !o.refinement.compute_covariance &&
+      c.output_covariance && KeySet(c, "output_covariance")) {
+    return contradict("covariance", "output_covariance",
+                      "no covariance is computed with covariance: false, so none can be written");
+  }
+  if (reads("pose_noise_batches") && KeySet(c, "pose_noise_batches") &&
+      o.pose_noise.method != PoseNoise::kBatchMeans) {
+    return ignored("pose_noise_batches", "unless pose_noise: batch_means");
+  }
+  if (reads("pose_variance") && !o.refinement.estimate_pose_variance) {
+    for (const char* key :
+         {"pose_disturbance_prior", "pose_disturbance_prior_dof", "prior_conflict_level",
+          "structure_test_level", "max_pose_disturbance"}) {
+      if (reads(key) && KeySet(c, key)) return ignored(key, "unless pose_variance: true");
+    }
+  }
+  if (reads("gyro_model") && c.gyro.parameterization == GyroParameterization::kNone) {
+    if (c.gyro.g_sensitivity) {
+      return contradict("gyro_model", "gyro_g_sensitivity",
+                        "gyro_model none estimates no gyroscope to give a g-sensitivity");
+    }
+    if (c.gyro.joint) {
+      return contradict("gyro_model", "gyro_joint",
+                        "gyro_model none estimates no gyroscope to refine jointly");
+    }
+    for (const char* key : {"gyro_loss", "gyro_loss_scale", "gyro_edge", "gyro_max_rotation"}) {
+      if (KeySet(c, key)) return ignored(key, "with gyro_model: none");
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool Config::IsValid(std::string* error) const {
@@ -75,6 +189,11 @@ bool Config::IsValid(std::string* error) const {
       return false;
     }
   }
+  const auto reads = [&](const char* name) {
+    const ConfigKey* key = FindConfigKey(name);
+    return key != nullptr && MethodReadsKey(*chosen, *key);
+  };
+  if (!CheckConsistency(*this, reads, error)) return false;
   if (chosen->validate && !chosen->validate(*this, error)) return false;
   MotionProfile profile;
   if (!sim_motion.empty() && !FromString(sim_motion, &profile)) {
@@ -133,15 +252,27 @@ std::string ConfigValueText(const Config& config, const std::string& key) {
 
 bool LoadConfigText(const std::string& text, const std::string& name, Config* config,
                     std::string* error) {
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(text);
+    documents = YAML::LoadAll(text);
   } catch (const YAML::Exception& e) {
     std::ostringstream s;
     s << name << ":" << e.mark.line + 1 << ": not valid YAML: " << e.msg;
     *error = s.str();
     return false;
   }
+  if (documents.size() > 1) {
+    std::ostringstream s;
+    s << name;
+    if (!documents[1].Mark().is_null()) s << ":" << documents[1].Mark().line + 1;
+    s << ": a second YAML document (a config is one document: remove the '---' and what "
+         "follows, or merge it into the first)";
+    *error = s.str();
+    return false;
+  }
+  if (documents.empty()) return true;
+  const YAML::Node& root = documents[0];
+  if (!CheckDuplicateKeys(root, name, error)) return false;
   if (root.IsNull()) return true;
   if (!root.IsMap()) {
     *error = name + ": the top level must be a map of keys";
@@ -163,6 +294,16 @@ bool LoadConfigText(const std::string& text, const std::string& name, Config* co
 }
 
 bool LoadConfigFile(const std::string& path, Config* config, std::string* error) {
+  // A folder, a device or a pipe is refused before it is read (an ifstream
+  // opens a folder and reads nothing: the defaults would run).
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    *error = path + ": not a regular file (" +
+             (std::filesystem::is_directory(status) ? "a folder" : "a device, pipe or socket") +
+             "); --config names a YAML file";
+    return false;
+  }
   std::ifstream in(path);
   if (!in) {
     *error = path + ": cannot open the config file";

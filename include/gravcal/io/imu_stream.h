@@ -57,6 +57,9 @@ class ImuCsvStreamReader {
   bool Next(ImuSample* sample, std::string* error);
   // The name used in messages ("standard input" for "-").
   const std::string& name() const { return name_; }
+  // Where the last sample was, for messages: "log.csv:17" for text,
+  // "log.bag: sample 16" for a log read whole.
+  std::string where() const;
 
  private:
   struct State;

@@ -186,6 +186,15 @@ struct EffectFitOptions {
 
   // Stopping rules of the Ceres solve.
   SolverTolerances solver = {50, 1e-12, 1e-12, 1e-10};
+  // Robust loss rho on each accelerometer residual block (a position's
+  // magnitude, its within-pose trend, a turn between poses), loss_scale (> 0)
+  // in standard deviations, as in the refinement (refinement.h): the solve is
+  // graduated from a scale holding every initial residual down to loss_scale,
+  // and the covariance weights each block's rows by sqrt(rho'(|r|^2)), the
+  // weights of iteratively reweighted least squares at the optimum. chi2 and
+  // the residuals stay unweighted. kNone = least squares.
+  LossType loss = LossType::kNone;
+  double loss_scale = 3.0;
 
   // Issue 21: add the AccelRotationResidual
   // (residuals/accel_rotation_residual.h) of every turn between consecutive
