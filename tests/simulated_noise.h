@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "gravcal/estimation/allan_deviation.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
@@ -45,6 +46,7 @@ inline ImuNoise SimulatedNoiseModel(const SimulatorOptions& o) {
       p.adev = p.lo = p.hi = std::sqrt(axes[a].AllanVariance(1.0));
       p.edf = 1.0;
       (*out)[a].rate_hz = o.sample_rate;
+      (*out)[a].confidence = AllanOptions().confidence;
       (*out)[a].points = {p};
     }
   };
