@@ -425,6 +425,14 @@ TEST_F(DestinationTest, BatchInItsOwnInputFolder) {
                 "u1.json: the batch would overwrite", "unit u1");
   EXPECT_EQ(Slurp(Work("own/u1.json")), log);
   EXPECT_EQ(Names(Work("own")), std::set<std::string>({"u1.json"}));
+
+  // A folder of AppleDouble files only: the message says why none is a unit.
+  ASSERT_EQ(mkdir(Work("apple").c_str(), 0755), 0);
+  Plant("apple/._u1.csv", log);
+  ExpectRefused(Run("batch --config " + ConfigPath() + " --input-dir " + Work("apple") +
+                    " --output-dir " + Work("apple/out")),
+                "apple: no file matches '*.csv'", "only hidden files do");
+  EXPECT_EQ(Names(Work("apple")), std::set<std::string>({"._u1.csv"}));
 }
 
 }  // namespace

@@ -177,11 +177,13 @@ bool UnitsFromDirectory(const std::string& folder, const std::string& pattern,
     return false;
   }
   std::vector<std::string> names;
+  size_t skipped = 0;  // hidden names that match
   while (const dirent* entry = readdir(dir)) {
     const std::string file = entry->d_name;
     if (file == "." || file == ".." || fnmatch(pattern.c_str(), file.c_str(), 0) != 0) continue;
     if (std::find(exclude.begin(), exclude.end(), file) != exclude.end()) continue;
     if (file[0] == '.') {
+      ++skipped;
       if (hidden != nullptr && !IsGravcalTemporaryName(file)) hidden->push_back(file);
       continue;
     }
@@ -194,7 +196,10 @@ bool UnitsFromDirectory(const std::string& folder, const std::string& pattern,
   std::sort(names.begin(), names.end());
   if (hidden != nullptr) std::sort(hidden->begin(), hidden->end());
   if (names.empty()) {
-    *error = folder + ": no file matches '" + pattern + "'";
+    *error = folder + ": no file matches '" + pattern + "'" +
+             (skipped == 0 ? ""
+                           : " (only hidden files do: hidden and AppleDouble '._' files are "
+                             "never units)");
     return false;
   }
   std::vector<BatchUnit> out;
