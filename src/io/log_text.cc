@@ -150,6 +150,7 @@ std::string_view LogLines::Head(size_t bytes, std::string* error) {
 }
 
 bool LogLines::FindLineEnd(size_t from, size_t* at, size_t* length) {
+  if (from >= end_) return false;  // (memchr on an empty text's null data)
   const char* const p = data_ + from;
   const size_t n = end_ - from;
   if (ends_ == Ends::kNewline) {

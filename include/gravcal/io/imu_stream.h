@@ -1,5 +1,5 @@
-// gravcal/io/imu_stream.h: contract CSV logs (docs/data_contract.md, "Raw
-// log") read and written one sample at a time, in constant memory, for logs
+// gravcal/io/imu_stream.h: raw logs (docs/data_contract.md, "Raw log") read
+// and contract CSV written one sample at a time, in constant memory, for logs
 // larger than memory. "-" names standard input / standard output.
 //
 // The reader holds every text log to the same rules as log_reader.h (one

@@ -17,8 +17,11 @@
 // from their first bytes (gravcal/io/recording.h); for them the layout keys
 // above do not apply.
 //
-// Every error names the file and line: "session.csv:17: column 'ay': 'abc' is
-// not a number".
+// Every text log, read here or streamed by imu_stream.h, goes through one
+// checked reader: finite values, strictly increasing time, a UTF-8 byte
+// order mark dropped, "\n", "\r\n" or CR-only line ends, lines of at most
+// 64 KiB, a column named twice refused. Every error names the file and line:
+// "session.csv:17: column 'ay': 'abc' is not a number".
 #ifndef GRAVCAL_IO_LOG_READER_H_
 #define GRAVCAL_IO_LOG_READER_H_
 
