@@ -493,8 +493,8 @@ TEST(PlanIo, TurnIndicesOutsideThePosesAreRefusedNotWrapped) {
 // for range and sign, with a message naming the entry and the value.
 TEST(PlanIo, EveryValueReadIsCheckedWithAMessageNamingIt) {
   const auto plan = [](const std::string& pose, const std::string& turn) {
-    return R"({"poses": [{"up": [0, 0, 1], "hold_s": 10}, )" + pose +
-           R"(], "rotations": [)" + turn + "]}";
+    return R"({"poses": [{"up": [0, 0, 1], "hold_s": 10}, )" + pose + R"(], "rotations": [)" +
+           turn + "]}";
   };
   const std::string good_pose = R"({"up": [1, 0, 0], "hold_s": 10})";
   const std::string good_turn = R"({"from": 0, "to": 1, "axis": [0, 1, 0], "angle_deg": 90})";
