@@ -78,11 +78,13 @@ bool FitSession(const std::string& config_name, const std::string& file, RealFit
 bool FitCkExplorer(RealFit* fit) {
   Config config;
   std::string error;
+  // The shipped twelve_position.yaml with this file's input layout.
   const std::string text =
-      "method: twelve_position\nformat: csv\nsample_rate: 100\nnominal_scale: 9.80665\n"
-      "gravity: 9.80665\nparameterization: scale_misalignment\n";
+      "format: csv\nsample_rate: 100\nnominal_scale: 9.80665\ngravity: 9.80665\n";
   ImuLog log;
-  if (!LoadConfigText(text, "ck_explorer", &config, &error) || !ApplyOverrides(&config, &error) ||
+  if (!LoadConfigFile(testing_util::SourceDir() + "/configs/twelve_position.yaml", &config,
+                      &error) ||
+      !LoadConfigText(text, "ck_explorer", &config, &error) || !ApplyOverrides(&config, &error) ||
       !ReadImuLog(testing_util::RealDataDir() + "/ck_explorer_poses/acc_log.csv", config.input,
                   &log, &error)) {
     ADD_FAILURE() << error;
@@ -249,9 +251,13 @@ TEST(RealHonesty, HandPlacedSimulationLooksLikeTheRealSessions) {
   std::string error;
   ASSERT_TRUE(LoadConfigFile(testing_util::SourceDir() + "/configs/hand_placed.yaml", &sim, &error))
       << error;
-  // The shipped uncertainty pipeline, not the profile's own prior.
-  sim.calibration = ShippedCalibrationOptions();
-  ASSERT_TRUE(SetConfigValue("parameterization", "scale_misalignment", &sim, &error)) << error;
+  // The shipped uncertainty pipeline (configs/twelve_position.yaml), not
+  // the profile's own prior.
+  Config shipped;
+  ASSERT_TRUE(
+      LoadConfigFile(testing_util::SourceDir() + "/configs/twelve_position.yaml", &shipped, &error))
+      << error;
+  sim.calibration = shipped.calibration;
   sim.gyro = GyroCalibrationOptions();
   for (uint64_t seed = 1; seed <= 2; ++seed) {
     SimulatedSession session;

@@ -57,30 +57,7 @@ bool SetNode(const std::string& key, const YAML::Node& node, Config* config, std
   return true;
 }
 
-// The shipped prior on the per-pose scatter s (methods/pose_variance.h),
-// chosen on all the real hand-placed recordings of ../shared/data/real
-// (docs/workflows/noise.md has the table): REML alone finds s = 0.0003-0.0009
-// m/s^2 on the AHRS repeats, 0.002-0.003 on the NilsPod faces, 0.009 on the
-// 160 ck_explorer poses, so no single s0 fits every sensor. The prior is
-// therefore weak (one degree of freedom: the data outweigh it from a few
-// residual directions on) and at the low end of what hand placement showed,
-// so that a session with one to three residual degrees of freedom cannot
-// come out with white-noise sigmas because those few residuals happened to
-// be small, while a good sensor's sigmas are not widened towards a poor
-// one's.
-constexpr double kShippedPoseDisturbancePrior = 0.0005;
-constexpr double kShippedPoseDisturbancePriorDof = 1.0;
-
 }  // namespace
-
-CalibrationOptions ShippedCalibrationOptions() {
-  CalibrationOptions options;
-  options.refinement.estimate_pose_variance = true;
-  options.refinement.pose_disturbance_prior = kShippedPoseDisturbancePrior;
-  options.refinement.pose_disturbance_prior_dof = kShippedPoseDisturbancePriorDof;
-  options.pose_noise.method = PoseNoise::kBatchMeans;
-  return options;
-}
 
 bool Config::IsValid(std::string* error) const {
   const CalibrationMethod* chosen = FindCalibrationMethod(method);

@@ -27,21 +27,11 @@
 
 namespace gravcal {
 
-// The calibration options a config starts from: the library's defaults,
-// except that the per-pose variance component is on (REML with a weak
-// hand-placement prior, methods/pose_variance.h) and each pose's variance
-// comes from batch means. Real hand-placed sessions scatter far beyond their
-// samples' white noise (chi2 / dof 9-28 on the recordings of
-// ../shared/data/real); this pipeline keeps their standard deviations
-// honest (docs/workflows/noise.md, "Honest by default"). A fixture or rate
-// table config may set pose_variance: false.
-CalibrationOptions ShippedCalibrationOptions();
-
 struct Config {
   // Calibration method, a name in the method registry (method_registry.h).
   std::string method = "twelve_position";
   LogReaderOptions input;
-  CalibrationOptions calibration = ShippedCalibrationOptions();
+  CalibrationOptions calibration;
   SimulatorOptions simulation;
   // Gyroscope from the rotations between the poses (gyro_model != none).
   GyroCalibrationOptions gyro;
