@@ -230,7 +230,9 @@ INSTANTIATE_TEST_SUITE_P(
     Recordings, RealData,
     ::testing::Values(RealCase{"ferraris_nilspod.yaml", "ferraris_nilspod/session.csv", 6, 13},
                       RealCase{"mpu6050_ten_pose.yaml", "mpu6050_ten_pose/session.csv", 10, 10},
-                      RealCase{"ahrs_static_poses.yaml", "ahrs_static_poses/imu_good1.txt", 8, 9}),
+                      // good2: good1's nine poses fit the config's nine
+                      // parameters exactly, so no pose can be left out.
+                      RealCase{"ahrs_static_poses.yaml", "ahrs_static_poses/imu_good2.txt", 9, 14}),
     [](const ::testing::TestParamInfo<RealCase>& info) {
       std::string name = info.param.config;
       return name.substr(0, name.find('.'));

@@ -1,9 +1,9 @@
 // Issue 14: repeated recordings of one unit must agree within their
-// reported sigmas. Three recordings of the same AHRS (imu_good1..3.txt, the
-// first identical to ../shared/data/real/ahrs_static_poses/imu_good1.txt)
-// in $GRAVCAL_REPEAT_DATA_DIR/ahrs (the test skips when the variable is
-// unset or the files are absent) are each calibrated with the shipped
-// configs/ahrs_static_poses.yaml, and every parameter is compared pairwise,
+// reported sigmas. Three recordings of the same AHRS (imu_good1..3.txt in
+// ../shared/data/real/ahrs_static_poses; the test skips when they are
+// absent) are each calibrated with configs/ahrs_static_poses.yaml's input
+// layout, the `scale` model and this unit's own pose-scatter prior (below),
+// and every parameter is compared pairwise,
 //
 //   z = (p_i - p_j) / sqrt(sigma_i^2 + sigma_j^2),
 //
@@ -13,14 +13,18 @@
 // variance component that absorbed a missing term give rms far below it
 // (before the structure test pooled the prior, good2-good3 gave 0.14).
 //
-// Caveat: the config's prior comes from good2 and good3 (see its comment),
-// so this is not an independent check of the prior.
+// The prior, s0 = 0.0007 m/s^2 on 11 dof, is this unit's own: REML alone on
+// good2 and good3 fitted with scale_misalignment gives s = 0.00041 on 5 dof
+// and 0.00082 on 6, pooled s0^2 = (5 s2^2 + 6 s3^2) / 11. With it the
+// structure test has power on these poses (methods/pose_variance.h). It
+// comes from the recordings compared, so this checks the structure test
+// and the set-aside rule, not the prior; the shipped default is checked on
+// the same recordings in real_honesty_test.cc.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -33,11 +37,10 @@ namespace {
 
 using testing_util::FreeParameters;
 
-// The folder with ahrs/imu_good{1,2,3}.txt, or "" when it is not there.
+// The folder with imu_good{1,2,3}.txt, or "" when it is not there.
 std::string RepeatDataDir() {
-  const char* env = std::getenv("GRAVCAL_REPEAT_DATA_DIR");
-  if (env == nullptr) return "";
-  const std::string dir = std::string(env) + "/ahrs";
+  if (testing_util::RealDataDir().empty()) return "";
+  const std::string dir = testing_util::RealDataDir() + "/ahrs_static_poses";
   for (int i = 1; i <= 3; ++i) {
     struct stat st;
     const std::string file = dir + "/imu_good" + std::to_string(i) + ".txt";
@@ -66,6 +69,8 @@ bool CalibrateRecording(int index, AccelParameterization parameterization, Fit* 
     return false;
   }
   config.calibration.refinement.parameterization = parameterization;
+  config.calibration.refinement.pose_disturbance_prior = 0.0007;
+  config.calibration.refinement.pose_disturbance_prior_dof = 11.0;
   Calibration& c = fit->calibration;
   if (!RunCalibration(config, input, &c) || !c.refinement.covariance_available) return false;
   fit->value = FreeParameters(c.accel.model, parameterization);
@@ -119,11 +124,11 @@ void ExpectAgreement(const std::vector<double>& z, const char* what) {
   for (double v : z) EXPECT_LT(std::fabs(v), 4.0) << what;
 }
 
-// The shipped config (`scale`): good2 and good3 have enough poses for the
+// The `scale` model with the unit's prior: good2 and good3 have enough poses for the
 // structure test (with the prior pooled in) to name non-orthogonality, so
 // their excess is not absorbed and their sigmas are the white ones; good1's
 // nine poses cannot test it and contradict the prior, which is set aside.
-TEST(RepeatRecordings, ShippedConfigAgreesWithinSigmas) {
+TEST(RepeatRecordings, ScaleWithTheUnitsPriorAgreesWithinSigmas) {
   if (RepeatDataDir().empty()) GTEST_SKIP() << "repeat recordings not found";
   Fit fits[3];
   for (int i = 0; i < 3; ++i) {
