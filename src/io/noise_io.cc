@@ -192,9 +192,9 @@ std::string NoiseToJson(const ImuNoise& noise) {
       {"fit",
        {{"readings",
          "white noise and random walk where they dominate the curve with the smallest predicted "
-         "uncertainty, bias instability at the curve's measured floor, taus disturbed by a "
-         "spectral line left out; sigmas inflated by the readings' scatter over each term's "
-         "range"}}}};
+         "uncertainty, bias instability at the curve's measured floor, random walk on a rise "
+         "near +1/2; the spectral lines' Allan variance subtracted and the taus a line "
+         "dominates left out; sigmas inflated by the readings' scatter over each term's range"}}}};
   out["accel"] = internal::SensorJson(m.accel, noise.accel_curves, noise.accel_lines);
   if (!noise.gyro_curves[0].points.empty()) {
     out["gyro"] = internal::SensorJson(m.gyro, noise.gyro_curves, noise.gyro_lines);
