@@ -246,6 +246,37 @@ TEST(Check, SixFacesNameTheNonOrthogonalityAndTheProposedPosesDetermineIt) {
   std::printf("%s\n", CoverageReportText(report).c_str());
 }
 
+// Three axis-up poses: each bias trades one for one against its axis's
+// scale, which one pose per axis cannot fix; a single level pose leaves the
+// bias along gravity so too. Neither is a confident number: check names them
+// undetermined, with no finite sigma (a sigma conditional on holding the
+// scale would read "ok").
+TEST(Check, BiasTradingWithAnUndeterminedScaleIsUndetermined) {
+  const Config config = TwelveConfig();
+  const std::vector<std::vector<Eigen::Vector3d>> sessions = {
+      {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()},
+      {Eigen::Vector3d::UnitZ()}};
+  const std::vector<std::vector<std::string>> expected = {{"bias_x", "bias_y", "bias_z"},
+                                                          {"bias_z"}};
+  for (size_t k = 0; k < sessions.size(); ++k) {
+    CoverageReport report;
+    std::string error;
+    ASSERT_TRUE(CheckRecording(SimulateUps(sessions[k], 10.0, 7 + k).log, config, PlanRequest(),
+                               &report, &error))
+        << error;
+    const std::string text = CoverageReportText(report);
+    for (const std::string& name : expected[k]) {
+      EXPECT_NE(std::find(report.undetermined.begin(), report.undetermined.end(), name),
+                report.undetermined.end())
+          << name << "\n"
+          << text;
+      const int i = Index(report.accel.parameter_names, name);
+      ASSERT_LT(i, static_cast<int>(report.accel.parameter_names.size()));
+      EXPECT_FALSE(std::isfinite(report.accel.predicted_std(i))) << name;
+    }
+  }
+}
+
 TEST(ExperimentDesign, CandidateTurnsTakeOneUpDirectionToTheOther) {
   std::vector<Eigen::Vector3d> ups;
   ASSERT_TRUE(CandidateDirections("free", 40, &ups));

@@ -24,7 +24,8 @@ constexpr double kScale = kStandardGravity / 1000.0;
 // One pose of `seconds`, gravity on z, noise `o` (SI) on every axis, in
 // counts; the interval and the white-noise position.
 void Pose(const NoiseProcessOptions& o, uint64_t seed, double seconds, ImuLog* log,
-          std::vector<StaticInterval>* intervals) {
+          std::vector<StaticInterval>* intervals,
+          const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ(), double offset = 0.0) {
   const size_t n = static_cast<size_t>(seconds * kSampleRate);
   const size_t begin = log->size();
   StaticInterval s;
@@ -34,9 +35,9 @@ void Pose(const NoiseProcessOptions& o, uint64_t seed, double seconds, ImuLog* l
   for (int a = 0; a < 3; ++a) axes.emplace_back(o, seed * 4 + a);
   for (size_t i = 0; i < n; ++i) {
     log->t.push_back((begin + i) / kSampleRate);
-    Eigen::Vector3d v(0.0, 0.0, kStandardGravity);
+    Eigen::Vector3d v = kStandardGravity * up;
     for (int a = 0; a < 3; ++a) v[a] += axes[a].Next();
-    log->accel.push_back(v / kScale);
+    log->accel.push_back(v / kScale + Eigen::Vector3d::Constant(offset));
     s.accel_mean += log->accel.back() / static_cast<double>(n);
   }
   for (size_t i = s.begin; i < s.end; ++i) {
@@ -85,6 +86,41 @@ TEST(PoseMeanCovariance, ModelGivesItsAllanVarianceInRawUnits) {
 // 400 poses of white noise: batch / white averages nu / (nu - 2) = 19 / 17
 // (4 sd of the average: 4 sqrt(2 / 19) / sqrt(1200) = 0.04); with a random
 // walk dominating over the pose, batch means is several times C / n.
+// An offset sensor (unsigned counts around 32768): the raw unit comes from
+// the coarse fit's scale, not from |raw mean|, so a white-noise model gives
+// the white-noise covariance of the mean (within a factor 2; |raw mean|
+// would make it 30-50 times too large) and no warning of a factor.
+TEST(PoseMeanCovariance, OffsetSensorTakesTheRawUnitFromTheCoarseFit) {
+  NoiseProcessOptions o;
+  o.white_noise = 2e-3;
+  ImuLog log;
+  std::vector<StaticInterval> intervals;
+  for (int k = 0; k < 6; ++k) {
+    Eigen::Vector3d up = Eigen::Vector3d::Zero();
+    up[k / 2] = k % 2 == 0 ? 1.0 : -1.0;
+    Pose(o, 10 + k, 10.0, &log, &intervals, up, 32768.0);
+  }
+  ImuNoiseModel model;
+  for (AxisNoiseModel& a : model.accel) a.white_noise.value = o.white_noise;
+  PoseNoiseOptions options;
+  options.model = &model;
+  std::vector<Position> positions = PositionsFromIntervals(intervals);
+  std::vector<std::string> notes;
+  std::string error;
+  ASSERT_TRUE(SetPoseMeanCovariance(log, intervals, options, &positions, &notes, &error)) << error;
+  for (const std::string& note : notes) {
+    EXPECT_EQ(note.find("factor"), std::string::npos) << note;
+  }
+  const std::vector<Position> white = PositionsFromIntervals(intervals);
+  for (size_t k = 0; k < positions.size(); ++k) {
+    for (int a = 0; a < 3; ++a) {
+      const double ratio = std::sqrt(positions[k].raw_mean_cov(a, a) / white[k].raw_mean_cov(a, a));
+      EXPECT_GT(ratio, 0.5) << k << " " << a;
+      EXPECT_LT(ratio, 2.0) << k << " " << a;
+    }
+  }
+}
+
 TEST(PoseMeanCovariance, BatchMeansOnWhiteNoiseAndRandomWalk) {
   NoiseProcessOptions white;
   white.white_noise = 2e-3;

@@ -114,23 +114,40 @@ std::string TauText(double tau) {
 }
 
 // The points a fit uses: tau >= min_tau and a positive deviation, with
-// their taus and Allan variances.
+// their taus and Allan variances, each spectral line's Allan variance
+// subtracted (LineAllanVariance) and a fifth of its bound counted as the
+// subtraction's standard deviation (extra, a variance of the Allan
+// variance); a point where the lines' bound exceeds line_share of its
+// Allan variance is left out (*line_excluded counts them).
 struct FitPoints {
   std::vector<size_t> used;
   std::vector<double> tau;
   std::vector<double> avar;
+  std::vector<double> extra;
 };
 
-FitPoints SelectFitPoints(const AllanDeviation& curve, double min_tau) {
+FitPoints SelectFitPoints(const AllanDeviation& curve, double min_tau,
+                          const std::vector<SpectralLine>& lines, double line_share,
+                          int* line_excluded) {
   FitPoints p;
+  *line_excluded = 0;
   for (size_t i = 0; i < curve.points.size(); ++i) {
-    if (curve.points[i].tau >= min_tau * (1.0 - 1e-9) && curve.points[i].adev > 0.0) {
-      p.used.push_back(i);
+    const AllanPoint& point = curve.points[i];
+    if (point.tau < min_tau * (1.0 - 1e-9) || !(point.adev > 0.0)) continue;
+    const double avar = point.adev * point.adev;
+    double bound = 0.0, line_variance = 0.0;
+    for (const SpectralLine& line : lines) {
+      bound += LineAllanBound(line, point.tau);
+      line_variance += LineAllanVariance(line, point.tau, curve.rate_hz);
     }
-  }
-  for (size_t i : p.used) {
-    p.tau.push_back(curve.points[i].tau);
-    p.avar.push_back(curve.points[i].adev * curve.points[i].adev);
+    if (bound > line_share * avar || !(avar - line_variance > 0.0)) {
+      ++*line_excluded;
+      continue;
+    }
+    p.used.push_back(i);
+    p.tau.push_back(point.tau);
+    p.avar.push_back(avar - line_variance);
+    p.extra.push_back(0.04 * bound * bound);
   }
   return p;
 }
@@ -148,7 +165,8 @@ Coefficients FitAndWeigh(const FitPoints& p, double confidence, AllanDeviation* 
   *model = p.avar;
   for (int iteration = 0; iteration < 6; ++iteration) {
     for (size_t k = 0; k < n; ++k) {
-      sd[k] = (*model)[k] * std::sqrt(2.0 / curve->points[p.used[k]].edf);
+      sd[k] =
+          std::sqrt((*model)[k] * (*model)[k] * 2.0 / curve->points[p.used[k]].edf + p.extra[k]);
     }
     c = NonNegativeFit(p.tau, p.avar, sd);
     for (size_t k = 0; k < n; ++k) (*model)[k] = std::max(ModelVariance(c, p.tau[k]), 1e-300);
@@ -160,52 +178,64 @@ Coefficients FitAndWeigh(const FitPoints& p, double confidence, AllanDeviation* 
   return c;
 }
 
-// The point where term j is read (bias instability at its largest share,
-// the flat minimum; quantisation at the shortest tau; the slopes where the
-// predicted relative uncertainty is smallest), among those where it
-// dominates; -1 when it dominates nowhere, with term->reason saying so.
-// Sets the term's tau range.
-int ChooseReadingPoint(int j, const Coefficients& c, const FitPoints& p,
-                       const std::vector<double>& model, const AllanDeviation& curve,
-                       double dominance, NoiseTerm* term) {
-  double best_share = 0.0, best_tau = 0.0;
-  int chosen = -1;
-  double chosen_score = std::numeric_limits<double>::infinity();
-  for (size_t k = 0; k < p.used.size(); ++k) {
-    const double share = c[j] * Shape(j, p.tau[k]) / model[k];
-    if (share > best_share) {
-      best_share = share;
-      best_tau = p.tau[k];
-    }
-    if (share < dominance) continue;
-    term->tau_min = std::isnan(term->tau_min) ? p.tau[k] : std::min(term->tau_min, p.tau[k]);
-    term->tau_max = std::isnan(term->tau_max) ? p.tau[k] : std::max(term->tau_max, p.tau[k]);
-    const double edf = curve.points[p.used[k]].edf;
-    const double score = j == 2 ? -share : j == 0 ? p.tau[k] : std::sqrt(2.0 / edf) / share;
-    if (score < chosen_score) {
-      chosen_score = score;
-      chosen = static_cast<int>(k);
-    }
+const char* const kTermNames[kTerms] = {"quantisation (tau^-1)", "white noise (tau^-1/2)",
+                                        "bias instability (flat part)", "random walk (tau^+1/2)"};
+
+// Term j's reading at point k with the other terms' values subtracted, and
+// its variance: the Allan variance's own, 2 sigma^4 / edf (model sigma), and
+// the subtracted terms'.
+struct Reading {
+  double value = 0.0;
+  double variance = 0.0;
+  double statistical = 0.0;
+};
+
+Reading ReadAt(int j, size_t k, const Coefficients& value, const Coefficients& variance,
+               const FitPoints& p, const std::vector<double>& model, const AllanDeviation& curve) {
+  const double g = Shape(j, p.tau[k]);
+  double rest = 0.0, rest_variance = 0.0;
+  for (int o = 0; o < kTerms; ++o) {
+    if (o == j) continue;
+    const double go = Shape(o, p.tau[k]);
+    rest += value[o] * go;
+    rest_variance += variance[o] * go * go;
   }
-  if (chosen < 0) {
-    const char* names[kTerms] = {"quantisation (tau^-1)", "white noise (tau^-1/2)",
-                                 "bias instability (flat part)", "random walk (tau^+1/2)"};
-    term->reason = std::string(names[j]) +
-                   (c[j] > 0.0 ? " never dominates the curve: at most " +
-                                     std::to_string(static_cast<int>(100.0 * best_share)) +
-                                     " % of the Allan variance, at tau " + TauText(best_tau)
-                               : " is not in the fitted curve (tau " + TauText(p.tau.front()) +
-                                     " to " + TauText(p.tau.back()) + ")");
-  }
-  return chosen;
+  const double edf = curve.points[p.used[k]].edf;
+  Reading r;
+  r.value = (p.avar[k] - rest) / g;
+  r.statistical = (2.0 / edf * model[k] * model[k] + p.extra[k]) / (g * g);
+  r.variance = r.statistical + rest_variance / (g * g);
+  return r;
 }
 
-// Step 2: each dominating term read at one point, the others subtracted;
+// The index of the curve's measured floor: the smallest deviation among
+// points with at least 5 equivalent degrees of freedom (fewer scatter too
+// far to mark a floor), -1 if none.
+int FloorPoint(const FitPoints& p, const AllanDeviation& curve) {
+  int floor = -1;
+  for (size_t k = 0; k < p.used.size(); ++k) {
+    if (curve.points[p.used[k]].edf < 5.0) continue;
+    if (floor < 0 || p.avar[k] < p.avar[static_cast<size_t>(floor)]) floor = static_cast<int>(k);
+  }
+  return floor;
+}
+
+// Step 2: each term read where the curve shows it, the others subtracted;
 // twice, the second time with the first readings' values and variances.
-// Only terms that dominate somewhere are subtracted: a term the fit gives a
-// small share everywhere is not determined by the curve (quantisation and
-// white noise, both falling, trade against each other), and subtracting it
-// would bias the reading.
+//   white noise and random walk: among the points the term dominates
+//     (share >= dominance), the one with the smallest predicted
+//     uncertainty; the random walk only where the rising end has a slope
+//     near +1/2 (a steeper one is a drift or a slow line);
+//   bias instability: at the curve's measured floor, if it dominates there
+//     (not at the model's largest share, which a rising end can put at the
+//     longest tau);
+//   quantisation: its smallest dominated tau.
+// The variance is the reading's; when the readings over the term's whole
+// dominated range scatter more than their own variances say (chi-square per
+// degree of freedom above 1: the curve departs from the term's slope), it
+// is inflated by that ratio. Only terms that dominate somewhere are
+// subtracted: a term the fit gives a small share everywhere is not
+// determined by the curve.
 void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<double>& model,
                double dominance, NoiseFit* fit) {
   const size_t n = p.used.size();
@@ -215,6 +245,7 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
       if (c[j] * Shape(j, p.tau[k]) >= dominance * model[k]) value[j] = c[j];
     }
   }
+  const int floor = FloorPoint(p, fit->curve);
   Coefficients variance{0.0, 0.0, 0.0, 0.0};
   for (int pass = 0; pass < 2; ++pass) {
     Coefficients next{0.0, 0.0, 0.0, 0.0};
@@ -222,32 +253,113 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
     for (int j = 0; j < kTerms; ++j) {
       NoiseTerm* term = TermOf(j, &fit->model);
       *term = NoiseTerm();
-      const int chosen = ChooseReadingPoint(j, c, p, model, fit->curve, dominance, term);
-      if (chosen < 0) continue;
-      const size_t k = static_cast<size_t>(chosen);
-      const double g = Shape(j, p.tau[k]);
-      double rest = 0.0, rest_variance = 0.0;
-      for (int o = 0; o < kTerms; ++o) {
-        if (o == j) continue;
-        const double go = Shape(o, p.tau[k]);
-        rest += value[o] * go;
-        rest_variance += variance[o] * go * go;
+      std::vector<size_t> dominated;
+      double best_share = 0.0, best_tau = 0.0;
+      for (size_t k = 0; k < n; ++k) {
+        const double share = c[j] * Shape(j, p.tau[k]) / model[k];
+        if (share > best_share) {
+          best_share = share;
+          best_tau = p.tau[k];
+        }
+        if (share < dominance) continue;
+        dominated.push_back(k);
+        term->tau_min = std::isnan(term->tau_min) ? p.tau[k] : std::min(term->tau_min, p.tau[k]);
+        term->tau_max = std::isnan(term->tau_max) ? p.tau[k] : std::max(term->tau_max, p.tau[k]);
       }
-      const double edf = fit->curve.points[p.used[k]].edf;
-      const double coefficient = (p.avar[k] - rest) / g;
-      const double coefficient_variance =
-          (2.0 / edf * model[k] * model[k] + rest_variance) / (g * g);
+      if (dominated.empty()) {
+        term->reason = std::string(kTermNames[j]) +
+                       (c[j] > 0.0 ? " never dominates the curve: at most " +
+                                         std::to_string(static_cast<int>(100.0 * best_share)) +
+                                         " % of the Allan variance, at tau " + TauText(best_tau)
+                                   : " is not in the fitted curve (tau " + TauText(p.tau.front()) +
+                                         " to " + TauText(p.tau.back()) + ")");
+        continue;
+      }
+      int chosen = -1;
+      if (j == 2) {
+        if (floor >= 0 && std::find(dominated.begin(), dominated.end(),
+                                    static_cast<size_t>(floor)) != dominated.end()) {
+          chosen = floor;
+        } else {
+          term->reason = std::string(kTermNames[j]) + " does not dominate at the curve's floor" +
+                         (floor >= 0 ? " (tau " + TauText(p.tau[static_cast<size_t>(floor)]) + ")"
+                                     : std::string());
+          continue;
+        }
+      } else if (j == 0) {
+        chosen = static_cast<int>(dominated.front());
+      } else {
+        double best = std::numeric_limits<double>::infinity();
+        for (size_t k : dominated) {
+          const Reading r = ReadAt(j, k, value, variance, p, model, fit->curve);
+          const double score = std::sqrt(r.variance) * Shape(j, p.tau[k]) / model[k];
+          if (score < best) {
+            best = score;
+            chosen = static_cast<int>(k);
+          }
+        }
+      }
+      if (j == 3 && dominated.size() >= 4 &&
+          p.tau[dominated.back()] >= 4.0 * p.tau[dominated.front()]) {
+        // Slope of log adev on log tau over the rising end, weighted least
+        // squares: var(log adev) = 1 / (2 edf). A rise off +1/2 by more than
+        // 0.3 plus twice the slope's standard deviation is not a random walk
+        // (a drift rises at +1).
+        double sw = 0.0, sx = 0.0, sy = 0.0;
+        for (size_t k : dominated) {
+          const double w = 2.0 * fit->curve.points[p.used[k]].edf;
+          sw += w;
+          sx += w * std::log(p.tau[k]);
+          sy += w * 0.5 * std::log(p.avar[k]);
+        }
+        double sxx = 0.0, sxy = 0.0;
+        for (size_t k : dominated) {
+          const double w = 2.0 * fit->curve.points[p.used[k]].edf;
+          const double dx = std::log(p.tau[k]) - sx / sw;
+          sxx += w * dx * dx;
+          sxy += w * dx * (0.5 * std::log(p.avar[k]) - sy / sw);
+        }
+        // Overlapping averages make neighbouring points correlated: the
+        // independent points are about one per half octave, so the
+        // regression's standard deviation is scaled by sqrt(2 x points per
+        // octave).
+        const double per_octave =
+            std::max(1.0, (dominated.size() - 1.0) /
+                              std::log2(p.tau[dominated.back()] / p.tau[dominated.front()]));
+        const double slope = sxy / sxx;
+        const double slope_sd = std::sqrt(2.0 * per_octave / sxx);
+        if (std::abs(slope - 0.5) > 0.3 + 2.0 * slope_sd) {
+          std::ostringstream r;
+          r.precision(2);
+          r << "the rising end (tau " << TauText(p.tau[dominated.front()]) << " to "
+            << TauText(p.tau[dominated.back()]) << ") has slope " << slope << " +- " << slope_sd
+            << ", not +1/2: a drift or a slow line, not a random walk";
+          term->reason = r.str();
+          continue;
+        }
+      }
+      const size_t k = static_cast<size_t>(chosen);
+      const Reading reading = ReadAt(j, k, value, variance, p, model, fit->curve);
       term->tau = p.tau[k];
-      if (!(coefficient > 0.0)) {
+      if (!(reading.value > 0.0)) {
         term->reason = "the reading at tau " + TauText(p.tau[k]) +
                        " leaves nothing once the other terms are subtracted";
         next[j] = 0.0;
         continue;
       }
-      next[j] = coefficient;
-      next_variance[j] = coefficient_variance;
-      term->value = std::sqrt(coefficient);
-      term->std = std::sqrt(coefficient_variance) / (2.0 * term->value);
+      // The scatter of the readings over the dominated range.
+      double chi2 = 0.0;
+      for (size_t o : dominated) {
+        const Reading r = ReadAt(j, o, value, variance, p, model, fit->curve);
+        chi2 += (r.value - reading.value) * (r.value - reading.value) / r.statistical;
+      }
+      const double inflation = dominated.size() >= 3
+                                   ? std::max(1.0, chi2 / static_cast<double>(dominated.size() - 1))
+                                   : 1.0;
+      next[j] = reading.value;
+      next_variance[j] = reading.variance * inflation;
+      term->value = std::sqrt(reading.value);
+      term->std = std::sqrt(next_variance[j]) / (2.0 * term->value);
     }
     value = next;
     variance = next_variance;
@@ -317,6 +429,8 @@ bool NoiseFitOptions::IsValid(std::string* error) const {
     *error = "noise fit min_tau_samples must be >= 1";
   } else if (!(dominance > 0.0 && dominance < 1.0)) {
     *error = "noise fit dominance must be in (0, 1)";
+  } else if (!(line_share > 0.0 && line_share < 1.0)) {
+    *error = "noise fit line_share must be in (0, 1)";
   } else {
     return true;
   }
@@ -350,6 +464,93 @@ bool CheckUniformSampling(const std::vector<double>& t, size_t begin, size_t end
     }
   }
   *rate_hz = 1.0 / step;
+  return true;
+}
+
+bool ResolveSampleTiming(const std::vector<double>& t, size_t begin, size_t end,
+                         double nominal_rate_hz, double tolerance, double max_bias,
+                         double longest_tau, SampleTiming* timing, std::string* error) {
+  *timing = SampleTiming();
+  if (end > t.size() || end < begin + 2) {
+    *error = "fewer than two samples";
+    return false;
+  }
+  const size_t n = end - begin;
+  std::vector<double> steps(n - 1);
+  size_t off_median = 0;
+  for (size_t i = begin + 1; i < end; ++i) steps[i - begin - 1] = t[i] - t[i - 1];
+  const double median = Median(steps);
+  timing->median_step = median;
+  if (!(median > 0.0)) {
+    *error = "time does not increase (median step " + std::to_string(median) + " s)";
+    return false;
+  }
+  for (size_t i = begin + 1; i < end; ++i) {
+    const double d = t[i] - t[i - 1];
+    if (std::abs(d - median) > tolerance * median) ++off_median;
+    if (d > timing->largest_step) {
+      timing->largest_step = d;
+      timing->largest_step_at = i;
+    }
+  }
+  // The rate, then t0 by least squares for it: departures d_i = t_i - t0 - i / rate.
+  double rate = 1.0 / median;
+  timing->rate_source = "uniform time stamps (1 / median step)";
+  if (nominal_rate_hz > 0.0) {
+    rate = nominal_rate_hz;
+    timing->rate_source = "nominal rate (noise_rate)";
+  } else if (off_median > 0) {
+    const double mean_index = 0.5 * static_cast<double>(n - 1);
+    double mean_t = 0.0;
+    for (size_t i = begin; i < end; ++i) mean_t += t[i] - t[begin];
+    mean_t /= static_cast<double>(n);
+    double sxx = 0.0, sxy = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      const double di = static_cast<double>(i) - mean_index;
+      sxx += di * di;
+      sxy += di * (t[begin + i] - t[begin] - mean_t);
+    }
+    if (!(sxy > 0.0)) {
+      *error = "time does not increase over the log";
+      return false;
+    }
+    rate = sxx / sxy;
+    timing->rate_source = "least squares of time on sample index (the time stamps jitter)";
+  }
+  double mean_departure = 0.0;
+  for (size_t i = 0; i < n; ++i) mean_departure += t[begin + i] - t[begin] - i / rate;
+  mean_departure /= static_cast<double>(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double d = std::abs(t[begin + i] - t[begin] - i / rate - mean_departure);
+    timing->largest_departure = std::max(timing->largest_departure, d);
+  }
+  timing->rate_hz = rate;
+  timing->unbiased_tau =
+      off_median == 0 && nominal_rate_hz <= 0.0 ? 0.0 : timing->largest_departure / max_bias;
+  std::ostringstream s;
+  s.precision(4);
+  s << "samples taken as uniform at " << rate << " Hz from " << timing->rate_source;
+  if (off_median > 0 || nominal_rate_hz > 0.0) {
+    s << "; " << off_median << " of " << n - 1 << " steps are off the median " << median
+      << " s by more than " << 100.0 * tolerance << " %, the largest " << timing->largest_step
+      << " s at t = " << t[timing->largest_step_at] << " s; the time stamps depart from the grid "
+      << "by up to " << timing->largest_departure << " s: if they were the sample times, the "
+      << "Allan deviation would be biased by at most " << 100.0 * max_bias
+      << " % for tau >= " << timing->unbiased_tau << " s";
+  }
+  timing->message = s.str();
+  if (longest_tau > 0.0 && timing->unbiased_tau > longest_tau) {
+    std::ostringstream e;
+    e.precision(4);
+    e << "the time stamps depart from a uniform grid at " << rate << " Hz (" << timing->rate_source
+      << ") by up to " << timing->largest_departure
+      << " s: treating the samples as uniform could bias the Allan deviation by more than "
+      << 100.0 * max_bias << " % at every tau up to the longest, " << longest_tau
+      << " s (largest step " << timing->largest_step << " s at t = " << t[timing->largest_step_at]
+      << " s; noise_max_time_bias sets the bound)";
+    *error = e.str();
+    return false;
+  }
   return true;
 }
 
@@ -473,6 +674,11 @@ void SetAllanConfidence(const std::vector<AllanNoiseType>& types, double confide
 }
 
 bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, NoiseFit* fit) {
+  return FitNoiseTerms(curve, options, {}, fit);
+}
+
+bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options,
+                   const std::vector<SpectralLine>& lines, NoiseFit* fit) {
   using internal::kTerms;
   std::string error;
   if (!options.IsValid(&error)) {
@@ -482,9 +688,12 @@ bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, 
   fit->curve = curve;
   fit->model = AxisNoiseModel();
   const double min_tau = options.min_tau_samples / curve.rate_hz;
-  const internal::FitPoints points = internal::SelectFitPoints(curve, min_tau);
+  int line_excluded = 0;
+  const internal::FitPoints points =
+      internal::SelectFitPoints(curve, min_tau, lines, options.line_share, &line_excluded);
   if (points.used.empty()) {
-    fit->message = "no Allan deviation point at tau >= " + internal::TauText(min_tau);
+    fit->message = "no Allan deviation point at tau >= " + internal::TauText(min_tau) +
+                   (line_excluded > 0 ? " clear of the spectral lines" : "");
     return false;
   }
   std::vector<double> model;
@@ -494,7 +703,13 @@ bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, 
 
   std::ostringstream s;
   s << "fitted on " << points.used.size() << " taus from " << internal::TauText(points.tau.front())
-    << " to " << internal::TauText(points.tau.back()) << ":";
+    << " to " << internal::TauText(points.tau.back());
+  if (!lines.empty()) {
+    s << " (the Allan variance of the line";
+    for (const SpectralLine& line : lines) s << " at " << LineText(line);
+    s << " subtracted, " << line_excluded << " taus it dominates left out)";
+  }
+  s << ":";
   for (int j = 0; j < kTerms; ++j) {
     const NoiseTerm& term = *internal::TermOf(j, &fit->model);
     s << " " << ToString(internal::TypeOf(j)) << "="

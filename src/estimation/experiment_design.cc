@@ -399,37 +399,14 @@ Eigen::VectorXd PredictedStd(const Eigen::MatrixXd& fisher) {
 }
 
 Eigen::VectorXd DeterminedStd(const Eigen::MatrixXd& fisher, const Eigen::VectorXd& limits) {
-  const Eigen::Index p = fisher.rows();
-  Eigen::VectorXd out = Eigen::VectorXd::Constant(p, kInf);
-  std::vector<Eigen::Index> active;
-  for (Eigen::Index i = 0; i < p; ++i) active.push_back(i);
-  while (!active.empty()) {
-    const Eigen::Index n = static_cast<Eigen::Index>(active.size());
-    // In units of the limits: D F D, D = diag(limits).
-    Eigen::MatrixXd f(n, n);
-    for (Eigen::Index a = 0; a < n; ++a) {
-      for (Eigen::Index b = 0; b < n; ++b) {
-        f(a, b) = fisher(active[a], active[b]) * limits(active[a]) * limits(active[b]);
-      }
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(f);
-    if (eigen.info() != Eigen::Success || !f.allFinite()) return out;
-    const Eigen::VectorXd lambda = eigen.eigenvalues();
-    // Nonsingular and every sigma within its limit: done. Otherwise hold the
-    // parameter that moves most along the weakest direction.
-    if (lambda(0) > 1e-14 * lambda(n - 1)) {
-      const Eigen::VectorXd ratio = (eigen.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
-                                     eigen.eigenvectors().transpose())
-                                        .diagonal()
-                                        .cwiseSqrt();
-      if (ratio.maxCoeff() <= 1.0) {
-        for (Eigen::Index a = 0; a < n; ++a) out(active[a]) = ratio(a) * limits(active[a]);
-        return out;
-      }
-    }
-    Eigen::Index hold = 0;
-    eigen.eigenvectors().col(0).cwiseAbs().maxCoeff(&hold);
-    active.erase(active.begin() + hold);
+  // Unconditional: a parameter that trades against an undetermined or weak
+  // one (a bias against the scale of an axis seen from one side only) has a
+  // large or infinite marginal sigma, and is undetermined too; its sigma
+  // conditional on holding the other would be a confident number for what
+  // the data do not say.
+  Eigen::VectorXd out = PredictedStd(fisher);
+  for (Eigen::Index i = 0; i < out.size(); ++i) {
+    if (!(out(i) <= limits(i))) out(i) = kInf;
   }
   return out;
 }

@@ -16,14 +16,15 @@ namespace {
 // interval.
 bool CharacteriseAxis(const std::vector<double>& samples, const ImuNoiseModel& where,
                       const NoiseOptions& options, const std::string& name, AllanDeviation* curve,
-                      AxisNoiseModel* axis, std::string* error) {
+                      AxisNoiseModel* axis, std::vector<SpectralLine>* lines, std::string* error) {
   AllanDeviation raw;
   if (!ComputeAllanDeviation(samples, 0, samples.size(), where.rate_hz, options.allan, &raw)) {
     *error = name + ": " + raw.message;
     return false;
   }
+  *lines = FindSpectralLines(samples, 0, samples.size(), where.rate_hz);
   NoiseFit fit;
-  if (!FitNoiseTerms(raw, options.fit, &fit)) {
+  if (!FitNoiseTerms(raw, options.fit, *lines, &fit)) {
     *error = name + ": " + fit.message;
     return false;
   }
@@ -111,6 +112,14 @@ bool NoiseOptions::IsValid(std::string* error) const {
     *error = "noise max_tilt_deg must be > 0";
     return false;
   }
+  if (!(rate_hz >= 0.0) || !std::isfinite(rate_hz) || !accel_offset.allFinite()) {
+    *error = "noise rate must be >= 0 Hz and the accelerometer offset finite";
+    return false;
+  }
+  if (!(max_time_bias > 0.0 && max_time_bias < 1.0)) {
+    *error = "noise max_time_bias must be in (0, 1)";
+    return false;
+  }
   return (!find_still || detector.IsValid(error)) && allan.IsValid(error) && fit.IsValid(error);
 }
 
@@ -128,11 +137,18 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
   model.still_end = end;
   model.still_t_begin = log.t[begin];
   model.still_t_end = log.t[end - 1];
-  if (!CheckUniformSampling(log.t, begin, end, options.allan.time_step_tolerance, &model.rate_hz,
-                            &error)) {
+  const double span = log.t[end - 1] - log.t[begin];
+  const double longest_tau =
+      options.allan.max_tau > 0.0 ? options.allan.max_tau : options.allan.max_tau_fraction * span;
+  if (!ResolveSampleTiming(log.t, begin, end, options.rate_hz, options.allan.time_step_tolerance,
+                           options.max_time_bias, longest_tau, &result->timing, &error)) {
     result->message = log.source + ": " + error;
     return false;
   }
+  model.rate_hz = result->timing.rate_hz;
+  result->accel_scale = options.accel_scale;
+  result->gyro_scale = options.gyro_scale;
+  result->accel_offset = options.accel_offset;
   const double seconds = (end - begin) / model.rate_hz;
   if (options.allan.max_tau > 0.0 &&
       seconds * options.allan.max_tau_fraction < options.allan.max_tau) {
@@ -152,7 +168,8 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
   for (int a = 0; a < 3; ++a) {
     for (size_t i = begin; i < end; ++i) samples[i - begin] = options.accel_scale * log.accel[i](a);
     if (!internal::CharacteriseAxis(samples, model, options, std::string("accel ") + axes[a],
-                                    &result->accel_curves[a], &model.accel[a], &error)) {
+                                    &result->accel_curves[a], &model.accel[a],
+                                    &result->accel_lines[a], &error)) {
       result->message = log.source + ": " + error;
       return false;
     }
@@ -166,7 +183,8 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
     }
     for (size_t i = begin; i < end; ++i) samples[i - begin] = options.gyro_scale * log.gyro[i](a);
     if (!internal::CharacteriseAxis(samples, model, options, std::string("gyro ") + axes[a],
-                                    &result->gyro_curves[a], &model.gyro[a], &error)) {
+                                    &result->gyro_curves[a], &model.gyro[a], &result->gyro_lines[a],
+                                    &error)) {
       result->message = log.source + ": " + error;
       return false;
     }
@@ -183,6 +201,19 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
   s.precision(4);
   s << "noise from " << seconds << " s of rest (t = " << std::fixed << std::setprecision(2)
     << model.still_t_begin << " to " << model.still_t_end << " s) at " << model.rate_hz << " Hz";
+  if (!result->timing.rate_source.empty() && result->timing.unbiased_tau > 0.0) {
+    s << " (" << result->timing.message << ")";
+  }
+  for (int sensor = 0; sensor < 2; ++sensor) {
+    for (int a = 0; a < 3; ++a) {
+      const std::vector<SpectralLine>& lines =
+          sensor == 0 ? result->accel_lines[a] : result->gyro_lines[a];
+      if (lines.empty()) continue;
+      s << "; " << (sensor == 0 ? "accel " : "gyro ") << axes[a] << " spectral line"
+        << (lines.size() > 1 ? "s" : "") << " at";
+      for (const SpectralLine& line : lines) s << " " << LineText(line);
+    }
+  }
   result->message = s.str();
   return true;
 }

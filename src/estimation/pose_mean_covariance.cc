@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "gravcal/core/gravity.h"
+#include "gravcal/estimation/coarse_fit.h"
 #include "util/matrix_checks.h"
 
 namespace gravcal {
@@ -54,15 +55,29 @@ bool ModelCovariance(const StaticInterval& s, const Position& white, const ImuNo
   return true;
 }
 
-// m/s^2 per raw unit: standard gravity over the median |raw mean|; 0 when
-// there is no pose with a nonzero mean.
-double ScaleFromPoses(const std::vector<Position>& positions) {
+// m/s^2 per raw unit, and how it was found. The coarse fit's scale (the
+// cube root of |det| of its matrix) when the poses allow one: it separates an
+// offset (unsigned counts around 32768, volts around 1.65) from gravity.
+// Else standard gravity over the median |raw mean|, which assumes no offset;
+// 0 when there is no pose with a nonzero mean.
+double ScaleFromPoses(const std::vector<Position>& positions, std::string* how) {
+  CoarseFitResult coarse;
+  if (CoarseFit(positions, kStandardGravity, AccelParameterization::kScale, CoarseFitOptions(),
+                &coarse)) {
+    const double scale = std::cbrt(std::abs(coarse.model.matrix().determinant()));
+    if (std::isfinite(scale) && scale > 0.0) {
+      *how = "the coarse fit's scale";
+      return scale;
+    }
+  }
   std::vector<double> norms;
   for (const Position& p : positions) {
     if (p.raw_mean.norm() > 0.0) norms.push_back(p.raw_mean.norm());
   }
   if (norms.empty()) return 0.0;
   std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
+  *how = "g over the median |raw pose mean| (no coarse fit: " + coarse.message +
+         "; a raw offset would make it wrong)";
   return kStandardGravity / norms[norms.size() / 2];
 }
 
@@ -130,7 +145,8 @@ bool SetPoseMeanCovariance(const ImuLog& log, const std::vector<StaticInterval>&
     return false;
   }
   if (options.model == nullptr && options.method == PoseNoise::kWhite) return true;
-  const double nominal_scale = internal::ScaleFromPoses(*positions);
+  std::string scale_source;
+  const double nominal_scale = internal::ScaleFromPoses(*positions, &scale_source);
   int fallbacks = 0;
   double worst_ratio = 1.0;
   for (size_t k = 0; k < intervals.size(); ++k) {
@@ -166,8 +182,8 @@ bool SetPoseMeanCovariance(const ImuLog& log, const std::vector<StaticInterval>&
     r.precision(3);
     r << "the noise model's accelerometer white noise per sample differs from the poses' own "
          "by a factor up to "
-      << worst_ratio
-      << ": check that the noise model is of this sensor and that gravcal noise had the right "
+      << worst_ratio << " (raw unit " << nominal_scale << " m/s^2 from " << scale_source
+      << "): check that the noise model is of this sensor and that gravcal noise had the right "
          "nominal_scale and gyro_nominal_scale";
     notes->push_back(r.str());
   }

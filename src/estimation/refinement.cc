@@ -388,14 +388,23 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
       again.held_parameters.insert(again.held_parameters.end(), weak.begin(), weak.end());
       const double first_seconds = result->solve_seconds;
       const int first_iterations = result->iterations;
+      const Eigen::MatrixXd free_covariance = result->covariance;
       if (!Refine(positions, initial, gravity, again, result)) return false;
       result->solve_seconds += first_seconds;
       result->iterations += first_iterations;
+      // The other parameters' covariance from the free fit: the refit's is
+      // conditional on the held values being right, which the data do not
+      // say.
+      if (result->covariance_available && free_covariance.rows() == result->covariance.rows()) {
+        result->covariance = free_covariance;
+      }
       internal::AddWarning(WarningCode::kUndetermined,
                            "the positions do not determine " + listed +
                                " (standard deviation beyond max_bias_std / max_matrix_std); "
                                "they are held at the coarse fit's value and reported without "
-                               "a number: add positions with other axes up or down",
+                               "a number, and the other parameters' standard deviations are "
+                               "those of the free fit (not conditional on the held values): add "
+                               "positions with other axes up or down",
                            &result->warnings, &result->warning_codes);
       return true;
     }

@@ -152,11 +152,19 @@ AllanDeviation CurveFromJson(const json& j, double rate_hz, size_t samples, doub
 }
 
 json SensorJson(const std::array<AxisNoiseModel, 3>& axes,
-                const std::array<AllanDeviation, 3>& curves) {
+                const std::array<AllanDeviation, 3>& curves,
+                const std::array<std::vector<SpectralLine>, 3>& lines) {
   json sensor;
   for (int a = 0; a < 3; ++a) {
     json axis;
     for (const TermKey& k : kTermKeys) axis[k.name] = TermJson(axes[a].*(k.term));
+    json named = json::array();
+    for (const SpectralLine& line : lines[a]) {
+      named.push_back({{"frequency_hz", line.frequency_hz},
+                       {"amplitude", line.amplitude},
+                       {"prominence", line.prominence}});
+    }
+    axis["lines"] = named;
     axis["allan"] = CurveJson(curves[a]);
     sensor[kAxes[a]] = axis;
   }
@@ -165,10 +173,23 @@ json SensorJson(const std::array<AxisNoiseModel, 3>& axes,
 
 void SensorFromJson(const json& sensor, const std::string& name, double rate_hz, size_t samples,
                     double confidence, std::array<AxisNoiseModel, 3>* axes,
-                    std::array<AllanDeviation, 3>* curves) {
+                    std::array<AllanDeviation, 3>* curves,
+                    std::array<std::vector<SpectralLine>, 3>* lines) {
   for (int a = 0; a < 3; ++a) {
     const json& axis = sensor.at(kAxes[a]);
     const std::string where = name + "." + kAxes[a];
+    if (axis.contains("lines")) {
+      for (const json& l : axis.at("lines")) {
+        const std::string at = where + ".lines";
+        SpectralLine line;
+        line.frequency_hz = Required(l, "frequency_hz", at + ".frequency_hz", Range::kPositive);
+        line.amplitude = Required(l, "amplitude", at + ".amplitude", Range::kNonNegative);
+        line.prominence = l.contains("prominence")
+                              ? Required(l, "prominence", at + ".prominence", Range::kNonNegative)
+                              : 0.0;
+        (*lines)[a].push_back(line);
+      }
+    }
     for (const TermKey& k : kTermKeys) {
       if (axis.contains(k.name)) {
         (*axes)[a].*(k.term) = TermFromJson(axis.at(k.name), where + "." + k.name);
@@ -221,9 +242,33 @@ std::string NoiseToJson(const ImuNoise& noise) {
                   {"t_begin", m.still_t_begin},
                   {"t_end", m.still_t_end}};
   out["confidence"] = noise.accel_curves[0].confidence;
-  out["accel"] = internal::SensorJson(m.accel, noise.accel_curves);
+  // Every choice `gravcal noise` made: how the samples were placed in time,
+  // the raw units and how the accelerometer's unit was checked.
+  const SampleTiming& t = noise.timing;
+  out["choices"] = {
+      {"timing",
+       {{"rate_source", t.rate_source},
+        {"median_step", t.median_step},
+        {"largest_step", t.largest_step},
+        {"largest_departure", t.largest_departure},
+        {"unbiased_tau", t.unbiased_tau},
+        {"text", t.message}}},
+      {"units",
+       {{"accel_scale", noise.accel_scale},
+        {"gyro_scale", noise.gyro_scale},
+        {"accel_offset",
+         json::array({noise.accel_offset.x(), noise.accel_offset.y(), noise.accel_offset.z()})},
+        {"mean_removed", true},
+        {"unit_check", noise.unit_check}}},
+      {"fit",
+       {{"readings",
+         "white noise and random walk where they dominate the curve with the smallest predicted "
+         "uncertainty, bias instability at the curve's measured floor, random walk on a rise "
+         "near +1/2; the spectral lines' Allan variance subtracted and the taus a line "
+         "dominates left out; sigmas inflated by the readings' scatter over each term's range"}}}};
+  out["accel"] = internal::SensorJson(m.accel, noise.accel_curves, noise.accel_lines);
   if (!noise.gyro_curves[0].points.empty()) {
-    out["gyro"] = internal::SensorJson(m.gyro, noise.gyro_curves);
+    out["gyro"] = internal::SensorJson(m.gyro, noise.gyro_curves, noise.gyro_lines);
   }
   if (!noise.temperature_curve.points.empty()) {
     out["temperature"] = {{"allan", internal::CurveJson(noise.temperature_curve)}};
@@ -257,14 +302,38 @@ bool NoiseFromJson(const std::string& text, const std::string& name, ImuNoise* n
                                   : 0.683;
     const size_t samples = m.still_end - m.still_begin;
     internal::SensorFromJson(in.at("accel"), "accel", m.rate_hz, samples, confidence, &m.accel,
-                             &parsed.accel_curves);
+                             &parsed.accel_curves, &parsed.accel_lines);
     if (in.contains("gyro")) {
       internal::SensorFromJson(in.at("gyro"), "gyro", m.rate_hz, samples, confidence, &m.gyro,
-                               &parsed.gyro_curves);
+                               &parsed.gyro_curves, &parsed.gyro_lines);
     } else {
       NoiseTerm missing;
       missing.reason = "the log has no gyroscope";
       for (AxisNoiseModel& axis : m.gyro) axis = {missing, missing, missing, missing};
+    }
+    if (in.contains("choices")) {
+      const json& choices = in.at("choices");
+      if (choices.contains("timing")) {
+        const json& t = choices.at("timing");
+        SampleTiming& timing = parsed.timing;
+        timing.rate_hz = m.rate_hz;
+        timing.rate_source = t.value("rate_source", std::string());
+        timing.median_step = t.value("median_step", 0.0);
+        timing.largest_step = t.value("largest_step", 0.0);
+        timing.largest_departure = t.value("largest_departure", 0.0);
+        timing.unbiased_tau = t.value("unbiased_tau", 0.0);
+        timing.message = t.value("text", std::string());
+      }
+      if (choices.contains("units")) {
+        const json& u = choices.at("units");
+        parsed.accel_scale = u.value("accel_scale", 1.0);
+        parsed.gyro_scale = u.value("gyro_scale", 1.0);
+        if (u.contains("accel_offset")) {
+          for (int a = 0; a < 3; ++a)
+            parsed.accel_offset(a) = u.at("accel_offset").at(a).get<double>();
+        }
+        parsed.unit_check = u.value("unit_check", std::string());
+      }
     }
     if (in.contains("temperature")) {
       parsed.temperature_curve = internal::CurveFromJson(

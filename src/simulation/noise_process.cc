@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "gravcal/core/noise_model.h"
@@ -31,6 +32,11 @@ bool NoiseProcessOptions::IsValid(std::string* error) const {
   } else if (bias_instability > 0.0 &&
              !(bias_tau_low >= 10.0 / rate_hz && bias_tau_high > bias_tau_low)) {
     *error = "noise process bias tau range must satisfy 10 / rate_hz <= tau_low < tau_high";
+  } else if (std::any_of(tones.begin(), tones.end(), [&](const Tone& t) {
+               return !(t.frequency_hz > 0.0 && t.frequency_hz < 0.5 * rate_hz) ||
+                      !(t.amplitude >= 0.0) || !std::isfinite(t.amplitude);
+             })) {
+    *error = "noise process tones need 0 < frequency < rate_hz / 2 and amplitude >= 0";
   } else {
     return true;
   }
@@ -63,6 +69,11 @@ NoiseProcess::NoiseProcess(const NoiseProcessOptions& options, uint64_t seed)
       state_.push_back(component_std_ * unit_(rng_));
     }
   }
+  // The tones' phases from their own generator: the noise streams stay
+  // those of the same seed without tones.
+  std::mt19937_64 phases(seed ^ 0x5851f42d4c957f2dULL);
+  std::uniform_real_distribution<double> turn(0.0, 2.0 * M_PI);
+  for (size_t i = 0; i < options.tones.size(); ++i) tone_phase_.push_back(turn(phases));
 }
 
 double NoiseProcess::Next() {
@@ -73,6 +84,11 @@ double NoiseProcess::Next() {
     state_[i] = phi_[i] * state_[i] + drive_[i] * unit_(rng_);
   }
   if (walk_step_ > 0.0) walk_ += walk_step_ * unit_(rng_);
+  const double t = static_cast<double>(sample_++) / options_.rate_hz;
+  for (size_t i = 0; i < tone_phase_.size(); ++i) {
+    const NoiseProcessOptions::Tone& tone = options_.tones[i];
+    v += tone.amplitude * std::sin(2.0 * M_PI * tone.frequency_hz * t + tone_phase_[i]);
+  }
   return v;
 }
 
@@ -87,6 +103,11 @@ double NoiseProcess::ModelAllanVariance(double tau) const {
              options_.random_walk * options_.random_walk * tau / 3.0;
   for (double T : times_) {
     v += internal::GaussMarkovAllanVariance(component_std_ * component_std_, T, tau);
+  }
+  for (const NoiseProcessOptions::Tone& tone : options_.tones) {
+    const double x = M_PI * tone.frequency_hz * tau;
+    const double s = std::sin(x);
+    v += tone.amplitude * tone.amplitude * s * s * s * s / (x * x);
   }
   return v;
 }

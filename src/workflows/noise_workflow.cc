@@ -32,16 +32,43 @@ bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoi
   const ImuNoiseModel& m = noise->model;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (size_t i = m.still_begin; i < m.still_end; ++i) mean += log.accel[i];
-  const double g =
-      options.accel_scale * mean.norm() / static_cast<double>(m.still_end - m.still_begin);
-  if (std::abs(g / kStandardGravity - 1.0) <= 0.1) return true;
-  char text[256];
+  mean /= static_cast<double>(m.still_end - m.still_begin);
+  const bool offset_stated = options.accel_offset.squaredNorm() > 0.0;
+  const double g = options.accel_scale * (mean - options.accel_offset).norm();
+  char text[400];
+  if (std::abs(g / kStandardGravity - 1.0) <= 0.1) {
+    std::snprintf(text, sizeof(text),
+                  "checked: |mean accelerometer%s| over the still interval is %.4g m/s^2 with "
+                  "nominal_scale %.6g, within 10 %% of standard gravity",
+                  offset_stated ? " - nominal_offset" : "", g, options.accel_scale);
+    noise->unit_check = text;
+    return true;
+  }
+  // An unknown offset can move |mean| anywhere below the largest offset a
+  // sensor has (about 30 g: unsigned counts of a +-16 g part), but not to
+  // 1 m/s^2 exactly (data in g) nor far beyond.
+  const bool in_g = std::abs(g - 1.0) <= 0.1;
+  if (offset_stated || in_g || g > 100.0 * kStandardGravity) {
+    std::snprintf(
+        text, sizeof(text),
+        "%s: |mean accelerometer%s| over the still interval is %.4g m/s^2 with "
+        "nominal_scale %.6g, not about 9.8%s",
+        log.source.c_str(), offset_stated ? " - nominal_offset" : "", g, options.accel_scale,
+        in_g            ? ": the data look like g, set nominal_scale 9.80665"
+        : offset_stated ? ": set nominal_scale to m/s^2 per raw unit and nominal_offset to the raw "
+                          "value at zero specific force"
+                        : ": set nominal_scale to m/s^2 per raw unit");
+    *error = text;
+    return false;
+  }
   std::snprintf(text, sizeof(text),
-                "%s: |mean accelerometer| over the still interval is %.4g m/s^2 with "
-                "nominal_scale %.6g, not about 9.8: set nominal_scale to m/s^2 per raw unit",
-                log.source.c_str(), g, options.accel_scale);
-  *error = text;
-  return false;
+                "not checked: |mean accelerometer| over the still interval is %.4g m/s^2 with "
+                "nominal_scale %.6g, not about 9.8, taken as a raw offset (the Allan deviation "
+                "removes the mean; nominal_offset would let the unit be checked against gravity)",
+                g, options.accel_scale);
+  noise->unit_check = text;
+  noise->message += std::string("; unit ") + text;
+  return true;
 }
 
 bool WriteNoiseFiles(const ImuNoise& noise, const std::string& source, const NoiseFiles& files,

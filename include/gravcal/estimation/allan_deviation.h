@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "gravcal/core/noise_model.h"
+#include "gravcal/estimation/spectral_lines.h"
 
 namespace gravcal {
 
@@ -96,6 +97,43 @@ struct AllanDeviation {
 bool CheckUniformSampling(const std::vector<double>& t, size_t begin, size_t end, double tolerance,
                           double* rate_hz, std::string* error);
 
+// How the samples of a still log are placed in time for the Allan
+// deviation (ResolveSampleTiming).
+struct SampleTiming {
+  // The rate the samples are taken at, Hz, and where it came from:
+  // "uniform time stamps" (every step within tolerance of the median step:
+  // 1 / median step), "nominal rate" (given), or "least squares of time on
+  // sample index" (the time stamps jitter or have gaps: a host PC's reading
+  // times; the sensor's own clock is taken as uniform).
+  double rate_hz = 0.0;
+  std::string rate_source;
+  double median_step = 0.0;    // s
+  double largest_step = 0.0;   // s
+  size_t largest_step_at = 0;  // sample index
+  // The largest departure of a time stamp from the uniform grid
+  // t0 + i / rate_hz (t0 by least squares), s. If the time stamps were the
+  // true sample times, treating the samples as uniform would misplace an
+  // Allan average of length tau by up to twice this, a relative bias of the
+  // Allan deviation of at most departure / tau; none if the sensor samples
+  // uniformly and only the host's reading times jitter.
+  double largest_departure = 0.0;
+  // The shortest tau whose worst-case bias is within max_bias: departure /
+  // max_bias (0 for uniform time stamps).
+  double unbiased_tau = 0.0;
+  // One line saying what was done.
+  std::string message;
+};
+
+// The timing of samples [begin, end) of t. nominal_rate_hz > 0 is used as
+// the rate; else uniform time stamps give 1 / median step, and jittering
+// ones (a step off the median by more than `tolerance` of it) the least-
+// squares rate. Returns false with *error when time does not increase
+// (median step <= 0) or when the departures would bias the Allan deviation
+// by more than max_bias even at the longest tau, longest_tau (s).
+bool ResolveSampleTiming(const std::vector<double>& t, size_t begin, size_t end,
+                         double nominal_rate_hz, double tolerance, double max_bias,
+                         double longest_tau, SampleTiming* timing, std::string* error);
+
 // The Allan deviation of x sampled at times t (same size, uniform). Returns
 // false with result->message on invalid options, non-uniform time, or a
 // series too short for the tau asked.
@@ -119,6 +157,11 @@ struct NoiseFitOptions {
   // A term is read, and called visible, where it carries at least this
   // share of the fitted Allan variance.
   double dominance = 0.5;
+  // Spectral lines' Allan variance is subtracted from each point (with a
+  // fifth of its bound as uncertainty); a point is left out of the fit
+  // when the lines' bound (spectral_lines.h) there exceeds this share of
+  // the point's.
+  double line_share = 0.3;
 
   bool IsValid(std::string* error) const;
 };
@@ -137,18 +180,32 @@ struct NoiseFit {
 //    subset of terms tried), weights edf / (2 sigma^4) from the model itself,
 //    iterated; each point's edf from the term dominating it there;
 // 2. each term that dominates (share >= dominance) somewhere is read at one
-//    point, with the other terms' fitted contributions subtracted:
-//      white noise at the dominated tau with the smallest predicted
-//      uncertainty (the classic reading at tau = 1 s when that is it),
-//      random walk likewise (the tau^+1/2 line, classically read at 3 s),
-//      bias instability at the flat part's minimum (B = sigma_min / 0.664
-//      when nothing else contributes there),
+//    point, with the other terms' fitted contributions subtracted, where
+//    the curve shows it:
+//      white noise on the -1/2 slope it dominates, at the tau with the
+//      smallest predicted uncertainty (the classic reading at tau = 1 s
+//      when that is it), clear of spectral lines (the overload below);
+//      random walk likewise on the +1/2 rise, and only where the rise's
+//      slope is near +1/2 (within 0.3; a slope of +1 is a drift);
+//      bias instability at the curve's measured floor, its smallest
+//      deviation among points with 5 or more degrees of freedom (B =
+//      sigma_min / 0.664 when nothing else contributes there), if it
+//      dominates there; not at the model's largest share, which a rising
+//      end can put at the longest tau;
 //      quantisation at its smallest dominated tau;
 //    its variance is that of the Allan variance at that point,
-//    2 sigma^4 / edf, plus the other terms' subtracted variances.
+//    2 sigma^4 / edf, plus the other terms' subtracted variances, times the
+//    readings' chi-square per degree of freedom over the term's dominated
+//    range when above 1 (the curve departs from the term's slope).
 // A term that never dominates is NaN with the reason. Returns false only on
 // invalid options or an empty curve.
 bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, NoiseFit* fit);
+
+// The same, with the lines' Allan variance subtracted and the points a line
+// dominates (line_share) left out: the terms are then read on the slopes
+// clear of the lines.
+bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options,
+                   const std::vector<SpectralLine>& lines, NoiseFit* fit);
 
 }  // namespace gravcal
 

@@ -105,13 +105,12 @@ Eigen::MatrixXd DesignJacobian(const std::vector<DesignPose>& poses, const Desig
 // for a parameter F does not determine (a null direction of F involves it).
 Eigen::VectorXd PredictedStd(const Eigen::MatrixXd& fisher);
 
-// The standard deviations a fit reports when it holds what the data do not
-// determine (as the refinement holds weak parameters at their start): while
-// the information of the free parameters is singular, or some sigma exceeds
-// its limit (scale-free, e.g. the refinement's max_bias_std and
-// max_matrix_std), the parameter that moves most relative to its limit
-// along the weakest direction is held (infinity) and the rest recomputed,
-// conditional on the held ones.
+// The standard deviations a fit can report without holding anything: each
+// parameter's marginal sigma (PredictedStd, every other parameter free),
+// infinity when that exceeds its limit (scale-free, e.g. the refinement's
+// max_bias_std and max_matrix_std) or F does not determine it. A parameter
+// whose sigma is small only while another, undetermined one is held (a bias
+// against the scale of an axis seen from one side) is undetermined too.
 Eigen::VectorXd DeterminedStd(const Eigen::MatrixXd& fisher, const Eigen::VectorXd& limits);
 
 // Converts scale-free standard deviations to the calibration JSON's units

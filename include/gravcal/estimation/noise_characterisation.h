@@ -11,13 +11,16 @@
 #ifndef GRAVCAL_ESTIMATION_NOISE_CHARACTERISATION_H_
 #define GRAVCAL_ESTIMATION_NOISE_CHARACTERISATION_H_
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
+#include <vector>
 
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/noise_model.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/allan_deviation.h"
+#include "gravcal/estimation/spectral_lines.h"
 
 namespace gravcal {
 
@@ -26,6 +29,19 @@ struct NoiseOptions {
   // gyroscope unit (1 = the log is already in SI).
   double accel_scale = 1.0;
   double gyro_scale = 1.0;
+  // The raw accelerometer value at zero specific force (unsigned counts
+  // around 32768, volts around 1.65), per axis, raw units. Only the check of
+  // the unit against gravity uses it: the Allan deviation removes the mean.
+  Eigen::Vector3d accel_offset = Eigen::Vector3d::Zero();
+  // The sample rate, Hz; 0 = from the time stamps (SampleTiming).
+  double rate_hz = 0.0;
+  // Time stamps that jitter are accepted while the bias they could cause in
+  // the Allan deviation stays within this (relative) at the longest tau
+  // (ResolveSampleTiming).
+  // (A step off the median step by more than allan.time_step_tolerance of
+  // it marks the time stamps as jittering: the rate then comes from least
+  // squares.)
+  double max_time_bias = 0.05;
   // Use the longest still interval the detector finds (true), or the whole
   // log, known to be still (false).
   bool find_still = true;
@@ -50,6 +66,17 @@ struct ImuNoise {
   std::array<AllanDeviation, 3> gyro_curves;
   // Temperature in degrees Celsius: curve only, white-noise EDF.
   AllanDeviation temperature_curve;
+  // The lines in each axis's spectrum (spectral_lines.h), SI units; the
+  // fit leaves out the taus they disturb.
+  std::array<std::vector<SpectralLine>, 3> accel_lines;
+  std::array<std::vector<SpectralLine>, 3> gyro_lines;
+  // The choices made, written in noise.json: the timing, the raw units
+  // (scales, offset) and how the accelerometer's unit was checked.
+  SampleTiming timing;
+  double accel_scale = 1.0;
+  double gyro_scale = 1.0;
+  Eigen::Vector3d accel_offset = Eigen::Vector3d::Zero();
+  std::string unit_check;
   std::string message = "CharacteriseNoise was not called";
 };
 

@@ -5,11 +5,18 @@
 //    "still": {"begin": 0, "end": 360000, "t_begin": 0.0, "t_end": 3599.99},
 //    "accel": {"x": {"white_noise":      {"value": v, "std": s, "tau": t, "tau_range": [lo, hi]},
 //                    "bias_instability": {...}, "random_walk": {...}, "quantisation": {...},
+//                    "lines": [{"frequency_hz": f, "amplitude": a, "prominence": p}, ...],
 //                    "allan": {"tau": [...], "adev": [...], "lo": [...], "hi": [...]}},
 //              "y": ..., "z": ...},
 //    "gyro": {same; absent when the log has none},
 //    "temperature": {"allan": {...}} (when the log has one),
-//    "confidence": 0.683}
+//    "confidence": 0.683,
+//    "choices": {"timing": {"rate_source": "...", "median_step": s, "largest_step": s,
+//                           "largest_departure": s, "unbiased_tau": s, "text": "..."},
+//                "units": {"accel_scale": k, "gyro_scale": k, "accel_offset": [x, y, z],
+//                          "mean_removed": true, "unit_check": "..."},
+//                "fit": {"readings": "..."}}}
+// ("lines" and "choices" are optional on reading: older files lack them.)
 // in SI (accelerometer m/s^2, gyroscope rad/s; units of each term in
 // core/noise_model.h). A term the log cannot show has "value": null and a
 // "reason".

@@ -18,7 +18,10 @@
 //   flicker floor (2 ln 2 / pi) B^2 at the geometric middle of the range.
 //   Within [tau_low, tau_high] the sum stays within about 10 % of the floor
 //   (5 % in deviation; ModelAllanVariance gives it exactly), below tau_low it
-//   falls like a random walk, above tau_high like white noise.
+//   falls like a random walk, above tau_high like white noise;
+// - tones (lines in the spectrum: a fan's 17 Hz, a heater's slow cycle):
+//   A sin(2 pi f t + phase), the phase drawn from the seed, Allan variance
+//   A^2 sin^4(pi f tau) / (pi f tau)^2.
 #ifndef GRAVCAL_SIMULATION_NOISE_PROCESS_H_
 #define GRAVCAL_SIMULATION_NOISE_PROCESS_H_
 
@@ -40,6 +43,12 @@ struct NoiseProcessOptions {
   double bias_tau_high = 100.0;
   // Rate random walk density K (units/s/sqrt(Hz)); 0 = none.
   double random_walk = 0.0;
+  // Sinusoidal lines: frequency (0 < f < rate_hz / 2) and amplitude.
+  struct Tone {
+    double frequency_hz = 0.0;
+    double amplitude = 0.0;
+  };
+  std::vector<Tone> tones;
 
   bool IsValid(std::string* error) const;
 };
@@ -73,6 +82,8 @@ class NoiseProcess {
   std::vector<double> phi_;
   std::vector<double> drive_;
   std::vector<double> state_;
+  std::vector<double> tone_phase_;
+  size_t sample_ = 0;
 };
 
 }  // namespace gravcal

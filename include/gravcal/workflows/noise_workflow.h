@@ -24,10 +24,14 @@ namespace gravcal {
 bool NoiseOptionsFromConfig(const Config& config, NoiseOptions* options, std::string* error);
 
 // CharacteriseNoise, then a check of the accelerometer's unit: over the
-// still interval |mean accelerometer| * accel_scale must be within 10 % of
-// standard gravity, else nominal_scale is not m/s^2 per raw unit and every
-// accelerometer number would be in the wrong unit. False with a one-line
-// *error (naming log.source) on either failure.
+// still interval |mean accelerometer - accel_offset| * accel_scale within
+// 10 % of standard gravity is "checked" (noise->unit_check says so).
+// Otherwise, with no offset stated (accel_offset zero), the mean is taken as
+// a raw offset (unsigned counts, volts around 1.65; the Allan deviation
+// removes it) and the unit reported as not checked; refused when an offset
+// was stated, when the mean is 1 m/s^2 (data in g) or beyond 100 g (counts
+// at scale 1). False with a one-line *error (naming log.source) on any
+// failure.
 bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise* noise,
                           std::string* error);
 

@@ -8,6 +8,17 @@
 namespace gravcal {
 namespace internal {
 
+namespace {
+
+bool ReadNominalOffset(const YAML::Node& n, Config* c, std::string* e) {
+  double v = 0.0;
+  if (!ReadDouble(n, &v, e)) return false;
+  c->noise.accel_offset.setConstant(v);
+  return true;
+}
+
+}  // namespace
+
 ConfigSection PoseNoiseSection() {
   return {"pose_noise",
           ConfigSectionUse::kSomeMethods,
@@ -40,6 +51,18 @@ ConfigSection NoiseSection() {
                              "before the log counts as non-uniform"),
               GRAVCAL_DOUBLE("noise_confidence", noise.allan.confidence,
                              "noise: two-sided probability of the Allan confidence intervals"),
+              GRAVCAL_DOUBLE("noise_rate", noise.rate_hz,
+                             "noise: the sample rate, Hz (0 = from the time stamps: 1 / median "
+                             "step, or least squares of time on sample index when they jitter)"),
+              GRAVCAL_DOUBLE("noise_max_time_bias", noise.max_time_bias,
+                             "noise: jittering time stamps are refused when taking the samples as "
+                             "uniform could bias the Allan deviation by more than this (relative) "
+                             "at the longest tau"),
+              GRAVCAL_KEY("nominal_offset",
+                          "noise: raw accelerometer value at zero specific force on every axis "
+                          "(32768 for unsigned 16-bit counts, 1.65 for a 3.3 V analog part), to "
+                          "check the unit against gravity; 0 = none stated",
+                          ReadNominalOffset(n, c, e), DoubleText(c.noise.accel_offset.x())),
               GRAVCAL_DOUBLE("noise_max_tilt", noise.max_tilt_deg,
                              "noise: with noise_find_still false, the log counts as moving when "
                              "gravity turns by more than this between its tenths, degrees"),
