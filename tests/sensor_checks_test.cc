@@ -114,7 +114,7 @@ TEST(SensorChecks, HandheldDivergenceIsRefused) {
   ImuLog degrees = s.sensor.log;
   for (Eigen::Vector3d& w : degrees.gyro) w *= 180.0 / M_PI;
   EXPECT_FALSE(CalibrateHandheld(degrees, options, &c));
-  EXPECT_TRUE(c.not_converged);
+  EXPECT_TRUE(c.not_converged) << c.message;
   EXPECT_NE(c.message.find("diverged"), std::string::npos) << c.message;
   EXPECT_NE(c.message.find("gyro_nominal_scale"), std::string::npos) << c.message;
 }

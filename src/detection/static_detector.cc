@@ -414,18 +414,33 @@ std::vector<QuietRun> FindQuietRuns(const SensorWindows& accel, const SensorWind
     return LevelSteady(accel, j, w, trend_factor) &&
            (gyro.var == nullptr || LevelSteady(gyro, j, w, trend_factor));
   };
+  // Without a gyroscope, a window of low variance whose accelerometer level
+  // changes cuts the runs at its centre: only the windows centred on a step
+  // (poses published with the motion cut out) show it, so unlike a variance
+  // jump it leaves no gap of w windows between the runs.
+  const bool cuts = accel.trend != nullptr && gyro.var == nullptr;
+  size_t cut = 0;
   for (size_t k = 0; k < num_windows;) {
     if (!(low_variance(k) && steady(k))) {
+      if (cuts && low_variance(k)) cut = k + w / 2;
       ++k;
       continue;
     }
     const size_t first = k;
     while (k < num_windows && low_variance(k) && steady(k)) ++k;
-    // Quiet windows less than w apart share samples: one run.
+    const size_t end = k - 1 + w;
+    // Quiet windows less than w apart share samples: one run, unless a
+    // level change cut it; then the two meet at the cut.
     if (!runs.empty() && first <= runs.back().end) {
-      runs.back().end = k - 1 + w;
+      if (cut <= runs.back().begin) {
+        runs.back().end = end;
+        continue;
+      }
+      const size_t begin = std::max(first, cut);
+      runs.back().end = std::min(runs.back().end, begin);
+      runs.push_back({begin, end});
     } else {
-      runs.push_back({first, k - 1 + w});
+      runs.push_back({first, end});
     }
   }
   // Runs cut to nothing are dropped.
@@ -604,27 +619,28 @@ void NearlyStillStretches(const ImuLog& log, const SensorWindows& accel, const S
 
 // Splits samples [begin, end) at steps in the accelerometer mean until every
 // part's variance (summed over the axes) is within `max_var`: at the split
-// point s maximising n1 n2 / n |m1 - m2|^2 (the between-part sum of squares),
-// each part at least min_count samples. Appends the parts' [begin, end) to
-// *parts and returns true, or returns false (and *parts is unspecified)
-// when some part is above max_var and cannot be split further: a drift, not
-// steps.
+// point s maximising n1 n2 / n |m1 - m2|^2 (the between-part sum of squares).
+// Parts shorter than min_count are dropped (the few samples a run reaches
+// across a step). Appends the parts' [begin, end) to *parts and returns
+// true, or returns false (and *parts is unspecified) when a part above
+// max_var cannot be split into parts within it: a drift, not steps.
 bool SplitAtSteps(const ImuLog& log, size_t begin, size_t end, double max_var, size_t min_count,
                   std::vector<QuietRun>* parts) {
+  if (end - begin < min_count) return true;
   const StaticInterval whole = MakeInterval(log, begin, end);
   if (whole.accel_cov.trace() <= max_var) {
     parts->push_back({begin, end});
     return true;
   }
-  if (end - begin < 2 * min_count) return false;
+  if (end - begin < 2) return false;
   // Prefix sums of deviations from the first sample.
   const Eigen::Vector3d r = log.accel[begin];
   std::vector<Eigen::Vector3d> prefix(end - begin + 1, Eigen::Vector3d::Zero());
   for (size_t i = begin; i < end; ++i) prefix[i - begin + 1] = prefix[i - begin] + log.accel[i] - r;
   const double n = static_cast<double>(end - begin);
   double best = -1.0;
-  size_t split = begin;
-  for (size_t s = begin + min_count; s + min_count <= end; ++s) {
+  size_t split = begin + 1;
+  for (size_t s = begin + 1; s < end; ++s) {
     const double n1 = static_cast<double>(s - begin);
     const double n2 = n - n1;
     const Eigen::Vector3d m1 = prefix[s - begin] / n1;
@@ -635,6 +651,8 @@ bool SplitAtSteps(const ImuLog& log, size_t begin, size_t end, double max_var, s
       split = s;
     }
   }
+  // A split that leaves no part long enough cannot bring this part within.
+  if (split - begin < min_count && end - split < min_count) return false;
   return SplitAtSteps(log, begin, split, max_var, min_count, parts) &&
          SplitAtSteps(log, split, end, max_var, min_count, parts);
 }

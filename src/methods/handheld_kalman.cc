@@ -389,7 +389,14 @@ bool CalibrateHandheld(const ImuLog& log, const HandheldKalmanOptions& options,
 
   const std::vector<std::string> unexcited =
       internal::ReportConvergence(*filter, layout, options, &c);
-  if (!internal::FillSensorModels(*filter, layout, in, &c)) return false;
+  if (!internal::FillSensorModels(*filter, layout, in, &c)) {
+    // A singular estimated matrix: the filter ran away.
+    c.message +=
+        ": the filter diverged: check gyro_nominal_scale (a gyroscope in deg/s read as "
+        "rad/s?), nominal_scale and the noise settings";
+    c.not_converged = true;
+    return false;
+  }
 
   internal::FillSummary(*filter, layout, in, nis_sum, epochs, unexcited, clock_start, &c);
   // A filter that ran away (a gyroscope in deg/s read as rad/s, a wrong
