@@ -330,6 +330,8 @@ struct SensorWindows {
 
 // See TrimLevelEnds' use.
 constexpr double kGyroLevelFraction = 0.01;
+// TrimLevelEnds trims at most this many windows from each end of a run.
+constexpr size_t kMaxTrimWindows = 5;
 
 // The 99th percentile of |x - median| (median per axis), on a strided
 // subsample: the scale of the gyroscope's turns.
@@ -383,9 +385,12 @@ void TrimLevelEnds(const std::vector<Eigen::Vector3d>& x, const SensorWindows& s
       const double change2 = (means[j] - level).squaredNorm();
       return change2 <= min_change2 || change2 * static_cast<double>(w) <= trend_factor * var;
     };
+    // At most kMaxTrimWindows windows from each end: a turn's slow end, not
+    // the wander of a long still log's bias.
+    const size_t max_trim = kMaxTrimWindows * w;
     size_t first = 0, last = means.size();
-    while (first < means.size() && !steady(first)) ++first;
-    while (last > first && !steady(last - 1)) --last;
+    while (first < means.size() && first < max_trim && !steady(first)) ++first;
+    while (last > first && means.size() - last < max_trim && !steady(last - 1)) --last;
     if (last > first) kept.push_back({run.begin + first, run.begin + last - 1 + w});
   }
   *runs = std::move(kept);
