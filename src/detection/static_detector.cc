@@ -478,7 +478,6 @@ std::vector<StaticInterval> TrimAndMerge(const ImuLog& log, const std::vector<Qu
                                          const StaticDetection& detection, bool use_gyro,
                                          std::vector<RejectedStretch>* rejected) {
   const double max_gap = options.merge_gap_windows * static_cast<double>(w);
-  const double wd = static_cast<double>(w);
   std::vector<StaticInterval> pieces;
   std::vector<QuietRun> piece_runs;
   for (const QuietRun& run : runs) {
@@ -507,13 +506,15 @@ std::vector<StaticInterval> TrimAndMerge(const ImuLog& log, const std::vector<Qu
       // turn: the means must agree within trend_factor times the noise of a
       // window's mean (no finer: hand-held noise is not white).
       if (options.trend_factor > 0.0) {
+        // The windows on either side of the gap, not the whole intervals:
+        // a long still log's bias wanders between distant samples.
+        const size_t na = std::min(current.count(), w);
+        const size_t nb = std::min(next.count(), w);
+        const Eigen::Vector3d ma = MakeInterval(log, current.end - na, current.end).accel_mean;
+        const Eigen::Vector3d mb = MakeInterval(log, next.begin, next.begin + nb).accel_mean;
         const double noise = detection.accel_noise_floor *
-                             (1.0 / std::min<double>(static_cast<double>(current.count()), wd) +
-                              1.0 / std::min<double>(static_cast<double>(next.count()), wd));
-        if (!((current.accel_mean - next.accel_mean).squaredNorm() <=
-              options.trend_factor * noise)) {
-          break;
-        }
+                             (1.0 / static_cast<double>(na) + 1.0 / static_cast<double>(nb));
+        if (!((ma - mb).squaredNorm() <= options.trend_factor * noise)) break;
       }
       StaticInterval merged = MakeInterval(log, current.begin, next.end);
       if (!(merged.accel_cov.trace() <= detection.accel_threshold) ||
