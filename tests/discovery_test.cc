@@ -349,33 +349,19 @@ TEST(Discovery, GyroscopeExcessDoesNotMaskAccelerometerEffect) {
         with_gyro.verdict.find("no catalogue effect explains it") != std::string::npos) {
       ++gyro_unexplained;
     }
-    // The accelerometer's first round, scored with and without the
-    // gyroscope: the same p-values, BIC and cross-validation (as long as
-    // the accelerometer's fit uses no gyroscope information, which its
-    // `information` would say).
-    const std::vector<CandidateScore>& a =
-        with_gyro.steps.empty() ? with_gyro.final_candidates : with_gyro.steps.front().candidates;
-    const std::vector<CandidateScore>& b = without_gyro.steps.empty()
-                                               ? without_gyro.final_candidates
-                                               : without_gyro.steps.front().candidates;
-    bool same = !a.empty() && a.size() == b.size();
-    for (size_t i = 0; same && i < a.size(); ++i) {
-      if (Info(a[i].effect).sensor != EffectSensor::kAccelerometer || !a[i].tried) continue;
-      same = b[i].tried && !a[i].information.empty();
-      if (!same || a[i].information != b[i].information) continue;
-      same = a[i].significant == b[i].significant && a[i].reason == b[i].reason &&
-             a[i].p_value == b[i].p_value && a[i].delta_bic == b[i].delta_bic &&
-             a[i].cv_gap.accel_sigma == b[i].cv_gap.accel_sigma;
-    }
+    // The accelerometer's verdict is the same with and without the
+    // gyroscope. (Its scores are no longer identical: the static detector
+    // judges the level on the gyroscope when there is one, issue 33, so the
+    // intervals differ by a few samples at the turns' ends.)
+    const bool same = with_gyro.verdict.rfind(without_gyro.verdict, 0) == 0;
     same_scores += same ? 1 : 0;
     std::printf("seed %d: %s | without gyroscope: %s\n", seed, with_gyro.verdict.c_str(),
                 without_gyro.verdict.c_str());
   }
   // Measured on seeds 1001-1060 (the same session through `gravcal
   // simulate` and `discover`): named first in 60 of 60 (lower 99.9 % bound
-  // 0.89), the gyroscope reported unexplained in every seed. The scores are
-  // identical by construction: any difference is a coupling between the
-  // sensors.
+  // 0.89), the gyroscope reported unexplained in every seed, and the
+  // accelerometer's verdict the same without the gyroscope.
   EXPECT_GE(named, testing_util::RequiredSuccesses(seeds, 0.89)) << named << " of " << seeds;
   EXPECT_EQ(gyro_unexplained, seeds);
   EXPECT_EQ(same_scores, seeds);

@@ -176,10 +176,10 @@ TEST(MethodComparison, ReproducesTheReadmeTable) {
   // floating-point rounding, orders of magnitude below 1 %, while another random stream would
   // move an rms over 20 seeds by about 1 / sqrt(40), 16 %.
   const std::map<std::string, Eigen::Vector4d> readme = {
-      {order[0], {14.7, 813, 8.31, 18.7}},    {order[1], {0.411, 46.3, 0.2, 18.7}},
-      {order[2], {0.41, 46.1, 0.2, 18.7}},    {order[3], {0.41, 46.1, 0.2, 32.7}},
-      {order[4], {0.405, 45.3, 0.181, 0.41}}, {order[5], {0.383, 43.7, 0.246, 0.386}},
-      {order[6], {0.396, 44.2, 0.187, NAN}}};
+      {order[0], {14.6, 813, 8.31, 18.7}},     {order[1], {0.41, 46.9, 0.199, 18.7}},
+      {order[2], {0.41, 46.7, 0.199, 18.7}},   {order[3], {0.41, 46.7, 0.199, 32.7}},
+      {order[4], {0.407, 45.6, 0.178, 0.412}}, {order[5], {0.387, 44.2, 0.247, 0.386}},
+      {order[6], {0.401, 44.7, 0.19, NAN}}};
   for (const std::string& name : order) {
     const Eigen::Vector4d v = rows[name].Rms();
     for (int i = 0; i < 4; ++i) {

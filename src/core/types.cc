@@ -129,6 +129,7 @@ const EnumName<WarningCode> kWarningCodes[] = {
     {WarningCode::kAlignment, "alignment"},
     {WarningCode::kEffectUntestable, "effect_untestable"},
     {WarningCode::kRotationsAboveNoise, "rotations_above_noise"},
+    {WarningCode::kSensorData, "sensor_data"},
 };
 
 }  // namespace

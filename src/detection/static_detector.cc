@@ -89,6 +89,31 @@ bool WindowVariance(const std::vector<Eigen::Vector3d>& x, size_t w, float* var)
   return true;
 }
 
+// Moving-window level change of one 3-axis signal: trend[k] = |m2 - m1|^2
+// (summed over the axes), m1 and m2 the means of x[k, k+h) and x[k+h, k+w),
+// h = w / 2, for k in [0, n - w]. Running sums of deviations from a
+// reference renewed every block, as WindowVariance.
+void WindowTrend(const std::vector<Eigen::Vector3d>& x, size_t w, float* trend) {
+  const size_t num_windows = x.size() - w + 1;
+  const size_t h = w / 2;
+  const double inv1 = 1.0 / static_cast<double>(h);
+  const double inv2 = 1.0 / static_cast<double>(w - h);
+  const size_t block = std::max<size_t>(16 * w, 4096);
+  for (size_t k0 = 0; k0 < num_windows; k0 += block) {
+    const Eigen::Vector3d r = x[k0];
+    Eigen::Vector3d s1 = Eigen::Vector3d::Zero(), s2 = Eigen::Vector3d::Zero();
+    for (size_t i = k0; i < k0 + h; ++i) s1 += x[i] - r;
+    for (size_t i = k0 + h; i < k0 + w; ++i) s2 += x[i] - r;
+    const size_t k_last = std::min(num_windows, k0 + block) - 1;
+    for (size_t k = k0;; ++k) {
+      trend[k] = static_cast<float>((s2 * inv2 - s1 * inv1).squaredNorm());
+      if (k == k_last) break;
+      s1 += x[k + h] - x[k];
+      s2 += x[k + w] - x[k + h];
+    }
+  }
+}
+
 // Half the mean squared sample-to-sample difference (summed over the axes) in
 // non-overlapping blocks of w samples, at most kMaxWhiteBlocks of them evenly
 // spread: the white-noise variance, which smooth motion barely raises.
@@ -177,6 +202,10 @@ bool StaticDetectorOptions::IsValid(std::string* error) const {
     return fail("merge_gap_windows must be >= 0 (got " + Num(merge_gap_windows) + ")");
   if (!(std::isfinite(candidate_factor) && candidate_factor >= 1.0))
     return fail("candidate_factor must be at least 1 (got " + Num(candidate_factor) + ")");
+  if (!(std::isfinite(trend_factor) && (trend_factor == 0.0 || trend_factor >= 1.0)))
+    return fail("trend_factor must be 0 (off) or at least 1 (got " + Num(trend_factor) + ")");
+  if (!(std::isfinite(spread_factor) && (spread_factor == 0.0 || spread_factor >= 1.0)))
+    return fail("spread_factor must be 0 (off) or at least 1 (got " + Num(spread_factor) + ")");
   return true;
 }
 
@@ -288,30 +317,141 @@ struct QuietRun {
   size_t begin, end;
 };
 
+// The windowed statistics of one sensor: variance, level change (null when
+// trend_factor is 0) and the noise floor.
+struct SensorWindows {
+  const float* var = nullptr;
+  const float* trend = nullptr;
+  double floor = 0.0;
+  // Level changes (squared, summed over the axes) up to this are no motion
+  // whatever the noise (see kGyroLevelFraction).
+  double min_change2 = 0.0;
+};
+
+// See TrimLevelEnds' use.
+constexpr double kGyroLevelFraction = 0.01;
+// TrimLevelEnds trims at most this many windows from each end of a run.
+constexpr size_t kMaxTrimWindows = 5;
+
+// The 99th percentile of |x - median| (median per axis), on a strided
+// subsample: the scale of the gyroscope's turns.
+double RateScale(const std::vector<Eigen::Vector3d>& x, std::vector<double>* scratch) {
+  Eigen::Vector3d median;
+  std::vector<double> axis;
+  const size_t stride = std::max<size_t>(1, x.size() / kMaxQuantileValues);
+  for (int a = 0; a < 3; ++a) {
+    axis.clear();
+    for (size_t i = 0; i < x.size(); i += stride) axis.push_back(x[i][a]);
+    median[a] = StridedQuantile(axis.data(), axis.size(), 0.5, scratch);
+  }
+  axis.clear();
+  for (size_t i = 0; i < x.size(); i += stride) axis.push_back((x[i] - median).norm());
+  return StridedQuantile(axis.data(), axis.size(), 0.99, scratch);
+}
+
+// The ends of each run where the sensor's level (its window mean) is away
+// from the run's own (the median of its window means, per axis) by more
+// than trend_factor times the noise of a window mean are cut off: the slow
+// start and end of a turn, whose rate is small but not zero. The run's
+// level, not a global one, so that a bias that differs from pose to pose
+// (g-sensitivity, drift) is no motion. Runs left shorter than a window are
+// dropped.
+void TrimLevelEnds(const std::vector<Eigen::Vector3d>& x, const SensorWindows& s, size_t w,
+                   double trend_factor, std::vector<QuietRun>* runs) {
+  const double min_change2 = s.min_change2;
+  std::vector<QuietRun> kept;
+  std::vector<Eigen::Vector3d> means;
+  std::vector<double> scratch;
+  for (const QuietRun& run : *runs) {
+    // Windows k in [run.begin, run.end - w] lie inside the run.
+    means.clear();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    const Eigen::Vector3d r = x[run.begin];
+    for (size_t i = run.begin; i < run.begin + w; ++i) sum += x[i] - r;
+    for (size_t k = run.begin;; ++k) {
+      means.push_back(sum / static_cast<double>(w));
+      if (k + w >= run.end) break;
+      sum += x[k + w] - x[k];
+    }
+    Eigen::Vector3d level;
+    for (int a = 0; a < 3; ++a) {
+      scratch.clear();
+      for (const Eigen::Vector3d& m : means) scratch.push_back(m[a]);
+      std::nth_element(scratch.begin(), scratch.begin() + scratch.size() / 2, scratch.end());
+      level[a] = scratch[scratch.size() / 2];
+    }
+    auto steady = [&](size_t j) {
+      const double var = std::max<double>(s.var[run.begin + j], s.floor);
+      const double change2 = (means[j] - level).squaredNorm();
+      return change2 <= min_change2 || change2 * static_cast<double>(w) <= trend_factor * var;
+    };
+    // At most kMaxTrimWindows windows from each end: a turn's slow end, not
+    // the wander of a long still log's bias.
+    const size_t max_trim = kMaxTrimWindows * w;
+    size_t first = 0, last = means.size();
+    while (first < means.size() && first < max_trim && !steady(first)) ++first;
+    while (last > first && means.size() - last < max_trim && !steady(last - 1)) --last;
+    if (last > first) kept.push_back({run.begin + first, run.begin + last - 1 + w});
+  }
+  *runs = std::move(kept);
+}
+
+// Whether window j of the sensor has its two halves' means within
+// `trend_factor` times their noise (top of static_detector.h).
+bool LevelSteady(const SensorWindows& s, size_t j, size_t w, double trend_factor) {
+  if (s.trend == nullptr) return true;
+  const double var = std::max<double>(s.var[j], s.floor);
+  return s.trend[j] <= s.min_change2 ||
+         static_cast<double>(s.trend[j]) * static_cast<double>(w) <= trend_factor * 4.0 * var;
+}
+
 // Static runs: the union of the quiet windows' samples (window k covers
-// samples [k, k + w)); gyro_var is null when the gyroscope is not used.
-std::vector<QuietRun> FindQuietRuns(const float* accel_var, const float* gyro_var,
+// samples [k, k + w)); gyro.var is null when the gyroscope is not used.
+std::vector<QuietRun> FindQuietRuns(const SensorWindows& accel, const SensorWindows& gyro,
                                     size_t num_windows, size_t w, double accel_threshold,
-                                    double gyro_threshold) {
+                                    double gyro_threshold, double trend_factor) {
   std::vector<QuietRun> runs;
-  auto quiet = [&](size_t j) {
-    return accel_var[j] <= accel_threshold &&
-           (gyro_var == nullptr || gyro_var[j] <= gyro_threshold);
+  auto low_variance = [&](size_t j) {
+    return accel.var[j] <= accel_threshold &&
+           (gyro.var == nullptr || gyro.var[j] <= gyro_threshold);
   };
+  auto steady = [&](size_t j) {
+    return LevelSteady(accel, j, w, trend_factor) &&
+           (gyro.var == nullptr || LevelSteady(gyro, j, w, trend_factor));
+  };
+  // Without a gyroscope, a window of low variance whose accelerometer level
+  // changes cuts the runs at its centre: only the windows centred on a step
+  // (poses published with the motion cut out) show it, so unlike a variance
+  // jump it leaves no gap of w windows between the runs.
+  const bool cuts = accel.trend != nullptr && gyro.var == nullptr;
+  size_t cut = 0;
   for (size_t k = 0; k < num_windows;) {
-    if (!quiet(k)) {
+    if (!(low_variance(k) && steady(k))) {
+      if (cuts && low_variance(k)) cut = k + w / 2;
       ++k;
       continue;
     }
     const size_t first = k;
-    while (k < num_windows && quiet(k)) ++k;
-    // Quiet windows less than w apart share samples: one run.
+    while (k < num_windows && low_variance(k) && steady(k)) ++k;
+    const size_t end = k - 1 + w;
+    // Quiet windows less than w apart share samples: one run, unless a
+    // level change cut it; then the two meet at the cut.
     if (!runs.empty() && first <= runs.back().end) {
-      runs.back().end = k - 1 + w;
+      if (cut <= runs.back().begin) {
+        runs.back().end = end;
+        continue;
+      }
+      const size_t begin = std::max(first, cut);
+      runs.back().end = std::min(runs.back().end, begin);
+      runs.push_back({begin, end});
     } else {
-      runs.push_back({first, k - 1 + w});
+      runs.push_back({first, end});
     }
   }
+  // Runs cut to nothing are dropped.
+  runs.erase(
+      std::remove_if(runs.begin(), runs.end(), [](const QuietRun& r) { return r.end <= r.begin; }),
+      runs.end());
   return runs;
 }
 
@@ -333,10 +473,11 @@ RejectedStretch MakeRejected(const ImuLog& log, size_t begin, size_t end, Reject
 // least min_count samples; the runs that are too short go to *rejected
 // (with the samples of the whole run, settling time included).
 std::vector<StaticInterval> TrimAndMerge(const ImuLog& log, const std::vector<QuietRun>& runs,
-                                         size_t settle, size_t min_count, double max_gap,
+                                         size_t settle, size_t min_count, size_t w,
                                          const StaticDetectorOptions& options,
                                          const StaticDetection& detection, bool use_gyro,
                                          std::vector<RejectedStretch>* rejected) {
+  const double max_gap = options.merge_gap_windows * static_cast<double>(w);
   std::vector<StaticInterval> pieces;
   std::vector<QuietRun> piece_runs;
   for (const QuietRun& run : runs) {
@@ -360,6 +501,20 @@ std::vector<StaticInterval> TrimAndMerge(const ImuLog& log, const std::vector<Qu
       if (!(static_cast<double>(next.begin - current.end) < max_gap) ||
           !(AngleDeg(current.accel_mean, next.accel_mean) < options.merge_angle_deg)) {
         break;
+      }
+      // A step in the mean across the gap is a new pose, however small the
+      // turn: the means must agree within trend_factor times the noise of a
+      // window's mean (no finer: hand-held noise is not white).
+      if (options.trend_factor > 0.0) {
+        // The windows on either side of the gap, not the whole intervals:
+        // a long still log's bias wanders between distant samples.
+        const size_t na = std::min(current.count(), w);
+        const size_t nb = std::min(next.count(), w);
+        const Eigen::Vector3d ma = MakeInterval(log, current.end - na, current.end).accel_mean;
+        const Eigen::Vector3d mb = MakeInterval(log, next.begin, next.begin + nb).accel_mean;
+        const double noise = detection.accel_noise_floor *
+                             (1.0 / static_cast<double>(na) + 1.0 / static_cast<double>(nb));
+        if (!((ma - mb).squaredNorm() <= options.trend_factor * noise)) break;
       }
       StaticInterval merged = MakeInterval(log, current.begin, next.end);
       if (!(merged.accel_cov.trace() <= detection.accel_threshold) ||
@@ -388,15 +543,17 @@ std::vector<StaticInterval> TrimAndMerge(const ImuLog& log, const std::vector<Qu
 // trimmed goes to *rejected as too much motion (the accelerometer was above
 // its threshold somewhere) or rotating (only the gyroscope was). `quiet` are
 // the quiet runs, in time order.
-void NearlyStillStretches(const ImuLog& log, const float* accel_var, const float* gyro_var,
+void NearlyStillStretches(const ImuLog& log, const SensorWindows& accel, const SensorWindows& gyro,
                           size_t num_windows, size_t w, const std::vector<QuietRun>& quiet,
                           size_t settle, size_t min_count, const StaticDetectorOptions& options,
                           const StaticDetection& detection,
                           std::vector<RejectedStretch>* rejected) {
   const double f = options.candidate_factor;
+  const float* accel_var = accel.var;
+  const float* gyro_var = gyro.var;
   const std::vector<QuietRun> loose =
-      FindQuietRuns(accel_var, gyro_var, num_windows, w, f * detection.accel_threshold,
-                    f * detection.gyro_threshold);
+      FindQuietRuns(accel, gyro, num_windows, w, f * detection.accel_threshold,
+                    f * detection.gyro_threshold, f * options.trend_factor);
   std::vector<double> scratch;
   auto report = [&](size_t begin, size_t end) {
     if (end < begin + w || end - begin < min_count + 2 * settle) return;
@@ -407,25 +564,51 @@ void NearlyStillStretches(const ImuLog& log, const float* accel_var, const float
     // No window inside [begin, end) is quiet: the typical (median) ratios
     // of the variances to their thresholds say why (the ends of the
     // stretch are the ends of motions).
-    std::vector<double> accel_ratio, gyro_ratio;
+    std::vector<double> accel_ratio, gyro_ratio, accel_level, gyro_level;
+    // The level change over what noise gives it, as in LevelSteady.
+    auto level = [&](const SensorWindows& sw, size_t k) {
+      const double var = std::max<double>(sw.var[k], sw.floor);
+      return static_cast<double>(sw.trend[k]) * static_cast<double>(w) /
+             (options.trend_factor * 4.0 * var);
+    };
     for (size_t k = begin; k + w <= end; ++k) {
       accel_ratio.push_back(accel_var[k] / detection.accel_threshold);
       if (gyro_var) gyro_ratio.push_back(gyro_var[k] / detection.gyro_threshold);
+      if (accel.trend) accel_level.push_back(level(accel, k));
+      if (gyro.trend) gyro_level.push_back(level(gyro, k));
     }
-    const double accel_median =
-        StridedQuantile(accel_ratio.data(), accel_ratio.size(), 0.5, &scratch);
-    const double gyro_median = StridedQuantile(gyro_ratio.data(), gyro_ratio.size(), 0.5, &scratch);
+    auto median = [&](const std::vector<double>& v) {
+      return StridedQuantile(v.data(), v.size(), 0.5, &scratch);
+    };
+    const double accel_median = median(accel_ratio);
+    const double gyro_median = median(gyro_ratio);
+    const double accel_level_median = median(accel_level);
+    const double gyro_level_median = median(gyro_level);
     const std::string seconds = Num(log.t[end - 1] - log.t[begin]);
-    if (accel_median > 1.0 || gyro_var == nullptr) {
+    if (accel_median > 1.0 || (gyro_var == nullptr && accel_level_median <= 1.0)) {
       rejected->push_back(MakeRejected(log, begin, end, RejectionReason::kTooMuchMotion,
                                        "nearly still for " + seconds +
                                            " s, but the accelerometer variance was typically " +
                                            Num(accel_median) + " times its threshold"));
-    } else {
+    } else if (accel_level_median > 1.0) {
+      rejected->push_back(MakeRejected(
+          log, begin, end, RejectionReason::kTooMuchMotion,
+          "nearly still for " + seconds +
+              " s, but the accelerometer's level was changing (slow motion): its half-window "
+              "means differed by typically " +
+              Num(accel_level_median) + " times the trend threshold"));
+    } else if (gyro_median > 1.0 || gyro_level_median <= 1.0) {
       rejected->push_back(MakeRejected(log, begin, end, RejectionReason::kRotating,
                                        "the accelerometer was nearly still for " + seconds +
                                            " s, but the gyroscope variance was typically " +
                                            Num(gyro_median) + " times its threshold"));
+    } else {
+      rejected->push_back(MakeRejected(
+          log, begin, end, RejectionReason::kRotating,
+          "the accelerometer was nearly still for " + seconds +
+              " s, but the gyroscope showed a slow turn: its half-window means differed by "
+              "typically " +
+              Num(gyro_level_median) + " times the trend threshold"));
     }
   };
   size_t q = 0;
@@ -438,6 +621,98 @@ void NearlyStillStretches(const ImuLog& log, const float* accel_var, const float
     }
     if (run.end > cursor) report(cursor, run.end);
   }
+}
+
+// Splits samples [begin, end) at steps in the accelerometer mean until every
+// part's variance (summed over the axes) is within `max_var`: at the split
+// point s maximising n1 n2 / n |m1 - m2|^2 (the between-part sum of squares).
+// Parts shorter than min_count are dropped (the few samples a run reaches
+// across a step). Appends the parts' [begin, end) to *parts and returns
+// true, or returns false (and *parts is unspecified) when a part above
+// max_var cannot be split into parts within it: a drift, not steps.
+bool SplitAtSteps(const ImuLog& log, size_t begin, size_t end, double max_var, size_t min_count,
+                  std::vector<QuietRun>* parts) {
+  if (end - begin < min_count) return true;
+  const StaticInterval whole = MakeInterval(log, begin, end);
+  if (whole.accel_cov.trace() <= max_var) {
+    parts->push_back({begin, end});
+    return true;
+  }
+  if (end - begin < 2) return false;
+  // Prefix sums of deviations from the first sample.
+  const Eigen::Vector3d r = log.accel[begin];
+  std::vector<Eigen::Vector3d> prefix(end - begin + 1, Eigen::Vector3d::Zero());
+  for (size_t i = begin; i < end; ++i) prefix[i - begin + 1] = prefix[i - begin] + log.accel[i] - r;
+  const double n = static_cast<double>(end - begin);
+  double best = -1.0;
+  size_t split = begin + 1;
+  for (size_t s = begin + 1; s < end; ++s) {
+    const double n1 = static_cast<double>(s - begin);
+    const double n2 = n - n1;
+    const Eigen::Vector3d m1 = prefix[s - begin] / n1;
+    const Eigen::Vector3d m2 = (prefix.back() - prefix[s - begin]) / n2;
+    const double between = n1 * n2 / n * (m2 - m1).squaredNorm();
+    if (between > best) {
+      best = between;
+      split = s;
+    }
+  }
+  // A split that leaves no part long enough cannot bring this part within.
+  if (split - begin < min_count && end - split < min_count) return false;
+  return SplitAtSteps(log, begin, split, max_var, min_count, parts) &&
+         SplitAtSteps(log, split, end, max_var, min_count, parts);
+}
+
+// Each interval whose variance is above spread_factor times the noise floor
+// is split at its steps (SplitAtSteps) or, when it cannot be, kept and named
+// in detection->warnings. Returns the number of intervals split.
+size_t SplitOrFlagSpread(const ImuLog& log, size_t min_count, const StaticDetectorOptions& options,
+                         StaticDetection* detection) {
+  if (options.spread_factor <= 0.0) return 0;
+  const double max_var = options.spread_factor * detection->accel_noise_floor;
+  std::vector<StaticInterval> out;
+  size_t split = 0;
+  for (const StaticInterval& s : detection->intervals) {
+    const double spread = s.accel_cov.trace();
+    if (spread <= max_var) {
+      out.push_back(s);
+      continue;
+    }
+    std::vector<QuietRun> parts;
+    if (SplitAtSteps(log, s.begin, s.end, max_var, min_count, &parts)) {
+      for (const QuietRun& p : parts) out.push_back(MakeInterval(log, p.begin, p.end));
+      ++split;
+      continue;
+    }
+    out.push_back(s);
+    detection->warnings.push_back(
+        "the position at t " + Num(s.t_begin) + "-" + Num(s.t_end) + " s (samples " +
+        std::to_string(s.begin) + "-" + std::to_string(s.end) + ") is not one still pose: its " +
+        "spread is " + Num(std::sqrt(spread / detection->accel_noise_floor)) +
+        " times the noise (standard deviations) and it is no set of steps between still "
+        "levels: a slow motion or drift; hold the pose still, or drop it");
+  }
+  detection->intervals = std::move(out);
+  return split;
+}
+
+// A time step so long that a window holds fewer than two samples is most
+// likely a time column in another unit; the message names the likely one.
+std::string TimeUnitMessage(const std::string& name, double dt, double window_seconds) {
+  std::string message = name + ": the median time step is " + Num(dt) + " s (" + Num(1.0 / dt) +
+                        " Hz), too long for the " + Num(window_seconds) + " s window";
+  const struct {
+    double scale;
+    const char* unit;
+  } units[] = {{1e-3, "milliseconds"}, {1e-6, "microseconds"}, {1e-9, "nanoseconds"}};
+  for (const auto& u : units) {
+    const double rate = 1.0 / (dt * u.scale);
+    if (rate >= 5.0 && rate <= 1e5) {
+      return message + ": the time column looks like " + u.unit + " (" + Num(rate) +
+             " Hz if so); set time_scale: " + Num(u.scale);
+    }
+  }
+  return message + ": check the time column's unit (time_scale) or give a longer window";
 }
 
 }  // namespace
@@ -458,6 +733,9 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
     const double samples = seconds / dt;
     return samples < static_cast<double>(n) ? static_cast<size_t>(std::llround(samples)) : n + 1;
   };
+  if (options.window_seconds < 1.5 * dt) {
+    return Fail(detection, TimeUnitMessage(name, dt, options.window_seconds));
+  }
   const size_t w = std::max<size_t>(2, to_samples(options.window_seconds));
   if (n < w) {
     return Fail(detection, name + ": " + std::to_string(n) + " samples are shorter than one " +
@@ -486,16 +764,44 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
     detection->gyro_threshold = options.gyro_threshold_factor * detection->gyro_noise_floor;
   }
 
-  const std::vector<QuietRun> runs =
-      FindQuietRuns(accel_var.get(), gyro_var.get(), num_windows, w, detection->accel_threshold,
-                    detection->gyro_threshold);
+  // Level changes (slow motion, steps).
+  std::unique_ptr<float[]> accel_trend, gyro_trend;
+  SensorWindows accel{accel_var.get(), nullptr, detection->accel_noise_floor};
+  SensorWindows gyro{gyro_var.get(), nullptr, detection->gyro_noise_floor};
+  // The level is judged on the gyroscope when there is one (a hand-held
+  // pose sways the accelerometer's level, not the rate's), else on the
+  // accelerometer. A gyroscope's level is far more precise than a hand
+  // holds it still (a hand-held pose turns at a fraction of a degree per
+  // second): a change below kGyroLevelFraction of the log's turn rate (the
+  // 99th percentile of |rate - median|) is no turn.
+  if (options.trend_factor > 0.0) {
+    if (use_gyro) {
+      gyro_trend.reset(new float[num_windows]);
+      WindowTrend(log.gyro, w, gyro_trend.get());
+      gyro.trend = gyro_trend.get();
+      const double min_change = kGyroLevelFraction * RateScale(log.gyro, &scratch);
+      gyro.min_change2 = min_change * min_change;
+    } else {
+      accel_trend.reset(new float[num_windows]);
+      WindowTrend(log.accel, w, accel_trend.get());
+      accel.trend = accel_trend.get();
+    }
+  }
+
+  std::vector<QuietRun> runs =
+      FindQuietRuns(accel, gyro, num_windows, w, detection->accel_threshold,
+                    detection->gyro_threshold, options.trend_factor);
+  if (options.trend_factor > 0.0) {
+    TrimLevelEnds(use_gyro ? log.gyro : log.accel, use_gyro ? gyro : accel, w, options.trend_factor,
+                  &runs);
+  }
   const size_t settle = to_samples(options.settle_seconds);
   const size_t min_count = std::max<size_t>(1, to_samples(options.min_duration_seconds));
-  detection->intervals =
-      TrimAndMerge(log, runs, settle, min_count, options.merge_gap_windows * static_cast<double>(w),
-                   options, *detection, use_gyro, &detection->rejected);
-  NearlyStillStretches(log, accel_var.get(), gyro_var.get(), num_windows, w, runs, settle,
-                       min_count, options, *detection, &detection->rejected);
+  detection->intervals = TrimAndMerge(log, runs, settle, min_count, w, options, *detection,
+                                      use_gyro, &detection->rejected);
+  const size_t split = SplitOrFlagSpread(log, min_count, options, detection);
+  NearlyStillStretches(log, accel, gyro, num_windows, w, runs, settle, min_count, options,
+                       *detection, &detection->rejected);
   std::sort(detection->rejected.begin(), detection->rejected.end(),
             [](const RejectedStretch& a, const RejectedStretch& b) { return a.begin < b.begin; });
 
@@ -505,6 +811,9 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
       << " samples, accel threshold " << Num(detection->accel_threshold);
   if (use_gyro) msg << ", gyro threshold " << Num(detection->gyro_threshold);
   msg << ")";
+  if (split > 0) {
+    msg << "; " << split << " split at steps in the mean";
+  }
   if (!detection->rejected.empty()) {
     msg << "; " << detection->rejected.size() << " stretch"
         << (detection->rejected.size() == 1 ? "" : "es") << " rejected";

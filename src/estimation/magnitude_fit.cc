@@ -3,6 +3,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
+#include "util/statistics.h"
+
 namespace gravcal {
 namespace internal {
 
@@ -62,6 +65,29 @@ bool StartMagnitudeFit(const std::vector<Position>& positions, const AccelModel&
   start->normalized = start->norm.Apply(positions);
   start->normalized_model = start->norm.Apply(*model);
   return true;
+}
+
+// The chi-square verdict: an exact fit, or residuals beyond the noise level.
+void WarnOnChiSquare(RefinementResult* result) {
+  if (result->dof <= 0) {
+    internal::AddWarning(WarningCode::kExactFit,
+                         "as many positions as parameters: the fit is exact and cannot show "
+                         "whether the model or the noise estimate is right; record more positions",
+                         &result->warnings, &result->warning_codes);
+    return;
+  }
+  const double p_value = ChiSquareUpperTail(result->chi2, result->dof);
+  if (p_value < 1e-3) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "residuals are " << std::sqrt(result->chi2 / result->dof)
+      << " times the noise level (chi2 = " << result->chi2 << " on " << result->dof
+      << " dof, p = " << p_value
+      << "): the model misses an effect, a position was disturbed, or the noise is correlated; "
+         "the standard deviations are too small by about that factor";
+    internal::AddWarning(WarningCode::kResidualsAboveNoise, s.str(), &result->warnings,
+                         &result->warning_codes);
+  }
 }
 
 }  // namespace internal

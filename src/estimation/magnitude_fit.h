@@ -18,6 +18,10 @@ namespace internal {
 double WhitenedSumOfSquares(const std::vector<double>& residuals,
                             const std::vector<double>& sigmas);
 
+// The chi-square verdict both fits give: an exact fit (dof 0), or residuals
+// beyond the noise level (p < 1e-3); added to result->warnings.
+void WarnOnChiSquare(RefinementResult* result);
+
 // What both fits start from.
 struct MagnitudeFitStart {
   // Indices into the 6-vector of U that are free (FreeUpperIndices).

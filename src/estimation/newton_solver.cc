@@ -141,6 +141,7 @@ bool NewtonRefine(const std::vector<Position>& positions, const AccelModel& init
         jtj.ldlt().solve(Eigen::MatrixXd::Identity(num_parameters, num_parameters))));
     result->covariance_available = result->covariance.allFinite();
   }
+  internal::WarnOnChiSquare(result);
   std::ostringstream s;
   s << (result->converged ? "converged" : "did not converge") << " after " << iteration
     << " Newton iterations (" << ToString(options.residual) << " residual)";

@@ -66,7 +66,12 @@ bool ChooseStillRange(const ImuLog& log, const NoiseOptions& options, size_t* be
   *end = log.size();
   if (options.find_still) {
     StaticDetection detection;
-    if (!DetectStaticIntervals(log, options.detector, &detection)) {
+    // The bias's wander over a long still log is what the noise model
+    // measures, not a change of pose or a turn: no level checks.
+    StaticDetectorOptions detector = options.detector;
+    detector.spread_factor = 0.0;
+    detector.trend_factor = 0.0;
+    if (!DetectStaticIntervals(log, detector, &detection)) {
       *message = internal::PrefixSource(log.source, detection.message);
       return false;
     }

@@ -297,29 +297,6 @@ std::vector<std::string> WeakParameters(const RefinementOptions& options,
   return weak;
 }
 
-// The chi-square verdict: an exact fit, or residuals beyond the noise level.
-void WarnOnChiSquare(RefinementResult* result) {
-  if (result->dof <= 0) {
-    internal::AddWarning(WarningCode::kExactFit,
-                         "as many positions as parameters: the fit is exact and cannot show "
-                         "whether the model or the noise estimate is right; record more positions",
-                         &result->warnings, &result->warning_codes);
-    return;
-  }
-  const double p_value = ChiSquareUpperTail(result->chi2, result->dof);
-  if (p_value < 1e-3) {
-    std::ostringstream s;
-    s.precision(3);
-    s << "residuals are " << std::sqrt(result->chi2 / result->dof)
-      << " times the noise level (chi2 = " << result->chi2 << " on " << result->dof
-      << " dof, p = " << p_value
-      << "): the model misses an effect, a position was disturbed, or the noise is correlated; "
-         "the standard deviations are too small by about that factor";
-    internal::AddWarning(WarningCode::kResidualsAboveNoise, s.str(), &result->warnings,
-                         &result->warning_codes);
-  }
-}
-
 }  // namespace
 
 bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
@@ -417,7 +394,7 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
                            &result->warnings, &result->warning_codes);
     }
   }
-  WarnOnChiSquare(result);
+  internal::WarnOnChiSquare(result);
 
   std::ostringstream s;
   s << (result->converged ? "converged" : "did not converge") << " after " << result->iterations

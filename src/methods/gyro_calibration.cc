@@ -8,6 +8,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/sensor_checks.h"
 #include "core/warnings.h"
 #include "estimation/accel_uncertainty.h"
 #include "estimation/normalization.h"
@@ -335,6 +336,11 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
   GyroCalibrationResult& r = *result;
   internal::GyroPrepared prep;
   Eigen::Matrix3d m0;
+  const std::string accel_like = internal::GyroLooksLikeAccelerometer(intervals);
+  if (!accel_like.empty()) {
+    r.message = log.source.empty() ? accel_like : log.source + ": " + accel_like;
+    return false;
+  }
   if (!internal::CheckGyroInputs(accel, accel_covariance, gravity, options, &r.message) ||
       !internal::PrepareGyroRotations(log, intervals, accel, options, &prep, &m0, &r.warnings,
                                       &r.message)) {
@@ -379,6 +385,10 @@ bool CalibrateGyroscope(const ImuLog& log, const std::vector<StaticInterval>& in
   internal::WarnUndeterminedGyro(r.undetermined, &r.warnings);
   internal::CodeNewWarnings(WarningCode::kUndetermined, r.warnings, &r.warning_codes);
   internal::WarnLargeResiduals(&r);
+  const std::string handedness = internal::HandednessWarning("gyroscope", r.model.matrix);
+  if (!handedness.empty()) {
+    internal::AddWarning(WarningCode::kSensorData, handedness, &r.warnings, &r.warning_codes);
+  }
   if (!r.converged) {
     r.message = "the gyroscope calibration did not converge (" + r.termination + ": " +
                 solve.summary.message + ")";

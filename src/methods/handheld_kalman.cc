@@ -389,9 +389,32 @@ bool CalibrateHandheld(const ImuLog& log, const HandheldKalmanOptions& options,
 
   const std::vector<std::string> unexcited =
       internal::ReportConvergence(*filter, layout, options, &c);
-  if (!internal::FillSensorModels(*filter, layout, in, &c)) return false;
+  if (!internal::FillSensorModels(*filter, layout, in, &c)) {
+    // A singular estimated matrix: the filter ran away.
+    c.message +=
+        ": the filter diverged: check gyro_nominal_scale (a gyroscope in deg/s read as "
+        "rad/s?), nominal_scale and the noise settings";
+    c.not_converged = true;
+    return false;
+  }
 
   internal::FillSummary(*filter, layout, in, nis_sum, epochs, unexcited, clock_start, &c);
+  // A filter that ran away (a gyroscope in deg/s read as rad/s, a wrong
+  // nominal scale) ends with a calibration that misses gravity in the still
+  // window by far more than the nominal scales did: refused, as diverged.
+  const double before = c.residual_nominal.rms;
+  const double after = c.residual_refined.rms;
+  if (!(after <= 0.1 * c.gravity || after <= 3.0 * before)) {
+    std::ostringstream s;
+    s.precision(3);
+    s << log.source << ": the filter diverged: calibrated, the still window's |a| - g is " << after
+      << " m/s^2 (" << before
+      << " m/s^2 with the nominal scales): check gyro_nominal_scale (a gyroscope in deg/s "
+         "read as rad/s?), nominal_scale and the noise settings";
+    c.message = s.str();
+    c.not_converged = true;
+    return false;
+  }
   c.success = true;
   return true;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/calibration_gravity.h"
+#include "core/sensor_checks.h"
 #include "core/warnings.h"
 #include "gravcal/estimation/refinement.h"
 #include "util/source_prefix.h"
@@ -12,7 +13,8 @@ namespace gravcal {
 namespace internal {
 
 bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector,
-                        std::vector<StaticInterval>* intervals, std::string* message) {
+                        std::vector<StaticInterval>* intervals, std::string* message,
+                        std::vector<std::string>* warnings) {
   if (!log.Validate(message)) return false;
   StaticDetection detection;
   if (!DetectStaticIntervals(log, detector, &detection)) {
@@ -20,6 +22,14 @@ bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector
     return false;
   }
   *intervals = detection.intervals;
+  if (warnings != nullptr) {
+    for (const std::string& w : SaturationWarnings(log)) {
+      warnings->push_back(internal::PrefixSource(log.source, w));
+    }
+    for (const std::string& w : detection.warnings) {
+      warnings->push_back(internal::PrefixSource(log.source, w));
+    }
+  }
   return true;
 }
 
@@ -29,7 +39,13 @@ bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
   Calibration& c = *calibration;
   if (!options.IsValid(&c.message)) return false;
   if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
-  if (!DetectLogIntervals(log, options.detector, intervals, &c.message)) return false;
+  std::vector<std::string> data_warnings;
+  if (!DetectLogIntervals(log, options.detector, intervals, &c.message, &data_warnings)) {
+    return false;
+  }
+  for (const std::string& w : data_warnings) {
+    AddWarning(WarningCode::kSensorData, w, &c.warnings, &c.warning_codes);
+  }
   const bool ok = PosesFromIntervals(log, *intervals, options, positions, &c.warnings, &c.message);
   CodeNewWarnings(WarningCode::kNoiseModel, c.warnings, &c.warning_codes);
   return ok;

@@ -20,8 +20,11 @@ namespace internal {
 
 // Checks the log and detects its static intervals. Returns false with
 // *message on an invalid log or a detector failure (naming log.source).
+// *warnings (when not null) gets the detector's warnings and the log's
+// saturated axes (core/sensor_checks.h), each prefixed by log.source.
 bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector,
-                        std::vector<StaticInterval>* intervals, std::string* message);
+                        std::vector<StaticInterval>* intervals, std::string* message,
+                        std::vector<std::string>* warnings = nullptr);
 
 // The positions of the intervals with the covariance of each mean chosen by
 // options.pose_noise (pose_mean_covariance.h); *notes gets its fallbacks and

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/calibration_gravity.h"
+#include "core/sensor_checks.h"
 #include "core/warnings.h"
 #include "estimation/accel_uncertainty.h"
 #include "gravcal/estimation/housing_rotation.h"
@@ -209,8 +210,10 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
   CHECK(calibration != nullptr);
   *calibration = Calibration();
   std::vector<StaticInterval> detected;
+  std::vector<std::string> data_warnings;
   if (!options.IsValid(&calibration->message) ||
-      !internal::DetectLogIntervals(log, options.detector, &detected, &calibration->message)) {
+      !internal::DetectLogIntervals(log, options.detector, &detected, &calibration->message,
+                                    &data_warnings)) {
     return false;
   }
   if (intervals != nullptr) *intervals = detected;
@@ -221,6 +224,18 @@ bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options
     return false;
   }
   const bool ok = CalibrateFromPositions(positions, options, calibration);
+  for (const std::string& w : data_warnings) {
+    internal::AddWarning(WarningCode::kSensorData, w, &calibration->warnings,
+                         &calibration->warning_codes);
+  }
+  if (ok) {
+    const std::string handedness =
+        internal::HandednessWarning("accelerometer", calibration->accel.model.matrix());
+    if (!handedness.empty()) {
+      internal::AddWarning(WarningCode::kSensorData, handedness, &calibration->warnings,
+                           &calibration->warning_codes);
+    }
+  }
   for (const std::string& n : notes) {
     internal::AddWarning(WarningCode::kNoiseModel, n, &calibration->warnings,
                          &calibration->warning_codes);

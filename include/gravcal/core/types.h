@@ -190,12 +190,16 @@ enum class WarningCode {
   // g-sensitivity, a turn the gyroscope does not integrate); they are left
   // out of the fits.
   kRotationsAboveNoise,
+  // The data break what the model assumes, and the message names how: a
+  // saturated axis, a left-handed fitted matrix (a flipped or swapped axis),
+  // a detected position that is not one still pose.
+  kSensorData,
 };
 // "unclassified", "standard_gravity", "undetermined", "no_covariance",
 // "exact_fit", "residuals_above_noise", "pose_scatter", "few_poses",
 // "rotation_skipped", "method_scope", "parameter_source",
 // "not_still_at_start", "log_gap", "noise_model", "alignment",
-// "effect_untestable", "rotations_above_noise".
+// "effect_untestable", "rotations_above_noise", "sensor_data".
 const char* ToString(WarningCode code);
 bool FromString(const std::string& name, WarningCode* code);
 

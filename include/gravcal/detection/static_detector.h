@@ -24,6 +24,33 @@
 // reason: still but too short once trimmed, or nearly still (variances below
 // candidate_factor times the thresholds) but moving or rotating too much
 // for at least min_duration. Reporting them never changes the intervals.
+//
+// Variance alone misses slow motion: the slow start and end of a turn, and a
+// step between two poses published with the motion cut out, change the
+// window's level, not its spread. So the level is judged too, on the
+// gyroscope when the log has one (a hand-held pose sways the
+// accelerometer's level, not the rate's), else on the accelerometer:
+// - a window is still only when the means of its two halves agree: the
+//   squared difference summed over the axes is below trend_factor times
+//   what noise gives it, |m2 - m1|^2 <= trend_factor * 4 max(var, floor) / w,
+//   with var the window's variance and w its length in samples;
+// - the ends of each still run whose window means are away from the run's
+//   own level (the median of its window means) by more than trend_factor
+//   times the noise of a window mean are cut off (the slow ends of a turn).
+// A gyroscope's level is far more precise than a hand holds a pose still,
+// so for it a change below 1 % of the log's turn rate (the 99th percentile
+// of |rate - median|) is never motion. Without a gyroscope, a window of low
+// variance whose level changes cuts the run at its centre.
+// Each interval is then checked as a whole: when its variance (summed over
+// the axes) is above spread_factor times the accelerometer's noise floor, it
+// is split at its largest steps in the mean (recursively; parts shorter than
+// min_duration are dropped) when every part then lies within the spread;
+// otherwise it is kept and named in StaticDetection::warnings as not one
+// still pose. Neighbours are merged only when their means agree within
+// trend_factor times the noise of a window's mean.
+// Time units are checked too: a median time step so long that a window holds
+// fewer than two samples is refused, naming the unit (ms, us, ns) the time
+// column is likely in and the time_scale that fixes it.
 #ifndef GRAVCAL_DETECTION_STATIC_DETECTOR_H_
 #define GRAVCAL_DETECTION_STATIC_DETECTOR_H_
 
@@ -66,6 +93,12 @@ struct StaticDetectorOptions {
   // trimming, are reported as rejected (moving or rotating too much).
   // Reporting only: the intervals do not depend on it.
   double candidate_factor = 10.0;
+  // A window is still only when its two halves' means agree within this
+  // times their noise (see above; each sensor). 0 = off.
+  double trend_factor = 10.0;
+  // An interval whose variance is above this times the accelerometer's noise
+  // floor is split at its steps or named in warnings (see above). 0 = off.
+  double spread_factor = 25.0;
 
   bool IsValid(std::string* error) const;
 };
@@ -87,6 +120,10 @@ struct StaticDetection {
   // The stretches rejected (see the top of this file), in time order; none
   // overlaps an interval.
   std::vector<RejectedStretch> rejected;
+  // What the detector could not resolve and the user should know: a
+  // position whose spread is far above the noise (named by its time span),
+  // intervals split at steps in the mean. Empty for a clean session.
+  std::vector<std::string> warnings;
   // The noise floor and threshold actually used (variance, raw units^2).
   double accel_noise_floor = 0.0;
   double accel_threshold = 0.0;

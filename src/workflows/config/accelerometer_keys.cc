@@ -43,6 +43,12 @@ ConfigSection DetectorSection() {
                            "use the gyroscope variance too, when present"),
               GRAVCAL_DOUBLE("merge_angle", calibration.detector.merge_angle_deg,
                              "adjacent intervals closer than this are one pose, degrees"),
+              GRAVCAL_DOUBLE("trend_factor", calibration.detector.trend_factor,
+                             "still only when a window's half means agree within this times "
+                             "their noise (0 = off)"),
+              GRAVCAL_DOUBLE("spread_factor", calibration.detector.spread_factor,
+                             "an interval whose variance is above this times the floor is split "
+                             "at its steps or named (0 = off)"),
           }};
 }
 

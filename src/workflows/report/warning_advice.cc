@@ -83,6 +83,13 @@ WarningAdvice AdviceFor(WarningCode code) {
           "decisions use the magnitudes (and the within-pose trends) only.",
           "Fit the gyroscope's g-sensitivity first (gravcal discover names it), or turn "
           "more slowly and steadily between the poses."};
+    case WarningCode::kSensorData:
+      return {
+          "The data break what the model assumes, as the message names: a saturated axis, "
+          "a flipped or swapped axis (a left-handed matrix), or a position that was not "
+          "held still; the residuals alone would only say they are large.",
+          "Do what the message says: fix the axis convention, record with a larger range, "
+          "or hold the named pose still and record it again."};
   }
   return {"", ""};
 }
