@@ -87,8 +87,11 @@ TEST(MethodComparison, ReproducesTheReadmeTable) {
   // The table compares the methods on white-noise sessions (no pose
   // scatter), each with its white-noise sigmas: the shipped config's
   // hand-placement pipeline is off here, as on a fixture.
-  twelve.calibration.refinement.estimate_pose_variance = false;
-  twelve.calibration.pose_noise.method = PoseNoise::kWhite;
+  // As flags after the file (--pose_variance false --pose_noise white),
+  // which override the file's pose-variance keys.
+  std::string switch_error;
+  EXPECT_TRUE(SetConfigValue("pose_variance", "false", &twelve, &switch_error)) << switch_error;
+  EXPECT_TRUE(SetConfigValue("pose_noise", "white", &twelve, &switch_error)) << switch_error;
   Config twelve_affine = twelve;
   twelve_affine.calibration.refinement.parameterization = AccelParameterization::kAffine;
   const Config known = LoadConfig("known_attitude.yaml");

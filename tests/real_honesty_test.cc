@@ -208,8 +208,11 @@ bool StatisticsOf(const Config& config, const ImuLog& log, SessionStatistics* ou
   PipelineInput input;
   input.log = log;
   Config white = config;
-  white.calibration.refinement.estimate_pose_variance = false;
-  white.calibration.pose_noise.method = PoseNoise::kWhite;
+  // As flags after the file (--pose_variance false --pose_noise white),
+  // which override the file's pose-variance keys.
+  std::string switch_error;
+  EXPECT_TRUE(SetConfigValue("pose_variance", "false", &white, &switch_error)) << switch_error;
+  EXPECT_TRUE(SetConfigValue("pose_noise", "white", &white, &switch_error)) << switch_error;
   Calibration w, c;
   if (!RunCalibration(white, input, &w) || !RunCalibration(config, input, &c)) return false;
   out->white_chi2_dof = w.refinement.chi2 / std::max(w.refinement.dof, 1);

@@ -15,7 +15,7 @@ import tempfile
 SCRIPT = """
 import os, sys, gravcal
 assert gravcal.__file__.startswith(sys.prefix), gravcal.__file__
-truth, log = gravcal.simulate(seed=3, sim_hold=2)
+truth, log = gravcal.simulate(seed=3, sim_hold=4)
 cal = gravcal.calibrate(log)
 assert cal.apply(log.accel).shape == (len(log), 3)
 print(gravcal.__version__, os.path.dirname(gravcal.__file__))

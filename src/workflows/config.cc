@@ -57,7 +57,14 @@ bool SetNode(const std::string& key, const YAML::Node& node, Config* config, std
     return false;
   }
   std::vector<std::string>& set = config->keys_set;
-  if (std::find(set.begin(), set.end(), key) == set.end()) set.push_back(key);
+  config->key_layers.resize(set.size(), 0);
+  const auto it = std::find(set.begin(), set.end(), key);
+  if (it == set.end()) {
+    set.push_back(key);
+    config->key_layers.push_back(config->layer);
+  } else {
+    config->key_layers[it - set.begin()] = config->layer;
+  }
   return true;
 }
 
@@ -94,6 +101,22 @@ bool CheckDuplicateKeys(const YAML::Node& node, const std::string& name, std::st
 
 bool KeySet(const Config& c, const std::string& key) {
   return std::find(c.keys_set.begin(), c.keys_set.end(), key) != c.keys_set.end();
+}
+
+// The layer `key` was last set in (Config::key_layers), -1 when it was not set.
+int KeyLayer(const Config& c, const std::string& key) {
+  const auto it = std::find(c.keys_set.begin(), c.keys_set.end(), key);
+  if (it == c.keys_set.end()) return -1;
+  const size_t i = it - c.keys_set.begin();
+  return i < c.key_layers.size() ? c.key_layers[i] : 0;
+}
+
+// Whether `key`, set, is overridden by `path_switch` set in a later layer
+// (e.g. --pose_variance false on a config file that sets the prior): then the
+// key is quietly out of use, as the user asked; otherwise a key the switch
+// leaves unused is an error.
+bool OverriddenBy(const Config& c, const std::string& key, const std::string& path_switch) {
+  return KeyLayer(c, path_switch) > KeyLayer(c, key);
 }
 
 // Settings that contradict each other, and keys set that the chosen solver
@@ -136,7 +159,7 @@ bool CheckConsistency(const Config& c, const std::function<bool(const char*)>& r
     }
   }
   if (reads("newton_residual") && KeySet(c, "newton_residual") &&
-      o.solver != RefinementSolver::kNewton) {
+      o.solver != RefinementSolver::kNewton && !OverriddenBy(c, "newton_residual", "solver")) {
     return ignored("newton_residual", "unless solver: newton");
   }
   if (reads("covariance") && reads("output_covariance") && !o.refinement.compute_covariance &&
@@ -145,27 +168,32 @@ bool CheckConsistency(const Config& c, const std::function<bool(const char*)>& r
                       "no covariance is computed with covariance: false, so none can be written");
   }
   if (reads("pose_noise_batches") && KeySet(c, "pose_noise_batches") &&
-      o.pose_noise.method != PoseNoise::kBatchMeans) {
+      o.pose_noise.method != PoseNoise::kBatchMeans &&
+      !OverriddenBy(c, "pose_noise_batches", "pose_noise")) {
     return ignored("pose_noise_batches", "unless pose_noise: batch_means");
   }
   if (reads("pose_variance") && !o.refinement.estimate_pose_variance) {
     for (const char* key :
          {"pose_disturbance_prior", "pose_disturbance_prior_dof", "prior_conflict_level",
           "structure_test_level", "max_pose_disturbance"}) {
-      if (reads(key) && KeySet(c, key)) return ignored(key, "unless pose_variance: true");
+      if (reads(key) && KeySet(c, key) && !OverriddenBy(c, key, "pose_variance")) {
+        return ignored(key, "unless pose_variance: true");
+      }
     }
   }
   if (reads("gyro_model") && c.gyro.parameterization == GyroParameterization::kNone) {
-    if (c.gyro.g_sensitivity) {
+    if (c.gyro.g_sensitivity && !OverriddenBy(c, "gyro_g_sensitivity", "gyro_model")) {
       return contradict("gyro_model", "gyro_g_sensitivity",
                         "gyro_model none estimates no gyroscope to give a g-sensitivity");
     }
-    if (c.gyro.joint) {
+    if (c.gyro.joint && !OverriddenBy(c, "gyro_joint", "gyro_model")) {
       return contradict("gyro_model", "gyro_joint",
                         "gyro_model none estimates no gyroscope to refine jointly");
     }
     for (const char* key : {"gyro_loss", "gyro_loss_scale", "gyro_edge", "gyro_max_rotation"}) {
-      if (KeySet(c, key)) return ignored(key, "with gyro_model: none");
+      if (KeySet(c, key) && !OverriddenBy(c, key, "gyro_model")) {
+        return ignored(key, "with gyro_model: none");
+      }
     }
   }
   return true;
@@ -289,6 +317,8 @@ bool LoadConfigText(const std::string& text, const std::string& name, Config* co
       return false;
     }
   }
+  // What is set after this file overrides it (Config::key_layers).
+  updated.layer = config->layer + 1;
   *config = updated;
   return true;
 }

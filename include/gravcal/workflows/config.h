@@ -57,6 +57,15 @@ struct Config {
   // the order set (a key set twice appears once). Only these are checked
   // against the method: defaults never make a config invalid.
   std::vector<std::string> keys_set;
+  // The layer each key of keys_set was last set in (same index): a config
+  // file is one layer, and what is set after it (command-line flags,
+  // SetConfigValue) the next. A switch that turns a path off (pose_variance:
+  // false, gyro_model: none, ...) set in a later layer than the keys of that
+  // path overrides them; set in the same layer as them (or left at its
+  // default) the keys are an error, as the file contradicts itself.
+  std::vector<int> key_layers;
+  // The layer the next key is set in.
+  int layer = 0;
 
   // Checks the method (a registry name), that every key in keys_set is used
   // by it (or by every method, or is a command key such as sim_*), and the
