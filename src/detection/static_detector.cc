@@ -206,6 +206,10 @@ bool StaticDetectorOptions::IsValid(std::string* error) const {
     return fail("trend_factor must be 0 (off) or at least 1 (got " + Num(trend_factor) + ")");
   if (!(std::isfinite(spread_factor) && (spread_factor == 0.0 || spread_factor >= 1.0)))
     return fail("spread_factor must be 0 (off) or at least 1 (got " + Num(spread_factor) + ")");
+  if (!(std::isfinite(step_factor) && (step_factor == 0.0 || step_factor >= 1.0)))
+    return fail("step_factor must be 0 (off) or at least 1 (got " + Num(step_factor) + ")");
+  if (!(step_min_deg >= 0.0 && step_min_deg <= 180.0))
+    return fail("step_min_deg must be in [0, 180] (got " + Num(step_min_deg) + ")");
   return true;
 }
 
@@ -409,7 +413,8 @@ bool LevelSteady(const SensorWindows& s, size_t j, size_t w, double trend_factor
 // samples [k, k + w)); gyro.var is null when the gyroscope is not used.
 std::vector<QuietRun> FindQuietRuns(const SensorWindows& accel, const SensorWindows& gyro,
                                     size_t num_windows, size_t w, double accel_threshold,
-                                    double gyro_threshold, double trend_factor) {
+                                    double gyro_threshold, double trend_factor,
+                                    bool split_at_steps) {
   std::vector<QuietRun> runs;
   auto low_variance = [&](size_t j) {
     return accel.var[j] <= accel_threshold &&
@@ -422,8 +427,10 @@ std::vector<QuietRun> FindQuietRuns(const SensorWindows& accel, const SensorWind
   // Without a gyroscope, a window of low variance whose accelerometer level
   // changes cuts the runs at its centre: only the windows centred on a step
   // (poses published with the motion cut out) show it, so unlike a variance
-  // jump it leaves no gap of w windows between the runs.
-  const bool cuts = accel.trend != nullptr && gyro.var == nullptr;
+  // jump it leaves no gap of w windows between the runs. When the runs are
+  // split at their steps afterwards (split_at_steps), which places the split
+  // at the step itself, not at a window's centre, the runs are not cut.
+  const bool cuts = accel.trend != nullptr && gyro.var == nullptr && !split_at_steps;
   size_t cut = 0;
   for (size_t k = 0; k < num_windows;) {
     if (!(low_variance(k) && steady(k))) {
@@ -453,6 +460,106 @@ std::vector<QuietRun> FindQuietRuns(const SensorWindows& accel, const SensorWind
       std::remove_if(runs.begin(), runs.end(), [](const QuietRun& r) { return r.end <= r.begin; }),
       runs.end());
   return runs;
+}
+
+// Prefix sums over one run for the line fits of SplitRunAtSteps: of x - r,
+// j (x - r) and |x - r|^2 per axis, j the sample's index in the run and r
+// its first sample (small magnitudes: no cancellation with raw counts).
+struct LinePrefix {
+  std::vector<Eigen::Vector3d> s0, s1, s2;
+  LinePrefix(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end) {
+    const size_t n = end - begin;
+    s0.assign(n + 1, Eigen::Vector3d::Zero());
+    s1 = s0;
+    s2 = s0;
+    const Eigen::Vector3d r = x[begin];
+    for (size_t j = 0; j < n; ++j) {
+      const Eigen::Vector3d d = x[begin + j] - r;
+      s0[j + 1] = s0[j] + d;
+      s1[j + 1] = s1[j] + static_cast<double>(j) * d;
+      s2[j + 1] = s2[j] + d.cwiseProduct(d);
+    }
+  }
+  // The line fitted to run samples [a, a + len): its value at local position
+  // t (0 = sample a) and its residual variance summed over the axes; the
+  // samples' mean and variance about it.
+  void Fit(size_t a, size_t len, double t, Eigen::Vector3d* value, double* residual,
+           Eigen::Vector3d* mean, double* variance) const {
+    const double n = static_cast<double>(len);
+    const Eigen::Vector3d sx = s0[a + len] - s0[a];
+    const Eigen::Vector3d sjx = s1[a + len] - s1[a] - static_cast<double>(a) * sx;
+    const Eigen::Vector3d sxx = s2[a + len] - s2[a];
+    const double mean_j = 0.5 * (n - 1.0);
+    const double sjj = n * (n * n - 1.0) / 12.0;
+    const Eigen::Vector3d slope = (sjx - mean_j * sx) / sjj;
+    *value = sx / n + slope * (t - mean_j);
+    const double rss = (sxx - sx.cwiseProduct(sx) / n - slope.cwiseProduct(slope) * sjj).sum();
+    *residual = std::max(rss, 0.0) / std::max(n - 2.0, 1.0);
+    *mean = sx / n;
+    *variance = std::max((sxx - sx.cwiseProduct(sx) / n).sum(), 0.0) / std::max(n - 1.0, 1.0);
+  }
+};
+
+// Splits the still run [begin, end) at steps in the accelerometer level
+// (top of static_detector.h): lines on the w samples either side of each
+// sample, the step statistic T, recursively at its maximum while it is
+// above step_factor and the levels are step_min_deg apart. `floor` (the
+// noise floor, summed over the axes) bounds the residual variances from
+// below (quantised data can fit a line exactly). Appends the parts.
+void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& prefix, size_t base,
+                     size_t begin, size_t end, size_t w, double floor,
+                     const StaticDetectorOptions& options, std::vector<QuietRun>* parts) {
+  if (end - begin < 2 * w) {
+    parts->push_back({begin, end});
+    return;
+  }
+  const double len = static_cast<double>(w);
+  const double c = (4.0 * len - 2.0) / (len * (len + 1.0));
+  const double min_cos = std::cos(options.step_min_deg * internal::kDegToRad);
+  const Eigen::Vector3d r = x[base];
+  double best = options.step_factor;
+  size_t split = 0;
+  for (size_t s = begin + w; s + w <= end; ++s) {
+    Eigen::Vector3d left, right, m1, m2;
+    double r1, r2, v1, v2;
+    prefix.Fit(s - w - base, w, len - 0.5, &left, &r1, &m1, &v1);
+    prefix.Fit(s - base, w, -0.5, &right, &r2, &m2, &v2);
+    const double t_line =
+        (right - left).squaredNorm() / (c * (std::max(r1, floor) + std::max(r2, floor)));
+    const double t_mean =
+        (m2 - m1).squaredNorm() * len / (std::max(v1, floor) + std::max(v2, floor));
+    const double t = std::min(t_line, t_mean);
+    if (!(t > best)) continue;
+    const Eigen::Vector3d a = left + r, b = right + r;
+    if (a.dot(b) > min_cos * a.norm() * b.norm()) continue;
+    best = t;
+    split = s;
+  }
+  if (split == 0) {
+    parts->push_back({begin, end});
+    return;
+  }
+  SplitRunAtSteps(x, prefix, base, begin, split, w, floor, options, parts);
+  SplitRunAtSteps(x, prefix, base, split, end, w, floor, options, parts);
+}
+
+// Every run split at its accelerometer steps (SplitRunAtSteps). Returns the
+// number of steps found.
+size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double floor,
+                        const StaticDetectorOptions& options, std::vector<QuietRun>* runs) {
+  if (options.step_factor <= 0.0) return 0;
+  std::vector<QuietRun> out;
+  for (const QuietRun& run : *runs) {
+    if (run.end - run.begin < 2 * w) {
+      out.push_back(run);
+      continue;
+    }
+    const LinePrefix prefix(x, run.begin, run.end);
+    SplitRunAtSteps(x, prefix, run.begin, run.begin, run.end, w, floor, options, &out);
+  }
+  const size_t steps = out.size() - runs->size();
+  *runs = std::move(out);
+  return steps;
 }
 
 RejectedStretch MakeRejected(const ImuLog& log, size_t begin, size_t end, RejectionReason reason,
@@ -551,9 +658,9 @@ void NearlyStillStretches(const ImuLog& log, const SensorWindows& accel, const S
   const double f = options.candidate_factor;
   const float* accel_var = accel.var;
   const float* gyro_var = gyro.var;
-  const std::vector<QuietRun> loose =
-      FindQuietRuns(accel, gyro, num_windows, w, f * detection.accel_threshold,
-                    f * detection.gyro_threshold, f * options.trend_factor);
+  const std::vector<QuietRun> loose = FindQuietRuns(
+      accel, gyro, num_windows, w, f * detection.accel_threshold, f * detection.gyro_threshold,
+      f * options.trend_factor, options.step_factor > 0.0);
   std::vector<double> scratch;
   auto report = [&](size_t begin, size_t end) {
     if (end < begin + w || end - begin < min_count + 2 * settle) return;
@@ -790,7 +897,8 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
 
   std::vector<QuietRun> runs =
       FindQuietRuns(accel, gyro, num_windows, w, detection->accel_threshold,
-                    detection->gyro_threshold, options.trend_factor);
+                    detection->gyro_threshold, options.trend_factor, options.step_factor > 0.0);
+  const size_t steps = SplitRunsAtSteps(log.accel, w, detection->accel_noise_floor, options, &runs);
   if (options.trend_factor > 0.0) {
     TrimLevelEnds(use_gyro ? log.gyro : log.accel, use_gyro ? gyro : accel, w, options.trend_factor,
                   &runs);
@@ -811,6 +919,9 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
       << " samples, accel threshold " << Num(detection->accel_threshold);
   if (use_gyro) msg << ", gyro threshold " << Num(detection->gyro_threshold);
   msg << ")";
+  if (steps > 0) {
+    msg << "; " << steps << " step" << (steps == 1 ? "" : "s") << " between touching poses";
+  }
   if (split > 0) {
     msg << "; " << split << " split at steps in the mean";
   }

@@ -71,6 +71,7 @@ bool ChooseStillRange(const ImuLog& log, const NoiseOptions& options, size_t* be
     StaticDetectorOptions detector = options.detector;
     detector.spread_factor = 0.0;
     detector.trend_factor = 0.0;
+    detector.step_factor = 0.0;
     if (!DetectStaticIntervals(log, detector, &detection)) {
       *message = internal::PrefixSource(log.source, detection.message);
       return false;

@@ -41,6 +41,20 @@
 // so for it a change below 1 % of the log's turn rate (the 99th percentile
 // of |rate - median|) is never motion. Without a gyroscope, a window of low
 // variance whose level changes cuts the run at its centre.
+// A still run holds one pose only when its accelerometer level has no step
+// (poses published with the motion cut out touch with a step and nothing
+// between): at each sample s, a straight line is fitted on each side to the
+// w samples [s - w, s) and [s, s + w) (w the window length) and the step is
+// the difference d of the two lines at the boundary (so a slow drift, which
+// both lines follow, is no step). With r1, r2 the residual variances of the
+// lines (summed over the axes: each side's own noise, however it differs
+// between poses) and c = (4w - 2) / (w (w + 1)) the variance factor of a
+// line's end value, and likewise for the two sides' means m1, m2 and
+// variances v1, v2 (a wobble within a pose, which lines extrapolate, shows
+// in neither), the step statistic is
+//   T(s) = min(|d|^2 / (c (r1 + r2)), w |m2 - m1|^2 / (v1 + v2)).
+// The run is split at the s of largest T while T > step_factor and the two
+// levels differ by at least step_min_deg, recursively on both parts.
 // Each interval is then checked as a whole: when its variance (summed over
 // the axes) is above spread_factor times the accelerometer's noise floor, it
 // is split at its largest steps in the mean (recursively; parts shorter than
@@ -99,6 +113,11 @@ struct StaticDetectorOptions {
   // An interval whose variance is above this times the accelerometer's noise
   // floor is split at its steps or named in warnings (see above). 0 = off.
   double spread_factor = 25.0;
+  // Step change-points within a still run (see above): a step whose
+  // statistic is above this splits the run. 0 = off.
+  double step_factor = 25.0;
+  // ... and only when the two levels are at least this many degrees apart.
+  double step_min_deg = 1.0;
 
   bool IsValid(std::string* error) const;
 };

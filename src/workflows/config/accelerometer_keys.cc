@@ -49,6 +49,11 @@ ConfigSection DetectorSection() {
               GRAVCAL_DOUBLE("spread_factor", calibration.detector.spread_factor,
                              "an interval whose variance is above this times the floor is split "
                              "at its steps or named (0 = off)"),
+              GRAVCAL_DOUBLE("step_factor", calibration.detector.step_factor,
+                             "a still run is split where a step in its level is above this times "
+                             "its noise (0 = off)"),
+              GRAVCAL_DOUBLE("step_min", calibration.detector.step_min_deg,
+                             "a step splits only when its two levels are this far apart, degrees"),
           }};
 }
 
