@@ -178,6 +178,44 @@ TEST(Config, ContradictionsAndIgnoredKeysNameBothKeys) {
   }
 }
 
+// A switch that turns a path off, set after the file that sets the path's
+// keys (a flag after --config), overrides them; set in the same file, or
+// before the keys, it leaves them an error.
+TEST(Config, ASwitchSetLaterOverridesThePathsKeys) {
+  const std::string file =
+      "pose_variance: true\npose_disturbance_prior: 0.004\ngyro_model: full\ngyro_edge: 0.5\n";
+  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+           {"pose_variance", "false"}, {"gyro_model", "none"}}) {
+    Config config;
+    std::string error;
+    ASSERT_TRUE(LoadConfigText(file, "c.yaml", &config, &error)) << error;
+    ASSERT_TRUE(SetConfigValue(key, value, &config, &error)) << error;
+    EXPECT_TRUE(config.IsValid(&error)) << key << ": " << error;
+  }
+  // Every shipped static config can be turned to a fixture's white noise by flags.
+  for (const char* name : {"twelve_position.yaml", "hand_placed.yaml"}) {
+    Config config;
+    std::string error;
+    ASSERT_TRUE(LoadConfigFile(testing_util::SourceDir() + "/configs/" + name, &config, &error))
+        << error;
+    ASSERT_TRUE(SetConfigValue("pose_variance", "false", &config, &error)) << error;
+    EXPECT_TRUE(config.IsValid(&error)) << name << ": " << error;
+  }
+  // The same switch within the file: the file contradicts itself.
+  Config config;
+  std::string error;
+  ASSERT_TRUE(LoadConfigText("pose_variance: false\npose_disturbance_prior: 0.004\n", "c.yaml",
+                             &config, &error))
+      << error;
+  EXPECT_FALSE(config.IsValid(&error));
+  // A path key set by a flag after the file that switches the path off.
+  Config later;
+  ASSERT_TRUE(LoadConfigText("pose_variance: false\n", "c.yaml", &later, &error)) << error;
+  ASSERT_TRUE(SetConfigValue("pose_disturbance_prior", "0.004", &later, &error)) << error;
+  EXPECT_FALSE(later.IsValid(&error));
+  EXPECT_NE(error.find("'pose_disturbance_prior'"), std::string::npos) << error;
+}
+
 TEST(Config, InvalidValuesAreCaughtByValidation) {
   Config config;
   std::string error;

@@ -262,7 +262,8 @@ TEST(RealHonesty, HandPlacedSimulationLooksLikeTheRealSessions) {
       LoadConfigFile(testing_util::SourceDir() + "/configs/twelve_position.yaml", &shipped, &error))
       << error;
   sim.calibration = shipped.calibration;
-  sim.gyro = GyroCalibrationOptions();
+  // The accelerometer alone, as --gyro_model none after the file would.
+  ASSERT_TRUE(SetConfigValue("gyro_model", "none", &sim, &error)) << error;
   for (uint64_t seed = 1; seed <= 2; ++seed) {
     SimulatedSession session;
     ASSERT_TRUE(Simulate(sim.simulation, seed, &session, &error)) << error;
