@@ -153,6 +153,7 @@ TEST(Config, ContradictionsAndIgnoredKeysNameBothKeys) {
       {"pose_disturbance_prior: 0.004\n", {"'pose_disturbance_prior'", "pose_variance: true"}},
       {"pose_noise_batches: 8\n", {"'pose_noise_batches'", "pose_noise: batch_means"}},
       {"covariance: false\noutput_covariance: true\n", {"'covariance'", "'output_covariance'"}},
+      {"loss: none\nloss_scale: 2\n", {"'loss_scale'", "loss: none"}},
   };
   for (const auto& [text, names] : cases) {
     Config config;

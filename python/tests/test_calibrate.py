@@ -61,7 +61,7 @@ def test_config_dict_and_keywords_equal_the_yaml(session_dir):
     keys = {"method": "twelve_position", "format": "csv", "gravity": 9.81, "window": 1.0,
             "threshold_factor": 6.0, "min_duration": 2.0, "settle": 0.3,
             "parameterization": "scale_misalignment", "solver": "ceres", "loss": "none",
-            "loss_scale": 3.0, "covariance": True, "output_covariance": True,
+            "covariance": True, "output_covariance": True,
             "pose_noise": "batch_means", "pose_variance": True,
             "pose_disturbance_prior": 0.0005, "pose_disturbance_prior_dof": 1}
     from_dict = gravcal.calibrate(raw, config=keys)

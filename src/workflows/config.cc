@@ -159,6 +159,10 @@ bool CheckConsistency(const Config& c, const std::function<bool(const char*)>& r
                         "the fit with effects is by Ceres only (solver: ceres)");
     }
   }
+  if (reads("loss_scale") && KeySet(c, "loss_scale") && o.refinement.loss == LossType::kNone &&
+      !OverriddenBy(c, "loss_scale", "loss")) {
+    return ignored("loss_scale", "with loss: none (it is the scale of a robust loss)");
+  }
   if (reads("newton_residual") && KeySet(c, "newton_residual") &&
       o.solver != RefinementSolver::kNewton && !OverriddenBy(c, "newton_residual", "solver")) {
     return ignored("newton_residual", "unless solver: newton");
