@@ -57,6 +57,10 @@ struct CommandArgs {
   std::vector<std::string> positional;
   // batch: "all" makes one unit per sensor_msgs/Imu topic of --input.
   std::string topics;
+  // compare, verify (issue 36): the significance level and, for compare,
+  // the parameter space (model or intrinsic).
+  double level = 0.01;
+  std::string space = "model";
 };
 
 int RunDemo(const CommandArgs& args);
@@ -78,6 +82,11 @@ int RunInspect(const CommandArgs& args);
 // export_command.cc: 0 written; 1 bad input or a target that cannot take the
 // calibration (nothing written).
 int RunExport(const CommandArgs& args);
+
+// compare_command.cc (issue 36): 0 consistent, 3 changed, 1 bad input or
+// nothing to test (nothing written).
+int RunCompare(const CommandArgs& args);
+int RunVerify(const CommandArgs& args);
 
 // plan_command.cc: 0 written; 1 bad input, unmet targets (nothing written).
 int RunPlan(const CommandArgs& args);

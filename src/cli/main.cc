@@ -89,6 +89,10 @@ DEFINE_double(turn_seconds, gravcal::PlanRequest().turn_seconds,
               "plan: seconds a half turn takes (shorter turns proportionally less)");
 DEFINE_string(plan, "", "simulate: plan.json from gravcal plan (its poses replace sim_scheme)");
 
+DEFINE_double(level, 0.01, "compare, verify: significance level of the test");
+DEFINE_string(space, "model",
+              "compare: model (the calibrations' own parameters, same mounting) or intrinsic "
+              "(mount-invariant, Geist and Gaitan)");
 DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
 
 namespace {
@@ -171,6 +175,17 @@ const std::vector<CommandInfo>& Commands() {
        "write a calibration for kalibr, openvins, ros, px4, ardupilot or as C source (c)",
        {"calibration", "noise", "to", "output", "output_dir"},
        gravcal::cli::RunExport},
+      {"compare",
+       "are two calibrations of the same unchanged unit? per-parameter z, joint test; exit 3 "
+       "when not: gravcal compare a.json b.json",
+       {"level", "space", "output", "input", "config"},
+       gravcal::cli::RunCompare,
+       true},
+      {"verify",
+       "test a short check session against a stored calibration: consistent, or which term "
+       "changed; exit 3 when changed",
+       {"calibration", "input", "config", "level", "output"},
+       gravcal::cli::RunVerify},
       {"help",
        "list commands, or the flags and config keys of one: gravcal help <command>",
        {},
@@ -399,6 +414,8 @@ void CopyFlags(gravcal::cli::CommandArgs* args) {
   args->topics = FLAGS_topics;
   args->to = FLAGS_to;
   args->plan = FLAGS_plan;
+  args->level = FLAGS_level;
+  args->space = FLAGS_space;
   args->plan_request.targets = FLAGS_target;
   args->plan_request.pose_set = FLAGS_pose_set;
   args->plan_request.free_candidates = FLAGS_candidates;
