@@ -125,6 +125,7 @@ int RunCalibrate(const CommandArgs& args) {
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
+  if (!CheckAcceptanceArgs(args, &error)) return Fail(error);
   PipelineInput input;
   input.source = args.input;
   input.attitudes_path = args.attitudes;
@@ -163,7 +164,7 @@ int RunCalibrate(const CommandArgs& args) {
   std::fprintf(stderr, "gravcal: %s; %s; wrote %s\n", c.message.c_str(),
                ResidualLine(c, args.config.calibration.nominal_scale).c_str(),
                args.output == "-" ? "standard output" : args.output.c_str());
-  return 0;
+  return FinishAcceptance(args, c);
 }
 
 int RunSimulate(const CommandArgs& args) {

@@ -61,6 +61,11 @@ struct CommandArgs {
   // the parameter space (model or intrinsic).
   double level = 0.01;
   std::string space = "model";
+  // calibrate: acceptance limits (YAML), the certificate's path prefix and
+  // the unit's name on it (issue 36).
+  std::string limits;
+  std::string certificate;
+  std::string unit;
 };
 
 int RunDemo(const CommandArgs& args);
@@ -87,6 +92,12 @@ int RunExport(const CommandArgs& args);
 // nothing to test (nothing written).
 int RunCompare(const CommandArgs& args);
 int RunVerify(const CommandArgs& args);
+// acceptance_command.cc: calibrate's --limits and --certificate. The check
+// before any work (the limits file parses, the certificate's files may be
+// written), and after the calibration is written: 0, 4 when a limit fails,
+// 1 on an error.
+bool CheckAcceptanceArgs(const CommandArgs& args, std::string* error);
+int FinishAcceptance(const CommandArgs& args, const Calibration& calibration);
 
 // plan_command.cc: 0 written; 1 bad input, unmet targets (nothing written).
 int RunPlan(const CommandArgs& args);

@@ -93,6 +93,10 @@ DEFINE_double(level, 0.01, "compare, verify: significance level of the test");
 DEFINE_string(space, "model",
               "compare: model (the calibrations' own parameters, same mounting) or intrinsic "
               "(mount-invariant, Geist and Gaitan)");
+DEFINE_string(limits, "", "calibrate: acceptance limits (YAML); exit 4 when one fails");
+DEFINE_string(certificate, "",
+              "calibrate: write the calibration certificate to <prefix>.json and <prefix>.html");
+DEFINE_string(unit, "", "calibrate: the unit's name on the certificate (default: the log's name)");
 DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
 
 namespace {
@@ -118,8 +122,8 @@ const std::vector<CommandInfo>& Commands() {
       {"calibrate",
        "calibrate the sensors from a log with the config's method (the config key 'method' "
        "lists them)",
-       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report",
-        "check"},
+       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report", "check",
+        "limits", "certificate", "unit"},
        gravcal::cli::RunCalibrate},
       {"apply",
        "apply every term of a calibration to a contract CSV log (streaming; - for standard "
@@ -416,6 +420,9 @@ void CopyFlags(gravcal::cli::CommandArgs* args) {
   args->plan = FLAGS_plan;
   args->level = FLAGS_level;
   args->space = FLAGS_space;
+  args->limits = FLAGS_limits;
+  args->certificate = FLAGS_certificate;
+  args->unit = FLAGS_unit;
   args->plan_request.targets = FLAGS_target;
   args->plan_request.pose_set = FLAGS_pose_set;
   args->plan_request.free_candidates = FLAGS_candidates;

@@ -1,0 +1,97 @@
+// calibrate --limits limits.yaml and --certificate PREFIX (issue 36): the
+// pass/fail verdict against acceptance limits, and the calibration
+// certificate (PREFIX.json, PREFIX.html). Exit code 4 when a limit fails
+// (the calibration and the certificate are written: they record it).
+#include <unistd.h>
+
+#include <cstdio>
+#include <ctime>
+#include <string>
+
+#include "cli/commands.h"
+#include "gravcal/io/files.h"
+#include "gravcal/workflows/acceptance.h"
+#include "gravcal/workflows/batch.h"
+#include "util/content_hash.h"
+
+namespace gravcal {
+namespace cli {
+namespace {
+
+constexpr int kOutOfLimits = 4;
+
+std::string NowUtc() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm;
+  gmtime_r(&now, &tm);
+  char buffer[32];
+  std::strftime(buffer, sizeof(buffer), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buffer;
+}
+
+// The content hash of this program's executable ("" when it cannot be read).
+std::string ProgramHash() {
+  std::string bytes, error;
+  if (!ReadFileBytes("/proc/self/exe", &bytes, &error)) return "";
+  internal::ContentHash hash;
+  hash.Add(bytes);
+  return hash.Hex();
+}
+
+std::string UnitName(const CommandArgs& args) {
+  if (!args.unit.empty()) return args.unit;
+  std::string stem = args.input.substr(args.input.find_last_of('/') + 1);
+  return stem.substr(0, stem.find_last_of('.'));
+}
+
+}  // namespace
+
+bool CheckAcceptanceArgs(const CommandArgs& args, std::string* error) {
+  if (!args.limits.empty()) {
+    AcceptanceLimits limits;
+    if (!ReadAcceptanceLimits(args.limits, &limits, error)) return false;
+  }
+  if (!args.certificate.empty()) {
+    return CheckDestinations({{args.certificate + ".json", "--certificate"},
+                              {args.certificate + ".html", "--certificate"}},
+                             {{args.input, "--input"}, {args.config_path, "--config"}}, error);
+  }
+  return true;
+}
+
+int FinishAcceptance(const CommandArgs& args, const Calibration& calibration) {
+  if (args.limits.empty() && args.certificate.empty()) return 0;
+  std::string error;
+  AcceptanceLimits limits;
+  const bool has_limits = !args.limits.empty();
+  if (has_limits && !ReadAcceptanceLimits(args.limits, &limits, &error)) return Fail(error);
+  AcceptanceResult acceptance;
+  if (has_limits) CheckAcceptance(calibration, limits, &acceptance);
+  if (!args.certificate.empty()) {
+    CertificateInfo info;
+    info.unit = UnitName(args);
+    char host[256] = {0};
+    if (gethostname(host, sizeof(host) - 1) == 0) info.station = host;
+    info.date = NowUtc();
+    info.software_version = GravcalVersion();
+    info.software_hash = ProgramHash();
+    info.input_file = args.input;
+    info.input_hash = calibration.provenance.log_hash;
+    info.config_name = args.config_path.empty() ? "(defaults)" : args.config_path;
+    if (!args.config_path.empty()) ReadFileBytes(args.config_path, &info.config_text, &error);
+    Certificate certificate;
+    if (!MakeCertificate(calibration, info, has_limits ? &limits : nullptr, &certificate, &error)) {
+      return Fail(error);
+    }
+    if (!WriteFileAtomically(args.certificate + ".json", CertificateToJson(certificate), &error) ||
+        !WriteFileAtomically(args.certificate + ".html", CertificateToHtml(certificate), &error)) {
+      return Fail(error);
+    }
+  }
+  if (!has_limits) return 0;
+  std::fprintf(stderr, "gravcal: limits %s: %s\n", args.limits.c_str(), acceptance.message.c_str());
+  return acceptance.pass ? 0 : kOutOfLimits;
+}
+
+}  // namespace cli
+}  // namespace gravcal

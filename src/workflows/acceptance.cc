@@ -1,0 +1,402 @@
+#include "gravcal/workflows/acceptance.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "gravcal/estimation/calibration_comparison.h"
+#include "gravcal/io/files.h"
+#include "io/json_helpers.h"
+#include "workflows/report/svg_plot.h"
+
+namespace gravcal {
+
+namespace {
+
+bool KeyError(const std::string& name, const std::string& key, const std::string& what,
+              std::string* error) {
+  *error = name + ": key '" + key + "': " + what;
+  return false;
+}
+
+bool ReadNumber(const YAML::Node& node, const std::string& name, const std::string& key,
+                double* value, std::string* error) {
+  try {
+    *value = node.as<double>();
+  } catch (const YAML::Exception&) {
+    return KeyError(name, key, "must be a number", error);
+  }
+  if (!std::isfinite(*value)) return KeyError(name, key, "must be finite", error);
+  return true;
+}
+
+std::string Number(double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
+  return buffer;
+}
+
+// The value, standard deviation and determined flag of every parameter the
+// calibration has, in model and intrinsic names.
+struct NamedValues {
+  std::vector<std::string> names;
+  std::vector<double> values, stds;
+  std::vector<bool> determined;
+};
+
+NamedValues CollectValues(const Calibration& c) {
+  NamedValues out;
+  for (ComparisonSpace space : {ComparisonSpace::kModel, ComparisonSpace::kIntrinsic}) {
+    ParameterVector p;
+    std::string error;
+    if (!CalibrationParameters(c, space, &p, &error)) continue;
+    for (size_t i = 0; i < p.names.size(); ++i) {
+      if (std::find(out.names.begin(), out.names.end(), p.names[i]) != out.names.end()) continue;
+      out.names.push_back(p.names[i]);
+      out.values.push_back(p.values(i));
+      out.stds.push_back(p.determined[i] ? std::sqrt(std::max(0.0, p.covariance(i, i))) : NAN);
+      out.determined.push_back(p.determined[i]);
+    }
+  }
+  return out;
+}
+
+LimitCheck Range(const std::string& name, double measured, double min, double max) {
+  LimitCheck c;
+  c.name = name;
+  c.measured = measured;
+  c.min = min;
+  c.max = max;
+  c.pass = std::isfinite(measured) && measured >= min && measured <= max;
+  if (!std::isfinite(measured)) {
+    c.why = "not determined";
+  } else if (measured < min) {
+    c.why = Number(measured) + " below min " + Number(min);
+  } else if (measured > max) {
+    c.why = Number(measured) + " above max " + Number(max);
+  }
+  return c;
+}
+
+// The unit of a parameter (accelerometer raw unit "raw").
+std::string UnitOf(const std::string& name) {
+  if (name.find(".bias_") != std::string::npos) return "raw";
+  if (name.find(".sensitivity_") != std::string::npos) return "raw per m/s^2";
+  if (name.find(".nonorth_") != std::string::npos || name.find(".rot_") != std::string::npos) {
+    return "rad";
+  }
+  if (name.rfind("gyro.", 0) == 0) return "rad/s per raw";
+  return "m/s^2 per raw";
+}
+
+// Whether a gravity error scales the parameter (matrix entries, sensitivities).
+bool ScalesWithGravity(const std::string& name) {
+  return name.find(".u_") != std::string::npos || (name.rfind("accel.m_", 0) == 0) ||
+         name.find(".sensitivity_") != std::string::npos;
+}
+
+double GravityStd(const std::string& source, double given) {
+  if (given > 0.0) return given;
+  if (source == "given") return 1e-4;
+  if (source.rfind("normal gravity", 0) == 0) return 5e-3;
+  return 0.03;
+}
+
+}  // namespace
+
+bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
+                              AcceptanceLimits* limits, std::string* error) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    *error = name + ": line " + std::to_string(e.mark.line + 1) + ": not valid YAML";
+    return false;
+  }
+  if (!root.IsMap()) {
+    *error = name + ": must be a map with 'parameters', 'residual_rms', 'gravity_std'";
+    return false;
+  }
+  AcceptanceLimits out;
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    if (key == "residual_rms") {
+      if (!ReadNumber(entry.second, name, key, &out.max_residual_rms, error)) return false;
+    } else if (key == "gravity_std") {
+      if (!ReadNumber(entry.second, name, key, &out.gravity_std, error)) return false;
+      if (!(out.gravity_std > 0.0)) return KeyError(name, key, "must be positive", error);
+    } else if (key == "parameters") {
+      if (!entry.second.IsMap()) return KeyError(name, key, "must be a map of parameters", error);
+      for (const auto& p : entry.second) {
+        ParameterLimit limit;
+        limit.name = p.first.as<std::string>();
+        const std::string base = "parameters." + limit.name;
+        if (!p.second.IsMap() || p.second.size() == 0) {
+          return KeyError(name, base, "must be a map with min, max and/or max_std", error);
+        }
+        for (const auto& field : p.second) {
+          const std::string f = field.first.as<std::string>();
+          double* target = f == "min"       ? &limit.min
+                           : f == "max"     ? &limit.max
+                           : f == "max_std" ? &limit.max_std
+                                            : nullptr;
+          if (target == nullptr) {
+            return KeyError(name, base + "." + f, "unknown (min, max, max_std)", error);
+          }
+          if (!ReadNumber(field.second, name, base + "." + f, target, error)) return false;
+        }
+        if (limit.min > limit.max) return KeyError(name, base, "min is above max", error);
+        if (!(limit.max_std > 0.0))
+          return KeyError(name, base + ".max_std", "must be positive", error);
+        out.parameters.push_back(limit);
+      }
+    } else {
+      return KeyError(name, key, "unknown (parameters, residual_rms, gravity_std)", error);
+    }
+  }
+  *limits = out;
+  return true;
+}
+
+bool ReadAcceptanceLimits(const std::string& path, AcceptanceLimits* limits, std::string* error) {
+  std::string text;
+  if (!ReadFileBytes(path, &text, error)) return false;
+  return AcceptanceLimitsFromYaml(text, path, limits, error);
+}
+
+void CheckAcceptance(const Calibration& calibration, const AcceptanceLimits& limits,
+                     AcceptanceResult* result) {
+  *result = AcceptanceResult();
+  if (!calibration.success) {
+    LimitCheck c;
+    c.name = "calibration";
+    c.why = "failed: " + calibration.message;
+    result->checks.push_back(c);
+  }
+  const NamedValues values = CollectValues(calibration);
+  for (const ParameterLimit& limit : limits.parameters) {
+    const auto it = std::find(values.names.begin(), values.names.end(), limit.name);
+    if (it == values.names.end()) {
+      LimitCheck c;
+      c.name = limit.name;
+      c.why = "not estimated by this calibration (or no covariance)";
+      result->checks.push_back(c);
+      continue;
+    }
+    const size_t i = it - values.names.begin();
+    if (std::isfinite(limit.min) || std::isfinite(limit.max)) {
+      result->checks.push_back(
+          Range(limit.name + " value", values.values[i], limit.min, limit.max));
+    }
+    if (std::isfinite(limit.max_std)) {
+      result->checks.push_back(Range(limit.name + " std", values.stds[i], 0.0, limit.max_std));
+    }
+  }
+  if (std::isfinite(limits.max_residual_rms)) {
+    result->checks.push_back(
+        Range("residual_rms", calibration.residual_refined.rms, 0.0, limits.max_residual_rms));
+  }
+  std::string failed;
+  for (const LimitCheck& c : result->checks) {
+    if (c.pass) continue;
+    result->pass = false;
+    failed += (failed.empty() ? "" : "; ") + c.name + " " + c.why;
+  }
+  result->message = result->pass ? "pass (" + std::to_string(result->checks.size()) + " limits)"
+                                 : "fail: " + failed;
+}
+
+bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
+                     const AcceptanceLimits* limits, Certificate* certificate, std::string* error) {
+  if (!c.success) {
+    *error = "no certificate for a failed calibration: " + c.message;
+    return false;
+  }
+  Certificate out;
+  out.info = info;
+  out.gravity = c.gravity;
+  out.gravity_source = c.gravity_source;
+  out.gravity_std = GravityStd(c.gravity_source, limits != nullptr ? limits->gravity_std : 0.0);
+  out.method = c.method;
+  out.residual_rms = c.residual_refined.rms;
+  // The split of the fit variance between noise of the mean and pose scatter.
+  double noise = 0.0;
+  int poses = 0;
+  const Eigen::Matrix3d m = c.accel.model.matrix();
+  for (const PositionReport& p : c.positions) {
+    const Eigen::Vector3d u = (m * (p.position.raw_mean - c.accel.model.bias)).normalized();
+    noise += u.dot(m * p.position.raw_mean_cov * m.transpose() * u);
+    ++poses;
+  }
+  const double scatter = c.accel.pose_variance.absorbed ? c.accel.pose_variance.variance : 0.0;
+  const double noise_share =
+      poses > 0 && noise + poses * scatter > 0.0 ? noise / (noise + poses * scatter) : 1.0;
+  out.notes.push_back(
+      "fit variance split between noise and pose scatter in proportion of their "
+      "mean per-pose variances (noise share " +
+      Number(noise_share) + ")");
+  out.notes.push_back(c.effects.estimates.empty()
+                          ? "temperature: not modelled by this calibration (no temperature term "
+                            "fitted); not part of the budget"
+                          : "temperature: the fitted effect terms are part of the fit variance");
+  out.notes.push_back("gravity " + Number(c.gravity) + " m/s^2 (" + c.gravity_source +
+                      "), standard uncertainty " + Number(out.gravity_std) + " m/s^2");
+  const NamedValues values = CollectValues(c);
+  if (values.names.empty()) {
+    *error = "no certificate: the calibration has no covariance (output_covariance: true)";
+    return false;
+  }
+  for (size_t i = 0; i < values.names.size(); ++i) {
+    CertificateEntry e;
+    e.name = values.names[i];
+    e.unit = UnitOf(e.name);
+    e.value = values.values[i];
+    if (values.determined[i]) {
+      const double fit = values.stds[i];
+      const bool placement = e.name.find(".rot_") != std::string::npos;
+      if (placement) {
+        e.budget.emplace_back("placement", fit);
+      } else {
+        e.budget.emplace_back("noise", fit * std::sqrt(noise_share));
+        e.budget.emplace_back("pose scatter", fit * std::sqrt(1.0 - noise_share));
+      }
+      e.budget.emplace_back("gravity", ScalesWithGravity(e.name)
+                                           ? std::fabs(e.value) * out.gravity_std / c.gravity
+                                           : 0.0);
+      double sum = 0.0;
+      for (const auto& [source, u] : e.budget) sum += u * u;
+      e.standard_uncertainty = std::sqrt(sum);
+      e.expanded_uncertainty = info.coverage_factor * e.standard_uncertainty;
+    }
+    out.parameters.push_back(e);
+  }
+  if (limits != nullptr) {
+    out.has_limits = true;
+    CheckAcceptance(c, *limits, &out.acceptance);
+  }
+  *certificate = out;
+  return true;
+}
+
+std::string CertificateToJson(const Certificate& cert) {
+  using Json = nlohmann::ordered_json;
+  using internal::JsonNumber;
+  Json j;
+  j["unit"] = cert.info.unit;
+  j["date"] = cert.info.date;
+  j["station"] = cert.info.station;
+  j["software"] = {{"name", "gravcal"},
+                   {"version", cert.info.software_version},
+                   {"hash", cert.info.software_hash}};
+  j["input"] = {{"file", cert.info.input_file}, {"hash", cert.info.input_hash}};
+  j["config"] = {{"file", cert.info.config_name}, {"text", cert.info.config_text}};
+  j["method"] = cert.method;
+  j["gravity"] = {{"value", cert.gravity},
+                  {"source", cert.gravity_source},
+                  {"standard_uncertainty", cert.gravity_std}};
+  j["residual_rms"] = JsonNumber<Json>(cert.residual_rms);
+  j["coverage_factor"] = cert.info.coverage_factor;
+  Json parameters = Json::array();
+  for (const CertificateEntry& e : cert.parameters) {
+    Json p;
+    p["name"] = e.name;
+    p["unit"] = e.unit;
+    p["value"] = JsonNumber<Json>(e.value);
+    p["standard_uncertainty"] = JsonNumber<Json>(e.standard_uncertainty);
+    p["expanded_uncertainty"] = JsonNumber<Json>(e.expanded_uncertainty);
+    Json budget = Json::array();
+    for (const auto& [source, u] : e.budget) {
+      budget.push_back({{"source", source}, {"standard_uncertainty", JsonNumber<Json>(u)}});
+    }
+    p["budget"] = budget;
+    parameters.push_back(p);
+  }
+  j["parameters"] = parameters;
+  j["notes"] = cert.notes;
+  if (cert.has_limits) {
+    Json checks = Json::array();
+    for (const LimitCheck& c : cert.acceptance.checks) {
+      checks.push_back({{"name", c.name},
+                        {"measured", JsonNumber<Json>(c.measured)},
+                        {"min", JsonNumber<Json>(c.min)},
+                        {"max", JsonNumber<Json>(c.max)},
+                        {"pass", c.pass},
+                        {"why", c.why}});
+    }
+    j["verdict"] = cert.acceptance.pass ? "pass" : "fail";
+    j["limits"] = checks;
+    j["verdict_message"] = cert.acceptance.message;
+  } else {
+    j["verdict"] = nullptr;
+    j["verdict_message"] = "no limits given";
+  }
+  return j.dump(2) + "\n";
+}
+
+std::string CertificateToHtml(const Certificate& cert) {
+  std::string h =
+      "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>Calibration certificate " +
+      internal::HtmlEscape(cert.info.unit) +
+      "</title><style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
+      "td,th{border:1px solid #999;padding:2px 8px;text-align:right}th{background:#eee}"
+      ".pass{color:#070}.fail{color:#b00}</style></head><body>\n";
+  h += "<h1>Calibration certificate</h1>\n<table id='identity'>\n";
+  const std::pair<const char*, std::string> rows[] = {
+      {"Unit", cert.info.unit},
+      {"Date (UTC)", cert.info.date},
+      {"Station", cert.info.station},
+      {"Software", "gravcal " + cert.info.software_version + " (" + cert.info.software_hash + ")"},
+      {"Input", cert.info.input_file + " (" + cert.info.input_hash + ")"},
+      {"Config", cert.info.config_name},
+      {"Method", cert.method},
+      {"Gravity", Number(cert.gravity) + " m/s^2 (" + cert.gravity_source +
+                      "), u = " + Number(cert.gravity_std) + " m/s^2"},
+      {"Residual |a| - g rms", Number(cert.residual_rms) + " m/s^2"}};
+  for (const auto& [k, v] : rows)
+    h += "<tr><th>" + std::string(k) + "</th><td>" + internal::HtmlEscape(v) + "</td></tr>\n";
+  h += "</table>\n<h2>Parameters (expanded uncertainty, coverage factor k = " +
+       Number(cert.info.coverage_factor) +
+       ")</h2>\n<table id='parameters'>\n"
+       "<tr><th>parameter</th><th>unit</th><th>value</th><th>u (noise)</th><th>u (pose "
+       "scatter / placement)</th><th>u (gravity)</th><th>u_c</th><th>U = k u_c</th></tr>\n";
+  for (const CertificateEntry& e : cert.parameters) {
+    h += "<tr class='parameter'><td>" + internal::HtmlEscape(e.name) + "</td><td>" +
+         internal::HtmlEscape(e.unit) + "</td><td>" + Number(e.value) + "</td>";
+    if (!std::isfinite(e.standard_uncertainty)) {
+      h += "<td colspan='5'>not determined by this session</td></tr>\n";
+      continue;
+    }
+    std::string noise = "", scatter = "", gravity = "";
+    for (const auto& [source, u] : e.budget) {
+      (source == "noise" ? noise : source == "gravity" ? gravity : scatter) = Number(u);
+    }
+    h += "<td>" + noise + "</td><td>" + scatter + "</td><td>" + gravity + "</td><td>" +
+         Number(e.standard_uncertainty) + "</td><td>" + Number(e.expanded_uncertainty) +
+         "</td></tr>\n";
+  }
+  h += "</table>\n<ul>\n";
+  for (const std::string& n : cert.notes) h += "<li>" + internal::HtmlEscape(n) + "</li>\n";
+  h += "</ul>\n<h2>Verdict</h2>\n";
+  if (cert.has_limits) {
+    h += "<p id='verdict' class='" + std::string(cert.acceptance.pass ? "pass" : "fail") + "'>" +
+         (cert.acceptance.pass ? "PASS" : "FAIL") + ": " +
+         internal::HtmlEscape(cert.acceptance.message) +
+         "</p>\n<table id='limits'><tr><th>limit</th><th>measured</th><th>min</th><th>max</th>"
+         "<th>result</th></tr>\n";
+    for (const LimitCheck& c : cert.acceptance.checks) {
+      h += "<tr><td>" + internal::HtmlEscape(c.name) + "</td><td>" + Number(c.measured) +
+           "</td><td>" + Number(c.min) + "</td><td>" + Number(c.max) + "</td><td class='" +
+           (c.pass ? "pass'>pass" : "fail'>fail: " + internal::HtmlEscape(c.why)) + "</td></tr>\n";
+    }
+    h += "</table>\n";
+  } else {
+    h += "<p id='verdict'>no limits given</p>\n";
+  }
+  h += "<h2>Configuration</h2>\n<pre>" + internal::HtmlEscape(cert.info.config_text) +
+       "</pre>\n</body></html>\n";
+  return h;
+}
+
+}  // namespace gravcal

@@ -1,0 +1,150 @@
+// Issue 36: calibrate --limits and --certificate. Limits on a value, on a
+// sigma and on the residual pass or fail with the limit named (exit 4 when
+// one fails, the calibration and certificate still written); a bad limits
+// file is one line naming the key, nothing written. The certificate's
+// uncertainty budget sums (in squares) to the reported standard
+// uncertainty, and k = 2 times it is the expanded one; the HTML renders in
+// headless Chromium (skipped when there is none).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cli_runner.h"
+#include "test_util.h"
+
+namespace gravcal {
+namespace {
+
+using testing_util::CliResult;
+using testing_util::FileExists;
+using testing_util::RunCli;
+using testing_util::ScratchDir;
+using testing_util::Slurp;
+
+const std::string kConfig = testing_util::SourceDir() + "/configs/twelve_position.yaml";
+
+void WriteText(const std::string& path, const std::string& text) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fwrite(text.data(), 1, text.size(), f);
+  std::fclose(f);
+}
+
+// A chromium on PATH, or "".
+std::string Chromium() {
+  for (const char* p : {"/usr/bin/chromium", "/usr/bin/chromium-browser"}) {
+    if (access(p, X_OK) == 0) return p;
+  }
+  return "";
+}
+
+TEST(Acceptance, LimitsPassFailAndTheCertificate) {
+  ScratchDir dir;
+  CliResult r =
+      RunCli({"simulate", "--config", kConfig, "--seed", "4", "--output-dir", dir / "sim"}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string input = dir / "sim/raw.csv";
+  // Limits wide around this unit (raw counts, ~0.0006 m/s^2 per count).
+  WriteText(dir / "pass.yaml",
+            "parameters:\n"
+            "  accel.u_xx: {min: 0.0005, max: 0.0007, max_std: 0.00001}\n"
+            "  accel.bias_z: {min: -2000, max: 2000}\n"
+            "  accel.sensitivity_y: {max_std: 100}\n"
+            "residual_rms: 0.01\n"
+            "gravity_std: 0.0001\n");
+  r = RunCli({"calibrate", "--config", kConfig, "--input", input, "--output", dir / "a.json",
+              "--limits", dir / "pass.yaml", "--certificate", dir / "cert", "--unit", "SN-0042"},
+             dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("pass (5 limits)"), std::string::npos) << r.err;
+  const nlohmann::json cert = nlohmann::json::parse(Slurp(dir / "cert.json"));
+  EXPECT_EQ(cert["verdict"], "pass");
+  EXPECT_EQ(cert["unit"], "SN-0042");
+  EXPECT_EQ(cert["software"]["hash"].get<std::string>().size(), 32u);
+  EXPECT_EQ(cert["input"]["hash"].get<std::string>().size(), 32u);
+  EXPECT_DOUBLE_EQ(cert["gravity"]["standard_uncertainty"].get<double>(), 0.0001);
+  EXPECT_DOUBLE_EQ(cert["coverage_factor"].get<double>(), 2.0);
+  EXPECT_NE(cert["config"]["text"].get<std::string>().find("method"), std::string::npos);
+  int checked = 0;
+  for (const nlohmann::json& p : cert["parameters"]) {
+    if (p["standard_uncertainty"].is_null()) continue;
+    double sum = 0.0;
+    for (const nlohmann::json& b : p["budget"]) {
+      sum += std::pow(b["standard_uncertainty"].get<double>(), 2);
+    }
+    const double u = p["standard_uncertainty"].get<double>();
+    EXPECT_NEAR(std::sqrt(sum), u, 1e-12 * u) << p["name"];
+    EXPECT_NEAR(p["expanded_uncertainty"].get<double>(), 2.0 * u, 1e-12 * u) << p["name"];
+    ++checked;
+  }
+  EXPECT_GE(checked, 9);
+
+  // A planted out-of-limit unit: the scale limit below this unit's, and a
+  // sigma limit it cannot meet; both named, exit 4, files written.
+  WriteText(dir / "fail.yaml",
+            "parameters:\n"
+            "  accel.u_xx: {min: 0.0007, max: 0.0008}\n"
+            "  accel.bias_x: {max_std: 1e-9}\n"
+            "  accel.u_xy: {max: 1.0}\n");
+  r = RunCli({"calibrate", "--config", kConfig, "--input", input, "--output", dir / "b.json",
+              "--limits", dir / "fail.yaml", "--certificate", dir / "cert_fail"},
+             dir);
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("accel.u_xx value"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("accel.bias_x std"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("accel.u_xy"), std::string::npos) << r.err;
+  EXPECT_TRUE(FileExists(dir / "b.json"));
+  const nlohmann::json failed = nlohmann::json::parse(Slurp(dir / "cert_fail.json"));
+  EXPECT_EQ(failed["verdict"], "fail");
+
+  // The certificate in a real browser: the parameters, and the verdict.
+  if (Chromium().empty()) GTEST_SKIP() << "no Chromium: the certificate is not rendered";
+  const std::string command = "timeout 60 " + Chromium() +
+                              " --headless --no-sandbox --disable-gpu --dump-dom file://" +
+                              dir / "cert_fail.html" + " 2>/dev/null";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string dom;
+  char buffer[4096];
+  size_t n;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) dom.append(buffer, n);
+  ASSERT_EQ(pclose(pipe), 0);
+  EXPECT_NE(dom.find("id=\"verdict\" class=\"fail\""), std::string::npos) << dom.substr(0, 500);
+  EXPECT_EQ(testing_util::Count(dom, "class=\"parameter\""), cert["parameters"].size());
+}
+
+TEST(Acceptance, BadLimitsFileIsOneLineAndNothingWritten) {
+  ScratchDir dir;
+  CliResult r =
+      RunCli({"simulate", "--config", kConfig, "--seed", "5", "--output-dir", dir / "sim"}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const struct {
+    const char* text;
+    const char* says;
+  } cases[] = {
+      {"parameters:\n  accel.u_xx: {min: low}\n", "parameters.accel.u_xx.min"},
+      {"parameters:\n  accel.u_xx: {mean: 1}\n", "parameters.accel.u_xx.mean"},
+      {"parameters:\n  accel.u_xx: {min: 2, max: 1}\n", "min is above max"},
+      {"residual: 0.1\n", "'residual'"},
+      {"parameters: [1, 2\n", "not valid YAML"},
+  };
+  for (const auto& c : cases) {
+    WriteText(dir / "bad.yaml", c.text);
+    r = RunCli({"calibrate", "--config", kConfig, "--input", dir / "sim/raw.csv", "--output",
+                dir / "out.json", "--limits", dir / "bad.yaml", "--certificate", dir / "cert"},
+               dir);
+    EXPECT_EQ(r.exit_code, 1) << c.text;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
+    EXPECT_EQ(testing_util::Count(r.err, "\n"), 1u) << r.err;
+    EXPECT_FALSE(FileExists(dir / "out.json"));
+    EXPECT_FALSE(FileExists(dir / "cert.json"));
+  }
+}
+
+}  // namespace
+}  // namespace gravcal
