@@ -101,6 +101,20 @@ TEST(CompareCli, ExitCodesShapeAndTheNamedParameter) {
              dir);
   EXPECT_EQ(r.exit_code, 3) << r.err << r.out;
   EXPECT_NE(r.out.find("changed at level"), std::string::npos) << r.out;
+
+  // calibrate --store files the result; history lists it.
+  r = RunCli({"calibrate", "--config", kTwelve, "--input", dir / "a/raw.csv", "--output",
+              dir / "stored.json", "--store", dir / "store", "--unit", "SN-7"},
+             dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunCli({"history", "SN-7", "--store", dir / "store", "--output", dir / "history.json"}, dir);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(Slurp(dir / "history.json"));
+  EXPECT_EQ(j["calibrations"].size(), 1u);
+  EXPECT_EQ(j["parameters"].size(), 9u);
+  r = RunCli({"history", "SN-8", "--store", dir / "store"}, dir);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("SN-8"), std::string::npos) << r.err;
 }
 
 TEST(CompareCli, BadInputIsOneLineAndWritesNothing) {

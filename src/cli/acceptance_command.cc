@@ -12,6 +12,7 @@
 #include "gravcal/io/files.h"
 #include "gravcal/workflows/acceptance.h"
 #include "gravcal/workflows/batch.h"
+#include "gravcal/workflows/calibration_store.h"
 #include "util/content_hash.h"
 
 namespace gravcal {
@@ -20,14 +21,7 @@ namespace {
 
 constexpr int kOutOfLimits = 4;
 
-std::string NowUtc() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm;
-  gmtime_r(&now, &tm);
-  char buffer[32];
-  std::strftime(buffer, sizeof(buffer), "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buffer;
-}
+std::string NowUtc() { return FormatUtcDate(std::time(nullptr)); }
 
 // The content hash of this program's executable ("" when it cannot be read).
 std::string ProgramHash() {
@@ -60,8 +54,18 @@ bool CheckAcceptanceArgs(const CommandArgs& args, std::string* error) {
 }
 
 int FinishAcceptance(const CommandArgs& args, const Calibration& calibration) {
-  if (args.limits.empty() && args.certificate.empty()) return 0;
   std::string error;
+  if (!args.store.empty()) {
+    // The stored copy always has the covariance: history and compare need it.
+    const std::string date = NowUtc();
+    if (!FileCalibration(args.store, UnitName(args), date, CalibrationToJson(calibration, true),
+                         &error)) {
+      return Fail(error);
+    }
+    std::fprintf(stderr, "gravcal: filed as unit '%s', %s, in %s\n", UnitName(args).c_str(),
+                 date.c_str(), args.store.c_str());
+  }
+  if (args.limits.empty() && args.certificate.empty()) return 0;
   AcceptanceLimits limits;
   const bool has_limits = !args.limits.empty();
   if (has_limits && !ReadAcceptanceLimits(args.limits, &limits, &error)) return Fail(error);

@@ -66,6 +66,8 @@ struct CommandArgs {
   std::string limits;
   std::string certificate;
   std::string unit;
+  // calibrate: file the result in this calibration store; history: read it.
+  std::string store;
 };
 
 int RunDemo(const CommandArgs& args);
@@ -98,6 +100,8 @@ int RunVerify(const CommandArgs& args);
 // 1 on an error.
 bool CheckAcceptanceArgs(const CommandArgs& args, std::string* error);
 int FinishAcceptance(const CommandArgs& args, const Calibration& calibration);
+// history_command.cc: 0 listed; 1 bad input.
+int RunHistory(const CommandArgs& args);
 
 // plan_command.cc: 0 written; 1 bad input, unmet targets (nothing written).
 int RunPlan(const CommandArgs& args);

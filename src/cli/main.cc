@@ -97,6 +97,9 @@ DEFINE_string(limits, "", "calibrate: acceptance limits (YAML); exit 4 when one 
 DEFINE_string(certificate, "",
               "calibrate: write the calibration certificate to <prefix>.json and <prefix>.html");
 DEFINE_string(unit, "", "calibrate: the unit's name on the certificate (default: the log's name)");
+DEFINE_string(store, "",
+              "calibrate: file the calibration in this store (a folder, per unit and date); "
+              "history: the store to read");
 DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
 
 namespace {
@@ -123,7 +126,7 @@ const std::vector<CommandInfo>& Commands() {
        "calibrate the sensors from a log with the config's method (the config key 'method' "
        "lists them)",
        {"input", "config", "output", "attitudes", "segments", "history", "noise", "report", "check",
-        "limits", "certificate", "unit"},
+        "limits", "certificate", "unit", "store"},
        gravcal::cli::RunCalibrate},
       {"apply",
        "apply every term of a calibration to a contract CSV log (streaming; - for standard "
@@ -190,6 +193,13 @@ const std::vector<CommandInfo>& Commands() {
        "changed; exit 3 when changed",
        {"calibration", "input", "config", "level", "output"},
        gravcal::cli::RunVerify},
+      {"history",
+       "a unit's calibrations in a store: each parameter's trend, a drift test, compare "
+       "between consecutive ones: gravcal history UNIT --store DIR",
+       {"store", "level", "output"},
+       gravcal::cli::RunHistory,
+       true,
+       false},
       {"help",
        "list commands, or the flags and config keys of one: gravcal help <command>",
        {},
@@ -423,6 +433,7 @@ void CopyFlags(gravcal::cli::CommandArgs* args) {
   args->limits = FLAGS_limits;
   args->certificate = FLAGS_certificate;
   args->unit = FLAGS_unit;
+  args->store = FLAGS_store;
   args->plan_request.targets = FLAGS_target;
   args->plan_request.pose_set = FLAGS_pose_set;
   args->plan_request.free_candidates = FLAGS_candidates;
