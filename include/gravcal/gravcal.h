@@ -30,6 +30,8 @@
 
 // estimation
 #include "gravcal/estimation/allan_deviation.h"
+#include "gravcal/estimation/calibration_comparison.h"
+#include "gravcal/estimation/check_session.h"
 #include "gravcal/estimation/coarse_fit.h"
 #include "gravcal/estimation/error_state_layout.h"
 #include "gravcal/estimation/experiment_design.h"
@@ -48,6 +50,8 @@
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_export.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/calibration_uncertainty_io.h"
+#include "gravcal/io/comparison_io.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/imu_stream.h"
 #include "gravcal/io/log_reader.h"
@@ -71,9 +75,12 @@
 #include "gravcal/methods/twelve_position.h"
 
 // workflows
+#include "gravcal/workflows/acceptance.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/batch_manifest.h"
 #include "gravcal/workflows/batch_scheduler_shard.h"
+#include "gravcal/workflows/calibration_store.h"
+#include "gravcal/workflows/compare.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/discovery.h"
 #include "gravcal/workflows/discovery_report.h"

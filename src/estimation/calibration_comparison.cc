@@ -71,7 +71,10 @@ void AppendSensor(const std::string& prefix, const std::vector<std::string>& nam
   std::vector<double> values;
   for (size_t i = 0; i < names.size(); ++i) {
     double v = 0.0;
-    if (!ModelValue(names[i], bias, upper, matrix, rotation, &v)) continue;
+    if (!ModelValue(names[i], bias, upper, matrix, rotation, &v)) {
+      out->left_out.push_back(prefix + names[i]);
+      continue;
+    }
     kept.push_back(static_cast<int>(i));
     values.push_back(v);
   }
@@ -362,6 +365,14 @@ bool CompareParameters(const ParameterVector& a, const ParameterVector& b,
   for (const std::string& n : b.names) {
     if (std::find(a.names.begin(), a.names.end(), n) == a.names.end()) {
       result->not_compared.push_back(n);
+    }
+  }
+  for (const ParameterVector* p : {&a, &b}) {
+    for (const std::string& n : p->left_out) {
+      if (std::find(result->not_compared.begin(), result->not_compared.end(), n) ==
+          result->not_compared.end()) {
+        result->not_compared.push_back(n);
+      }
     }
   }
   const int m = static_cast<int>(pairs.size());

@@ -75,6 +75,9 @@ struct ParameterVector {
   std::vector<bool> determined;
   // Why there is no covariance, or "" (for the messages).
   std::string note;
+  // Names in the calibration's covariance the space has no value for
+  // (effect terms, g-sensitivity): compare lists them as not compared.
+  std::vector<std::string> left_out;
 };
 
 // The parameters of `calibration` in `space`. The accelerometer's part needs
