@@ -6,12 +6,16 @@
 // uncertainty, and k = 2 times it is the expanded one; the HTML renders in
 // headless Chromium (skipped when there is none).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "cli_runner.h"
 #include "test_util.h"
@@ -115,6 +119,51 @@ TEST(Acceptance, LimitsPassFailAndTheCertificate) {
   ASSERT_EQ(pclose(pipe), 0);
   EXPECT_NE(dom.find("id=\"verdict\" class=\"fail\""), std::string::npos) << dom.substr(0, 500);
   EXPECT_EQ(testing_util::Count(dom, "class=\"parameter\""), cert["parameters"].size());
+}
+
+// A batch of four simulated units (each seed draws its own truth) with a
+// limit on the z bias set between them: the units beyond it are counted and
+// named, the others pass, limits.csv says which, exit 4.
+TEST(Acceptance, BatchCountsAndNamesOutOfLimitUnits) {
+  ScratchDir dir;
+  ASSERT_EQ(mkdir((dir / "units").c_str(), 0755), 0);
+  for (int k = 1; k <= 4; ++k) {
+    const std::string sim = dir / ("sim" + std::to_string(k));
+    CliResult r = RunCli(
+        {"simulate", "--config", kConfig, "--seed", std::to_string(k), "--output-dir", sim}, dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_EQ(std::rename((sim + "/raw.csv").c_str(),
+                          (dir / ("units/u" + std::to_string(k) + ".csv")).c_str()),
+              0);
+  }
+  CliResult r = RunCli({"batch", "--input-dir", dir / "units", "--config", kConfig, "--output-dir",
+                        dir / "out", "--threads", "1"},
+                       dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The limit: below the median of the units' z biases (planted: the upper
+  // half is out of limits).
+  std::vector<std::pair<double, std::string>> bias;
+  for (int k = 1; k <= 4; ++k) {
+    const std::string unit = "u" + std::to_string(k);
+    const nlohmann::json j = nlohmann::json::parse(Slurp(dir / ("out/" + unit + ".json")));
+    bias.emplace_back(j["accel"]["bias"][2].get<double>(), unit);
+  }
+  std::sort(bias.begin(), bias.end());
+  const double limit = 0.5 * (bias[1].first + bias[2].first);
+  WriteText(dir / "limits.yaml", "parameters:\n  accel.bias_z: {max: " + std::to_string(limit) +
+                                     "}\nresidual_rms: 0.01\n");
+  r = RunCli({"batch", "--input-dir", dir / "units", "--config", kConfig, "--output-dir",
+              dir / "out", "--threads", "1", "--limits", dir / "limits.yaml"},
+             dir);
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("2 of 4 calibrated units pass; fail: "), std::string::npos) << r.err;
+  const std::string csv = Slurp(dir / "out/limits.csv");
+  for (int i = 0; i < 4; ++i) {
+    const bool out = i >= 2;
+    EXPECT_NE(csv.find(bias[i].second + (out ? ",fail," : ",pass,")), std::string::npos) << csv;
+    EXPECT_EQ(r.err.find(bias[i].second + " (accel.bias_z value") != std::string::npos, out)
+        << r.err;
+  }
 }
 
 TEST(Acceptance, BadLimitsFileIsOneLineAndNothingWritten) {

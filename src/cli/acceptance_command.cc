@@ -2,6 +2,7 @@
 // pass/fail verdict against acceptance limits, and the calibration
 // certificate (PREFIX.json, PREFIX.html). Exit code 4 when a limit fails
 // (the calibration and the certificate are written: they record it).
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "gravcal/io/calibration_uncertainty_io.h"
 #include "gravcal/io/files.h"
 #include "gravcal/workflows/acceptance.h"
 #include "gravcal/workflows/batch.h"
@@ -95,6 +97,41 @@ int FinishAcceptance(const CommandArgs& args, const Calibration& calibration) {
   if (!has_limits) return 0;
   std::fprintf(stderr, "gravcal: limits %s: %s\n", args.limits.c_str(), acceptance.message.c_str());
   return acceptance.pass ? 0 : kOutOfLimits;
+}
+
+int FinishBatchAcceptance(const CommandArgs& args, const std::vector<std::string>& units,
+                          int code) {
+  if (args.limits.empty()) return code;
+  std::string error;
+  AcceptanceLimits limits;
+  if (!ReadAcceptanceLimits(args.limits, &limits, &error)) return Fail(error);
+  std::string csv = "unit,verdict,failed\n";
+  std::string failed_units;
+  int checked = 0, failed = 0;
+  for (const std::string& unit : units) {
+    const std::string path = args.output_dir + "/" + unit + ".json";
+    Calibration c;
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0) continue;  // the unit failed: the batch says why
+    if (!ReadCalibrationUncertainty(path, &c, nullptr, &error)) return Fail(error);
+    AcceptanceResult result;
+    CheckAcceptance(c, limits, &result);
+    ++checked;
+    std::string why;
+    for (const LimitCheck& check : result.checks) {
+      if (!check.pass) why += (why.empty() ? "" : "; ") + check.name + " " + check.why;
+    }
+    csv += unit + "," + (result.pass ? "pass" : "fail") + ",\"" + why + "\"\n";
+    if (!result.pass) {
+      ++failed;
+      failed_units += (failed_units.empty() ? "" : ", ") + unit + " (" + why + ")";
+    }
+  }
+  if (!WriteFileAtomically(args.output_dir + "/limits.csv", csv, &error)) return Fail(error);
+  std::fprintf(stderr, "gravcal: limits %s: %d of %d calibrated units pass%s%s\n",
+               args.limits.c_str(), checked - failed, checked, failed > 0 ? "; fail: " : "",
+               failed_units.c_str());
+  return code != 0 ? code : (failed > 0 ? kOutOfLimits : 0);
 }
 
 }  // namespace cli

@@ -561,6 +561,7 @@ int RunBatch(const CommandArgs& args) {
   BatchSettings settings;
   std::string error;
   if (!ReadBatchSettings(args, &settings, &error)) return Fail(error);
+  if (!CheckAcceptanceArgs(args, &error)) return Fail(error);
   ShardUnits shard;
   if (!ListShardUnits(args, settings.shard, &shard, &error)) return Fail(error);
   if (!CheckUnitsAgainstOutputs(args, shard.units, &error)) return Fail(error);
@@ -606,7 +607,9 @@ int RunBatch(const CommandArgs& args) {
   }
   PrintBatchLine(settings, shard, statistics, counts, elapsed, stop, store.out());
   if (!stop.empty()) return Fail("batch " + stop);
-  return ExitCode(statistics);
+  std::vector<std::string> ids;
+  for (const BatchUnit& u : shard.units) ids.push_back(u.id);
+  return FinishBatchAcceptance(args, ids, ExitCode(statistics));
 }
 
 int RunMergeSummaries(const CommandArgs& args) {

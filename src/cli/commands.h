@@ -100,6 +100,11 @@ int RunVerify(const CommandArgs& args);
 // 1 on an error.
 bool CheckAcceptanceArgs(const CommandArgs& args, std::string* error);
 int FinishAcceptance(const CommandArgs& args, const Calibration& calibration);
+// batch --limits: each calibrated unit's <output-dir>/<unit>.json against
+// the limits, <output-dir>/limits.csv (unit, verdict, failed), the count and
+// the failing units named on stderr; returns `code` when it is not 0, else 4
+// when a unit fails.
+int FinishBatchAcceptance(const CommandArgs& args, const std::vector<std::string>& units, int code);
 // history_command.cc: 0 listed; 1 bad input.
 int RunHistory(const CommandArgs& args);
 

@@ -156,7 +156,8 @@ const std::vector<CommandInfo>& Commands() {
        "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
        "statistics)",
        {"manifest", "input_dir", "pattern", "config", "output_dir", "threads", "shard",
-        "outlier_sigmas", "outlier_min_units", "input", "topics", "report", "unit_timeout"},
+        "outlier_sigmas", "outlier_min_units", "input", "topics", "report", "unit_timeout",
+        "limits"},
        gravcal::cli::RunBatch},
       {"merge-summaries",
        "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "

@@ -139,6 +139,14 @@ bool CalibrationUncertaintyFromJson(const std::string& text, const std::string& 
       j["gravity"]["source"].is_string()) {
     out.gravity_source = j["gravity"]["source"].get<std::string>();
   }
+  // residual.after.rms: |a| - g rms of the refined model (acceptance limits).
+  if (j.contains("residual") && j["residual"].is_object() && j["residual"].contains("after") &&
+      j["residual"]["after"].is_object() && j["residual"]["after"].contains("rms") &&
+      j["residual"]["after"]["rms"].is_number()) {
+    out.residual_refined.rms = j["residual"]["after"]["rms"].get<double>();
+  } else {
+    out.residual_refined.rms = NAN;
+  }
   const json& accel = j["accel"];
   if (!ReadStd(accel, name, "accel", &out.accel.bias_std, &out.accel.matrix_std, error) ||
       !ReadCovariance(accel, name, "accel", &out.accel.covariance, &out.accel.covariance_names,

@@ -18,7 +18,8 @@ namespace gravcal {
 
 // Fills calibration->accel (model, bias_std, matrix_std, covariance and its
 // names), ->gyro (the same, estimated when the file has "gyro"), ->gravity,
-// ->method and ->provenance; `loaded` (may be null) receives what
+// ->method, ->provenance and ->residual_refined.rms (residual.after.rms, NaN
+// when absent); `loaded` (may be null) receives what
 // ReadCalibrationJson reads. Errors are one line naming the file and key.
 bool CalibrationUncertaintyFromJson(const std::string& text, const std::string& name,
                                     Calibration* calibration, LoadedCalibration* loaded,
