@@ -228,7 +228,7 @@ std::vector<Position> CheckSession(const AccelModel& truth, uint64_t seed) {
 // against its own stored calibration of `truth` (a new seed each: the
 // claims are over both the check's and the stored calibration's noise).
 CheckRates RunChecks(const AccelModel& truth, const std::string& name, double k, int sessions,
-                     uint64_t first_seed, bool at_mdc) {
+                     uint64_t first_seed, bool at_mdc, int samples = kCheckSamples) {
   CheckRates rates;
   const Calibration first = CalibrateTruth(truth, first_seed + 500000);
   int index = -1;
@@ -293,6 +293,37 @@ TEST(Verify, PowerAtTheMinimalDetectableChangeIsTheClaimedOne) {
     EXPECT_GE(r.alarms, testing_util::RequiredSuccesses(200, 0.9)) << name;
     EXPECT_LE(r.alarms, 197) << name;
   }
+}
+
+// plan --verify: the designed hold gives the stated power at the target
+// (10 stored sigmas) for the parameter that needs the longest hold.
+TEST(Verify, DesignedCheckSessionHasThePowerItStates) {
+  const Calibration stored = CalibrateTruth(CompareTruth(), 700);
+  CheckDesignOptions options;
+  // kNoise per sample at 100 Hz: density kNoise / sqrt(100).
+  options.noise_density = kNoise / 10.0;
+  CheckDesign design;
+  ASSERT_TRUE(DesignCheckSession(stored, options, &design)) << design.message;
+  ASSERT_TRUE(design.met) << design.message;
+  size_t binding = 0;
+  for (size_t j = 0; j < design.names.size(); ++j) {
+    EXPECT_LE(design.mdc_sigmas[j], 10.0) << design.names[j];
+    if (design.mdc_sigmas[j] > design.mdc_sigmas[binding]) binding = j;
+  }
+  EXPECT_GT(design.mdc_sigmas[binding], 9.5);
+  const int samples = static_cast<int>(std::ceil(design.hold_seconds * 100.0));
+  std::printf("designed hold %.2f s (%d samples), binding %s\n", design.hold_seconds, samples,
+              design.names[binding].c_str());
+  const CheckRates r =
+      RunChecks(CompareTruth(), design.names[binding].substr(6), 10.0, 200, 50000, false, samples);
+  EXPECT_GE(r.alarms, testing_util::RequiredSuccesses(200, 0.9));
+  // An impossible target is said, naming the parameters short of it.
+  options.target_sigmas = 0.5;
+  ASSERT_TRUE(DesignCheckSession(stored, options, &design));
+  EXPECT_FALSE(design.met);
+  EXPECT_FALSE(design.short_of_target.empty());
+  options.noise_density = 0.0;
+  EXPECT_FALSE(DesignCheckSession(stored, options, &design));
 }
 
 TEST(Verify, BadInputIsRefused) {

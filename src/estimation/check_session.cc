@@ -138,4 +138,99 @@ bool VerifyCheckSession(const std::vector<Position>& positions, const Calibratio
   return true;
 }
 
+bool CheckDesignOptions::IsValid(std::string* error) const {
+  if (!(noise_density > 0.0) || !std::isfinite(noise_density)) {
+    *error = "the accelerometer noise density must be positive (m/s^2/sqrt(Hz))";
+    return false;
+  }
+  if (!(target_sigmas > 0.0) || !(max_hold_seconds > 0.0)) {
+    *error = "the target (stored sigmas) and the longest hold must be positive";
+    return false;
+  }
+  return comparison.IsValid(error);
+}
+
+namespace {
+
+// MDC / stored sigma of every tested parameter at `hold` seconds.
+bool MdcAtHold(const Calibration& stored, const CheckDesignOptions& options,
+               const std::vector<Eigen::Vector3d>& directions, double hold,
+               CheckSessionResult* result) {
+  const AccelModel& model = stored.accel.model;
+  const Eigen::Matrix3d minv = model.matrix().inverse();
+  const double var = options.noise_density * options.noise_density / hold;
+  std::vector<Position> poses;
+  for (const Eigen::Vector3d& d : directions) {
+    Position p;
+    p.raw_mean = model.Invert(stored.gravity * d.normalized());
+    p.raw_mean_cov = var * minv * minv.transpose();
+    p.t_end = hold;
+    poses.push_back(p);
+  }
+  return VerifyCheckSession(poses, stored, options.comparison, result);
+}
+
+}  // namespace
+
+bool DesignCheckSession(const Calibration& stored, const CheckDesignOptions& options,
+                        CheckDesign* design) {
+  CHECK(design != nullptr);
+  *design = CheckDesign();
+  if (!options.IsValid(&design->message)) return false;
+  std::vector<Eigen::Vector3d> directions = options.directions;
+  if (directions.empty()) {
+    const double c = 1.0 / std::sqrt(3.0);
+    directions = {{c, c, c}, {c, -c, -c}, {-c, c, -c}, {-c, -c, c}};
+  }
+  // Worst MDC in stored sigmas at a hold (and the per-parameter values).
+  auto worst = [&](double hold, CheckDesign* d) -> double {
+    CheckSessionResult r;
+    if (!MdcAtHold(stored, options, directions, hold, &r)) {
+      d->message = r.comparison.message;
+      return NAN;
+    }
+    d->names.clear();
+    d->mdc_sigmas.clear();
+    d->short_of_target.clear();
+    double w = 0.0;
+    for (const ParameterDifference& p : r.comparison.parameters) {
+      d->names.push_back(p.name);
+      d->mdc_sigmas.push_back(NAN);
+    }
+    // The reference sigmas are the stored ones (sqrt of C_p's diagonal).
+    const std::vector<std::string>& names = stored.accel.covariance_names;
+    for (size_t j = 0; j < d->names.size(); ++j) {
+      for (size_t k = 0; k < names.size(); ++k) {
+        if ("accel." + names[k] != d->names[j]) continue;
+        const double sigma = std::sqrt(stored.accel.covariance(k, k));
+        d->mdc_sigmas[j] = r.comparison.minimal_detectable_change[j] / sigma;
+      }
+      if (!(d->mdc_sigmas[j] <= options.target_sigmas)) d->short_of_target.push_back(d->names[j]);
+      w = std::max(w, std::isfinite(d->mdc_sigmas[j]) ? d->mdc_sigmas[j] : INFINITY);
+    }
+    return w;
+  };
+  const double at_max = worst(options.max_hold_seconds, design);
+  if (std::isnan(at_max)) return false;
+  if (at_max > options.target_sigmas) {
+    design->hold_seconds = options.max_hold_seconds;
+    design->message = "no hold up to " + std::to_string(options.max_hold_seconds) +
+                      " s reaches the target for every parameter";
+    return true;
+  }
+  double lo = 0.0, hi = options.max_hold_seconds;
+  while (hi - lo > 0.01 * hi) {
+    const double mid = 0.5 * (lo + hi);
+    CheckDesign probe;
+    (worst(mid, &probe) <= options.target_sigmas ? hi : lo) = mid;
+  }
+  worst(hi, design);
+  design->met = true;
+  design->hold_seconds = hi;
+  design->message = std::to_string(directions.size()) + " poses held " + std::to_string(hi) +
+                    " s each detect a change of " + std::to_string(options.target_sigmas) +
+                    " stored sigmas in any one parameter";
+  return true;
+}
+
 }  // namespace gravcal

@@ -24,6 +24,8 @@
 #ifndef GRAVCAL_ESTIMATION_CHECK_SESSION_H_
 #define GRAVCAL_ESTIMATION_CHECK_SESSION_H_
 
+#include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "gravcal/core/calibration.h"
@@ -53,6 +55,40 @@ struct CheckSessionResult {
 // calibration without covariance.
 bool VerifyCheckSession(const std::vector<Position>& positions, const Calibration& stored,
                         const ComparisonOptions& options, CheckSessionResult* result);
+
+// The shortest check session with a given power (plan --verify): poses
+// along `directions` (body frame; default the four tetrahedral directions),
+// each held `hold` seconds, white accelerometer noise of density
+// `noise_density` (m/s^2/sqrt(Hz): the variance of a pose mean is N^2 / hold
+// per axis). The hold is the shortest (bisection, to 1 %) at which every
+// tested parameter's minimal detectable change is at most `target_sigmas`
+// stored sigmas, with `comparison.power` at `comparison.level`. The stored
+// calibration's own uncertainty sets a floor no hold goes below: a
+// parameter that cannot reach the target within max_hold_seconds is named.
+struct CheckDesignOptions {
+  std::vector<Eigen::Vector3d> directions;
+  double noise_density = 0.0;
+  double target_sigmas = 10.0;
+  double max_hold_seconds = 600.0;
+  ComparisonOptions comparison;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct CheckDesign {
+  bool met = false;
+  double hold_seconds = NAN;
+  // Per tested parameter at that hold: its minimal detectable change in
+  // stored sigmas.
+  std::vector<std::string> names;
+  std::vector<double> mdc_sigmas;
+  // Parameters that do not reach the target at max_hold_seconds.
+  std::vector<std::string> short_of_target;
+  std::string message;
+};
+
+bool DesignCheckSession(const Calibration& stored, const CheckDesignOptions& options,
+                        CheckDesign* design);
 
 }  // namespace gravcal
 
