@@ -102,6 +102,25 @@ TEST(CompareCli, ExitCodesShapeAndTheNamedParameter) {
   EXPECT_EQ(r.exit_code, 3) << r.err << r.out;
   EXPECT_NE(r.out.find("changed at level"), std::string::npos) << r.out;
 
+  // plan --verify: the shortest four-pose check session for this calibration.
+  r = RunCli({"plan", "--verify", a, "--accel-noise-density", "0.002", "--output",
+              dir / "check_plan.json"},
+             dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(Slurp(dir / "check_plan.json"));
+  EXPECT_EQ(j["parameters"].size(), 9u);
+  EXPECT_GT(j["hold_seconds"].get<double>(), 0.0);
+  if (j["met"].get<bool>()) {
+    for (const auto& p : j["parameters"]) {
+      EXPECT_LE(p["minimal_detectable_change_sigmas"].get<double>(), 10.0);
+    }
+  } else {
+    EXPECT_FALSE(j["short_of_target"].empty());
+  }
+  r = RunCli({"plan", "--verify", a, "--output", dir / "no.json"}, dir);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--accel-noise-density"), std::string::npos) << r.err;
+
   // calibrate --store files the result; history lists it.
   r = RunCli({"calibrate", "--config", kTwelve, "--input", dir / "a/raw.csv", "--output",
               dir / "stored.json", "--store", dir / "store", "--unit", "SN-7"},

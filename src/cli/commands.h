@@ -68,6 +68,8 @@ struct CommandArgs {
   std::string unit;
   // calibrate: file the result in this calibration store; history: read it.
   std::string store;
+  // plan --verify: the stored calibration to design a check session for.
+  std::string verify_calibration;
 };
 
 int RunDemo(const CommandArgs& args);
@@ -94,6 +96,9 @@ int RunExport(const CommandArgs& args);
 // nothing to test (nothing written).
 int RunCompare(const CommandArgs& args);
 int RunVerify(const CommandArgs& args);
+// plan --verify cal.json: the shortest check session (0 designed, 1 bad
+// input).
+int RunPlanVerify(const CommandArgs& args);
 // acceptance_command.cc: calibrate's --limits and --certificate. The check
 // before any work (the limits file parses, the certificate's files may be
 // written), and after the calibration is written: 0, 4 when a limit fails,

@@ -1,7 +1,9 @@
 // gravcal compare a.json b.json and gravcal verify (issue 36): is it the same
 // unit, unchanged? Exit codes: 0 consistent, 3 changed, 1 bad input or a
 // calibration that cannot be tested (no covariance), nothing written then.
+#include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "cli/commands.h"
@@ -153,6 +155,58 @@ int RunVerify(const CommandArgs& args) {
     PrintComparison(result.comparison, "change");
   }
   return result.comparison.consistent ? 0 : kChanged;
+}
+
+int RunPlanVerify(const CommandArgs& args) {
+  std::string error;
+  CheckDesignOptions options;
+  if (!ComparisonOptionsFromArgs(args, &options.comparison, &error)) return Fail(error);
+  options.noise_density = args.plan_request.accel_noise_density;
+  if (!(options.noise_density > 0.0)) {
+    return Fail("plan --verify needs --accel-noise-density (m/s^2/sqrt(Hz))");
+  }
+  if (!CheckDestinations({{args.output, "--output", true}}, {{args.verify_calibration, "--verify"}},
+                         &error)) {
+    return Fail(error);
+  }
+  Calibration stored;
+  if (!ReadCalibrationUncertainty(args.verify_calibration, &stored, nullptr, &error)) {
+    return Fail(error);
+  }
+  CheckDesign design;
+  if (!DesignCheckSession(stored, options, &design)) {
+    return Fail(args.verify_calibration + ": " + design.message);
+  }
+  nlohmann::ordered_json j;
+  j["met"] = design.met;
+  j["poses"] = 4;
+  j["hold_seconds"] = design.hold_seconds;
+  j["target_sigmas"] = options.target_sigmas;
+  j["power"] = options.comparison.power;
+  j["level"] = options.comparison.level;
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < design.names.size(); ++i) {
+    rows.push_back(
+        {{"name", design.names[i]},
+         {"minimal_detectable_change_sigmas", std::isfinite(design.mdc_sigmas[i])
+                                                  ? nlohmann::ordered_json(design.mdc_sigmas[i])
+                                                  : nlohmann::ordered_json(nullptr)}});
+  }
+  j["parameters"] = rows;
+  j["short_of_target"] = design.short_of_target;
+  j["message"] = design.message;
+  if (!args.output.empty() && !WriteOutput(args.output, j.dump(2) + "\n", &error)) {
+    return Fail(error);
+  }
+  if (args.output != "-") {
+    std::printf("check session for %s: %s\n", args.verify_calibration.c_str(),
+                design.message.c_str());
+    for (size_t i = 0; i < design.names.size(); ++i) {
+      std::printf("  %-20s smallest change detected: %.3g stored sigmas\n", design.names[i].c_str(),
+                  design.mdc_sigmas[i]);
+    }
+  }
+  return 0;
 }
 
 }  // namespace cli

@@ -100,6 +100,10 @@ DEFINE_string(unit, "", "calibrate: the unit's name on the certificate (default:
 DEFINE_string(store, "",
               "calibrate: file the calibration in this store (a folder, per unit and date); "
               "history: the store to read");
+DEFINE_string(verify, "",
+              "plan: design the shortest check session for this stored calibration (JSON) "
+              "instead: four poses, detecting 10 stored sigmas in any one parameter with power "
+              "0.9 at --level (needs --accel_noise_density)");
 DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
 
 namespace {
@@ -141,10 +145,26 @@ const std::vector<CommandInfo>& Commands() {
       {"plan",
        "plan a recording before it is made: plan.json with the poses, holds and predicted "
        "sigmas (least time meeting --target, or best within --max_time)",
-       {"config", "output", "noise", "target", "pose_set", "candidates", "max_time", "overhead",
-        "min_hold", "max_hold", "accel_noise_density", "accel_bias_instability",
-        "accel_random_walk", "pose_disturbance", "report", "gyro_noise_density", "turn_seconds",
-        "attitude_std"},
+       {"config",
+        "output",
+        "noise",
+        "target",
+        "pose_set",
+        "candidates",
+        "max_time",
+        "overhead",
+        "min_hold",
+        "max_hold",
+        "accel_noise_density",
+        "accel_bias_instability",
+        "accel_random_walk",
+        "pose_disturbance",
+        "report",
+        "gyro_noise_density",
+        "turn_seconds",
+        "attitude_std",
+        "verify",
+        "level"},
        gravcal::cli::RunPlan},
       {"check",
        "what a recorded session determines: predicted sigma per parameter, what is "
@@ -435,6 +455,7 @@ void CopyFlags(gravcal::cli::CommandArgs* args) {
   args->certificate = FLAGS_certificate;
   args->unit = FLAGS_unit;
   args->store = FLAGS_store;
+  args->verify_calibration = FLAGS_verify;
   args->plan_request.targets = FLAGS_target;
   args->plan_request.pose_set = FLAGS_pose_set;
   args->plan_request.free_candidates = FLAGS_candidates;

@@ -30,6 +30,7 @@ bool RequestFromArgs(const CommandArgs& args, ImuNoise* noise, PlanRequest* requ
 }  // namespace
 
 int RunPlan(const CommandArgs& args) {
+  if (!args.verify_calibration.empty()) return RunPlanVerify(args);
   if (args.output.empty()) return Fail("plan needs --output <plan.json>");
   std::string error;
   ImuNoise noise;

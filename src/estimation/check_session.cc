@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace gravcal {
@@ -214,8 +215,12 @@ bool DesignCheckSession(const Calibration& stored, const CheckDesignOptions& opt
   if (std::isnan(at_max)) return false;
   if (at_max > options.target_sigmas) {
     design->hold_seconds = options.max_hold_seconds;
-    design->message = "no hold up to " + std::to_string(options.max_hold_seconds) +
-                      " s reaches the target for every parameter";
+    char buffer[256];
+    std::snprintf(buffer, sizeof(buffer),
+                  "no hold up to %.4g s detects %.3g stored sigmas in every parameter (the "
+                  "stored calibration's own uncertainty, or poses that cannot tell terms apart)",
+                  options.max_hold_seconds, options.target_sigmas);
+    design->message = buffer;
     return true;
   }
   double lo = 0.0, hi = options.max_hold_seconds;
@@ -227,9 +232,13 @@ bool DesignCheckSession(const Calibration& stored, const CheckDesignOptions& opt
   worst(hi, design);
   design->met = true;
   design->hold_seconds = hi;
-  design->message = std::to_string(directions.size()) + " poses held " + std::to_string(hi) +
-                    " s each detect a change of " + std::to_string(options.target_sigmas) +
-                    " stored sigmas in any one parameter";
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "%zu poses held %.3g s each detect a change of %.3g stored sigmas in any one "
+                "parameter with power %.3g at level %.3g",
+                directions.size(), hi, options.target_sigmas, options.comparison.power,
+                options.comparison.level);
+  design->message = buffer;
   return true;
 }
 
