@@ -22,6 +22,21 @@
 #include <vector>
 
 #include "gravcal/gravcal.h"
+#include "gravcal/io/files.h"
+#include "gravcal/io/noise_io.h"
+#include "gravcal/io/plan_io.h"
+#include "gravcal/io/recording.h"
+#include "gravcal/workflows/batch.h"
+#include "gravcal/workflows/batch_manifest.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/discovery.h"
+#include "gravcal/workflows/discovery_report.h"
+#include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/noise_workflow.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/workflows/plan.h"
+#include "gravcal/workflows/report.h"
+#include "gravcal/workflows/simulation_workflow.h"
 
 namespace py = pybind11;
 
