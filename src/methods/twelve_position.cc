@@ -10,6 +10,7 @@
 #include "core/sensor_checks.h"
 #include "core/warnings.h"
 #include "estimation/accel_uncertainty.h"
+#include "estimation/newton_solver.h"
 #include "gravcal/estimation/housing_rotation.h"
 #include "methods/pose_variance.h"
 #include "methods/static_positions.h"
@@ -20,6 +21,8 @@
 namespace gravcal {
 
 using internal::MaxAbs;
+using internal::NewtonOptions;
+using internal::NewtonRefine;
 using internal::PropagateUncertainty;
 using internal::ResolveCalibrationGravity;
 using internal::Rms;
