@@ -85,6 +85,10 @@ class BatchResult:
     @property
     def timings(self) -> Dict[str, float]: ...
 
+class BatchResults(List[BatchResult]):
+    def full_report(self) -> str: ...
+    def brief_report(self) -> str: ...
+
 LogLike = Union[None, Log, PathLike, Any]
 
 def calibrate(log: LogLike = ..., *, config: ConfigLike = ..., t: Optional[ArrayLike] = ...,
@@ -100,7 +104,8 @@ def simulate(config: ConfigLike = ..., seed: int = ..., *, plan: Optional[PathLi
              return_files: bool, **keys: Any) -> Tuple[Result, Log, Dict[str, str]]: ...
 def batch(units: Union[PathLike, Sequence[Union[PathLike, Log, Mapping[str, Any]]]],
           config: ConfigLike = ..., threads: int = ..., *, pattern: str = ...,
-          **keys: Any) -> List[BatchResult]: ...
+          output_dir: Optional[PathLike] = ..., report: Optional[PathLike] = ...,
+          shard: Optional[str] = ..., **keys: Any) -> List[BatchResult]: ...
 def noise(log: LogLike = ..., *, config: ConfigLike = ..., kalibr: Optional[PathLike] = ...,
           handheld: Optional[PathLike] = ..., report: Optional[PathLike] = ...,
           t: Optional[ArrayLike] = ...,

@@ -233,6 +233,7 @@ bool ListBatchFolderUnits(const BatchSource& source, const Config& base,
                           std::string* error) {
   std::vector<BatchUnit> fleet;
   std::vector<std::string> own;
+  std::vector<std::string> hidden;
   if (!source.input_dir.empty() && !internal::OwnFilesInInput(source.input_dir, options.output_dir,
                                                               options.report, &own, error)) {
     return false;
@@ -240,19 +241,27 @@ bool ListBatchFolderUnits(const BatchSource& source, const Config& base,
   const bool listed =
       !source.topics.empty() ? UnitsFromTopics(source.input, &fleet, error)
       : source.manifest.empty()
-          ? UnitsFromDirectory(source.input_dir, source.pattern, &fleet, error, own, &out->hidden)
+          ? UnitsFromDirectory(source.input_dir, source.pattern, &fleet, error, own, &hidden)
           : ReadBatchManifest(source.manifest, base, &fleet, error);
   if (!listed) return false;
+  *out = ShardOfFleet(std::move(fleet), base, options.shard);
+  out->hidden = std::move(hidden);
+  return true;
+}
+
+BatchFolderUnits ShardOfFleet(std::vector<BatchUnit> fleet, const Config& base,
+                              const Shard& shard) {
+  BatchFolderUnits out;
   std::vector<std::string> ids;
   for (const BatchUnit& u : fleet) ids.push_back(u.id);
-  out->info.fleet = FleetHash(ids);
-  out->info.config = ConfigHash(base);
-  out->info.units_in_fleet = fleet.size();
-  out->info.shard_index = options.shard.index;
-  out->info.shard_count = options.shard.count;
-  out->positions = ShardPositions(fleet.size(), options.shard);
-  for (size_t p : out->positions) out->units.push_back(std::move(fleet[p]));
-  return true;
+  out.info.fleet = FleetHash(ids);
+  out.info.config = ConfigHash(base);
+  out.info.units_in_fleet = fleet.size();
+  out.info.shard_index = shard.index;
+  out.info.shard_count = shard.count;
+  out.positions = ShardPositions(fleet.size(), shard);
+  for (size_t p : out.positions) out.units.push_back(std::move(fleet[p]));
+  return out;
 }
 
 bool CalibrateBatchToFolder(const BatchFolderUnits& units, const Config& base,

@@ -119,6 +119,10 @@ bool ListBatchFolderUnits(const BatchSource& source, const Config& base,
                           const BatchFolderOptions& options, BatchFolderUnits* units,
                           std::string* error);
 
+// The units of `shard` among `fleet` (a list the caller made), with the
+// fleet's FleetInfo under `base`.
+BatchFolderUnits ShardOfFleet(std::vector<BatchUnit> fleet, const Config& base, const Shard& shard);
+
 // What a batch run did.
 struct BatchFolderSummary {
   // One per unit of the shard, in order (BatchResult::calibration empty
