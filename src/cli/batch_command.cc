@@ -108,7 +108,7 @@ void PrintLines(const std::string& text) {
 }
 
 // The flags as the library's source and options, checked.
-bool ReadBatchFlags(const CommandArgs& args, BatchSource* source, BatchFolderOptions* options,
+bool ReadBatchFlags(const BatchArgs& args, BatchSource* source, BatchFolderOptions* options,
                     std::string* shard_source, std::string* error) {
   if (args.output_dir.empty()) return SetError(error, "batch needs --output-dir <folder>");
   const bool by_topic = !args.topics.empty();
@@ -152,7 +152,7 @@ void PrintHiddenNote(const std::string& folder, const std::vector<std::string>& 
 
 }  // namespace
 
-int RunBatch(const CommandArgs& args) {
+int RunBatch(const BatchArgs& args) {
   BatchSource source;
   BatchFolderOptions options;
   std::string shard_source;
@@ -175,7 +175,7 @@ int RunBatch(const CommandArgs& args) {
   return ExitCode(summary.statistics);
 }
 
-int RunMergeSummaries(const CommandArgs& args) {
+int RunMergeSummaries(const BatchArgs& args) {
   if (args.output_dir.empty()) return Fail("merge-summaries needs --output-dir <folder>");
   if (args.positional.empty()) {
     return Fail("merge-summaries needs the folders of the shards' summaries");

@@ -67,7 +67,7 @@ std::string ResidualLine(const Calibration& c, double nominal_scale) {
 
 }  // namespace
 
-int RunDemo(const CommandArgs& args) {
+int RunDemo(const DemoArgs& args) {
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
   SimulatedSession session;
@@ -120,7 +120,7 @@ int RunDemo(const CommandArgs& args) {
   return 0;
 }
 
-int RunCalibrate(const CommandArgs& args) {
+int RunCalibrate(const CalibrateArgs& args) {
   if (args.input.empty()) return Fail("calibrate needs --input <raw log>");
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
@@ -166,7 +166,7 @@ int RunCalibrate(const CommandArgs& args) {
   return 0;
 }
 
-int RunSimulate(const CommandArgs& args) {
+int RunSimulate(const SimulateArgs& args) {
   if (args.output_dir.empty()) return Fail("simulate needs --output-dir <folder>");
   std::string error;
   SimulationRequest request;
