@@ -754,6 +754,12 @@ PYBIND11_MODULE(_gravcal, m) {
                     return PyCalibration::FromText(text, name);
                   })
       .def("write", &WriteCalibration)
+      .def("report",
+           [](const PyCalibration& c, bool full) {
+             Check(c.result != nullptr,
+                   c.name + ": a calibration read from JSON has no report (only a result has)");
+             return full ? c.result->FullReport() : c.result->BriefReport();
+           })
       .def("apply", &ApplyCalibration, py::arg("accel"), py::arg("gyro"), py::arg("temp"),
            py::arg("t"));
   m.def("calibrate", &Calibrate, py::arg("config"), py::arg("log"), py::arg("attitudes"),

@@ -346,6 +346,23 @@ class Calibration(_Section):
         a, w = self._core.apply(accel, gyro, temp, t)
         return a if gyro is None else (a, w)
 
+    def brief_report(self):
+        """One line: the message and the residual |a| - g before and after, as
+        ``gravcal calibrate`` prints it. Only for a result (not one read from
+        JSON)."""
+        return self._core.report(False)
+
+    def full_report(self):
+        """The message, every estimate with its standard deviation, the
+        residuals, the solver and the warnings. Only for a result."""
+        return self._core.report(True)
+
+    def __str__(self):
+        try:
+            return self.full_report()
+        except Error:
+            return repr(self)
+
     def __repr__(self):
         return "<gravcal.Calibration method=%s, gyro=%s>" % (
             self._dict().get("method"), "gyro" in self._dict())
