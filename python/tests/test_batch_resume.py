@@ -111,18 +111,26 @@ def test_killed_python_batch_resumes(fleet, tmp_path):
     env = dict(os.environ)
     p = subprocess.Popen([sys.executable, "-c", code, str(fleet), CONFIG, str(out)], env=env)
     state = out / "batch_state"
+
+    def stored_units():
+        # Not the temporaries of a write in flight (".gravcal-tmp....json").
+        return sorted(n[:-5] for n in os.listdir(state)
+                      if n.endswith(".json") and not n.startswith("."))
+
     deadline = time.time() + 60
     while p.poll() is None and time.time() < deadline:
-        if state.is_dir() and any(n.endswith(".json") for n in os.listdir(state)):
+        if state.is_dir() and stored_units():
             p.send_signal(signal.SIGKILL)
             break
         time.sleep(0.002)
     p.wait()
-    stored = sorted(n[:-5] for n in os.listdir(state) if n.endswith(".json"))
+    stored = stored_units()
     assert stored, "the killed run stored no unit"
     resumed = gravcal.batch(fleet, config=CONFIG, threads=2, output_dir=out)
     # Every unit the killed run stored is reused, every other one computed.
     assert sorted(r.unit for r in resumed if r.skipped) == stored
     assert len(resumed) == UNITS
-    assert not [n for n in os.listdir(out) if n.startswith(".gravcal-tmp.")]
+    # The killed run's temporaries are gone.
+    for folder in (out, state):
+        assert not [n for n in os.listdir(folder) if n.startswith(".gravcal-tmp.")]
     assert len((out / "summary.csv").read_text().splitlines()) == UNITS + 1
