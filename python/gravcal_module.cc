@@ -22,6 +22,8 @@
 #include <vector>
 
 #include "gravcal/gravcal.h"
+#include "gravcal/workflows/batch_folder.h"
+#include "gravcal/workflows/batch_scheduler_shard.h"
 
 namespace py = pybind11;
 

@@ -72,7 +72,6 @@
 
 // workflows
 #include "gravcal/workflows/batch.h"
-#include "gravcal/workflows/batch_folder.h"
 #include "gravcal/workflows/batch_manifest.h"
 #include "gravcal/workflows/batch_scheduler_shard.h"
 #include "gravcal/workflows/config.h"
