@@ -48,26 +48,9 @@ std::string WithStd(double value, double std, const char* format) {
   return buffer;
 }
 
-// "|a| - g rms <before> -> <after> m/s^2". Raw counts read without a
-// nominal_scale (1, the default) give a "before" residual in counts minus
-// m/s^2, which means nothing: then only the fitted residual is said.
-std::string ResidualLine(const Calibration& c, double nominal_scale) {
-  char line[200];
-  if (nominal_scale == 1.0 && c.residual_nominal.rms > 0.5 * c.gravity) {
-    std::snprintf(line, sizeof(line),
-                  "|a| - g rms %.5f m/s^2 (raw data unscaled: set nominal_scale for a 'before' "
-                  "figure)",
-                  c.residual_refined.rms);
-  } else {
-    std::snprintf(line, sizeof(line), "|a| - g rms %.5f -> %.5f m/s^2", c.residual_nominal.rms,
-                  c.residual_refined.rms);
-  }
-  return line;
-}
-
 }  // namespace
 
-int RunDemo(const CommandArgs& args) {
+int RunDemo(const DemoArgs& args) {
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
   SimulatedSession session;
@@ -120,7 +103,7 @@ int RunDemo(const CommandArgs& args) {
   return 0;
 }
 
-int RunCalibrate(const CommandArgs& args) {
+int RunCalibrate(const CalibrateArgs& args) {
   if (args.input.empty()) return Fail("calibrate needs --input <raw log>");
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
@@ -160,13 +143,12 @@ int RunCalibrate(const CommandArgs& args) {
     if (!args.history.empty()) std::remove(args.history.c_str());
     return Fail(error);
   }
-  std::fprintf(stderr, "gravcal: %s; %s; wrote %s\n", c.message.c_str(),
-               ResidualLine(c, args.config.calibration.nominal_scale).c_str(),
+  std::fprintf(stderr, "gravcal: %s; wrote %s\n", c.BriefReport().c_str(),
                args.output == "-" ? "standard output" : args.output.c_str());
   return 0;
 }
 
-int RunSimulate(const CommandArgs& args) {
+int RunSimulate(const SimulateArgs& args) {
   if (args.output_dir.empty()) return Fail("simulate needs --output-dir <folder>");
   std::string error;
   SimulationRequest request;

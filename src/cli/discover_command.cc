@@ -10,7 +10,7 @@
 namespace gravcal {
 namespace cli {
 
-int RunDiscover(const CommandArgs& args) {
+int RunDiscover(const LogReportArgs& args) {
   if (args.input.empty()) return Fail("discover needs --input <raw log>");
   if (args.output.empty()) return Fail("discover needs --output <discovery.json>");
   std::string error;

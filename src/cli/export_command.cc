@@ -16,7 +16,7 @@
 namespace gravcal {
 namespace cli {
 
-int RunExport(const CommandArgs& args) {
+int RunExport(const ExportArgs& args) {
   if (args.calibration.empty()) return Fail("export needs --calibration <calib.json>");
   ExportOptions options;
   if (!FromString(args.to, &options.target)) {
