@@ -186,10 +186,10 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
   return out.dump(2) + "\n";
 }
 
-bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error) {
+bool HistoryToCsv(const Calibration& calibration, std::string* csv, std::string* error) {
   const EstimateHistory& h = calibration.history;
   if (h.rows() == 0) {
-    *error = path + ": method '" + calibration.method + "' has no time history to write";
+    *error = "method '" + calibration.method + "' has no time history to write";
     return false;
   }
   std::ostringstream s;
@@ -202,7 +202,15 @@ bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, st
     }
     s << "\n";
   }
-  return WriteFileAtomically(path, s.str(), error);
+  *csv = s.str();
+  return true;
+}
+
+bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error) {
+  std::string csv;
+  if (!HistoryToCsv(calibration, &csv, error))
+    return internal::SetError(error, path + ": " + *error);
+  return WriteFileAtomically(path, csv, error);
 }
 
 bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,
