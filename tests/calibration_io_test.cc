@@ -341,6 +341,23 @@ TEST(CalibrationChecksOnLoad, TheMatrixHasTheStructureItsModelClaims) {
   EXPECT_NE(LoadError(j).find("key 'gyro.model'"), std::string::npos);
 }
 
+// A key set twice is refused naming it (nlohmann keeps one of the two
+// silently: an edited copy of "accel" above the written one was applied).
+TEST(CalibrationChecksOnLoad, AKeySetTwiceIsRefused) {
+  const std::string text = GoodCalibration().dump();
+  LoadedCalibration loaded;
+  std::string error;
+  const std::string twice =
+      R"({"accel": {"bias": [0, 0, 0], "matrix": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}, )" +
+      text.substr(1);
+  EXPECT_FALSE(CalibrationFromJson(twice, "c.json", &loaded, &error));
+  EXPECT_EQ(error, "c.json: key 'accel' appears twice (a key may be set once)");
+  std::string inner = text;
+  inner.replace(inner.find("\"bias\":"), 7, R"("bias": [1, 2, 3], "bias":)");
+  EXPECT_FALSE(CalibrationFromJson(inner, "c.json", &loaded, &error));
+  EXPECT_NE(error.find("key 'accel.bias' appears twice"), std::string::npos) << error;
+}
+
 TEST(CalibrationChecksOnLoad, SensorMatricesAreCheckedByConditioningNotDeterminant) {
   struct Case {
     json matrix;

@@ -562,6 +562,20 @@ TEST(PlanIo, EveryValueReadIsCheckedWithAMessageNamingIt) {
     EXPECT_NE(error.find("plan.json: rotations[0]: " + named), std::string::npos)
         << turn << ": " << error;
   }
+  // A key set twice (nlohmann keeps one silently), also inside a pose, and
+  // text that is no JSON at all (Python writes NaN).
+  const std::pair<std::string, std::string> bad_files[] = {
+      {R"({"poses": [], "poses": [{"up": [0, 0, 1], "hold_s": 10}]})", "key 'poses' appears twice"},
+      {R"({"poses": [{"up": [0, 0, 1], "hold_s": 10, "hold_s": 20}]})",
+       "key 'poses[].hold_s' appears twice"},
+      {R"({"poses": [{"up": [NaN, 0, 1], "hold_s": 10}]})", "not valid JSON"},
+  };
+  for (const auto& [text, named] : bad_files) {
+    EXPECT_FALSE(PlanPosesFromJson(text, "plan.json", &poses, &error)) << text;
+    EXPECT_EQ(error.find("plan.json: " + named), 0u) << text << ": " << error;
+    EXPECT_FALSE(PlanRotationsFromJson(text, "plan.json", 1, &turns, &error)) << text;
+    EXPECT_EQ(error.find("plan.json: " + named), 0u) << text << ": " << error;
+  }
 }
 
 }  // namespace

@@ -599,6 +599,10 @@ bool CalibrationFromJson(const std::string& text, const std::string& name,
     *error = name + ": not valid JSON (" + e.what() + ")";
     return false;
   }
+  if (const std::string twice = internal::DuplicateJsonKey(text); !twice.empty()) {
+    *error = name + ": key '" + twice + "' appears twice (a key may be set once)";
+    return false;
+  }
   JsonReader r(name, error);
   if (!j.is_object()) return r.Fail("accel", "is missing (the file is not a JSON object)");
   LoadedCalibration out;
