@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "detection/cut_poses.h"
 #include "util/units.h"
 
 namespace gravcal {
@@ -334,6 +335,11 @@ struct SensorWindows {
 
 // See TrimLevelEnds' use.
 constexpr double kGyroLevelFraction = 0.01;
+// A step of the rate splits a still run only when the two levels differ by
+// at least this fraction of the log's turn rate (RateScale): a constant turn
+// started or stopped is a large part of it, a hand's sway within a pose a
+// few percent at most (measured: 1 % split a hand-held MPU-6050 pose).
+constexpr double kGyroStepFraction = 0.1;
 // TrimLevelEnds trims at most this many windows from each end of a run.
 constexpr size_t kMaxTrimWindows = 5;
 
@@ -500,14 +506,16 @@ struct LinePrefix {
   }
 };
 
-// Splits the still run [begin, end) at steps in the accelerometer level
-// (top of static_detector.h): lines on the w samples either side of each
-// sample, the step statistic T, recursively at its maximum while it is
-// above step_factor and the levels are step_min_deg apart. `floor` (the
-// noise floor, summed over the axes) bounds the residual variances from
-// below (quantised data can fit a line exactly). Appends the parts.
+// Splits the still run [begin, end) at steps in the level of `x` (top of
+// static_detector.h): lines on the w samples either side of each sample,
+// the step statistic T, recursively at its maximum while it is above
+// step_factor and the levels are step_min_deg apart (the accelerometer) or,
+// with min_change2 > 0 (the gyroscope, whose still level is near zero and
+// has no direction), |b - a|^2 >= min_change2 apart. `floor` (the noise
+// floor, summed over the axes) bounds the residual variances from below
+// (quantised data can fit a line exactly). Appends the parts.
 void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& prefix, size_t base,
-                     size_t begin, size_t end, size_t w, double floor,
+                     size_t begin, size_t end, size_t w, double floor, double min_change2,
                      const StaticDetectorOptions& options, std::vector<QuietRun>* parts) {
   if (end - begin < 2 * w) {
     parts->push_back({begin, end});
@@ -531,7 +539,10 @@ void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& pr
     const double t = std::min(t_line, t_mean);
     if (!(t > best)) continue;
     const Eigen::Vector3d a = left + r, b = right + r;
-    if (a.dot(b) > min_cos * a.norm() * b.norm()) continue;
+    if (min_change2 > 0.0 ? (b - a).squaredNorm() < min_change2
+                          : a.dot(b) > min_cos * a.norm() * b.norm()) {
+      continue;
+    }
     best = t;
     split = s;
   }
@@ -539,14 +550,15 @@ void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& pr
     parts->push_back({begin, end});
     return;
   }
-  SplitRunAtSteps(x, prefix, base, begin, split, w, floor, options, parts);
-  SplitRunAtSteps(x, prefix, base, split, end, w, floor, options, parts);
+  SplitRunAtSteps(x, prefix, base, begin, split, w, floor, min_change2, options, parts);
+  SplitRunAtSteps(x, prefix, base, split, end, w, floor, min_change2, options, parts);
 }
 
-// Every run split at its accelerometer steps (SplitRunAtSteps). Returns the
-// number of steps found.
+// Every run split at the steps of `x` (SplitRunAtSteps). Returns the number
+// of steps found.
 size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double floor,
-                        const StaticDetectorOptions& options, std::vector<QuietRun>* runs) {
+                        double min_change2, const StaticDetectorOptions& options,
+                        std::vector<QuietRun>* runs) {
   if (options.step_factor <= 0.0) return 0;
   std::vector<QuietRun> out;
   for (const QuietRun& run : *runs) {
@@ -555,7 +567,7 @@ size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double 
       continue;
     }
     const LinePrefix prefix(x, run.begin, run.end);
-    SplitRunAtSteps(x, prefix, run.begin, run.begin, run.end, w, floor, options, &out);
+    SplitRunAtSteps(x, prefix, run.begin, run.begin, run.end, w, floor, min_change2, options, &out);
   }
   const size_t steps = out.size() - runs->size();
   *runs = std::move(out);
@@ -824,17 +836,21 @@ std::string TimeUnitMessage(const std::string& name, double dt, double window_se
 
 }  // namespace
 
-bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& options,
+bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& given,
                            StaticDetection* detection) {
   if (detection == nullptr) return false;
   *detection = StaticDetection();
   std::string error;
-  if (!options.IsValid(&error)) return Fail(detection, error);
+  if (!given.IsValid(&error)) return Fail(detection, error);
+  StaticDetectorOptions options = given;
   const std::string name = log.source.empty() ? std::string("log") : log.source;
   if (!CheckDetectionInput(log, name, &error)) return Fail(detection, error);
   const size_t n = log.size();
   std::vector<double> scratch;
   const double dt = MedianSampleInterval(log.t, &scratch);
+  // Holds of poses published with the motion cut out, shorter than the
+  // options keep: the time scales fitted to them (detection/cut_poses.h).
+  const std::string fitted = internal::FitToCutPoses(log, dt, &options);
   // Durations in samples, at most n + 1 (no overflow for absurd durations).
   auto to_samples = [dt, n](double seconds) {
     const double samples = seconds / dt;
@@ -898,7 +914,14 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
   std::vector<QuietRun> runs =
       FindQuietRuns(accel, gyro, num_windows, w, detection->accel_threshold,
                     detection->gyro_threshold, options.trend_factor, options.step_factor > 0.0);
-  const size_t steps = SplitRunsAtSteps(log.accel, w, detection->accel_noise_floor, options, &runs);
+  size_t steps = SplitRunsAtSteps(log.accel, w, detection->accel_noise_floor, 0.0, options, &runs);
+  // A step of the rate alone (a constant turn about gravity started or
+  // stopped with the motion cut out) splits too.
+  if (gyro.trend != nullptr && gyro.min_change2 > 0.0) {
+    const double ratio = kGyroStepFraction / kGyroLevelFraction;
+    steps += SplitRunsAtSteps(log.gyro, w, detection->gyro_noise_floor,
+                              ratio * ratio * gyro.min_change2, options, &runs);
+  }
   if (options.trend_factor > 0.0) {
     TrimLevelEnds(use_gyro ? log.gyro : log.accel, use_gyro ? gyro : accel, w, options.trend_factor,
                   &runs);
@@ -925,6 +948,7 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
   if (split > 0) {
     msg << "; " << split << " split at steps in the mean";
   }
+  if (!fitted.empty()) msg << "; " << fitted;
   if (!detection->rejected.empty()) {
     msg << "; " << detection->rejected.size() << " stretch"
         << (detection->rejected.size() == 1 ? "" : "es") << " rejected";
