@@ -7,6 +7,7 @@
 
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/plan_io.h"
 #include "gravcal/methods/twelve_position.h"
@@ -135,12 +136,18 @@ int RunCalibrate(const CalibrateArgs& args) {
   }
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
-  if (!args.history.empty() && !WriteHistoryCsv(c, args.history, &error)) return Fail(error);
-  if (!WriteOutput(args.output,
-                   CalibrationToJson(c, args.config.output_covariance,
-                                     CalibrationCheckSections(args, input.log)),
-                   &error)) {
-    if (!args.history.empty()) std::remove(args.history.c_str());
+  // The history and the calibration are put in place together (the report,
+  // written above, also says why a calibration failed).
+  std::vector<FileContents> files;
+  if (!args.history.empty()) {
+    files.push_back({args.history, ""});
+    if (!HistoryToCsv(c, &files.back().contents, &error)) return Fail(args.history + ": " + error);
+  }
+  const std::string json = CalibrationToJson(c, args.config.output_covariance,
+                                             CalibrationCheckSections(args, input.log));
+  if (args.output != "-") files.push_back({args.output, json});
+  if (!WriteFilesAtomically(files, &error) ||
+      (args.output == "-" && !WriteOutput(args.output, json, &error))) {
     return Fail(error);
   }
   std::fprintf(stderr, "gravcal: %s; wrote %s\n", c.BriefReport().c_str(),
@@ -157,28 +164,20 @@ int RunSimulate(const SimulateArgs& args) {
   SimulationFiles files;
   if (!SimulateFromConfig(args.config, request, &files, &error)) return Fail(error);
   const SimulatedSession& session = files.session;
-  mkdir(args.output_dir.c_str(), 0755);
-  struct stat st;
-  if (stat(args.output_dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
-    return Fail(args.output_dir + ": cannot create the folder");
-  }
+  if (!MakeFolders(args.output_dir, &error)) return Fail(error);
   const std::string raw = args.output_dir + "/raw.csv";
   const std::string truth = args.output_dir + "/truth.json";
   const std::string attitudes = args.output_dir + "/attitudes.csv";
-  if (!WriteImuLogCsv(session.log, raw, &error)) return Fail(error);
-  if (!WriteFileAtomically(truth, files.truth_json, &error)) {
-    std::remove(raw.c_str());
-    return Fail(error);
-  }
-  if (!WriteFileAtomically(attitudes, files.attitudes_csv, &error)) {
-    std::remove(raw.c_str());
-    std::remove(truth.c_str());
-    return Fail(error);
-  }
   const std::string segments_path = args.output_dir + "/segments.csv";
   const bool segments = !files.segments_csv.empty();
-  if (segments && !WriteFileAtomically(segments_path, files.segments_csv, &error)) {
-    for (const std::string& f : {raw, truth, attitudes}) std::remove(f.c_str());
+  std::string raw_csv;
+  if (!ImuLogToCsv(session.log, &raw_csv, &error)) return Fail(raw + ": " + error);
+  // All four files or none.
+  if (!WriteFilesAtomically({{raw, std::move(raw_csv)},
+                             {truth, files.truth_json},
+                             {attitudes, files.attitudes_csv},
+                             {segments ? segments_path : "", files.segments_csv}},
+                            &error)) {
     return Fail(error);
   }
   std::fprintf(stderr, "gravcal: wrote %s (%zu samples), %s and %s%s%s\n", raw.c_str(),

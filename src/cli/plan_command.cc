@@ -38,9 +38,9 @@ int RunPlan(const PlanArgs& args) {
   if (!RequestWithNoise(args.request, args.noise, &noise, &request, &error)) return Fail(error);
   RecordingPlan plan;
   if (!MakeRecordingPlan(args.config, request, &plan, &error)) return Fail(error);
-  if (!WritePlanJson(plan, args.output, &error)) return Fail(error);
-  if (!args.report.empty() && !WriteFileAtomically(args.report, PlanToHtml(plan), &error)) {
-    std::remove(args.output.c_str());
+  if (!WriteFilesAtomically({{args.output, PlanToJson(plan)},
+                             {args.report, args.report.empty() ? "" : PlanToHtml(plan)}},
+                            &error)) {
     return Fail(error);
   }
   std::fprintf(stderr, "gravcal: wrote %s: %s\n", args.output.c_str(), plan.message.c_str());

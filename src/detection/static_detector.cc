@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "detection/cut_poses.h"
 #include "detection/static_detector_internal.h"
 #include "util/units.h"
 
@@ -185,6 +186,11 @@ struct SensorWindows {
 
 // See TrimLevelEnds' use.
 constexpr double kGyroLevelFraction = 0.01;
+// A step of the rate splits a still run only when the two levels differ by
+// at least this fraction of the log's turn rate (RateScale): a constant turn
+// started or stopped is a large part of it, a hand's sway within a pose a
+// few percent at most (measured: 1 % split a hand-held MPU-6050 pose).
+constexpr double kGyroStepFraction = 0.1;
 // TrimLevelEnds trims at most this many windows from each end of a run.
 constexpr size_t kMaxTrimWindows = 5;
 
@@ -486,17 +492,21 @@ std::string TimeUnitMessage(const std::string& name, double dt, double window_se
 
 }  // namespace
 
-bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& options,
+bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& given,
                            StaticDetection* detection) {
   if (detection == nullptr) return false;
   *detection = StaticDetection();
   std::string error;
-  if (!options.IsValid(&error)) return Fail(detection, error);
+  if (!given.IsValid(&error)) return Fail(detection, error);
+  StaticDetectorOptions options = given;
   const std::string name = log.source.empty() ? std::string("log") : log.source;
   if (!CheckDetectionInput(log, name, &error)) return Fail(detection, error);
   const size_t n = log.size();
   std::vector<double> scratch;
   const double dt = MedianSampleInterval(log.t, &scratch);
+  // Holds of poses published with the motion cut out, shorter than the
+  // options keep: the time scales fitted to them (detection/cut_poses.h).
+  const std::string fitted = internal::FitToCutPoses(log, dt, &options);
   // Durations in samples, at most n + 1 (no overflow for absurd durations).
   auto to_samples = [dt, n](double seconds) {
     const double samples = seconds / dt;
@@ -560,7 +570,14 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
   std::vector<QuietRun> runs =
       FindQuietRuns(accel, gyro, num_windows, w, detection->accel_threshold,
                     detection->gyro_threshold, options.trend_factor, options.step_factor > 0.0);
-  const size_t steps = SplitRunsAtSteps(log.accel, w, detection->accel_noise_floor, options, &runs);
+  size_t steps = SplitRunsAtSteps(log.accel, w, detection->accel_noise_floor, 0.0, options, &runs);
+  // A step of the rate alone (a constant turn about gravity started or
+  // stopped with the motion cut out) splits too.
+  if (gyro.trend != nullptr && gyro.min_change2 > 0.0) {
+    const double ratio = kGyroStepFraction / kGyroLevelFraction;
+    steps += SplitRunsAtSteps(log.gyro, w, detection->gyro_noise_floor,
+                              ratio * ratio * gyro.min_change2, options, &runs);
+  }
   if (options.trend_factor > 0.0) {
     TrimLevelEnds(use_gyro ? log.gyro : log.accel, use_gyro ? gyro : accel, w, options.trend_factor,
                   &runs);
@@ -587,6 +604,7 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
   if (split > 0) {
     msg << "; " << split << " split at steps in the mean";
   }
+  if (!fitted.empty()) msg << "; " << fitted;
   if (!detection->rejected.empty()) {
     msg << "; " << detection->rejected.size() << " stretch"
         << (detection->rejected.size() == 1 ? "" : "es") << " rejected";

@@ -70,7 +70,8 @@ double RateScale(const std::vector<Eigen::Vector3d>& x, std::vector<double>* scr
 
 // Every run split at its accelerometer steps; returns the number of steps.
 size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double floor,
-                        const StaticDetectorOptions& options, std::vector<QuietRun>* runs);
+                        double min_change2, const StaticDetectorOptions& options,
+                        std::vector<QuietRun>* runs);
 // Intervals spread beyond spread_factor times the noise floor split at their
 // steps, or kept and named in detection->warnings; returns how many split.
 size_t SplitOrFlagSpread(const ImuLog& log, size_t min_count, const StaticDetectorOptions& options,

@@ -53,14 +53,16 @@ struct LinePrefix {
   }
 };
 
-// Splits the still run [begin, end) at steps in the accelerometer level
-// (top of static_detector.h): lines on the w samples either side of each
-// sample, the step statistic T, recursively at its maximum while it is
-// above step_factor and the levels are step_min_deg apart. `floor` (the
-// noise floor, summed over the axes) bounds the residual variances from
-// below (quantised data can fit a line exactly). Appends the parts.
+// Splits the still run [begin, end) at steps in the level of `x` (top of
+// static_detector.h): lines on the w samples either side of each sample,
+// the step statistic T, recursively at its maximum while it is above
+// step_factor and the levels are step_min_deg apart (the accelerometer) or,
+// with min_change2 > 0 (the gyroscope, whose still level is near zero and
+// has no direction), |b - a|^2 >= min_change2 apart. `floor` (the noise
+// floor, summed over the axes) bounds the residual variances from below
+// (quantised data can fit a line exactly). Appends the parts.
 void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& prefix, size_t base,
-                     size_t begin, size_t end, size_t w, double floor,
+                     size_t begin, size_t end, size_t w, double floor, double min_change2,
                      const StaticDetectorOptions& options, std::vector<QuietRun>* parts) {
   if (end - begin < 2 * w) {
     parts->push_back({begin, end});
@@ -84,7 +86,10 @@ void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& pr
     const double t = std::min(t_line, t_mean);
     if (!(t > best)) continue;
     const Eigen::Vector3d a = left + r, b = right + r;
-    if (a.dot(b) > min_cos * a.norm() * b.norm()) continue;
+    if (min_change2 > 0.0 ? (b - a).squaredNorm() < min_change2
+                          : a.dot(b) > min_cos * a.norm() * b.norm()) {
+      continue;
+    }
     best = t;
     split = s;
   }
@@ -92,16 +97,17 @@ void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& pr
     parts->push_back({begin, end});
     return;
   }
-  SplitRunAtSteps(x, prefix, base, begin, split, w, floor, options, parts);
-  SplitRunAtSteps(x, prefix, base, split, end, w, floor, options, parts);
+  SplitRunAtSteps(x, prefix, base, begin, split, w, floor, min_change2, options, parts);
+  SplitRunAtSteps(x, prefix, base, split, end, w, floor, min_change2, options, parts);
 }
 
 }  // namespace
 
-// Every run split at its accelerometer steps (SplitRunAtSteps). Returns the
-// number of steps found.
+// Every run split at the steps of `x` (SplitRunAtSteps). Returns the number
+// of steps found.
 size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double floor,
-                        const StaticDetectorOptions& options, std::vector<QuietRun>* runs) {
+                        double min_change2, const StaticDetectorOptions& options,
+                        std::vector<QuietRun>* runs) {
   if (options.step_factor <= 0.0) return 0;
   std::vector<QuietRun> out;
   for (const QuietRun& run : *runs) {
@@ -110,7 +116,7 @@ size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double 
       continue;
     }
     const LinePrefix prefix(x, run.begin, run.end);
-    SplitRunAtSteps(x, prefix, run.begin, run.begin, run.end, w, floor, options, &out);
+    SplitRunAtSteps(x, prefix, run.begin, run.begin, run.end, w, floor, min_change2, options, &out);
   }
   const size_t steps = out.size() - runs->size();
   *runs = std::move(out);

@@ -186,10 +186,10 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
   return out.dump(2) + "\n";
 }
 
-bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error) {
+bool HistoryToCsv(const Calibration& calibration, std::string* csv, std::string* error) {
   const EstimateHistory& h = calibration.history;
   if (h.rows() == 0) {
-    *error = path + ": method '" + calibration.method + "' has no time history to write";
+    *error = "method '" + calibration.method + "' has no time history to write";
     return false;
   }
   std::ostringstream s;
@@ -202,7 +202,15 @@ bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, st
     }
     s << "\n";
   }
-  return WriteFileAtomically(path, s.str(), error);
+  *csv = s.str();
+  return true;
+}
+
+bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error) {
+  std::string csv;
+  if (!HistoryToCsv(calibration, &csv, error))
+    return internal::SetError(error, path + ": " + *error);
+  return WriteFileAtomically(path, csv, error);
 }
 
 bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,
@@ -320,6 +328,24 @@ bool CheckUpperTriangular(const Eigen::Matrix3d& u, std::string* why) {
   return true;
 }
 
+// True when `m` has the zeros its model claims (relative to its largest
+// entry): none off the diagonal (`diagonal`), else none below it; else sets
+// `why`, naming the entry.
+bool CheckClaimedZeros(const Eigen::Matrix3d& m, bool diagonal, std::string* why) {
+  const double scale = m.cwiseAbs().maxCoeff();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      if (r == c || (!diagonal && c > r)) continue;
+      if (!(std::abs(m(r, c)) <= kCalibrationRelativeTolerance * scale)) {
+        return internal::SetError(why, "has (" + std::to_string(r) + "," + std::to_string(c) +
+                                           ") = " + internal::ExactNumber(m(r, c)) +
+                                           (diagonal ? " off" : " below") + " the diagonal");
+      }
+    }
+  }
+  return true;
+}
+
 // |a - b| / |b| in the Frobenius norm (|a - b| when b is 0).
 double RelativeDifference(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   const double norm = b.norm();
@@ -384,6 +410,28 @@ bool ReadGyro(const json& j, JsonReader* r, ImuCorrector* c) {
     return false;
   }
   c->has_gyro = true;
+  // gravcal writes no gyro.model; a file that states one is held to it.
+  if (j["gyro"].contains("model")) {
+    const json& m = j["gyro"]["model"];
+    GyroParameterization p;
+    if (!m.is_string() || !FromString(m.get<std::string>(), &p) ||
+        p == GyroParameterization::kNone) {
+      return r->Fail("gyro.model", "must be one of bias, scale, full");
+    }
+    const Eigen::Matrix3d& g = c->gyro.matrix;
+    std::string why;
+    if (p != GyroParameterization::kFull && !CheckClaimedZeros(g, true, &why)) {
+      return r->Fail("gyro.matrix",
+                     why + ", but key 'gyro.model' is '" + ToString(p) + "' (a diagonal matrix)");
+    }
+    if (p == GyroParameterization::kBias &&
+        !(g.diagonal().maxCoeff() - g.diagonal().minCoeff() <=
+          kCalibrationRelativeTolerance * g.diagonal().cwiseAbs().maxCoeff())) {
+      return r->Fail("gyro.matrix",
+                     "has unequal diagonal entries, but key 'gyro.model' is 'bias' (one common "
+                     "scale, M_g = s I)");
+    }
+  }
   return true;
 }
 
@@ -551,6 +599,10 @@ bool CalibrationFromJson(const std::string& text, const std::string& name,
     *error = name + ": not valid JSON (" + e.what() + ")";
     return false;
   }
+  if (const std::string twice = internal::DuplicateJsonKey(text); !twice.empty()) {
+    *error = name + ": key '" + twice + "' appears twice (a key may be set once)";
+    return false;
+  }
   JsonReader r(name, error);
   if (!j.is_object()) return r.Fail("accel", "is missing (the file is not a JSON object)");
   LoadedCalibration out;
@@ -610,6 +662,16 @@ bool CheckCalibrationModels(const LoadedCalibration& c, const std::string& name,
   if (!CheckRotation(accel.rotation, &why)) return fail("accel.rotation", why);
   if (!CheckUpperTriangular(accel.upper, &why)) return fail("accel.upper", why);
   if (!CheckSensorMatrix(accel.matrix(), &why)) return fail("accel.matrix", why);
+  // scale and scale_misalignment hold R = I: the matrix is upper triangular
+  // (diagonal for scale), as the model says.
+  const AccelParameterization p = accel.parameterization;
+  if (p != AccelParameterization::kAffine &&
+      !CheckClaimedZeros(accel.matrix(), p == AccelParameterization::kScale, &why)) {
+    return fail("accel.matrix",
+                why + ", but key 'accel.model' is '" + ToString(p) + "' (" +
+                    (p == AccelParameterization::kScale ? "a diagonal matrix)"
+                                                        : "R = I, an upper-triangular matrix)"));
+  }
   if (c.corrector.has_gyro) {
     if (!c.corrector.gyro.bias.allFinite()) return fail("gyro.bias", "is not finite");
     if (!CheckSensorMatrix(c.corrector.gyro.matrix, &why)) return fail("gyro.matrix", why);

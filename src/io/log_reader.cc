@@ -282,10 +282,10 @@ bool ParseImuLog(std::string_view text, const std::string& name, const LogReader
   }
 }
 
-bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* error) {
+bool ImuLogToCsv(const ImuLog& log, std::string* text, std::string* error) {
   try {
     std::string why;
-    if (!CheckWritable(log, &why)) return SetError(error, path + ": cannot write log: " + why);
+    if (!CheckWritable(log, &why)) return SetError(error, "cannot write log: " + why);
     const bool gyro = log.has_gyro();
     const bool temperature = log.has_temperature();
     std::string header = "t,ax,ay,az";
@@ -319,10 +319,17 @@ bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* err
       if (temperature) put(log.temperature[i], '\n');
     }
     contents.resize(static_cast<size_t>(p - contents.data()));
-    return WriteFileAtomically(path, contents, error);
+    *text = std::move(contents);
+    return true;
   } catch (const std::exception& e) {
-    return SetError(error, path + ": cannot write: " + e.what());
+    return SetError(error, std::string("cannot write log: ") + e.what());
   }
+}
+
+bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* error) {
+  std::string contents;
+  if (!ImuLogToCsv(log, &contents, error)) return SetError(error, path + ": " + *error);
+  return WriteFileAtomically(path, contents, error);
 }
 
 }  // namespace gravcal

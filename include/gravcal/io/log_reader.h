@@ -76,6 +76,10 @@ bool ParseImuLog(std::string_view text, const std::string& name, const LogReader
 // precision, atomically (temporary file, then rename).
 bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* error);
 
+// The text WriteImuLogCsv writes (for a command that puts several files in
+// place together, WriteFilesAtomically). False with the reason in `error`.
+bool ImuLogToCsv(const ImuLog& log, std::string* contents, std::string* error);
+
 }  // namespace gravcal
 
 #endif  // GRAVCAL_IO_LOG_READER_H_
