@@ -125,29 +125,30 @@ int RunCalibrate(const CommandArgs& args) {
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
-  PipelineInput input;
-  input.source = args.input;
-  input.attitudes_path = args.attitudes;
-  input.segments_path = args.segments;
-  input.noise_path = args.noise;
-  if (!ReadImuLog(args.input, args.config.input, &input.log, &error)) return Fail(error);
+  // The log is read once: its provenance hash comes from the same bytes.
+  Session session;
   CalibrationProvenance provenance;
-  if (!LogProvenance(args.input, &provenance, &error)) return Fail(error);
+  if (!ReadImuLog(args.input, args.config.input, &session.log, &provenance, &error)) {
+    return Fail(error);
+  }
+  SessionFiles files;
+  files.attitudes_path = args.attitudes;
+  files.segments_path = args.segments;
+  files.noise_path = args.noise;
   Calibration c;
-  const bool ok = RunCalibration(args.config, input, &c);
+  const bool ok = RunCalibration(args.config, files, &session, &c);
   c.provenance = provenance;
   PrintWarnings(c);
   // The report also for a failed calibration: it says why. For a session of
-  // static poses it shows what the detector rejected too.
-  StaticDetection detection;
+  // static poses it shows what the detector rejected too (the detection the
+  // method used).
+  const ImuLog& log = session.log;
   if (!args.report.empty() &&
-      !WriteFileAtomically(
-          args.report,
-          !c.positions.empty() &&
-                  DetectStaticIntervals(input.log, args.config.calibration.detector, &detection)
-              ? CalibrationToHtml(c, input.log, args.input, detection)
-              : CalibrationToHtml(c, input.log, args.input),
-          &error)) {
+      !WriteFileAtomically(args.report,
+                           !c.positions.empty() && session.detection_ok
+                               ? CalibrationToHtml(c, log, args.input, session.detection)
+                               : CalibrationToHtml(c, log, args.input),
+                           &error)) {
     return Fail(error);
   }
   // 2 only for a solver that ran and did not converge; 1 for the data.
@@ -155,7 +156,7 @@ int RunCalibrate(const CommandArgs& args) {
   if (!args.history.empty() && !WriteHistoryCsv(c, args.history, &error)) return Fail(error);
   if (!WriteOutput(args.output,
                    CalibrationToJson(c, args.config.output_covariance,
-                                     CalibrationCheckSections(args, input.log)),
+                                     CalibrationCheckSections(args, session)),
                    &error)) {
     if (!args.history.empty()) std::remove(args.history.c_str());
     return Fail(error);

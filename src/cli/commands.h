@@ -87,7 +87,7 @@ int RunCheck(const CommandArgs& args);
 // check says it) with --check, for the methods of the magnitude model;
 // prints the text on stderr. Empty without --check, when the method has
 // none or when the check cannot be made.
-JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log);
+JsonSections CalibrationCheckSections(const CommandArgs& args, const Session& session);
 
 // destinations.cc: the command's destinations checked against the
 // destination contract (io/files.h) before it runs: false with a one-line

@@ -61,14 +61,14 @@ int RunCheck(const CommandArgs& args) {
   return 0;
 }
 
-JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log) {
+JsonSections CalibrationCheckSections(const CommandArgs& args, const Session& session) {
   if (!args.check || args.config.method != "twelve_position") return {};
-  std::string error;
-  ImuNoise noise;
-  PlanRequest request;
-  if (!RequestFromArgs(args, &noise, &request, &error)) return {};
+  // The session's noise model (read with the log), its poses (detected once).
+  PlanRequest request = args.plan_request;
+  request.noise_model = session.noise_model();
   CoverageReport report;
-  if (!CheckRecording(log, args.config, request, &report, &error)) return {};
+  std::string error;
+  if (!CheckRecording(session, args.config, request, &report, &error)) return {};
   std::fprintf(stderr, "check: %s", CoverageReportText(report).c_str());
   return {{"check", CoverageToJson(report)}};
 }
