@@ -10,8 +10,10 @@
 
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/methods/known_attitude.h"
 #include "gravcal/methods/rate_table.h"
 #include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/plan.h"
@@ -85,6 +87,43 @@ TEST(Pipeline, MethodAndCheckReadTheSessionsDetection) {
   Calibration c_broken;
   EXPECT_FALSE(RunCalibration(config, SessionFiles(), &broken, &c_broken));
   EXPECT_EQ(c_broken.message, "detector failed (test)");
+}
+
+// A method takes its side data as values: known_attitude on a session
+// holding the fixture's rows gives what the pipeline gives from the file.
+TEST(Pipeline, SideDataInMemoryEqualsTheFile) {
+  SimulatorOptions sim;
+  sim.hold_seconds = 4.0;
+  sim.initial_still_seconds = 4.0;
+  SimulatedSession simulated;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, 14, &simulated, &error)) << error;
+  const std::vector<FixtureAttitude> rows = SimulatedFixtureAttitudes(simulated, 0.05, 14);
+  const std::string path = ::testing::TempDir() + "/pipeline_attitudes.csv";
+  std::ofstream(path) << FixtureAttitudesToCsv(rows);
+  Config config;
+  ASSERT_TRUE(SetConfigValue("method", "known_attitude", &config, &error)) << error;
+  config.calibration.gravity.gravity = simulated.gravity;
+  PipelineInput input;
+  input.log = simulated.log;
+  input.attitudes_path = path;
+  Calibration from_file;
+  ASSERT_TRUE(RunCalibration(config, input, &from_file)) << from_file.message;
+  // The rows as the file holds them (its text rounds the simulated values).
+  std::vector<FixtureAttitude> read;
+  ASSERT_TRUE(ReadFixtureAttitudes(path, &read, &error)) << error;
+  std::remove(path.c_str());
+  ASSERT_EQ(read.size(), rows.size());
+  Session session;
+  session.log = simulated.log;
+  session.attitudes = read;
+  session.attitudes_name = path;
+  Calibration in_memory;
+  ASSERT_TRUE(CalibrateKnownAttitude(session, {config.calibration}, &in_memory))
+      << in_memory.message;
+  EXPECT_EQ(in_memory.method, "known_attitude");
+  from_file.refinement.solve_seconds = in_memory.refinement.solve_seconds = 0.0;
+  EXPECT_EQ(CalibrationToJson(in_memory, true), CalibrationToJson(from_file, true));
 }
 
 // The log is read once: the provenance hash comes from the bytes parsed,
