@@ -22,13 +22,18 @@
 namespace gravcal {
 namespace {
 
-TEST(Pipeline, TwelvePositionEqualsCalibrateAccelerometer) {
+// A twelve-pose session with 4 s holds (a short start still too).
+bool ShortHolds(uint64_t seed, SimulatedSession* session, std::string* error) {
   SimulatorOptions sim;
   sim.hold_seconds = 4.0;
   sim.initial_still_seconds = 4.0;
+  return Simulate(sim, seed, session, error);
+}
+
+TEST(Pipeline, TwelvePositionEqualsCalibrateAccelerometer) {
   SimulatedSession session;
   std::string error;
-  ASSERT_TRUE(Simulate(sim, 11, &session, &error)) << error;
+  ASSERT_TRUE(ShortHolds(11, &session, &error)) << error;
   Config config;
   config.calibration.gravity.gravity = session.gravity;
   PipelineInput input;
@@ -50,12 +55,9 @@ TEST(Pipeline, TwelvePositionEqualsCalibrateAccelerometer) {
 // detection lost one interval gives one position fewer to both, so neither
 // detected again.
 TEST(Pipeline, MethodAndCheckReadTheSessionsDetection) {
-  SimulatorOptions sim;
-  sim.hold_seconds = 4.0;
-  sim.initial_still_seconds = 4.0;
   SimulatedSession simulated;
   std::string error;
-  ASSERT_TRUE(Simulate(sim, 12, &simulated, &error)) << error;
+  ASSERT_TRUE(ShortHolds(12, &simulated, &error)) << error;
   Config config;
   config.calibration.gravity.gravity = simulated.gravity;
   Session session;
@@ -92,12 +94,9 @@ TEST(Pipeline, MethodAndCheckReadTheSessionsDetection) {
 // A method takes its side data as values: known_attitude on a session
 // holding the fixture's rows gives what the pipeline gives from the file.
 TEST(Pipeline, SideDataInMemoryEqualsTheFile) {
-  SimulatorOptions sim;
-  sim.hold_seconds = 4.0;
-  sim.initial_still_seconds = 4.0;
   SimulatedSession simulated;
   std::string error;
-  ASSERT_TRUE(Simulate(sim, 14, &simulated, &error)) << error;
+  ASSERT_TRUE(ShortHolds(14, &simulated, &error)) << error;
   const std::vector<FixtureAttitude> rows = SimulatedFixtureAttitudes(simulated, 0.05, 14);
   const std::string path = ::testing::TempDir() + "/pipeline_attitudes.csv";
   std::ofstream(path) << FixtureAttitudesToCsv(rows);
