@@ -376,8 +376,7 @@ std::unique_ptr<PyCalibration> CalibrateFile(const Config& config, const std::st
   bool ok;
   {
     py::gil_scoped_release release;
-    ok = ReadImuLog(path, config.input, &input.log, &error) &&
-         LogProvenance(path, &provenance, &error);
+    ok = ReadImuLog(path, config.input, &input.log, &provenance, &error);
   }
   Check(ok, error);
   return Run(config, input, &provenance);
@@ -684,7 +683,8 @@ double ThreadCpuSeconds() {
 
 // For benchmarks/python_overhead.py: CPU seconds per call of a C++ user's
 // code doing what the Python call does, `repeats` calls: on `path`,
-// ReadImuLog, LogProvenance and RunCalibration (as `gravcal calibrate`);
+// ReadImuLog (with the provenance, one read) and RunCalibration (as
+// `gravcal calibrate`);
 // with an empty path, RunCalibration on the log in memory.
 double TimeCalibrate(const Config& config, const LogHandle& log, const std::string& path,
                      int repeats) {
@@ -700,8 +700,8 @@ double TimeCalibrate(const Config& config, const LogHandle& log, const std::stri
     input.source = path;
     CalibrationProvenance provenance;
     std::string error;
-    if (ReadImuLog(path, config.input, &input.log, &error) &&
-        LogProvenance(path, &provenance, &error) && RunCalibration(config, input, &c)) {
+    if (ReadImuLog(path, config.input, &input.log, &provenance, &error) &&
+        RunCalibration(config, input, &c)) {
       c.provenance = provenance;
     }
   }

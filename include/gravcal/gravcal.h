@@ -38,8 +38,10 @@
 #include "gravcal/methods/handheld_kalman.h"
 #include "gravcal/methods/known_attitude.h"
 #include "gravcal/methods/rate_table.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/methods/ten_position.h"
 #include "gravcal/methods/twelve_position.h"
+#include "gravcal/methods/twelve_position_method.h"
 
 // Read and write: logs, fixture attitudes, calibrations and their exports.
 #include "gravcal/io/attitude_fixture.h"

@@ -109,44 +109,45 @@ int RunCalibrate(const CalibrateArgs& args) {
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
-  PipelineInput input;
-  input.source = args.input;
-  input.attitudes_path = args.attitudes;
-  input.segments_path = args.segments;
-  input.noise_path = args.noise;
-  if (!ReadImuLog(args.input, args.config.input, &input.log, &error)) return Fail(error);
+  // The log is read once: its provenance hash comes from the same bytes.
+  Session session;
   CalibrationProvenance provenance;
-  if (!LogProvenance(args.input, &provenance, &error)) return Fail(error);
+  if (!ReadImuLog(args.input, args.config.input, &session.log, &provenance, &error)) {
+    return Fail(error);
+  }
+  SessionFiles files;
+  files.attitudes_path = args.attitudes;
+  files.segments_path = args.segments;
+  files.noise_path = args.noise;
   Calibration c;
-  const bool ok = RunCalibration(args.config, input, &c);
+  const bool ok = RunCalibration(args.config, files, &session, &c);
   c.provenance = provenance;
   PrintWarnings(c);
   // The report also for a failed calibration: it says why. For a session of
-  // static poses it shows what the detector rejected too.
-  StaticDetection detection;
+  // static poses it shows what the detector rejected too (the detection the
+  // method used).
+  const ImuLog& log = session.log;
   if (!args.report.empty() &&
-      !WriteFileAtomically(
-          args.report,
-          !c.positions.empty() &&
-                  DetectStaticIntervals(input.log, args.config.calibration.detector, &detection)
-              ? CalibrationToHtml(c, input.log, args.input, detection)
-              : CalibrationToHtml(c, input.log, args.input),
-          &error)) {
+      !WriteFileAtomically(args.report,
+                           !c.positions.empty() && session.detection_ok
+                               ? CalibrationToHtml(c, log, args.input, session.detection)
+                               : CalibrationToHtml(c, log, args.input),
+                           &error)) {
     return Fail(error);
   }
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
   // The history and the calibration are put in place together (the report,
   // written above, also says why a calibration failed).
-  std::vector<FileContents> files;
+  std::vector<FileContents> outputs;
   if (!args.history.empty()) {
-    files.push_back({args.history, ""});
-    if (!HistoryToCsv(c, &files.back().contents, &error)) return Fail(args.history + ": " + error);
+    outputs.push_back({args.history, ""});
+    if (!HistoryToCsv(c, &outputs.back().contents, &error)) return Fail(args.history + ": " + error);
   }
   const std::string json = CalibrationToJson(c, args.config.output_covariance,
-                                             CalibrationCheckSections(args, input.log));
-  if (args.output != "-") files.push_back({args.output, json});
-  if (!WriteFilesAtomically(files, &error) ||
+                                             CalibrationCheckSections(args, session));
+  if (args.output != "-") outputs.push_back({args.output, json});
+  if (!WriteFilesAtomically(outputs, &error) ||
       (args.output == "-" && !WriteOutput(args.output, json, &error))) {
     return Fail(error);
   }

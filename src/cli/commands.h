@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/plan.h"
 
@@ -135,7 +136,7 @@ int RunCheck(const PlanArgs& args);
 // check says it) with --check, for the methods of the magnitude model;
 // prints the text on stderr. Empty without --check, when the method has
 // none or when the check cannot be made.
-JsonSections CalibrationCheckSections(const CalibrateArgs& args, const ImuLog& log);
+JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session);
 
 // destinations.cc: the command's destinations checked against the
 // destination contract (io/files.h) before it runs: false with a one-line

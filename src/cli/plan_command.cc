@@ -62,14 +62,14 @@ int RunCheck(const PlanArgs& args) {
   return 0;
 }
 
-JsonSections CalibrationCheckSections(const CalibrateArgs& args, const ImuLog& log) {
+JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session) {
   if (!args.check || args.config.method != "twelve_position") return {};
-  std::string error;
-  ImuNoise noise;
+  // The session's noise model (read with the log), its poses (detected once).
   PlanRequest request;
-  if (!RequestWithNoise(PlanRequest(), args.noise, &noise, &request, &error)) return {};
+  request.noise_model = session.noise_model();
   CoverageReport report;
-  if (!CheckRecording(log, args.config, request, &report, &error)) return {};
+  std::string error;
+  if (!CheckRecording(session, args.config, request, &report, &error)) return {};
   std::fprintf(stderr, "check: %s", CoverageReportText(report).c_str());
   return {{"check", CoverageToJson(report)}};
 }

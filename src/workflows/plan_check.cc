@@ -51,6 +51,14 @@ using internal::Median;
 
 bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& request,
                     CoverageReport* report, std::string* error) {
+  Session session;
+  session.log = log;
+  return CheckRecording(session, config, request, report, error);
+}
+
+bool CheckRecording(const Session& session, const Config& config, const PlanRequest& request,
+                    CoverageReport* report, std::string* error) {
+  const ImuLog& log = session.log;
   internal::PlanStart start;
   if (!internal::StartPlan(config, request, &start, error)) return false;
   const DesignModel& model = start.model;
@@ -62,7 +70,7 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
   Calibration calibration;
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
-  if (!internal::DetectStaticPositions(log, options, &calibration, &intervals, &positions)) {
+  if (!internal::DetectStaticPositions(session, options, &calibration, &intervals, &positions)) {
     *error = calibration.message;
     return false;
   }

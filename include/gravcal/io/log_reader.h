@@ -30,6 +30,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gravcal/core/calibration.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/types.h"
 #include "gravcal/io/files.h"
@@ -67,6 +68,12 @@ struct LogReaderOptions {
 // and sets `error` to one line naming the file and line.
 bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
                 std::string* error);
+
+// Same, and *provenance gets the file's name, content hash and the
+// library's version (calibration_io.h LogProvenance), hashed from the bytes
+// read for the log: a text log is read once.
+bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
+                CalibrationProvenance* provenance, std::string* error);
 
 // Same as ReadImuLog on text already in memory; `name` is used in messages.
 bool ParseImuLog(std::string_view text, const std::string& name, const LogReaderOptions& options,
