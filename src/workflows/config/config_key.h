@@ -71,6 +71,21 @@ bool ReadEnum(const YAML::Node& n, Enum* v, const char* choices, std::string* er
 std::string DoubleText(double v);  // NaN = "null"
 std::string ListText(const std::vector<std::string>& v);
 
+// The reader and printer of a plain field by its type, for tables that bind
+// members (simulation/simulator_fields.h).
+inline bool ReadValue(const YAML::Node& n, double* v, std::string* e) {
+  return ReadDouble(n, v, e);
+}
+inline bool ReadValue(const YAML::Node& n, int* v, std::string* e) { return ReadInt(n, v, e); }
+inline bool ReadValue(const YAML::Node& n, bool* v, std::string* e) { return ReadBool(n, v, e); }
+inline bool ReadValue(const YAML::Node& n, std::string* v, std::string* e) {
+  return ReadString(n, v, e);
+}
+inline std::string ValueText(double v) { return DoubleText(v); }
+inline std::string ValueText(int v) { return std::to_string(v); }
+inline std::string ValueText(bool v) { return v ? "true" : "false"; }
+inline std::string ValueText(const std::string& v) { return v.empty() ? "\"\"" : v; }
+
 }  // namespace internal
 }  // namespace gravcal
 
@@ -82,14 +97,13 @@ std::string ListText(const std::vector<std::string>& v);
         [](const Config& c) { return print; }                                        \
   }
 #define GRAVCAL_DOUBLE(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadDouble(n, &c->field, e), DoubleText(c.field))
+  GRAVCAL_KEY(name, help, ReadDouble(n, &c->field, e), ValueText(c.field))
 #define GRAVCAL_INT(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadInt(n, &c->field, e), std::to_string(c.field))
+  GRAVCAL_KEY(name, help, ReadInt(n, &c->field, e), ValueText(c.field))
 #define GRAVCAL_BOOL(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadBool(n, &c->field, e), std::string(c.field ? "true" : "false"))
-#define GRAVCAL_STRING(name, field, help)              \
-  GRAVCAL_KEY(name, help, ReadString(n, &c->field, e), \
-              c.field.empty() ? std::string("\"\"") : c.field)
+  GRAVCAL_KEY(name, help, ReadBool(n, &c->field, e), ValueText(c.field))
+#define GRAVCAL_STRING(name, field, help) \
+  GRAVCAL_KEY(name, help, ReadString(n, &c->field, e), ValueText(c.field))
 #define GRAVCAL_ENUM(name, field, choices, help) \
   GRAVCAL_KEY(name, help, ReadEnum(n, &c->field, choices, e), std::string(ToString(c.field)))
 
