@@ -74,8 +74,10 @@
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/batch_manifest.h"
 #include "gravcal/workflows/batch_scheduler_shard.h"
+#include "gravcal/workflows/calibration_config.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/discovery.h"
+#include "gravcal/workflows/discovery_config.h"
 #include "gravcal/workflows/discovery_report.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/method_registry.h"
@@ -84,5 +86,6 @@
 #include "gravcal/workflows/plan.h"
 #include "gravcal/workflows/rate_table_segments.h"
 #include "gravcal/workflows/report.h"
+#include "gravcal/workflows/simulation_config.h"
 #include "gravcal/workflows/simulation_workflow.h"
 #endif  // GRAVCAL_GRAVCAL_H_

@@ -13,16 +13,16 @@ namespace internal {
 namespace {
 
 // The handler of one field of SimulatorOptions (simulator_fields.h).
-ConfigKeyHandler FieldHandler(const SimulatorField& field) {
-  ConfigKeyHandler h;
+KeyHandlerOf<SimulationConfig> FieldHandler(const SimulatorField& field) {
+  KeyHandlerOf<SimulationConfig> h;
   h.name = field.key;
   h.help = field.help;
   std::visit(
       [&h](auto member) {
-        h.set = [member](const YAML::Node& n, Config* c, std::string* e) {
+        h.set = [member](const YAML::Node& n, SimulationConfig* c, std::string* e) {
           return ReadValue(n, &(c->simulation.*member), e);
         };
-        h.get = [member](const Config& c) { return ValueText(c.simulation.*member); };
+        h.get = [member](const SimulationConfig& c) { return ValueText(c.simulation.*member); };
       },
       field.member);
   return h;
@@ -30,13 +30,13 @@ ConfigKeyHandler FieldHandler(const SimulatorField& field) {
 
 }  // namespace
 
-ConfigSection SimulatorSection() {
-  ConfigSection section{"simulator", ConfigSectionUse::kCommand, {}};
+SectionOf<SimulationConfig> SimulatorSection() {
+  SectionOf<SimulationConfig> section{"simulator", ConfigSectionUse::kCommand, {}};
   for (const SimulatorField& field : SimulatorFields()) section.keys.push_back(FieldHandler(field));
   return section;
 }
 
-ConfigSection MotionSimulatorSection() {
+SectionOf<SimulationConfig> MotionSimulatorSection() {
   return {
       "motion simulator",
       ConfigSectionUse::kCommand,
