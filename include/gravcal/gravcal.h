@@ -11,6 +11,7 @@
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/imu_corrector.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/core/imu_model.h"
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/noise_model.h"
 #include "gravcal/core/position.h"
