@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "gravcal/core/imu_model.h"
+
 namespace gravcal {
 
 namespace {
@@ -23,13 +25,13 @@ bool ImuCorrector::RequiresTime() const {
 
 bool ImuCorrector::CorrectAccel(const Eigen::Vector3d& raw, double temperature, double time,
                                 Eigen::Vector3d* a) const {
-  const Eigen::Vector3d m = accel.upper * (raw - accel.bias);
-  Eigen::Vector3d s = m;
-  if (!active_effects.empty() &&
-      !gravcal::CorrectAccel(effects, active_effects, m, temperature, time, &s)) {
+  const ImuParameters p(accel, nullptr, effects, active_effects);
+  Eigen::Vector3d out;
+  if (!p.Model().CorrectAccel(raw, p.TemperatureOffset(temperature), p.TimeOffset(time),
+                              out.data())) {
     return false;
   }
-  *a = accel.rotation * s;
+  *a = out;
   return true;
 }
 
@@ -37,12 +39,13 @@ Eigen::Vector3d ImuCorrector::CorrectGyro(const Eigen::Vector3d& raw,
                                           const Eigen::Vector3d& accel_housing, double temperature,
                                           double time) const {
   if (!has_gyro) return raw;
-  Eigen::Vector3d u = raw - gyro.bias;
-  if (!active_effects.empty()) {
-    const Eigen::Vector3d force = accel.rotation.transpose() * accel_housing;
-    u -= GyroOffset(effects, active_effects, force, temperature, time);
-  }
-  return gyro.matrix * u;
+  const ImuParameters p(accel, &gyro, effects, active_effects);
+  // The effects' G' was fitted against the force in the sensor frame.
+  const Eigen::Vector3d force = accel.rotation.transpose() * accel_housing;
+  Eigen::Vector3d w;
+  p.Model().CorrectGyro(raw, force.data(), p.TemperatureOffset(temperature), p.TimeOffset(time),
+                        w.data());
+  return w;
 }
 
 bool ImuCorrector::CorrectRow(double temperature, double time, Eigen::Vector3d* accel,
