@@ -1,5 +1,6 @@
 // The gyroscope part of the effect fit (effect_fit.h): b_g and the
-// gyroscope effects from the static mean rates.
+// gyroscope effects from the static mean rates, with the robust loss of the
+// accelerometer part.
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
@@ -7,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "estimation/robust_loss.h"
 #include "gravcal/methods/effect_fit.h"
 #include "gravcal/residuals/gyro_static_residual.h"
 #include "methods/effect_fit_parts.h"
@@ -32,11 +34,12 @@ bool GyroWhitening(const std::vector<StaticObservation>& observations,
   return true;
 }
 
-// fit->chi2 and, with `covariance`, the dense Jacobian (3 rows per
-// position) of b_g and the blocks that are on (G, gamma, eta).
+// fit->chi2, the whitened residuals (3 rows per position) and, with
+// `covariance`, the dense Jacobian of b_g and the blocks that are on (G,
+// gamma, eta).
 void EvaluateGyroFit(const std::vector<std::unique_ptr<ceres::CostFunction>>& owned,
                      const double* const params[4], const bool on[3], bool covariance,
-                     Eigen::MatrixXd* jacobian, SensorFitSummary* fit) {
+                     Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals, SensorFitSummary* fit) {
   fit->chi2 = 0.0;
   for (int k = 0; k < static_cast<int>(owned.size()); ++k) {
     double r[3];
@@ -45,6 +48,7 @@ void EvaluateGyroFit(const std::vector<std::unique_ptr<ceres::CostFunction>>& ow
     owned[k]->Evaluate(params, r, covariance ? jacobians : nullptr);
     for (int row = 0; row < 3; ++row) {
       fit->chi2 += r[row] * r[row];
+      (*residuals)(3 * k + row) = r[row];
       if (!covariance) continue;
       int col = 0;
       for (int i = 0; i < 3; ++i) (*jacobian)(3 * k + row, col++) = jb[3 * row + i];
@@ -87,9 +91,6 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   if (!on_t) std::fill(temperature_bias, temperature_bias + 3, 0.0);
   if (!on_d) std::fill(drift, drift + 3, 0.0);
 
-  ceres::Problem::Options keep;
-  keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(keep);
   std::vector<std::unique_ptr<ceres::CostFunction>> owned;
   for (int k = 0; k < n; ++k) {
     const StaticObservation& o = observations[k];
@@ -97,17 +98,46 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
         o.gyro_mean, whitening[k], result->forces[k],
         TemperatureOffset(initial_parameters, o.temperature()),
         o.time() - initial_parameters.reference_time));
-    problem.AddResidualBlock(owned.back().get(), nullptr, bias, g, temperature_bias, drift);
+  }
+  const double* params[4] = {bias, g, temperature_bias, drift};
+  // The robust loss of the accelerometer part, graduated the same way: from
+  // a scale that holds every initial residual down to loss_scale.
+  double largest = 0.0;
+  if (options.loss != LossType::kNone) {
+    for (const auto& cost : owned) {
+      Eigen::Vector3d r;
+      if (cost->Evaluate(params, r.data(), nullptr)) largest = std::max(largest, r.norm());
+    }
+  }
+  const std::vector<double> scales = GraduatedLossScales(options.loss, options.loss_scale, largest);
+  ceres::Problem::Options keep;
+  keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  keep.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(keep);
+  std::unique_ptr<ceres::LossFunctionWrapper> loss;
+  if (options.loss != LossType::kNone) {
+    loss = std::make_unique<ceres::LossFunctionWrapper>(MakeLoss(options.loss, scales.back()),
+                                                        ceres::TAKE_OWNERSHIP);
+  }
+  for (const auto& cost : owned) {
+    problem.AddResidualBlock(cost.get(), loss.get(), bias, g, temperature_bias, drift);
   }
   if (!on_g) problem.SetParameterBlockConstant(g);
   if (!on_t) problem.SetParameterBlockConstant(temperature_bias);
   if (!on_d) problem.SetParameterBlockConstant(drift);
+  // Once per loss scale, widest first (one solve without a loss).
   ceres::Solver::Summary summary;
-  ceres::Solve(EffectFitSolverOptions(options), &problem, &summary);
   SensorFitSummary& fit = result->gyro_fit;
+  fit.iterations = 0;
+  for (auto it = scales.rbegin(); it != scales.rend(); ++it) {
+    if (loss) loss->Reset(MakeLoss(options.loss, *it), ceres::TAKE_OWNERSHIP);
+    ceres::Solve(EffectFitSolverOptions(options), &problem, &summary);
+    fit.iterations += static_cast<int>(summary.iterations.size()) - 1;
+    if (!summary.IsSolutionUsable()) break;
+  }
   fit.fitted = true;
   fit.information = "static mean rates";
-  fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  if (loss) fit.information += std::string(" (") + ToString(options.loss) + " loss)";
   fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {
     result->message = "gyroscope effect fit failed: " + summary.message;
@@ -125,8 +155,11 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   }
   const int np = static_cast<int>(fit.parameter_names.size());
   Eigen::MatrixXd jacobian(3 * n, np);
-  const double* params[4] = {bias, g, temperature_bias, drift};
-  EvaluateGyroFit(owned, params, on, options.compute_covariance, &jacobian, &fit);
+  Eigen::VectorXd residual_rows(3 * n);
+  EvaluateGyroFit(owned, params, on, options.compute_covariance, &jacobian, &residual_rows, &fit);
+  if (loss && options.compute_covariance) {
+    WeightRowsByLoss(std::vector<int>(n, 3), options, &jacobian, &residual_rows);
+  }
   fit.num_residuals = 3 * n;
   fit.num_parameters = np;
   result->gyro.bias = Eigen::Vector3d(bias[0], bias[1], bias[2]);
