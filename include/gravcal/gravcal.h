@@ -49,6 +49,7 @@
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_export.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/calibration_models.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/imu_stream.h"
 #include "gravcal/io/log_reader.h"
