@@ -14,6 +14,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "gravcal/gravcal.h"
+#include "gravcal/io/calibration_models.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/io/plan_io.h"
@@ -204,16 +206,23 @@ LogHandle ReadLog(const std::string& path, const Config& config) {
 }
 
 // ---------------------------------------------------------------------------
-// Calibration: the calibration JSON text (what `gravcal calibrate` writes)
-// and the models read back from it (what `gravcal apply` uses).
+// Calibration: the library's result, or a calibration file's JSON text, and
+// the models `apply` and `export` use. A result made here reaches its models
+// directly (io/calibration_models.h); JSON text is made only when asked for
+// (to_json, to_dict, write) and parsed only for a file's text.
+
+// How many times a calibration was turned into JSON text or parsed back
+// (the Python tests check that calibrate, apply and export make none).
+std::atomic<int> json_conversions{0};
 
 struct PyCalibration {
   // The library's result, when made here (null when read from a file).
   std::shared_ptr<const Calibration> result;
   bool include_covariance = true;
   std::string name;
-  // The JSON text (built from `result` on first use) and the models read
-  // back from it, as ReadCalibrationJson would (on first apply).
+  // The JSON text (built from `result` on first use) and the models (from
+  // `result`, else read from the text as ReadCalibrationJson would; on
+  // first use).
   mutable std::string json;
   mutable bool has_json = false;
   mutable bool parsed = false;
@@ -244,6 +253,7 @@ struct PyCalibration {
     if (!has_json) {
       json = CalibrationToJson(*result, include_covariance);
       has_json = true;
+      ++json_conversions;
     }
     return json;
   }
@@ -251,7 +261,12 @@ struct PyCalibration {
   const LoadedCalibration& Models() const {
     if (!parsed) {
       std::string error;
-      Check(CalibrationFromJson(Json(), name, &models, &error), error);
+      if (result != nullptr) {
+        Check(ModelsFromCalibration(*result, name, &models, &error), error);
+      } else {
+        Check(CalibrationFromJson(json, name, &models, &error), error);
+        ++json_conversions;
+      }
       parsed = true;
     }
     return models;
@@ -779,6 +794,7 @@ PYBIND11_MODULE(_gravcal, m) {
            })
       .def("apply", &ApplyCalibration, py::arg("accel"), py::arg("gyro"), py::arg("temp"),
            py::arg("t"));
+  m.def("_json_conversions", [] { return json_conversions.load(); });
   m.def("calibrate", &Calibrate, py::arg("config"), py::arg("log"), py::arg("attitudes"),
         py::arg("segments"), py::arg("noise"));
   m.def("calibrate_file", &CalibrateFile, py::arg("config"), py::arg("path"), py::arg("attitudes"),

@@ -22,6 +22,7 @@
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/imu_corrector.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/core/imu_model.h"
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/noise_model.h"
 #include "gravcal/core/position.h"
@@ -47,6 +48,7 @@
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_export.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/calibration_models.h"
 #include "gravcal/io/log_reader.h"
 
 #endif  // GRAVCAL_GRAVCAL_H_

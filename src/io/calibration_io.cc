@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "gravcal/core/imu_model.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "io/json_helpers.h"
@@ -478,33 +479,7 @@ bool ReadEffect(const json& entry, Effect effect, const std::string& key, JsonRe
       v[i] = 0.0;
     }
   }
-  EffectParameters& p = out->corrector.effects;
-  const Eigen::Vector3d three(v[0], v[1], v[2]);
-  switch (effect) {
-    case Effect::kAccelQuadratic:
-      p.accel_quadratic = three;
-      break;
-    case Effect::kAccelTemperatureBias:
-      p.accel_temperature_bias = three;
-      break;
-    case Effect::kAccelTemperatureScale:
-      p.accel_temperature_scale = three;
-      break;
-    case Effect::kAccelBiasDrift:
-      p.accel_bias_drift = three;
-      break;
-    case Effect::kGyroTemperatureBias:
-      p.gyro_temperature_bias = three;
-      break;
-    case Effect::kGyroBiasDrift:
-      p.gyro_bias_drift = three;
-      break;
-    case Effect::kGyroGSensitivity:
-      for (int i = 0; i < 9; ++i) p.gyro_g_sensitivity(i / 3, i % 3) = v[i];
-      break;
-    case Effect::kAccelMisalignment:
-      break;
-  }
+  SetEffectValues(effect, v, &out->corrector.effects);
   if (Info(effect).sensor == EffectSensor::kGyroscope && !out->corrector.has_gyro) {
     return r->Fail(key, "is a gyroscope effect but the file has no 'gyro' section");
   }
