@@ -17,7 +17,6 @@ namespace {
 
 using internal::MedianSampleInterval;
 using internal::NoiseFloor;
-using internal::Num;
 using internal::QuietRun;
 using internal::RateScale;
 using internal::SplitOrFlagSpread;
@@ -25,6 +24,8 @@ using internal::SplitRunsAtSteps;
 using internal::StridedQuantile;
 using internal::WindowTrend;
 using internal::WindowVariance;
+
+std::string Num(double v) { return internal::DetectorNumber(v); }
 
 // MakeInterval looks for the accelerometer resolution in this many samples.
 constexpr size_t kResolutionSamples = 256;

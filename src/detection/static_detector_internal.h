@@ -24,8 +24,9 @@ namespace internal {
 // (and much faster) beyond.
 constexpr size_t kMaxQuantileValues = size_t{1} << 14;
 
-// A number as the detector's messages write it (6 significant digits).
-inline std::string Num(double v) {
+// A number as the detector's messages write it (6 significant digits). Not
+// called Num: in a unity build other files' anonymous Num share the batch.
+inline std::string DetectorNumber(double v) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.6g", v);
   return buf;

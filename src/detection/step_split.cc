@@ -190,9 +190,10 @@ size_t SplitOrFlagSpread(const ImuLog& log, size_t min_count, const StaticDetect
     }
     out.push_back(s);
     detection->warnings.push_back(
-        "the position at t " + Num(s.t_begin) + "-" + Num(s.t_end) + " s (samples " +
-        std::to_string(s.begin) + "-" + std::to_string(s.end) + ") is not one still pose: its " +
-        "spread is " + Num(std::sqrt(spread / detection->accel_noise_floor)) +
+        "the position at t " + DetectorNumber(s.t_begin) + "-" + DetectorNumber(s.t_end) +
+        " s (samples " + std::to_string(s.begin) + "-" + std::to_string(s.end) +
+        ") is not one still pose: its " + "spread is " +
+        DetectorNumber(std::sqrt(spread / detection->accel_noise_floor)) +
         " times the noise (standard deviations) and it is no set of steps between still "
         "levels: a slow motion or drift; hold the pose still, or drop it");
   }
