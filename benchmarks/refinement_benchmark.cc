@@ -18,15 +18,18 @@
 #include <string>
 #include <vector>
 
+#include "estimation/newton_solver.h"
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/position.h"
 #include "gravcal/estimation/coarse_fit.h"
-#include "gravcal/estimation/newton_solver.h"
 #include "gravcal/estimation/refinement.h"
 #include "test_util.h"
 
 namespace gravcal {
 namespace {
+
+using internal::NewtonOptions;
+using internal::NewtonRefine;
 
 constexpr double kG = 9.80665;
 constexpr double kCountScale = kG / 16384.0;

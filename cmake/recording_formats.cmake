@@ -16,9 +16,9 @@ foreach(var GRAVCAL_ZLIB_LIBRARY GRAVCAL_SQLITE3_LIBRARY GRAVCAL_SQLITE3_INCLUDE
     message(FATAL_ERROR "${var} not found: install libsqlite3-dev libzstd-dev liblz4-dev zlib1g-dev")
   endif()
 endforeach()
-target_include_directories(gravcal SYSTEM PRIVATE
+target_include_directories(${GRAVCAL_COMPILE_TARGET} SYSTEM PRIVATE
   ${GRAVCAL_SQLITE3_INCLUDE} ${GRAVCAL_ZSTD_INCLUDE} ${GRAVCAL_LZ4_INCLUDE})
-target_link_libraries(gravcal PRIVATE
+target_link_libraries(${GRAVCAL_COMPILE_TARGET} PRIVATE
   ${GRAVCAL_SQLITE3_LIBRARY} ${GRAVCAL_ZSTD_LIBRARY} ${GRAVCAL_LZ4_LIBRARY} ${GRAVCAL_ZLIB_LIBRARY})
 
 # Debian's rosbag_storage headers include the ROS 2 pluginlib, class_loader,
@@ -53,7 +53,7 @@ if(GRAVCAL_WITH_ROSBAG)
       APPEND PROPERTY COMPILE_OPTIONS ${_gravcal_rosbag_flags})
     set_property(SOURCE ${_gravcal_rosbag_sources}
       APPEND PROPERTY COMPILE_DEFINITIONS GRAVCAL_HAVE_ROSBAG)
-    target_link_libraries(gravcal PRIVATE ${_gravcal_rosbag_libraries})
+    target_link_libraries(${GRAVCAL_COMPILE_TARGET} PRIVATE ${_gravcal_rosbag_libraries})
   else()
     message(STATUS "ROS 1 bags: librosbag_storage not found, bags are refused")
   endif()

@@ -14,6 +14,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -22,6 +23,24 @@
 #include <vector>
 
 #include "gravcal/gravcal.h"
+#include "gravcal/io/calibration_models.h"
+#include "gravcal/io/files.h"
+#include "gravcal/io/noise_io.h"
+#include "gravcal/io/plan_io.h"
+#include "gravcal/io/recording.h"
+#include "gravcal/workflows/batch.h"
+#include "gravcal/workflows/batch_folder.h"
+#include "gravcal/workflows/batch_manifest.h"
+#include "gravcal/workflows/batch_scheduler_shard.h"
+#include "gravcal/workflows/config.h"
+#include "gravcal/workflows/discovery.h"
+#include "gravcal/workflows/discovery_report.h"
+#include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/noise_workflow.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/workflows/plan.h"
+#include "gravcal/workflows/report.h"
+#include "gravcal/workflows/simulation_workflow.h"
 
 namespace py = pybind11;
 
@@ -187,16 +206,23 @@ LogHandle ReadLog(const std::string& path, const Config& config) {
 }
 
 // ---------------------------------------------------------------------------
-// Calibration: the calibration JSON text (what `gravcal calibrate` writes)
-// and the models read back from it (what `gravcal apply` uses).
+// Calibration: the library's result, or a calibration file's JSON text, and
+// the models `apply` and `export` use. A result made here reaches its models
+// directly (io/calibration_models.h); JSON text is made only when asked for
+// (to_json, to_dict, write) and parsed only for a file's text.
+
+// How many times a calibration was turned into JSON text or parsed back
+// (the Python tests check that calibrate, apply and export make none).
+std::atomic<int> json_conversions{0};
 
 struct PyCalibration {
   // The library's result, when made here (null when read from a file).
   std::shared_ptr<const Calibration> result;
   bool include_covariance = true;
   std::string name;
-  // The JSON text (built from `result` on first use) and the models read
-  // back from it, as ReadCalibrationJson would (on first apply).
+  // The JSON text (built from `result` on first use) and the models (from
+  // `result`, else read from the text as ReadCalibrationJson would; on
+  // first use).
   mutable std::string json;
   mutable bool has_json = false;
   mutable bool parsed = false;
@@ -227,6 +253,7 @@ struct PyCalibration {
     if (!has_json) {
       json = CalibrationToJson(*result, include_covariance);
       has_json = true;
+      ++json_conversions;
     }
     return json;
   }
@@ -234,7 +261,12 @@ struct PyCalibration {
   const LoadedCalibration& Models() const {
     if (!parsed) {
       std::string error;
-      Check(CalibrationFromJson(Json(), name, &models, &error), error);
+      if (result != nullptr) {
+        Check(ModelsFromCalibration(*result, name, &models, &error), error);
+      } else {
+        Check(CalibrationFromJson(json, name, &models, &error), error);
+        ++json_conversions;
+      }
       parsed = true;
     }
     return models;
@@ -359,8 +391,7 @@ std::unique_ptr<PyCalibration> CalibrateFile(const Config& config, const std::st
   bool ok;
   {
     py::gil_scoped_release release;
-    ok = ReadImuLog(path, config.input, &input.log, &error) &&
-         LogProvenance(path, &provenance, &error);
+    ok = ReadImuLog(path, config.input, &input.log, &provenance, &error);
   }
   Check(ok, error);
   return Run(config, input, &provenance);
@@ -409,6 +440,27 @@ struct UnitSpec {
   Keys overrides;
 };
 
+// One unit's result for Python; the calibration as the unit's <unit>.json
+// (what `gravcal batch` writes).
+PyBatchResult ToPython(BatchResult* r, const BatchUnit& unit, const Config& base) {
+  PyBatchResult p;
+  p.unit = r->unit;
+  p.status = ToString(r->status);
+  p.skipped = r->skipped;
+  p.message = r->message;
+  p.content_hash = r->content_hash;
+  p.timings = r->timings;
+  Config config;
+  std::string error;
+  if (r->status == BatchStatus::kOk && !r->skipped &&
+      EffectiveConfig(unit, base, &config, &error)) {
+    p.calibration = py::cast(
+        PyCalibration::FromResult(std::make_shared<const Calibration>(std::move(r->calibration)),
+                                  config.output_covariance, r->unit));
+  }
+  return p;
+}
+
 std::vector<PyBatchResult> Batch(const std::vector<BatchUnit>& units, const Config& base,
                                  int threads) {
   BatchOptions options;
@@ -421,25 +473,50 @@ std::vector<PyBatchResult> Batch(const std::vector<BatchUnit>& units, const Conf
     ok = CalibrateBatch(units, base, options, &results, &error);
   }
   Check(ok, error);
-  std::vector<PyBatchResult> out(results.size());
-  for (size_t i = 0; i < results.size(); ++i) {
-    const BatchResult& r = results[i];
-    PyBatchResult& p = out[i];
-    p.unit = r.unit;
-    p.status = ToString(r.status);
-    p.skipped = r.skipped;
-    p.message = r.message;
-    p.content_hash = r.content_hash;
-    p.timings = r.timings;
-    Config config;
-    if (r.status == BatchStatus::kOk && EffectiveConfig(units[i], base, &config, &error)) {
-      // The unit's <unit>.json as `gravcal batch` writes it.
-      p.calibration = py::cast(PyCalibration::FromResult(
-          std::make_shared<const Calibration>(std::move(results[i].calibration)),
-          config.output_covariance, r.unit));
-    }
-  }
+  std::vector<PyBatchResult> out;
+  for (size_t i = 0; i < results.size(); ++i) out.push_back(ToPython(&results[i], units[i], base));
   return out;
+}
+
+// `gravcal batch` from Python (workflows/batch_folder.h): the units of the
+// manifest or folder in `source` (else `units`), written into output_dir and
+// resumed from it. A skipped unit's status and message come from its stored
+// row. Returns (results, full report text).
+py::tuple BatchToFolder(const std::vector<BatchUnit>& units, const BatchSource& source,
+                        const Config& base, int threads, const std::string& output_dir,
+                        const std::string& report, const std::string& shard) {
+  BatchFolderOptions options;
+  options.output_dir = output_dir;
+  options.report = report;
+  options.threads = threads;
+  std::string error;
+  std::string shard_source;
+  Check(IsSchedulerShard(shard)
+            ? ShardFromScheduler(shard, ProcessEnvironment(), &options.shard, &shard_source, &error)
+            : shard.empty() || ParseShard(shard, &options.shard, &error),
+        error);
+  BatchFolderUnits shard_units;
+  BatchFolderSummary summary;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = (source.manifest.empty() && source.input_dir.empty()
+              ? (shard_units = ShardOfFleet(units, base, options.shard), true)
+              : ListBatchFolderUnits(source, base, options, &shard_units, &error)) &&
+         CalibrateBatchToFolder(shard_units, base, options, &summary, &error);
+  }
+  Check(ok, error);
+  summary.shard_source = shard_source;
+  std::vector<PyBatchResult> out;
+  for (size_t i = 0; i < summary.results.size(); ++i) {
+    BatchResult& r = summary.results[i];
+    if (r.skipped) {
+      r.status = summary.rows[i].status;
+      r.message = summary.rows[i].message;
+    }
+    out.push_back(ToPython(&r, shard_units.units[i], base));
+  }
+  return py::make_tuple(out, summary.FullReport());
 }
 
 std::vector<BatchUnit> UnitsFromSpecs(const std::vector<UnitSpec>& specs) {
@@ -621,7 +698,8 @@ double ThreadCpuSeconds() {
 
 // For benchmarks/python_overhead.py: CPU seconds per call of a C++ user's
 // code doing what the Python call does, `repeats` calls: on `path`,
-// ReadImuLog, LogProvenance and RunCalibration (as `gravcal calibrate`);
+// ReadImuLog (with the provenance, one read) and RunCalibration (as
+// `gravcal calibrate`);
 // with an empty path, RunCalibration on the log in memory.
 double TimeCalibrate(const Config& config, const LogHandle& log, const std::string& path,
                      int repeats) {
@@ -637,8 +715,8 @@ double TimeCalibrate(const Config& config, const LogHandle& log, const std::stri
     input.source = path;
     CalibrationProvenance provenance;
     std::string error;
-    if (ReadImuLog(path, config.input, &input.log, &error) &&
-        LogProvenance(path, &provenance, &error) && RunCalibration(config, input, &c)) {
+    if (ReadImuLog(path, config.input, &input.log, &provenance, &error) &&
+        RunCalibration(config, input, &c)) {
       c.provenance = provenance;
     }
   }
@@ -708,8 +786,15 @@ PYBIND11_MODULE(_gravcal, m) {
                     return PyCalibration::FromText(text, name);
                   })
       .def("write", &WriteCalibration)
+      .def("report",
+           [](const PyCalibration& c, bool full) {
+             Check(c.result != nullptr,
+                   c.name + ": a calibration read from JSON has no report (only a result has)");
+             return full ? c.result->FullReport() : c.result->BriefReport();
+           })
       .def("apply", &ApplyCalibration, py::arg("accel"), py::arg("gyro"), py::arg("temp"),
            py::arg("t"));
+  m.def("_json_conversions", [] { return json_conversions.load(); });
   m.def("calibrate", &Calibrate, py::arg("config"), py::arg("log"), py::arg("attitudes"),
         py::arg("segments"), py::arg("noise"));
   m.def("calibrate_file", &CalibrateFile, py::arg("config"), py::arg("path"), py::arg("attitudes"),
@@ -749,6 +834,17 @@ PYBIND11_MODULE(_gravcal, m) {
       },
       py::arg("specs"));
   m.def("batch", &Batch, py::arg("units"), py::arg("config"), py::arg("threads"));
+  m.def(
+      "batch_to_folder",
+      [](const std::vector<BatchUnit>& units, const std::string& manifest,
+         const std::string& input_dir, const std::string& pattern, const Config& base, int threads,
+         const std::string& output_dir, const std::string& report, const std::string& shard) {
+        return BatchToFolder(units, {manifest, input_dir, pattern, "", ""}, base, threads,
+                             output_dir, report, shard);
+      },
+      py::arg("units"), py::arg("manifest"), py::arg("input_dir"), py::arg("pattern"),
+      py::arg("config"), py::arg("threads"), py::arg("output_dir"), py::arg("report"),
+      py::arg("shard"));
   m.def(
       "noise",
       [](const Config& config, const LogHandle& log, const std::string& kalibr,

@@ -290,6 +290,74 @@ TEST(CalibrationChecksOnLoad, ARotationThatIsNotOneIsRefused) {
   EXPECT_NE(LoadError(j).find("key 'accel.upper': is not upper triangular"), std::string::npos);
 }
 
+// accel.model states a structure: scale_misalignment holds R = I (the matrix
+// upper triangular), scale a diagonal matrix. A file whose matrix breaks it
+// (an edit, another tool's full matrix under the wrong model name) is refused
+// naming the entry and both keys; a stated gyro.model is held the same way.
+TEST(CalibrationChecksOnLoad, TheMatrixHasTheStructureItsModelClaims) {
+  json j = GoodCalibration();
+  j["accel"]["model"] = "scale_misalignment";
+  std::string error = LoadError(j);  // the small rotation puts entries below
+  EXPECT_NE(error.find("c.json: key 'accel.matrix': has (1,0) = "), std::string::npos) << error;
+  EXPECT_NE(error.find("below the diagonal, but key 'accel.model' is 'scale_misalignment'"),
+            std::string::npos)
+      << error;
+  // The same without upper and rotation: matrix is authoritative.
+  j["accel"].erase("upper");
+  j["accel"].erase("rotation");
+  EXPECT_NE(LoadError(j).find("key 'accel.model' is 'scale_misalignment'"), std::string::npos);
+  // R = I and an upper-triangular matrix load; as "scale" they are refused
+  // (off the diagonal), a diagonal one loads.
+  j = GoodCalibration();
+  j["accel"]["model"] = "scale_misalignment";
+  j["accel"]["rotation"] = Diagonal(1.0, 1.0, 1.0);
+  j["accel"]["matrix"] = j["accel"]["upper"];
+  EXPECT_EQ(LoadError(j), "");
+  j["accel"]["model"] = "scale";
+  error = LoadError(j);
+  EXPECT_NE(error.find("key 'accel.matrix': has (0,1) = 2e-07 off the diagonal, but key "
+                       "'accel.model' is 'scale'"),
+            std::string::npos)
+      << error;
+  j["accel"]["upper"] = j["accel"]["matrix"] = Diagonal(6e-4, 5.9e-4, 6.1e-4);
+  EXPECT_EQ(LoadError(j), "");
+  // gyro.model (gravcal writes none): bias = s I, scale diagonal, full any.
+  j = GoodCalibration();
+  for (const char* model : {"bias", "scale", "full"}) {
+    j["gyro"]["model"] = model;
+    EXPECT_EQ(LoadError(j), "") << model;
+  }
+  j["gyro"]["matrix"] = Diagonal(1.3e-4, 1.2e-4, 1.3e-4);
+  j["gyro"]["model"] = "bias";
+  EXPECT_NE(LoadError(j).find("key 'gyro.matrix': has unequal diagonal entries"),
+            std::string::npos);
+  j["gyro"]["matrix"][2][1] = 1e-6;
+  j["gyro"]["model"] = "scale";
+  EXPECT_NE(LoadError(j).find("key 'gyro.matrix': has (2,1) = 1e-06 off the diagonal"),
+            std::string::npos);
+  j["gyro"]["model"] = "full";
+  EXPECT_EQ(LoadError(j), "");
+  j["gyro"]["model"] = "none";
+  EXPECT_NE(LoadError(j).find("key 'gyro.model'"), std::string::npos);
+}
+
+// A key set twice is refused naming it (nlohmann keeps one of the two
+// silently: an edited copy of "accel" above the written one was applied).
+TEST(CalibrationChecksOnLoad, AKeySetTwiceIsRefused) {
+  const std::string text = GoodCalibration().dump();
+  LoadedCalibration loaded;
+  std::string error;
+  const std::string twice =
+      R"({"accel": {"bias": [0, 0, 0], "matrix": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}, )" +
+      text.substr(1);
+  EXPECT_FALSE(CalibrationFromJson(twice, "c.json", &loaded, &error));
+  EXPECT_EQ(error, "c.json: key 'accel' appears twice (a key may be set once)");
+  std::string inner = text;
+  inner.replace(inner.find("\"bias\":"), 7, R"("bias": [1, 2, 3], "bias":)");
+  EXPECT_FALSE(CalibrationFromJson(inner, "c.json", &loaded, &error));
+  EXPECT_NE(error.find("key 'accel.bias' appears twice"), std::string::npos) << error;
+}
+
 TEST(CalibrationChecksOnLoad, SensorMatricesAreCheckedByConditioningNotDeterminant) {
   struct Case {
     json matrix;

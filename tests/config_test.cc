@@ -6,11 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/method_registry.h"
 #include "test_util.h"
 
@@ -338,6 +341,59 @@ TEST(Config, RegistrySectionsAndKeysExist) {
     bool read = false;
     for (const CalibrationMethod& m : CalibrationMethods()) read |= MethodReadsKey(m, k);
     EXPECT_TRUE(read) << k.name;
+  }
+}
+
+// The simulator's truth (truth.json "options") and its config section come
+// from one table: every sim_ key of the section appears in the truth under a
+// name of its own, the truth has no option without a key, and the truth read
+// back through the keys gives the same config.
+TEST(Config, SimulatorTruthHoldsEverySimulatorKey) {
+  const Config defaults;
+  const auto options_json = [](const Config& c) {
+    return nlohmann::json::parse(TruthToJson(SimulatedSession(), c.simulation))["options"];
+  };
+  const nlohmann::json base = options_json(defaults);
+  Config changed;
+  std::map<std::string, std::string> truth_name;  // key -> its name in the truth
+  std::set<std::string> names;
+  for (const ConfigKey& key : ConfigKeys()) {
+    if (key.section != "simulator") continue;
+    // A value away from the default, of the key's type.
+    const std::string text = ConfigValueText(defaults, key.name);
+    std::string value = "changed_" + key.name;
+    if (text == "true" || text == "false") {
+      value = text == "true" ? "false" : "true";
+    } else if (text == "null") {
+      value = "1.5";
+    } else if (text.find_first_not_of("0123456789.e+-") == std::string::npos) {
+      value = std::to_string(std::stod(text) + 0.375);
+    }
+    Config one;
+    std::string error;
+    ASSERT_TRUE(SetConfigValue(key.name, value, &one, &error)) << error;
+    ASSERT_TRUE(SetConfigValue(key.name, value, &changed, &error)) << error;
+    std::vector<std::string> moved;
+    const nlohmann::json options = options_json(one);
+    for (const auto& [name, v] : options.items()) {
+      if (!base.contains(name) || base[name] != v) moved.push_back(name);
+    }
+    ASSERT_EQ(moved.size(), 1u) << key.name << " moves " << moved.size() << " truth options";
+    EXPECT_TRUE(names.insert(moved[0]).second) << key.name << " shares " << moved[0];
+    truth_name[key.name] = moved[0];
+  }
+  EXPECT_GE(truth_name.size(), 43u);
+  EXPECT_EQ(base.size(), truth_name.size()) << "a truth option without a sim_ key";
+  // Round trip: the truth of `changed`, set back through the keys.
+  const nlohmann::json truth = options_json(changed);
+  Config read_back;
+  for (const auto& [key, name] : truth_name) {
+    const nlohmann::json& v = truth[name];
+    std::string error;
+    ASSERT_TRUE(
+        SetConfigValue(key, v.is_string() ? v.get<std::string>() : v.dump(), &read_back, &error))
+        << key << ": " << error;
+    EXPECT_EQ(ConfigValueText(read_back, key), ConfigValueText(changed, key)) << key;
   }
 }
 

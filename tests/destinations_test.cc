@@ -435,5 +435,47 @@ TEST_F(DestinationTest, BatchInItsOwnInputFolder) {
   EXPECT_EQ(Names(Work("apple")), std::set<std::string>({"._u1.csv"}));
 }
 
+// Several outputs are one: a second file that cannot be written leaves the
+// first as the user had it (never removed, never a link deleted), and no
+// temporary stays behind. Then all are put in place, a link's target replaced.
+TEST_F(DestinationTest, SeveralOutputsAllOrNone) {
+  ASSERT_EQ(mkdir(Work("real").c_str(), 0755), 0);
+  Plant("real/plan.json", "precious");
+  ASSERT_EQ(symlink("real/plan.json", Work("plan.json").c_str()), 0);
+  Plant("report.html", "kept");
+  std::string error;
+  EXPECT_FALSE(WriteFilesAtomically(
+      {{Work("plan.json"), "new"}, {Work("report.html"), "new"}, {Work("gone/r.html"), "x"}},
+      &error));
+  EXPECT_NE(error.find(Work("gone/r.html")), std::string::npos) << error;
+  EXPECT_EQ(error.find("gravcal-tmp"), std::string::npos) << error;
+  EXPECT_TRUE(IsSymlink(Work("plan.json")));
+  EXPECT_EQ(Slurp(Work("real/plan.json")), "precious");
+  EXPECT_EQ(Slurp(Work("report.html")), "kept");
+  EXPECT_EQ(Names(work_), std::set<std::string>({"real", "plan.json", "report.html"}));
+  EXPECT_EQ(Names(Work("real")), std::set<std::string>({"plan.json"}));
+  ASSERT_TRUE(WriteFilesAtomically({{Work("plan.json"), "new"}, {"", "skipped"}}, &error)) << error;
+  EXPECT_TRUE(IsSymlink(Work("plan.json")));
+  EXPECT_EQ(Slurp(Work("real/plan.json")), "new");
+  EXPECT_EQ(Names(work_), std::set<std::string>({"real", "plan.json", "report.html"}));
+}
+
+// simulate --output-dir makes every missing level (mkdir -p), as export --to c
+// does; a level that is a file is refused by name.
+TEST_F(DestinationTest, OutputFolderMadeAtEveryLevel) {
+  CliResult r =
+      Run("simulate --config " + ConfigPath() + " --seed 4 --output-dir " + Work("a/b/c"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(Names(Work("a/b/c")),
+            std::set<std::string>({"raw.csv", "truth.json", "attitudes.csv"}));
+  r = Run("export --calibration " + calibration_ + " --to c --output-dir " + Work("x/y"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(Names(Work("x/y")), std::set<std::string>({"gravcal_correct.h", "gravcal_correct.c"}));
+  Plant("file", "precious");
+  r = Run("simulate --config " + ConfigPath() + " --output-dir " + Work("file/b"));
+  ExpectRefused(r, Work("file/b"), "not a folder");
+  EXPECT_EQ(Slurp(Work("file")), "precious");
+}
+
 }  // namespace
 }  // namespace gravcal

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "gravcal/estimation/strapdown.h"
+#include "estimation/strapdown.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/handheld_simulator.h"
@@ -19,6 +19,8 @@
 
 namespace gravcal {
 namespace {
+
+using internal::EarthRateEnu;
 
 // Seeds of the Monte Carlo tests: 30 where a run is cheap enough, so that
 // sigmas twice too large fail SigmaCheck's band.

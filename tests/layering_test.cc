@@ -1,8 +1,9 @@
 // The layering rule of docs/architecture.md, checked on the source tree:
 // every file under include/gravcal/<wing>/ and src/<wing>/ includes only
 // headers of its own wing or of lower wings, public headers include no
-// private header, and every source file lives in a known wing. A violation
-// names the file, the line and the include.
+// private header, no public header but the residuals (and their umbrella
+// gravcal/ceres.h) includes Ceres or glog, and every source file lives in a
+// known wing. A violation names the file, the line and the include.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -35,15 +36,27 @@ struct Include {
   bool is_public = false;
 };
 
-// "gravcal/core/x.h" -> public core; "util/x.h" -> private util; the
-// umbrella "gravcal/gravcal.h" is the top of the public API (rank of
-// workflows).
+// The umbrella headers directly in include/gravcal/ and the wing they
+// belong to: gravcal.h (the core: log, model, methods, read/write) at the
+// rank of methods, ceres.h (the residuals) at the residuals'.
+const std::map<std::string, std::string>& Umbrellas() {
+  static const std::map<std::string, std::string> umbrellas = {
+      {"gravcal.h", "methods"},
+      {"ceres.h", "residuals"},
+  };
+  return umbrellas;
+}
+
+// "gravcal/core/x.h" -> public core; "util/x.h" -> private util; an
+// umbrella "gravcal/gravcal.h" -> its wing.
 Include Classify(const std::string& path) {
   Include inc;
-  if (path == "gravcal/gravcal.h") {
-    inc.wing = "workflows";
-    inc.is_public = true;
-    return inc;
+  for (const auto& [name, wing] : Umbrellas()) {
+    if (path == "gravcal/" + name) {
+      inc.wing = wing;
+      inc.is_public = true;
+      return inc;
+    }
   }
   const size_t slash = path.find('/');
   if (slash == std::string::npos) return inc;
@@ -62,6 +75,7 @@ Include Classify(const std::string& path) {
 std::vector<std::string> CheckLayering(const fs::path& root) {
   std::vector<std::string> violations;
   const std::regex include_re("^\\s*#\\s*include\\s+\"([^\"]+)\"");
+  const std::regex solver_re("^\\s*#\\s*include\\s+<((ceres|glog)/[^>]+)>");
   struct Tree {
     fs::path dir;
     bool is_public;
@@ -74,9 +88,11 @@ std::vector<std::string> CheckLayering(const fs::path& root) {
       if (ext != ".h" && ext != ".cc") continue;
       const fs::path rel = fs::relative(entry.path(), tree.dir);
       const std::string shown = fs::relative(entry.path(), root).generic_string();
-      if (tree.is_public && rel == "gravcal.h") continue;  // the umbrella
-      const std::string wing = rel.begin()->string();
-      if (WingRanks().count(wing) == 0 || std::distance(rel.begin(), rel.end()) < 2) {
+      const bool umbrella = tree.is_public && Umbrellas().count(rel.generic_string()) != 0;
+      const std::string wing =
+          umbrella ? Umbrellas().at(rel.generic_string()) : rel.begin()->string();
+      if (!umbrella &&
+          (WingRanks().count(wing) == 0 || std::distance(rel.begin(), rel.end()) < 2)) {
         violations.push_back(shown + ": not inside a wing folder");
         continue;
       }
@@ -91,6 +107,10 @@ std::vector<std::string> CheckLayering(const fs::path& root) {
                                ": gflags outside src/cli");
         }
         std::smatch m;
+        if (tree.is_public && wing != "residuals" && std::regex_search(line, m, solver_re)) {
+          violations.push_back(shown + ":" + std::to_string(line_number) +
+                               ": public header outside residuals/ includes <" + m[1].str() + ">");
+        }
         if (!std::regex_search(line, m, include_re)) continue;
         const std::string target = m[1];
         const Include inc = Classify(target);
@@ -143,9 +163,13 @@ TEST(Layering, PlantedViolationsAreNamed) {
   write("src/util/ok.h", "#include <cmath>\n");
   write("src/loose.cc", "int x;\n");
   write("src/workflows/flags.cc", "#include <gflags/gflags.h>\n");
+  write("include/gravcal/estimation/f.h", "#include <ceres/ceres.h>\n");
+  write("include/gravcal/residuals/ok.h", "#include <ceres/ceres.h>\n");
+  write("include/gravcal/gravcal.h", "#include <glog/logging.h>\n#include \"gravcal/core/a.h\"\n");
+  write("include/gravcal/ceres.h", "#include \"gravcal/residuals/d.h\"\n");
   const std::vector<std::string> v = CheckLayering(root);
   const std::string all = Join(v);
-  EXPECT_EQ(v.size(), 6u) << all;
+  EXPECT_EQ(v.size(), 8u) << all;
   EXPECT_NE(all.find("include/gravcal/core/a.h:1: wing 'core' includes \"gravcal/methods/b.h\""),
             std::string::npos)
       << all;
@@ -161,6 +185,14 @@ TEST(Layering, PlantedViolationsAreNamed) {
       << all;
   EXPECT_NE(all.find("src/loose.cc: not inside a wing folder"), std::string::npos) << all;
   EXPECT_NE(all.find("src/workflows/flags.cc:1: gflags outside src/cli"), std::string::npos) << all;
+  EXPECT_NE(all.find("include/gravcal/estimation/f.h:1: public header outside residuals/ includes "
+                     "<ceres/ceres.h>"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("include/gravcal/gravcal.h:1: public header outside residuals/ includes "
+                     "<glog/logging.h>"),
+            std::string::npos)
+      << all;
   fs::remove_all(root);
 }
 

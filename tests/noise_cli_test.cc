@@ -293,6 +293,10 @@ TEST(NoiseCli, EveryNoiseJsonValueIsCheckedForRangeAndSign) {
       {"/gyro/y/allan/adev/2", -1.0, "gyro.y.allan.adev[2] must be a number >= 0"},
       {"/accel/y/allan/lo/0", 1.0, "accel.y.allan[0]: lo <= adev <= hi"},
       {"/accel/y/allan/edf/0", 0.0, "accel.y.allan.edf[0] must be a positive number"},
+      // A variance (the square) beyond double arithmetic.
+      {"/accel/x/white_noise/value", 1e300,
+       "accel.x.white_noise.value must be a positive number up to 1e150"},
+      {"/gyro/y/random_walk/std", 1e200, "gyro.y.random_walk.std must be a number >= 0, up to"},
   };
   for (const Case& c : cases) {
     nlohmann::json bad = good;
@@ -301,6 +305,23 @@ TEST(NoiseCli, EveryNoiseJsonValueIsCheckedForRangeAndSign) {
     EXPECT_EQ(error.rfind("bad_noise.json: ", 0), 0u) << error;
     EXPECT_NE(error.find(c.named), std::string::npos) << c.pointer << ": " << error;
   }
+  // A missing axis or section is named by its path (not the JSON library's
+  // "key 'y' not found"); a key set twice is refused, not the last one taken.
+  const std::pair<std::string, std::string> edits[] = {{"/accel/y", "accel.y is missing"},
+                                                       {"/still", "still is missing"}};
+  for (const auto& [pointer, named] : edits) {
+    nlohmann::json bad = good;
+    bad[nlohmann::json::json_pointer(pointer).parent_pointer()].erase(
+        pointer.substr(pointer.rfind('/') + 1));
+    EXPECT_FALSE(NoiseFromJson(bad.dump(), "bad_noise.json", &read, &error)) << pointer;
+    EXPECT_EQ(error, "bad_noise.json: not a noise.json: " + named);
+  }
+  const std::string text = good.dump();
+  const std::string twice = "{\"rate_hz\": 50, " + text.substr(1);
+  EXPECT_FALSE(NoiseFromJson(twice, "bad_noise.json", &read, &error));
+  EXPECT_EQ(
+      error,
+      "bad_noise.json: not a noise.json: key 'rate_hz' appears twice (a key may be set once)");
 }
 
 // calibrate --noise: a bad noise file or a method that uses none is one

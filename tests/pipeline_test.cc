@@ -9,22 +9,31 @@
 #include <fstream>
 
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/methods/known_attitude.h"
 #include "gravcal/methods/rate_table.h"
 #include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/method_registry.h"
+#include "gravcal/workflows/plan.h"
 #include "gravcal/workflows/rate_table_segments.h"
 
 namespace gravcal {
 namespace {
 
-TEST(Pipeline, TwelvePositionEqualsCalibrateAccelerometer) {
+// A twelve-pose session with 4 s holds (a short start still too).
+bool ShortHolds(uint64_t seed, SimulatedSession* session, std::string* error) {
   SimulatorOptions sim;
   sim.hold_seconds = 4.0;
   sim.initial_still_seconds = 4.0;
+  return Simulate(sim, seed, session, error);
+}
+
+TEST(Pipeline, TwelvePositionEqualsCalibrateAccelerometer) {
   SimulatedSession session;
   std::string error;
-  ASSERT_TRUE(Simulate(sim, 11, &session, &error)) << error;
+  ASSERT_TRUE(ShortHolds(11, &session, &error)) << error;
   Config config;
   config.calibration.gravity.gravity = session.gravity;
   PipelineInput input;
@@ -38,6 +47,106 @@ TEST(Pipeline, TwelvePositionEqualsCalibrateAccelerometer) {
   // Timing fields differ from run to run; everything else must be identical.
   via_pipeline.refinement.solve_seconds = direct.refinement.solve_seconds = 0.0;
   EXPECT_EQ(CalibrationToJson(via_pipeline, true), CalibrationToJson(direct, true));
+}
+
+// The static poses are detected once, by the pipeline, into the session;
+// the method and the coverage check read that detection (the CLI's report
+// takes session.detection too). Shown by construction: a session whose
+// detection lost one interval gives one position fewer to both, so neither
+// detected again.
+TEST(Pipeline, MethodAndCheckReadTheSessionsDetection) {
+  SimulatedSession simulated;
+  std::string error;
+  ASSERT_TRUE(ShortHolds(12, &simulated, &error)) << error;
+  Config config;
+  config.calibration.gravity.gravity = simulated.gravity;
+  Session session;
+  session.log = simulated.log;
+  Calibration c;
+  ASSERT_TRUE(RunCalibration(config, SessionFiles(), &session, &c)) << c.message;
+  ASSERT_TRUE(session.detected);
+  ASSERT_TRUE(session.detection_ok);
+  const size_t n = session.detection.intervals.size();
+  ASSERT_GE(n, 10u);
+  EXPECT_EQ(c.positions.size(), n);
+
+  Session fewer = session;
+  fewer.detection.intervals.pop_back();
+  Calibration c_fewer;
+  ASSERT_TRUE(RunCalibration(config, SessionFiles(), &fewer, &c_fewer)) << c_fewer.message;
+  EXPECT_EQ(c_fewer.positions.size(), n - 1);
+  CoverageReport report;
+  ASSERT_TRUE(CheckRecording(fewer, config, PlanRequest(), &report, &error)) << error;
+  EXPECT_EQ(report.positions, static_cast<int>(n - 1));
+  ASSERT_TRUE(CheckRecording(session, config, PlanRequest(), &report, &error)) << error;
+  EXPECT_EQ(report.positions, static_cast<int>(n));
+
+  // A failed detection is reported by the method, at its own step.
+  Session broken;
+  broken.log = simulated.log;
+  broken.detected = true;
+  broken.detection.message = "detector failed (test)";
+  Calibration c_broken;
+  EXPECT_FALSE(RunCalibration(config, SessionFiles(), &broken, &c_broken));
+  EXPECT_EQ(c_broken.message, "detector failed (test)");
+}
+
+// A method takes its side data as values: known_attitude on a session
+// holding the fixture's rows gives what the pipeline gives from the file.
+TEST(Pipeline, SideDataInMemoryEqualsTheFile) {
+  SimulatedSession simulated;
+  std::string error;
+  ASSERT_TRUE(ShortHolds(14, &simulated, &error)) << error;
+  const std::vector<FixtureAttitude> rows = SimulatedFixtureAttitudes(simulated, 0.05, 14);
+  const std::string path = ::testing::TempDir() + "/pipeline_attitudes.csv";
+  std::ofstream(path) << FixtureAttitudesToCsv(rows);
+  Config config;
+  ASSERT_TRUE(SetConfigValue("method", "known_attitude", &config, &error)) << error;
+  config.calibration.gravity.gravity = simulated.gravity;
+  PipelineInput input;
+  input.log = simulated.log;
+  input.attitudes_path = path;
+  Calibration from_file;
+  ASSERT_TRUE(RunCalibration(config, input, &from_file)) << from_file.message;
+  // The rows as the file holds them (its text rounds the simulated values).
+  std::vector<FixtureAttitude> read;
+  ASSERT_TRUE(ReadFixtureAttitudes(path, &read, &error)) << error;
+  std::remove(path.c_str());
+  ASSERT_EQ(read.size(), rows.size());
+  Session session;
+  session.log = simulated.log;
+  session.attitudes = read;
+  session.attitudes_name = path;
+  Calibration in_memory;
+  ASSERT_TRUE(CalibrateKnownAttitude(session, {config.calibration}, &in_memory))
+      << in_memory.message;
+  EXPECT_EQ(in_memory.method, "known_attitude");
+  from_file.refinement.solve_seconds = in_memory.refinement.solve_seconds = 0.0;
+  EXPECT_EQ(CalibrationToJson(in_memory, true), CalibrationToJson(from_file, true));
+}
+
+// The log is read once: the provenance hash comes from the bytes parsed,
+// and equals the hash of the file read on its own.
+TEST(Pipeline, LogAndProvenanceFromOneRead) {
+  SimulatorOptions sim;
+  sim.hold_seconds = 2.0;
+  SimulatedSession simulated;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, 13, &simulated, &error)) << error;
+  const std::string path = ::testing::TempDir() + "/pipeline_provenance.csv";
+  ASSERT_TRUE(WriteImuLogCsv(simulated.log, path, &error)) << error;
+  ImuLog log;
+  CalibrationProvenance once;
+  ASSERT_TRUE(ReadImuLog(path, LogReaderOptions(), &log, &once, &error)) << error;
+  CalibrationProvenance separately;
+  ASSERT_TRUE(LogProvenance(path, &separately, &error)) << error;
+  std::remove(path.c_str());
+  EXPECT_EQ(log.size(), simulated.log.size());
+  EXPECT_EQ(once.log_file, path);
+  EXPECT_EQ(once.log_hash, separately.log_hash);
+  EXPECT_EQ(once.gravcal_version, separately.gravcal_version);
+  EXPECT_FALSE(ReadImuLog(path, LogReaderOptions(), &log, &once, &error));
+  EXPECT_NE(error.find(path), std::string::npos) << error;
 }
 
 TEST(Pipeline, InvalidConfigFailsWithTheKey) {

@@ -277,6 +277,33 @@ TEST(Check, BiasTradingWithAnUndeterminedScaleIsUndetermined) {
   }
 }
 
+// A sensor with an offset (unsigned counts around 32768): check takes the raw
+// unit and the pose directions from the coarse fit, so the offset changes no
+// predicted sigma. |raw mean| (about 57000 counts for 1000 per g) made every
+// pose point along (1,1,1) and the unit 57 times too small.
+TEST(Check, AnOffsetSensorGivesTheSameSigmas) {
+  std::vector<Eigen::Vector3d> faces;
+  ASSERT_TRUE(CandidateDirections("faces", 0, &faces));
+  const Config config = TwelveConfig();
+  SimulatedSession session = SimulateUps(faces, 10.0, 11);
+  CoverageReport plain, offset;
+  std::string error;
+  ASSERT_TRUE(CheckRecording(session.log, config, PlanRequest(), &plain, &error)) << error;
+  for (Eigen::Vector3d& a : session.log.accel) a += Eigen::Vector3d(32768.0, 32000.0, 33500.0);
+  ASSERT_TRUE(CheckRecording(session.log, config, PlanRequest(), &offset, &error)) << error;
+  EXPECT_EQ(offset.positions, plain.positions);
+  EXPECT_EQ(offset.undetermined, plain.undetermined) << CoverageReportText(offset);
+  const Eigen::VectorXd& a = plain.accel.predicted_std;
+  const Eigen::VectorXd& b = offset.accel.predicted_std;
+  ASSERT_EQ(a.size(), b.size());
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    if (!std::isfinite(a(i))) continue;
+    // The offset moves only the coarse fit's bias; the scale and directions
+    // it finds agree to well under a percent.
+    EXPECT_NEAR(b(i) / a(i), 1.0, 0.01) << plain.accel.parameter_names[i];
+  }
+}
+
 TEST(ExperimentDesign, CandidateTurnsTakeOneUpDirectionToTheOther) {
   std::vector<Eigen::Vector3d> ups;
   ASSERT_TRUE(CandidateDirections("free", 40, &ups));
@@ -561,6 +588,20 @@ TEST(PlanIo, EveryValueReadIsCheckedWithAMessageNamingIt) {
         << turn;
     EXPECT_NE(error.find("plan.json: rotations[0]: " + named), std::string::npos)
         << turn << ": " << error;
+  }
+  // A key set twice (nlohmann keeps one silently), also inside a pose, and
+  // text that is no JSON at all (Python writes NaN).
+  const std::pair<std::string, std::string> bad_files[] = {
+      {R"({"poses": [], "poses": [{"up": [0, 0, 1], "hold_s": 10}]})", "key 'poses' appears twice"},
+      {R"({"poses": [{"up": [0, 0, 1], "hold_s": 10, "hold_s": 20}]})",
+       "key 'poses[].hold_s' appears twice"},
+      {R"({"poses": [{"up": [NaN, 0, 1], "hold_s": 10}]})", "not valid JSON"},
+  };
+  for (const auto& [text, named] : bad_files) {
+    EXPECT_FALSE(PlanPosesFromJson(text, "plan.json", &poses, &error)) << text;
+    EXPECT_EQ(error.find("plan.json: " + named), 0u) << text << ": " << error;
+    EXPECT_FALSE(PlanRotationsFromJson(text, "plan.json", 1, &turns, &error)) << text;
+    EXPECT_EQ(error.find("plan.json: " + named), 0u) << text << ": " << error;
   }
 }
 

@@ -5,9 +5,9 @@
 
 #include <cstdio>
 
+#include "estimation/newton_solver.h"
 #include "gravcal/core/calibration.h"
 #include "gravcal/estimation/coarse_fit.h"
-#include "gravcal/estimation/newton_solver.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/residuals/gravity_magnitude_residual.h"
 #include "sigma_check.h"
@@ -16,6 +16,8 @@
 namespace gravcal {
 namespace {
 
+using internal::NewtonOptions;
+using internal::NewtonRefine;
 using testing_util::FreeParameters;
 
 using testing_util::kCountScale;

@@ -708,6 +708,61 @@ TEST(StaticDetector, CutPosesAreSplitAtTheirSteps) {
   EXPECT_LT(d.intervals.size(), num_poses) << d.message;
 }
 
+// The same cut poses held 1 s each (the samples at four times the rate):
+// shorter than the defaults keep (min_duration 2 s, settling 0.3 s at each
+// end, a 1 s window). The detector sees isolated steps and no motion, fits
+// its time scales to the holds and says so; every pose is found inside its
+// hold.
+TEST(StaticDetector, CutPosesShorterThanTheDefaultsAreFittedToTheirHolds) {
+  SimulatedSession s;
+  std::vector<size_t> cuts;
+  ImuLog log = CutPoseLog(&s, &cuts);
+  for (size_t i = 0; i < log.size(); ++i) log.t[i] = static_cast<double>(i) / 400.0;
+  const size_t num_poses = cuts.size() - 1;
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  EXPECT_NE(d.message.find("motion cut out"), std::string::npos) << d.message;
+  EXPECT_NE(d.message.find("holds of 1 s"), std::string::npos) << d.message;
+  ASSERT_EQ(d.intervals.size(), num_poses) << d.message;
+  for (size_t p = 0; p < num_poses; ++p) {
+    EXPECT_GE(d.intervals[p].begin, cuts[p]) << p;
+    EXPECT_LE(d.intervals[p].end, cuts[p + 1]) << p;
+    EXPECT_GT(d.intervals[p].count(), (cuts[p + 1] - cuts[p]) * 3 / 4) << p;
+  }
+  // A session with motion between its poses is never taken for cut poses.
+  std::vector<Truth> truth;
+  ASSERT_TRUE(DetectStaticIntervals(MakeLog(SixPoses(3.0), SyntheticOptions(), &truth),
+                                    StaticDetectorOptions(), &d))
+      << d.message;
+  EXPECT_EQ(d.message.find("cut out"), std::string::npos) << d.message;
+  EXPECT_EQ(d.intervals.size(), 6u) << d.message;
+}
+
+// A constant turn about gravity started and stopped with the motion cut
+// out: the accelerometer does not change, only the rate steps (0 -> 10
+// deg/s -> 0). Each level is its own interval, its gyroscope mean one rate;
+// the detector that split at accelerometer steps only made one interval of
+// the three.
+TEST(StaticDetector, CutRateStepsSplitOnTheGyroscope) {
+  SyntheticOptions o;
+  o.move_seconds = 0.0;
+  std::vector<Truth> truth;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  ImuLog log = MakeLog({{up, 6.0}, {up, 6.0}, {up, 6.0}}, o, &truth);
+  ASSERT_EQ(truth.size(), 3u);
+  const double rate = 10.0 * M_PI / 180.0;
+  for (size_t i = truth[1].begin; i < truth[1].end; ++i) log.gyro[i].z() += rate;
+  StaticDetection d;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &d)) << d.message;
+  ASSERT_EQ(d.intervals.size(), 3u) << d.message;
+  for (size_t p = 0; p < 3; ++p) {
+    EXPECT_GE(d.intervals[p].begin, truth[p].begin) << p;
+    EXPECT_LE(d.intervals[p].end, truth[p].end) << p;
+    EXPECT_GT(d.intervals[p].count(), (truth[p].end - truth[p].begin) / 2) << p;
+    EXPECT_NEAR(d.intervals[p].gyro_mean.z() - 0.005, p == 1 ? rate : 0.0, 0.01 * rate) << p;
+  }
+}
+
 // --- Real recordings (skipped when ../shared/data/real is missing) ---------
 
 // A real recording read with its shipped config's input settings.
@@ -871,6 +926,17 @@ TEST(StaticDetectorRealData, CkExplorerCutPoses) {
   EXPECT_LT(split, 1.05 * achievable);
   // The detector without the step split merges or loses a third of the poses.
   EXPECT_LT(merged.intervals.size(), 110u);
+  // With the default options (a 1 s window, min_duration 2 s: longer than
+  // these 1 s holds) the detector fits itself to the holds: every block is
+  // one position again (before: none).
+  StaticDetection defaults;
+  ASSERT_TRUE(DetectStaticIntervals(log, StaticDetectorOptions(), &defaults)) << defaults.message;
+  std::printf("ck_explorer, default options: %s\n", defaults.message.c_str());
+  EXPECT_NE(defaults.message.find("motion cut out"), std::string::npos) << defaults.message;
+  EXPECT_EQ(defaults.intervals.size(), 160u) << defaults.message;
+  inside = 0;
+  for (const StaticInterval& s : defaults.intervals) inside += s.begin / 100 == (s.end - 1) / 100;
+  EXPECT_EQ(inside, defaults.intervals.size());
 }
 
 }  // namespace

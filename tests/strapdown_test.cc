@@ -1,4 +1,4 @@
-#include "gravcal/estimation/strapdown.h"
+#include "estimation/strapdown.h"
 
 #include <gtest/gtest.h>
 
@@ -13,6 +13,11 @@ namespace {
 
 using Eigen::Quaterniond;
 using Eigen::Vector3d;
+using internal::EarthRateEnu;
+using internal::LevelAttitude;
+using internal::NavigationState;
+using internal::Strapdown;
+using internal::StrapdownOptions;
 
 TEST(Strapdown, StillUnitStaysStill) {
   StrapdownOptions options;

@@ -1,16 +1,28 @@
-// gravcal/gravcal.h: the whole public API of gravcal in one include, wing by
-// wing from the bottom (shared types) to the top (workflows); see
-// docs/architecture.md.
+// gravcal/gravcal.h: the core of gravcal's public API in one include: the IMU
+// log, the sensor model and the calibration result, the calibration methods'
+// entry points and options, and reading and writing logs and calibrations.
+// It includes no Ceres or glog header, so a program built against the core
+// needs Eigen and gravcal only (a test checks it: HeaderCheck.CoreWithoutCeres).
+//
+// Elsewhere in the public API, included one by one where needed:
+// - gravcal/ceres.h: the Ceres residuals, for estimators that build their own
+//   ceres::Problem (link gravcal::ceres, which adds Ceres);
+// - gravcal/estimation/*.h: the estimation steps the methods are made of;
+// - gravcal/simulation/*.h: simulators with known truth;
+// - gravcal/workflows/*.h: configs, RunCalibration by method name, batch,
+//   discovery, plans and reports (what the command-line tool runs).
+// See docs/architecture.md.
 #ifndef GRAVCAL_GRAVCAL_H_
 #define GRAVCAL_GRAVCAL_H_
 
-// core
+// The log, the model, the result and the shared vocabulary.
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/gravity.h"
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/imu_corrector.h"
 #include "gravcal/core/imu_log.h"
+#include "gravcal/core/imu_model.h"
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/noise_model.h"
 #include "gravcal/core/position.h"
@@ -18,78 +30,25 @@
 #include "gravcal/core/solver_result.h"
 #include "gravcal/core/types.h"
 
-// detection
+// Static poses of a log, the input of the static methods.
 #include "gravcal/detection/static_detector.h"
 
-// residuals
-#include "gravcal/residuals/accel_rotation_residual.h"
-#include "gravcal/residuals/accel_trend_residual.h"
-#include "gravcal/residuals/gravity_magnitude_residual.h"
-#include "gravcal/residuals/gyro_rotation_residual.h"
-#include "gravcal/residuals/gyro_static_residual.h"
-
-// estimation
-#include "gravcal/estimation/allan_deviation.h"
-#include "gravcal/estimation/calibration_comparison.h"
-#include "gravcal/estimation/check_session.h"
-#include "gravcal/estimation/coarse_fit.h"
-#include "gravcal/estimation/error_state_layout.h"
-#include "gravcal/estimation/experiment_design.h"
-#include "gravcal/estimation/housing_rotation.h"
-#include "gravcal/estimation/newton_solver.h"
-#include "gravcal/estimation/noise_characterisation.h"
-#include "gravcal/estimation/observability.h"
-#include "gravcal/estimation/pose_mean_covariance.h"
-#include "gravcal/estimation/recording_plan.h"
-#include "gravcal/estimation/refinement.h"
-#include "gravcal/estimation/solver_tolerances.h"
-#include "gravcal/estimation/static_alignment.h"
-#include "gravcal/estimation/strapdown.h"
-
-// io
-#include "gravcal/io/attitude_fixture.h"
-#include "gravcal/io/calibration_export.h"
-#include "gravcal/io/calibration_io.h"
-#include "gravcal/io/calibration_uncertainty_io.h"
-#include "gravcal/io/comparison_io.h"
-#include "gravcal/io/files.h"
-#include "gravcal/io/imu_stream.h"
-#include "gravcal/io/log_reader.h"
-#include "gravcal/io/noise_io.h"
-#include "gravcal/io/plan_io.h"
-#include "gravcal/io/recording.h"
-
-// simulation
-#include "gravcal/simulation/handheld_simulator.h"
-#include "gravcal/simulation/noise_process.h"
-#include "gravcal/simulation/simulated_attitudes.h"
-#include "gravcal/simulation/simulator.h"
-
-// methods
+// The methods: entry points and options.
 #include "gravcal/methods/effect_fit.h"
 #include "gravcal/methods/gyro_calibration.h"
 #include "gravcal/methods/handheld_kalman.h"
 #include "gravcal/methods/known_attitude.h"
 #include "gravcal/methods/rate_table.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/methods/ten_position.h"
 #include "gravcal/methods/twelve_position.h"
+#include "gravcal/methods/twelve_position_method.h"
 
-// workflows
-#include "gravcal/workflows/acceptance.h"
-#include "gravcal/workflows/batch.h"
-#include "gravcal/workflows/batch_manifest.h"
-#include "gravcal/workflows/batch_scheduler_shard.h"
-#include "gravcal/workflows/calibration_store.h"
-#include "gravcal/workflows/compare.h"
-#include "gravcal/workflows/config.h"
-#include "gravcal/workflows/discovery.h"
-#include "gravcal/workflows/discovery_report.h"
-#include "gravcal/workflows/fleet_summary.h"
-#include "gravcal/workflows/method_registry.h"
-#include "gravcal/workflows/noise_workflow.h"
-#include "gravcal/workflows/pipeline.h"
-#include "gravcal/workflows/plan.h"
-#include "gravcal/workflows/rate_table_segments.h"
-#include "gravcal/workflows/report.h"
-#include "gravcal/workflows/simulation_workflow.h"
+// Read and write: logs, fixture attitudes, calibrations and their exports.
+#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/io/calibration_export.h"
+#include "gravcal/io/calibration_io.h"
+#include "gravcal/io/calibration_models.h"
+#include "gravcal/io/log_reader.h"
+
 #endif  // GRAVCAL_GRAVCAL_H_

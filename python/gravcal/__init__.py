@@ -28,8 +28,8 @@ from ._gravcal import Error, Log
 __version__ = _gravcal.__version__
 
 __all__ = [
-    "Error", "Log", "Calibration", "Result", "BatchResult", "Config", "config", "read_log",
-    "log", "calibrate", "simulate", "batch", "noise", "discover", "plan", "check", "export",
+    "Error", "Log", "Calibration", "Result", "BatchResult", "BatchResults", "Config", "config",
+    "read_log", "log", "calibrate", "simulate", "batch", "noise", "discover", "plan", "check", "export",
     "config_keys", "__version__",
 ]
 
@@ -346,6 +346,23 @@ class Calibration(_Section):
         a, w = self._core.apply(accel, gyro, temp, t)
         return a if gyro is None else (a, w)
 
+    def brief_report(self):
+        """One line: the message and the residual |a| - g before and after, as
+        ``gravcal calibrate`` prints it. Only for a result (not one read from
+        JSON)."""
+        return self._core.report(False)
+
+    def full_report(self):
+        """The message, every estimate with its standard deviation, the
+        residuals, the solver and the warnings. Only for a result."""
+        return self._core.report(True)
+
+    def __str__(self):
+        try:
+            return self.full_report()
+        except Error:
+            return repr(self)
+
     def __repr__(self):
         return "<gravcal.Calibration method=%s, gyro=%s>" % (
             self._dict().get("method"), "gyro" in self._dict())
@@ -433,26 +450,69 @@ def _unit_spec(i, unit):
                 % (i, type(unit).__name__))
 
 
-def batch(units, config=None, threads=0, *, pattern="*.csv", **keys):
+class BatchResults(list):
+    """The results of :func:`batch` with ``output_dir``, one per unit, and
+    the run's text as ``gravcal batch`` prints it."""
+
+    def __init__(self, results, report):
+        list.__init__(self, results)
+        self._report = report
+
+    def full_report(self):
+        """The failed units, the outliers and the run's counts, one line each."""
+        return self._report
+
+    def brief_report(self):
+        """The run's counts (and why it stopped, if it did)."""
+        return "".join(line + "\n" for line in self._report.splitlines()
+                       if line.startswith("batch"))
+
+    def __str__(self):
+        return self._report
+
+
+def batch(units, config=None, threads=0, *, pattern="*.csv", output_dir=None, report=None,
+          shard=None, **keys):
     """Calibrates many units in parallel (C++ threads, the GIL released), each
     exactly as ``gravcal batch`` would. ``units`` is a list (paths, Logs, or
     dicts with id, path or log, attitudes, overrides), a manifest CSV path, or
     a folder (every file matching ``pattern``). ``threads`` 0 = one per core.
     Returns one :class:`BatchResult` per unit in input order (``unit``,
     ``status``, ``message``, ``content_hash``, ``calibration`` or None,
-    ``timings``); a failed unit does not raise."""
+    ``timings``); a failed unit does not raise.
+
+    With ``output_dir`` the batch writes that folder as ``gravcal batch
+    --output-dir`` does (each unit's JSON, its state, summary.csv and
+    summary.json; ``report`` the HTML fleet report; ``shard`` "K/N" or
+    "auto") and resumes from it: a unit whose stored result is current is
+    not computed again (``skipped``; its calibration is read from the
+    folder). The list then also has ``full_report()`` / ``brief_report()``."""
     cfg = _config(config, **keys)
-    if isinstance(units, (str, _os.PathLike)):
-        p = _os.fspath(units)
-        core_units = (_gravcal.units_from_folder(p, pattern) if _os.path.isdir(p)
-                      else _gravcal.units_from_manifest(p, cfg))
-    else:
+    source = _os.fspath(units) if isinstance(units, (str, _os.PathLike)) else None
+    folder = source if source is not None and _os.path.isdir(source) else ""
+    manifest = source if source is not None and not folder else ""
+    if source is None:
         core_units = _gravcal.units([_unit_spec(i, u) for i, u in enumerate(units)])
-    results = _gravcal.batch(core_units, cfg, int(threads))
+    elif output_dir is None:
+        core_units = (_gravcal.units_from_folder(folder, pattern) if folder
+                      else _gravcal.units_from_manifest(manifest, cfg))
+    else:
+        core_units = []  # The library lists them, leaving its own files out.
+    if output_dir is None:
+        if report is not None or shard is not None:
+            raise Error("batch: report and shard need output_dir")
+        results = _gravcal.batch(core_units, cfg, int(threads))
+    else:
+        out = _os.fspath(output_dir)
+        results, text = _gravcal.batch_to_folder(
+            core_units, manifest, folder, pattern, cfg, int(threads), out,
+            "" if report is None else _os.fspath(report), shard or "")
     for r in results:
         if r.calibration is not None:
             r.calibration = Calibration(r.calibration)
-    return results
+        elif output_dir is not None and r.skipped and r.status == "ok":
+            r.calibration = Calibration.from_json(_os.path.join(out, r.unit + ".json"))
+    return results if output_dir is None else BatchResults(results, text)
 
 
 def _check_outputs(outputs, inputs=()):

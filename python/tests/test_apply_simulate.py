@@ -104,3 +104,24 @@ def test_log_arrays_are_read_only_views():
     assert log.accel.shape == (len(log), 3) and log.t.shape == (len(log),)
     with pytest.raises(ValueError):
         log.accel[0, 0] = 1.0
+
+
+def test_calibrate_apply_export_make_no_json_text(session_dir, cli_calibration):
+    # Issue 34: a result made in memory reaches its corrector and the
+    # exporters directly; JSON text is made only when asked for.
+    raw = gravcal.read_log(session_dir / "raw.csv")
+    before = gravcal._gravcal._json_conversions()
+    cal = gravcal.calibrate(raw, config=config_path("twelve_position_gyro.yaml"))
+    accel, gyro = cal.apply(raw.accel, raw.gyro)
+    exported = {to: gravcal.export(cal, to, name="unit") for to in ("c",)}
+    assert gravcal._gravcal._json_conversions() == before
+    # The same numbers as through the CLI's file, and the same files as
+    # through the result's own JSON text (which asking for makes).
+    file_accel, file_gyro = gravcal.Calibration.from_json(cli_calibration).apply(
+        raw.accel, raw.gyro)
+    np.testing.assert_array_equal(accel, file_accel)
+    np.testing.assert_array_equal(gyro, file_gyro)
+    from_text = gravcal.Calibration.from_json_text(cal.to_json())
+    assert gravcal._gravcal._json_conversions() > before
+    for to, result in exported.items():
+        assert result["files"] == gravcal.export(from_text, to, name="unit")["files"], to

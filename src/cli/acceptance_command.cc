@@ -34,7 +34,7 @@ std::string ProgramHash() {
   return hash.Hex();
 }
 
-std::string UnitName(const CommandArgs& args) {
+std::string UnitName(const CalibrateArgs& args) {
   if (!args.unit.empty()) return args.unit;
   std::string stem = args.input.substr(args.input.find_last_of('/') + 1);
   return stem.substr(0, stem.find_last_of('.'));
@@ -42,20 +42,12 @@ std::string UnitName(const CommandArgs& args) {
 
 }  // namespace
 
-bool CheckAcceptanceArgs(const CommandArgs& args, std::string* error) {
-  if (!args.limits.empty()) {
-    AcceptanceLimits limits;
-    if (!ReadAcceptanceLimits(args.limits, &limits, error)) return false;
-  }
-  if (!args.certificate.empty()) {
-    return CheckDestinations({{args.certificate + ".json", "--certificate"},
-                              {args.certificate + ".html", "--certificate"}},
-                             {{args.input, "--input"}, {args.config_path, "--config"}}, error);
-  }
-  return true;
+bool CheckLimitsFile(const std::string& limits, std::string* error) {
+  AcceptanceLimits parsed;
+  return limits.empty() || ReadAcceptanceLimits(limits, &parsed, error);
 }
 
-int FinishAcceptance(const CommandArgs& args, const Calibration& calibration) {
+int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration) {
   std::string error;
   if (!args.store.empty()) {
     // The stored copy always has the covariance: history and compare need it.
@@ -99,8 +91,7 @@ int FinishAcceptance(const CommandArgs& args, const Calibration& calibration) {
   return acceptance.pass ? 0 : kOutOfLimits;
 }
 
-int FinishBatchAcceptance(const CommandArgs& args, const std::vector<std::string>& units,
-                          int code) {
+int FinishBatchAcceptance(const BatchArgs& args, const std::vector<std::string>& units, int code) {
   if (args.limits.empty()) return code;
   std::string error;
   AcceptanceLimits limits;

@@ -34,7 +34,7 @@ std::vector<std::string> OutputComment(const std::string& calibration_path,
 
 }  // namespace
 
-int RunApply(const CommandArgs& args) {
+int RunApply(const ApplyArgs& args) {
   if (args.calibration.empty()) return Fail("apply needs --calibration <calib.json>");
   if (args.input.empty()) return Fail("apply needs --input <raw log, or - for standard input>");
   if (args.output.empty())

@@ -7,6 +7,7 @@
 
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/plan_io.h"
 #include "gravcal/methods/twelve_position.h"
@@ -48,26 +49,9 @@ std::string WithStd(double value, double std, const char* format) {
   return buffer;
 }
 
-// "|a| - g rms <before> -> <after> m/s^2". Raw counts read without a
-// nominal_scale (1, the default) give a "before" residual in counts minus
-// m/s^2, which means nothing: then only the fitted residual is said.
-std::string ResidualLine(const Calibration& c, double nominal_scale) {
-  char line[200];
-  if (nominal_scale == 1.0 && c.residual_nominal.rms > 0.5 * c.gravity) {
-    std::snprintf(line, sizeof(line),
-                  "|a| - g rms %.5f m/s^2 (raw data unscaled: set nominal_scale for a 'before' "
-                  "figure)",
-                  c.residual_refined.rms);
-  } else {
-    std::snprintf(line, sizeof(line), "|a| - g rms %.5f -> %.5f m/s^2", c.residual_nominal.rms,
-                  c.residual_refined.rms);
-  }
-  return line;
-}
-
 }  // namespace
 
-int RunDemo(const CommandArgs& args) {
+int RunDemo(const DemoArgs& args) {
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
   SimulatedSession session;
@@ -120,54 +104,61 @@ int RunDemo(const CommandArgs& args) {
   return 0;
 }
 
-int RunCalibrate(const CommandArgs& args) {
+int RunCalibrate(const CalibrateArgs& args) {
   if (args.input.empty()) return Fail("calibrate needs --input <raw log>");
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
-  if (!CheckAcceptanceArgs(args, &error)) return Fail(error);
-  PipelineInput input;
-  input.source = args.input;
-  input.attitudes_path = args.attitudes;
-  input.segments_path = args.segments;
-  input.noise_path = args.noise;
-  if (!ReadImuLog(args.input, args.config.input, &input.log, &error)) return Fail(error);
+  if (!CheckLimitsFile(args.limits, &error)) return Fail(error);
+  // The log is read once: its provenance hash comes from the same bytes.
+  Session session;
   CalibrationProvenance provenance;
-  if (!LogProvenance(args.input, &provenance, &error)) return Fail(error);
+  if (!ReadImuLog(args.input, args.config.input, &session.log, &provenance, &error)) {
+    return Fail(error);
+  }
+  SessionFiles files;
+  files.attitudes_path = args.attitudes;
+  files.segments_path = args.segments;
+  files.noise_path = args.noise;
   Calibration c;
-  const bool ok = RunCalibration(args.config, input, &c);
+  const bool ok = RunCalibration(args.config, files, &session, &c);
   c.provenance = provenance;
   PrintWarnings(c);
   // The report also for a failed calibration: it says why. For a session of
-  // static poses it shows what the detector rejected too.
-  StaticDetection detection;
+  // static poses it shows what the detector rejected too (the detection the
+  // method used).
+  const ImuLog& log = session.log;
   if (!args.report.empty() &&
-      !WriteFileAtomically(
-          args.report,
-          !c.positions.empty() &&
-                  DetectStaticIntervals(input.log, args.config.calibration.detector, &detection)
-              ? CalibrationToHtml(c, input.log, args.input, detection)
-              : CalibrationToHtml(c, input.log, args.input),
-          &error)) {
+      !WriteFileAtomically(args.report,
+                           !c.positions.empty() && session.detection_ok
+                               ? CalibrationToHtml(c, log, args.input, session.detection)
+                               : CalibrationToHtml(c, log, args.input),
+                           &error)) {
     return Fail(error);
   }
   // 2 only for a solver that ran and did not converge; 1 for the data.
   if (!ok) return Fail(c.message, c.not_converged ? 2 : 1);
-  if (!args.history.empty() && !WriteHistoryCsv(c, args.history, &error)) return Fail(error);
-  if (!WriteOutput(args.output,
-                   CalibrationToJson(c, args.config.output_covariance,
-                                     CalibrationCheckSections(args, input.log)),
-                   &error)) {
-    if (!args.history.empty()) std::remove(args.history.c_str());
+  // The history and the calibration are put in place together (the report,
+  // written above, also says why a calibration failed).
+  std::vector<FileContents> outputs;
+  if (!args.history.empty()) {
+    outputs.push_back({args.history, ""});
+    if (!HistoryToCsv(c, &outputs.back().contents, &error))
+      return Fail(args.history + ": " + error);
+  }
+  const std::string json =
+      CalibrationToJson(c, args.config.output_covariance, CalibrationCheckSections(args, session));
+  if (args.output != "-") outputs.push_back({args.output, json});
+  if (!WriteFilesAtomically(outputs, &error) ||
+      (args.output == "-" && !WriteOutput(args.output, json, &error))) {
     return Fail(error);
   }
-  std::fprintf(stderr, "gravcal: %s; %s; wrote %s\n", c.message.c_str(),
-               ResidualLine(c, args.config.calibration.nominal_scale).c_str(),
+  std::fprintf(stderr, "gravcal: %s; wrote %s\n", c.BriefReport().c_str(),
                args.output == "-" ? "standard output" : args.output.c_str());
   return FinishAcceptance(args, c);
 }
 
-int RunSimulate(const CommandArgs& args) {
+int RunSimulate(const SimulateArgs& args) {
   if (args.output_dir.empty()) return Fail("simulate needs --output-dir <folder>");
   std::string error;
   SimulationRequest request;
@@ -176,28 +167,20 @@ int RunSimulate(const CommandArgs& args) {
   SimulationFiles files;
   if (!SimulateFromConfig(args.config, request, &files, &error)) return Fail(error);
   const SimulatedSession& session = files.session;
-  mkdir(args.output_dir.c_str(), 0755);
-  struct stat st;
-  if (stat(args.output_dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
-    return Fail(args.output_dir + ": cannot create the folder");
-  }
+  if (!MakeFolders(args.output_dir, &error)) return Fail(error);
   const std::string raw = args.output_dir + "/raw.csv";
   const std::string truth = args.output_dir + "/truth.json";
   const std::string attitudes = args.output_dir + "/attitudes.csv";
-  if (!WriteImuLogCsv(session.log, raw, &error)) return Fail(error);
-  if (!WriteFileAtomically(truth, files.truth_json, &error)) {
-    std::remove(raw.c_str());
-    return Fail(error);
-  }
-  if (!WriteFileAtomically(attitudes, files.attitudes_csv, &error)) {
-    std::remove(raw.c_str());
-    std::remove(truth.c_str());
-    return Fail(error);
-  }
   const std::string segments_path = args.output_dir + "/segments.csv";
   const bool segments = !files.segments_csv.empty();
-  if (segments && !WriteFileAtomically(segments_path, files.segments_csv, &error)) {
-    for (const std::string& f : {raw, truth, attitudes}) std::remove(f.c_str());
+  std::string raw_csv;
+  if (!ImuLogToCsv(session.log, &raw_csv, &error)) return Fail(raw + ": " + error);
+  // All four files or none.
+  if (!WriteFilesAtomically({{raw, std::move(raw_csv)},
+                             {truth, files.truth_json},
+                             {attitudes, files.attitudes_csv},
+                             {segments ? segments_path : "", files.segments_csv}},
+                            &error)) {
     return Fail(error);
   }
   std::fprintf(stderr, "gravcal: wrote %s (%zu samples), %s and %s%s%s\n", raw.c_str(),

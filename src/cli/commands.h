@@ -7,127 +7,216 @@
 #include <vector>
 
 #include "gravcal/io/calibration_io.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/plan.h"
 
 namespace gravcal {
 namespace cli {
 
-struct CommandArgs {
+// What every command gets: the config (--config, then config keys given as
+// flags) and the arguments that are not flags.
+struct CommonArgs {
   Config config;
+  std::string config_path;
+  // merge-summaries: the shard folders; compare: the two calibrations;
+  // history: the unit.
+  std::vector<std::string> positional;
+};
+
+// Each command's own flags (main.cc binds each flag of the table in flags.h
+// to a field here). Paths are empty when the flag is not given.
+struct DemoArgs : CommonArgs {
+  uint64_t seed = 1;
+};
+
+struct CalibrateArgs : CommonArgs {
   std::string input;
   std::string output;
-  std::string output_dir;
-  std::string calibration;
-  std::string config_path;
-  // Side inputs of the methods that need them (method_registry.h): the
-  // attitudes CSV, the rate table's segments CSV.
+  // Side inputs of the methods that need them (method_registry.h).
   std::string attitudes;
   std::string segments;
-  // calibrate: the time history CSV of recursive methods (--history).
+  // The time history CSV of recursive methods.
   std::string history;
-  // calibrate, batch, noise, discover: the HTML report to write (optional).
-  std::string report;
-  // noise: Kalibr's imu.yaml and the handheld filter's keys (optional).
-  std::string kalibr;
-  std::string handheld;
-  // calibrate: the noise model from gravcal noise (--noise).
+  // The noise model from gravcal noise.
   std::string noise;
-  // export: the target (--to).
-  std::string to;
-  uint64_t seed = 1;
-  // batch and merge-summaries.
-  std::string manifest;
-  std::string input_dir;
-  std::string pattern = "*.csv";
-  int threads = 0;
-  // K/N, auto or auto/N (batch_scheduler_shard.h).
-  std::string shard;
-  // batch: seconds one unit may take; 0 = no limit.
-  double unit_timeout = 0.0;
-  double outlier_sigmas = 5.0;
-  int outlier_min_units = 5;
-  // plan and check: the request from --target, --pose_set, ... (not the
-  // noise model, which --noise names); simulate: --plan.
-  PlanRequest plan_request;
-  std::string plan;
-  // calibrate: add the check section (what the session lacks, --check).
+  std::string report;
+  // Add the check section (what the session lacks).
   bool check = false;
-  // Arguments that are not flags (merge-summaries: the shard folders).
-  std::vector<std::string> positional;
-  // batch: "all" makes one unit per sensor_msgs/Imu topic of --input.
-  std::string topics;
-  // compare, verify (issue 36): the significance level and, for compare,
-  // the parameter space (model or intrinsic).
-  double level = 0.01;
-  std::string space = "model";
-  // calibrate: acceptance limits (YAML), the certificate's path prefix and
-  // the unit's name on it (issue 36).
+  // Issue 36: acceptance limits (YAML), the certificate's path prefix
+  // (<prefix>.json, <prefix>.html), the unit's name (default: the log's
+  // name) and the calibration store to file the result in.
   std::string limits;
   std::string certificate;
   std::string unit;
-  // calibrate: file the result in this calibration store; history: read it.
   std::string store;
-  // plan --verify: the stored calibration to design a check session for.
-  std::string verify_calibration;
 };
 
-int RunDemo(const CommandArgs& args);
-int RunCalibrate(const CommandArgs& args);
-int RunApply(const CommandArgs& args);
-int RunSimulate(const CommandArgs& args);
+struct ApplyArgs : CommonArgs {
+  std::string calibration;
+  std::string input;
+  std::string output;
+};
+
+struct SimulateArgs : CommonArgs {
+  uint64_t seed = 1;
+  std::string output_dir;
+  // plan.json from gravcal plan.
+  std::string plan;
+};
+
+// plan and check: the request from --target, --pose_set, ... (not the noise
+// model, which --noise names).
+struct PlanArgs : CommonArgs {
+  std::string input;
+  std::string output;
+  std::string noise;
+  std::string report;
+  PlanRequest request;
+  // plan --verify (issue 36): the stored calibration to design a check
+  // session for, and the test's significance level.
+  std::string verify_calibration;
+  double level = 0.01;
+};
+
+struct BatchArgs : CommonArgs {
+  std::string manifest;
+  std::string input_dir;
+  std::string pattern = "*.csv";
+  // A bag with --topics all: one unit per sensor_msgs/Imu topic.
+  std::string input;
+  std::string topics;
+  std::string output_dir;
+  std::string report;
+  int threads = 0;
+  // K/N, auto or auto/N (batch_scheduler_shard.h).
+  std::string shard;
+  // Seconds one unit may take; 0 = no limit.
+  double unit_timeout = 0.0;
+  double outlier_sigmas = 5.0;
+  int outlier_min_units = 5;
+  // Acceptance limits (YAML, issue 36): each calibrated unit against them.
+  std::string limits;
+};
+
+// discover and noise.
+struct LogReportArgs : CommonArgs {
+  std::string input;
+  std::string output;
+  std::string report;
+  // noise: Kalibr's imu.yaml and the handheld filter's keys.
+  std::string kalibr;
+  std::string handheld;
+};
+
+struct InspectArgs : CommonArgs {
+  std::string input;
+};
+
+struct ExportArgs : CommonArgs {
+  std::string calibration;
+  std::string noise;
+  // The target (--to).
+  std::string to;
+  std::string output;
+  std::string output_dir;
+};
+
+// compare a.json b.json (the two calibrations are the positional
+// arguments); --input: the difference in corrected output over that log.
+struct CompareArgs : CommonArgs {
+  std::string input;
+  std::string output;
+  // The test's significance level.
+  double level = 0.01;
+  // The parameters compared: model or intrinsic (ComparisonSpace).
+  std::string space = "model";
+};
+
+// verify: a short check session (--input) against a stored calibration.
+struct VerifyArgs : CommonArgs {
+  std::string calibration;
+  std::string input;
+  std::string output;
+  double level = 0.01;
+};
+
+// history UNIT (positional) --store DIR.
+struct HistoryArgs : CommonArgs {
+  std::string store;
+  std::string output;
+  double level = 0.01;
+};
+
+int RunDemo(const DemoArgs& args);
+int RunCalibrate(const CalibrateArgs& args);
+int RunApply(const ApplyArgs& args);
+int RunSimulate(const SimulateArgs& args);
 // batch_command.cc. Exit codes: 0 every unit calibrated; 1 bad invocation
 // or manifest (nothing written), or at least one unit failed as calibrate
 // would with exit 1; 2 the only failures are units that did not converge.
-int RunBatch(const CommandArgs& args);
+int RunBatch(const BatchArgs& args);
 // 0 merged; 1 bad input (nothing written).
-int RunMergeSummaries(const CommandArgs& args);
-int RunDiscover(const CommandArgs& args);
+int RunMergeSummaries(const BatchArgs& args);
+int RunDiscover(const LogReportArgs& args);
 // noise_command.cc: 0 written; 1 bad input (nothing written).
-int RunNoise(const CommandArgs& args);
+int RunNoise(const LogReportArgs& args);
 // inspect_command.cc: 0 the file was read; 1 it cannot be.
-int RunInspect(const CommandArgs& args);
+int RunInspect(const InspectArgs& args);
 // apply_command.cc: 0 written; 1 bad input (no output file).
 // export_command.cc: 0 written; 1 bad input or a target that cannot take the
 // calibration (nothing written).
-int RunExport(const CommandArgs& args);
+int RunExport(const ExportArgs& args);
 
 // compare_command.cc (issue 36): 0 consistent, 3 changed, 1 bad input or
 // nothing to test (nothing written).
-int RunCompare(const CommandArgs& args);
-int RunVerify(const CommandArgs& args);
+int RunCompare(const CompareArgs& args);
+int RunVerify(const VerifyArgs& args);
 // plan --verify cal.json: the shortest check session (0 designed, 1 bad
 // input).
-int RunPlanVerify(const CommandArgs& args);
-// acceptance_command.cc: calibrate's --limits and --certificate. The check
-// before any work (the limits file parses, the certificate's files may be
-// written), and after the calibration is written: 0, 4 when a limit fails,
-// 1 on an error.
-bool CheckAcceptanceArgs(const CommandArgs& args, std::string* error);
-int FinishAcceptance(const CommandArgs& args, const Calibration& calibration);
+int RunPlanVerify(const PlanArgs& args);
+// acceptance_command.cc: calibrate's and batch's --limits, and calibrate's
+// --certificate and --store. The check before any work (the limits file,
+// when given, parses), and after the calibration is written: 0, 4 when a
+// limit fails, 1 on an error.
+bool CheckLimitsFile(const std::string& limits, std::string* error);
+int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration);
 // batch --limits: each calibrated unit's <output-dir>/<unit>.json against
 // the limits, <output-dir>/limits.csv (unit, verdict, failed), the count and
 // the failing units named on stderr; returns `code` when it is not 0, else 4
 // when a unit fails.
-int FinishBatchAcceptance(const CommandArgs& args, const std::vector<std::string>& units, int code);
+int FinishBatchAcceptance(const BatchArgs& args, const std::vector<std::string>& units, int code);
 // history_command.cc: 0 listed; 1 bad input.
-int RunHistory(const CommandArgs& args);
+int RunHistory(const HistoryArgs& args);
 
 // plan_command.cc: 0 written; 1 bad input, unmet targets (nothing written).
-int RunPlan(const CommandArgs& args);
+int RunPlan(const PlanArgs& args);
 // 0 reported; 1 bad input.
-int RunCheck(const CommandArgs& args);
+int RunCheck(const PlanArgs& args);
 // Issue 15: calibrate's "check" section (what the session lacks, as gravcal
 // check says it) with --check, for the methods of the magnitude model;
 // prints the text on stderr. Empty without --check, when the method has
 // none or when the check cannot be made.
-JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log);
+JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session);
 
 // destinations.cc: the command's destinations checked against the
 // destination contract (io/files.h) before it runs: false with a one-line
-// message naming the destination.
-bool CheckCommandDestinations(const std::string& command, const CommandArgs& args,
-                              std::string* error);
+// message naming the destination. The CommonArgs form checks the config
+// and the gyroscope file it names (commands that write nothing).
+bool CheckCommandDestinations(const CommonArgs& args, std::string* error);
+bool CheckCommandDestinations(const CalibrateArgs& args, std::string* error);
+bool CheckCommandDestinations(const ApplyArgs& args, std::string* error);
+bool CheckCommandDestinations(const SimulateArgs& args, std::string* error);
+// plan (check writes nothing: its --output is empty).
+bool CheckCommandDestinations(const PlanArgs& args, std::string* error);
+// batch, and merge-summaries (positional shard folders).
+bool CheckCommandDestinations(const BatchArgs& args, std::string* error);
+// discover and noise.
+bool CheckCommandDestinations(const LogReportArgs& args, std::string* error);
+bool CheckCommandDestinations(const ExportArgs& args, std::string* error);
+bool CheckCommandDestinations(const CompareArgs& args, std::string* error);
+bool CheckCommandDestinations(const VerifyArgs& args, std::string* error);
+bool CheckCommandDestinations(const HistoryArgs& args, std::string* error);
 // Writes `text` to `path` atomically, or to standard output for "-" (the
 // outputs CheckCommandDestinations lets stream).
 bool WriteOutput(const std::string& path, const std::string& text, std::string* error);

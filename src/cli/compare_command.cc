@@ -40,9 +40,8 @@ void PrintComparison(const ComparisonResult& r, const char* difference_label) {
   std::printf("%s\n", r.message.c_str());
 }
 
-bool ComparisonOptionsFromArgs(const CommandArgs& args, ComparisonOptions* options,
-                               std::string* error) {
-  options->level = args.level;
+bool ComparisonOptionsFromLevel(double level, ComparisonOptions* options, std::string* error) {
+  options->level = level;
   if (!options->IsValid(error)) {
     *error = "--level: " + *error;
     return false;
@@ -52,24 +51,16 @@ bool ComparisonOptionsFromArgs(const CommandArgs& args, ComparisonOptions* optio
 
 }  // namespace
 
-int RunCompare(const CommandArgs& args) {
+int RunCompare(const CompareArgs& args) {
   if (args.positional.size() != 2) {
     return Fail("compare needs two calibration files: gravcal compare a.json b.json");
   }
   std::string error;
   ComparisonOptions options;
-  if (!ComparisonOptionsFromArgs(args, &options, &error)) return Fail(error);
+  if (!ComparisonOptionsFromLevel(args.level, &options, &error)) return Fail(error);
   ComparisonSpace space;
   if (!FromString(args.space, &space)) {
     return Fail("--space: '" + args.space + "' is not model or intrinsic");
-  }
-  if (!CheckDestinations({{args.output, "--output", true}},
-                         {{args.positional[0], "first calibration"},
-                          {args.positional[1], "second calibration"},
-                          {args.input, "--input"},
-                          {args.config_path, "--config"}},
-                         &error)) {
-    return Fail(error);
   }
   Calibration cal[2];
   LoadedCalibration loaded[2];
@@ -117,19 +108,12 @@ int RunCompare(const CommandArgs& args) {
   return result.consistent ? 0 : kChanged;
 }
 
-int RunVerify(const CommandArgs& args) {
+int RunVerify(const VerifyArgs& args) {
   if (args.calibration.empty()) return Fail("verify needs --calibration (the stored calibration)");
   if (args.input.empty()) return Fail("verify needs --input (the check session's log)");
   std::string error;
   ComparisonOptions options;
-  if (!ComparisonOptionsFromArgs(args, &options, &error)) return Fail(error);
-  if (!CheckDestinations({{args.output, "--output", true}},
-                         {{args.calibration, "--calibration"},
-                          {args.input, "--input"},
-                          {args.config_path, "--config"}},
-                         &error)) {
-    return Fail(error);
-  }
+  if (!ComparisonOptionsFromLevel(args.level, &options, &error)) return Fail(error);
   Calibration stored;
   if (!ReadCalibrationUncertainty(args.calibration, &stored, nullptr, &error)) return Fail(error);
   ImuLog log;
@@ -157,17 +141,13 @@ int RunVerify(const CommandArgs& args) {
   return result.comparison.consistent ? 0 : kChanged;
 }
 
-int RunPlanVerify(const CommandArgs& args) {
+int RunPlanVerify(const PlanArgs& args) {
   std::string error;
   CheckDesignOptions options;
-  if (!ComparisonOptionsFromArgs(args, &options.comparison, &error)) return Fail(error);
-  options.noise_density = args.plan_request.accel_noise_density;
+  if (!ComparisonOptionsFromLevel(args.level, &options.comparison, &error)) return Fail(error);
+  options.noise_density = args.request.accel_noise_density;
   if (!(options.noise_density > 0.0)) {
     return Fail("plan --verify needs --accel-noise-density (m/s^2/sqrt(Hz))");
-  }
-  if (!CheckDestinations({{args.output, "--output", true}}, {{args.verify_calibration, "--verify"}},
-                         &error)) {
-    return Fail(error);
   }
   Calibration stored;
   if (!ReadCalibrationUncertainty(args.verify_calibration, &stored, nullptr, &error)) {

@@ -18,65 +18,120 @@ std::string In(const std::string& folder, const char* name) {
   return folder + (folder.back() == '/' ? "" : "/") + name;
 }
 
+// The config and the gyroscope file it may name (input: gyro_path).
+std::vector<Source> ConfigSources(const CommonArgs& args) {
+  return {{args.config_path, "--config"}, {args.config.input.gyro_path, "gyro_path"}};
+}
+
+// `out` and `in` checked, `in` after the config's sources.
+bool Check(const CommonArgs& args, const std::vector<Destination>& out,
+           const std::vector<Source>& in, std::string* error) {
+  std::vector<Source> sources = ConfigSources(args);
+  sources.insert(sources.end(), in.begin(), in.end());
+  return CheckDestinations(out, sources, error);
+}
+
+// The folder and its files `names`, under `flag`.
+std::vector<Destination> FolderFiles(const std::string& folder, const char* flag,
+                                     const std::vector<const char*>& names) {
+  std::vector<Destination> out = {{folder, flag, false, true}};
+  for (const char* name : names) out.push_back({In(folder, name), flag});
+  return out;
+}
+
 }  // namespace
 
-bool CheckCommandDestinations(const std::string& command, const CommandArgs& args,
-                              std::string* error) {
-  std::vector<Destination> out;
-  // The config and the gyroscope file it may name (input: gyro_path).
-  std::vector<Source> in = {{args.config_path, "--config"},
-                            {args.config.input.gyro_path, "gyro_path"}};
-  auto folder_files = [&](const char* flag, const std::vector<const char*>& names) {
-    out.push_back({args.output_dir, flag, false, true});
-    for (const char* name : names) out.push_back({In(args.output_dir, name), flag});
-  };
-  if (command == "calibrate") {
-    out = {{args.output, "--output", true}, {args.report, "--report"}, {args.history, "--history"}};
-    in.insert(in.end(), {{args.input, "--input"},
-                         {args.attitudes, "--attitudes"},
-                         {args.segments, "--segments"},
-                         {args.noise, "--noise"}});
-  } else if (command == "apply") {
-    out = {{args.output, "--output", true}};
-    in.insert(in.end(), {{args.input, "--input"}, {args.calibration, "--calibration"}});
-  } else if (command == "simulate") {
-    folder_files("--output-dir", {"raw.csv", "truth.json", "attitudes.csv", "segments.csv"});
-    in.push_back({args.plan, "--plan"});
-  } else if (command == "plan") {
-    out = {{args.output, "--output"}, {args.report, "--report"}};
-    in.push_back({args.noise, "--noise"});
-  } else if (command == "batch") {
-    // --input-dir may be the output folder: the batch tells its own files
-    // apart (batch_command.cc).
-    folder_files("--output-dir", {"summary.csv", "summary.json"});
-    out.push_back({args.report, "--report"});
-    in.insert(in.end(), {{args.manifest, "--manifest"}, {args.input, "--input"}});
-  } else if (command == "merge-summaries") {
-    folder_files("--output-dir", {"summary.csv", "summary.json"});
-    for (const std::string& folder : args.positional) {
-      in.insert(in.end(), {{folder, "shard folder"},
-                           {In(folder, "summary.csv"), "shard summary"},
-                           {In(folder, "summary.json"), "shard summary"}});
-    }
-  } else if (command == "discover") {
-    out = {{args.output, "--output"}, {args.report, "--report"}};
-    in.push_back({args.input, "--input"});
-  } else if (command == "noise") {
-    out = {{args.output, "--output"},
-           {args.kalibr, "--kalibr"},
-           {args.handheld, "--handheld"},
-           {args.report, "--report"}};
-    in.push_back({args.input, "--input"});
-  } else if (command == "export") {
-    ExportTarget target;
-    if (FromString(args.to, &target) && target == ExportTarget::kC) {
-      folder_files("--output-dir", {"gravcal_correct.h", "gravcal_correct.c"});
-    } else {
-      out = {{args.output, "--output", true}};
-    }
-    in.insert(in.end(), {{args.calibration, "--calibration"}, {args.noise, "--noise"}});
+bool CheckCommandDestinations(const CommonArgs& args, std::string* error) {
+  return Check(args, {}, {}, error);
+}
+
+bool CheckCommandDestinations(const CalibrateArgs& args, std::string* error) {
+  std::vector<Destination> out = {
+      {args.output, "--output", true}, {args.report, "--report"}, {args.history, "--history"}};
+  if (!args.certificate.empty()) {
+    out.push_back({args.certificate + ".json", "--certificate"});
+    out.push_back({args.certificate + ".html", "--certificate"});
   }
-  return CheckDestinations(out, in, error);
+  return Check(args, out,
+               {{args.input, "--input"},
+                {args.attitudes, "--attitudes"},
+                {args.segments, "--segments"},
+                {args.noise, "--noise"},
+                {args.limits, "--limits"}},
+               error);
+}
+
+bool CheckCommandDestinations(const ApplyArgs& args, std::string* error) {
+  return Check(args, {{args.output, "--output", true}},
+               {{args.input, "--input"}, {args.calibration, "--calibration"}}, error);
+}
+
+bool CheckCommandDestinations(const SimulateArgs& args, std::string* error) {
+  return Check(args,
+               FolderFiles(args.output_dir, "--output-dir",
+                           {"raw.csv", "truth.json", "attitudes.csv", "segments.csv"}),
+               {{args.plan, "--plan"}}, error);
+}
+
+bool CheckCommandDestinations(const PlanArgs& args, std::string* error) {
+  // plan --verify's design may go to standard output.
+  const bool verify = !args.verify_calibration.empty();
+  return Check(args, {{args.output, "--output", verify}, {args.report, "--report"}},
+               {{args.noise, "--noise"}, {args.verify_calibration, "--verify"}}, error);
+}
+
+bool CheckCommandDestinations(const BatchArgs& args, std::string* error) {
+  // --input-dir may be the output folder: the batch tells its own files
+  // apart (workflows/batch_folder.h).
+  std::vector<Destination> out =
+      FolderFiles(args.output_dir, "--output-dir", {"summary.csv", "summary.json"});
+  out.push_back({args.report, "--report"});
+  if (!args.limits.empty()) out.push_back({In(args.output_dir, "limits.csv"), "--output-dir"});
+  std::vector<Source> in = {
+      {args.manifest, "--manifest"}, {args.input, "--input"}, {args.limits, "--limits"}};
+  for (const std::string& folder : args.positional) {
+    in.insert(in.end(), {{folder, "shard folder"},
+                         {In(folder, "summary.csv"), "shard summary"},
+                         {In(folder, "summary.json"), "shard summary"}});
+  }
+  return Check(args, out, in, error);
+}
+
+bool CheckCommandDestinations(const LogReportArgs& args, std::string* error) {
+  return Check(args,
+               {{args.output, "--output"},
+                {args.kalibr, "--kalibr"},
+                {args.handheld, "--handheld"},
+                {args.report, "--report"}},
+               {{args.input, "--input"}}, error);
+}
+
+bool CheckCommandDestinations(const ExportArgs& args, std::string* error) {
+  ExportTarget target;
+  const bool c_target = FromString(args.to, &target) && target == ExportTarget::kC;
+  return Check(args,
+               c_target ? FolderFiles(args.output_dir, "--output-dir",
+                                      {"gravcal_correct.h", "gravcal_correct.c"})
+                        : std::vector<Destination>{{args.output, "--output", true}},
+               {{args.calibration, "--calibration"}, {args.noise, "--noise"}}, error);
+}
+
+bool CheckCommandDestinations(const CompareArgs& args, std::string* error) {
+  std::vector<Source> in = {{args.input, "--input"}};
+  const char* names[] = {"first calibration", "second calibration"};
+  for (size_t i = 0; i < args.positional.size() && i < 2; ++i) {
+    in.push_back({args.positional[i], names[i]});
+  }
+  return Check(args, {{args.output, "--output", true}}, in, error);
+}
+
+bool CheckCommandDestinations(const VerifyArgs& args, std::string* error) {
+  return Check(args, {{args.output, "--output", true}},
+               {{args.calibration, "--calibration"}, {args.input, "--input"}}, error);
+}
+
+bool CheckCommandDestinations(const HistoryArgs& args, std::string* error) {
+  return Check(args, {{args.output, "--output", true}}, {}, error);
 }
 
 bool WriteOutput(const std::string& path, const std::string& text, std::string* error) {

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/discovery.h"
 #include "gravcal/workflows/discovery_report.h"
@@ -10,7 +11,7 @@
 namespace gravcal {
 namespace cli {
 
-int RunDiscover(const CommandArgs& args) {
+int RunDiscover(const LogReportArgs& args) {
   if (args.input.empty()) return Fail("discover needs --input <raw log>");
   if (args.output.empty()) return Fail("discover needs --output <discovery.json>");
   std::string error;
@@ -25,9 +26,9 @@ int RunDiscover(const CommandArgs& args) {
   for (const std::string& w : result.warnings) {
     std::fprintf(stderr, "gravcal: warning: %s\n", w.c_str());
   }
-  if (!WriteFileAtomically(args.output, DiscoveryToJson(result), &error)) return Fail(error);
-  if (!args.report.empty() && !WriteFileAtomically(args.report, DiscoveryToHtml(result), &error)) {
-    std::remove(args.output.c_str());
+  if (!WriteFilesAtomically({{args.output, DiscoveryToJson(result)},
+                             {args.report, args.report.empty() ? "" : DiscoveryToHtml(result)}},
+                            &error)) {
     return Fail(error);
   }
   for (size_t i = 0; i < result.steps.size(); ++i) {

@@ -16,7 +16,7 @@
 namespace gravcal {
 namespace cli {
 
-int RunExport(const CommandArgs& args) {
+int RunExport(const ExportArgs& args) {
   if (args.calibration.empty()) return Fail("export needs --calibration <calib.json>");
   ExportOptions options;
   if (!FromString(args.to, &options.target)) {
@@ -42,18 +42,19 @@ int RunExport(const CommandArgs& args) {
   for (const std::string& line : result.dropped) {
     std::fprintf(stderr, "gravcal: export --to %s drops: %s\n", args.to.c_str(), line.c_str());
   }
+  if (c_target && !MakeFolders(args.output_dir, &error)) return Fail(error);
+  // Every file in place, or none.
+  std::vector<FileContents> files;
   std::vector<std::string> written;
   for (const ExportedFile& file : result.files) {
-    std::string path = args.output;
-    if (c_target) {
-      mkdir(args.output_dir.c_str(), 0755);
-      path = args.output_dir + "/" + file.name;
-    }
-    if (!WriteOutput(path, file.text, &error)) {
-      for (const std::string& w : written) std::remove(w.c_str());
+    written.push_back(c_target ? args.output_dir + "/" + file.name : args.output);
+    if (written.back() != "-") files.push_back({written.back(), file.text});
+  }
+  if (!WriteFilesAtomically(files, &error)) return Fail(error);
+  for (const ExportedFile& file : result.files) {
+    if (!c_target && args.output == "-" && !WriteOutput(args.output, file.text, &error)) {
       return Fail(error);
     }
-    written.push_back(path);
   }
   std::string names;
   for (const std::string& w : written)

@@ -12,12 +12,11 @@
 namespace gravcal {
 namespace cli {
 
-int RunHistory(const CommandArgs& args) {
+int RunHistory(const HistoryArgs& args) {
   if (args.positional.size() != 1) return Fail("history needs one unit: gravcal history UNIT");
   if (args.store.empty()) return Fail("history needs --store (the calibration store folder)");
   std::string error;
   if (!(args.level > 0.0 && args.level < 1.0)) return Fail("--level: must lie in (0, 1)");
-  if (!CheckDestinations({{args.output, "--output", true}}, {}, &error)) return Fail(error);
   UnitHistory history;
   if (!ReadUnitHistory(args.store, args.positional[0], args.level, &history, &error)) {
     return Fail(error);

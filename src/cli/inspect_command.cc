@@ -10,7 +10,7 @@
 namespace gravcal {
 namespace cli {
 
-int RunInspect(const CommandArgs& args) {
+int RunInspect(const InspectArgs& args) {
   if (args.input.empty()) return Fail("inspect needs --input");
   RecordingSummary summary;
   std::string error;

@@ -11,216 +11,233 @@
 #include <Eigen/Core>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/flags.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/method_registry.h"
 
-DEFINE_string(input, "", "raw log to read");
-DEFINE_string(output, "", "file to write (calibration JSON or corrected CSV)");
-DEFINE_string(output_dir, "",
-              "folder to write into (simulate: raw.csv, truth.json; batch: results)");
-DEFINE_string(config, "", "YAML config file (configs/*.yaml)");
-DEFINE_string(calibration, "", "calibration JSON to apply");
-DEFINE_uint64(seed, 1, "random seed of the simulator");
-DEFINE_string(manifest, "", "batch: CSV with columns unit, path and optional config keys");
-DEFINE_string(input_dir, "", "batch: every file matching --pattern in this folder is a unit");
-DEFINE_string(pattern, "*.csv", "batch: file name pattern for --input-dir");
-DEFINE_int32(threads, 0, "batch: worker threads, 0 = one per core");
-DEFINE_string(shard, "",
-              "batch: K/N, calibrate only units i with i mod N = K - 1; auto or auto/N: K and N "
-              "from the scheduler's job array (Slurm, Kubernetes, AWS Batch)");
-DEFINE_double(unit_timeout, 0.0,
-              "batch: seconds one unit may take; a unit over it fails with a message and the "
-              "batch goes on (0 = no limit)");
-DEFINE_double(outlier_sigmas, gravcal::FleetOptions().outlier_sigmas,
-              "batch: outlier threshold, robust standard deviations from the fleet median");
-DEFINE_int32(outlier_min_units, gravcal::FleetOptions().min_units,
-             "batch: fewest calibrated units for the outlier check");
-DEFINE_string(attitudes, "",
-              "CSV of each static position's roll and pitch (methods that need the fixture's "
-              "attitudes)");
-DEFINE_string(segments, "",
-              "CSV of the constant-rate segments, t_begin, t_end, rates (methods that need a rate "
-              "table)");
-DEFINE_string(history, "", "calibrate: write the estimates' time history (CSV) here");
-DEFINE_string(report, "", "HTML report to write (calibrate, batch, noise, discover)");
-DEFINE_string(kalibr, "", "noise: also write Kalibr's imu.yaml (continuous-time densities) here");
-DEFINE_string(handheld, "", "noise: also write the handheld filter's hk_* noise keys (YAML) here");
-DEFINE_string(topics, "",
-              "batch: 'all' makes one unit per sensor_msgs/Imu topic of the bag --input");
-DEFINE_string(noise, "",
-              "noise.json from 'gravcal noise': the variance of each pose's mean, and the "
-              "handheld filter's noise, from the noise model");
-// Issue 15: gravcal plan / check / simulate --plan.
-DEFINE_string(target, "",
-              "plan, check: targets, e.g. \"accel_bias=0.5mg accel_scale=50ppm "
-              "accel_misalignment=0.1mrad\" (or parameter names bias_x ... u_zz)");
-DEFINE_string(pose_set, gravcal::PlanRequest().pose_set,
-              "plan, check: candidate orientations: faces, faces+45 or free");
-DEFINE_int32(candidates, gravcal::PlanRequest().free_candidates,
-             "plan, check: directions of the free pose set (besides faces+45)");
-DEFINE_double(max_time, 0.0, "plan: the session may not take longer, seconds (0 = no limit)");
-DEFINE_double(overhead, gravcal::PlanRequest().overhead_seconds,
-              "plan: seconds to move and settle the housing before each pose");
-DEFINE_double(min_hold, gravcal::PlanRequest().min_hold_seconds, "plan: shortest hold, s");
-DEFINE_double(max_hold, gravcal::PlanRequest().max_hold_seconds, "plan: longest hold, s");
-DEFINE_double(accel_noise_density, 0.0,
-              "plan, check: accelerometer white noise N, m/s^2/sqrt(Hz) (datasheet; instead of "
-              "--noise)");
-DEFINE_double(accel_bias_instability, 0.0, "plan, check: accelerometer bias instability B, m/s^2");
-DEFINE_double(accel_random_walk, 0.0, "plan, check: accelerometer random walk K, m/s^3/sqrt(Hz)");
-DEFINE_double(pose_disturbance, 0.0,
-              "plan, check: per-pose disturbance of |a|, m/s^2 rms (0 = none)");
-DEFINE_double(gyro_noise_density, 0.0,
-              "plan: gyroscope white noise N, rad/s/sqrt(Hz) (datasheet; instead of --noise): "
-              "plans the turns between poses for the gyroscope");
-DEFINE_double(attitude_std, 0.0,
-              "plan (method known_attitude): the fixture's roll and pitch standard deviation, "
-              "degrees");
-DEFINE_bool(check, false,
-            "calibrate: add what the session lacks (as gravcal check says it) to the output "
-            "and the calibration JSON ('check')");
-DEFINE_double(turn_seconds, gravcal::PlanRequest().turn_seconds,
-              "plan: seconds a half turn takes (shorter turns proportionally less)");
-DEFINE_string(plan, "", "simulate: plan.json from gravcal plan (its poses replace sim_scheme)");
-
-DEFINE_double(level, 0.01, "compare, verify: significance level of the test");
-DEFINE_string(space, "model",
-              "compare: model (the calibrations' own parameters, same mounting) or intrinsic "
-              "(mount-invariant, Geist and Gaitan)");
-DEFINE_string(limits, "", "calibrate: acceptance limits (YAML); exit 4 when one fails");
-DEFINE_string(certificate, "",
-              "calibrate: write the calibration certificate to <prefix>.json and <prefix>.html");
-DEFINE_string(unit, "", "calibrate: the unit's name on the certificate (default: the log's name)");
-DEFINE_string(store, "",
-              "calibrate: file the calibration in this store (a folder, per unit and date); "
-              "history: the store to read");
-DEFINE_string(verify, "",
-              "plan: design the shortest check session for this stored calibration (JSON) "
-              "instead: four poses, detecting 10 stored sigmas in any one parameter with power "
-              "0.9 at --level (needs --accel_noise_density)");
-DEFINE_string(to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)");
-
+namespace gravcal {
+namespace cli {
 namespace {
 
 struct CommandInfo {
   const char* name;
   const char* summary;
+  // The flags it takes, in help's order.
   std::vector<const char*> flags;
-  // nullptr for help, which main handles before parsing flags.
-  int (*run)(const gravcal::cli::CommandArgs&);
+  // Fills the command's args from the parsed flags and `common`, checks its
+  // destinations and runs it. Empty for help, which main handles before
+  // parsing flags.
+  std::function<int(CommonArgs common)> run;
   // Takes arguments that are not flags (merge-summaries: the shard folders).
   bool positional = false;
   // Reads the config: takes config keys as flags (--gravity 9.81).
   bool config_keys = true;
 };
 
+// A command whose flags fill Args (commands.h) and that runs as `run`.
+template <typename Args>
+CommandInfo Command(const char* name, const char* summary, std::vector<FlagBinding<Args>> bindings,
+                    int (*run)(const Args&), bool positional = false, bool config_keys = true) {
+  CommandInfo info{name, summary, {}, nullptr, positional, config_keys};
+  for (const FlagBinding<Args>& b : bindings) info.flags.push_back(b.name);
+  info.run = [bindings, run](CommonArgs common) {
+    Args args;
+    static_cast<CommonArgs&>(args) = std::move(common);
+    for (const FlagBinding<Args>& b : bindings) b.set(FlagText(b.name), &args);
+    std::string error;
+    if (!CheckCommandDestinations(args, &error)) return Fail(error);
+    return run(args);
+  };
+  return info;
+}
+
+// --config, for every command that reads a config file.
+template <typename Args>
+FlagBinding<Args> ConfigFlag() {
+  return FlagField<Args>("config", &CommonArgs::config_path);
+}
+
+// The flags of plan and check that fill the plan request.
+FlagBinding<PlanArgs> RequestFlag(const char* name, std::string gravcal::PlanRequest::*field) {
+  return FlagAt<PlanArgs>(name, [field](PlanArgs* a) { return &(a->request.*field); });
+}
+FlagBinding<PlanArgs> RequestFlag(const char* name, double gravcal::PlanRequest::*field) {
+  return FlagAt<PlanArgs>(name, [field](PlanArgs* a) { return &(a->request.*field); });
+}
+FlagBinding<PlanArgs> RequestFlag(const char* name, int gravcal::PlanRequest::*field) {
+  return FlagAt<PlanArgs>(name, [field](PlanArgs* a) { return &(a->request.*field); });
+}
+
 const std::vector<CommandInfo>& Commands() {
+  using gravcal::PlanRequest;
   static const std::vector<CommandInfo> commands = {
-      {"demo",
-       "simulate a twelve-position session in raw counts, calibrate it, print estimate vs truth",
-       {"config", "seed"},
-       gravcal::cli::RunDemo},
-      {"calibrate",
-       "calibrate the sensors from a log with the config's method (the config key 'method' "
-       "lists them)",
-       {"input", "config", "output", "attitudes", "segments", "history", "noise", "report", "check",
-        "limits", "certificate", "unit", "store"},
-       gravcal::cli::RunCalibrate},
-      {"apply",
-       "apply every term of a calibration to a contract CSV log (streaming; - for standard "
-       "input/output), writing SI units",
-       {"calibration", "input", "output", "config"},
-       gravcal::cli::RunApply},
-      {"simulate",
-       "simulate a session: raw.csv, truth.json, the fixture's attitudes.csv (and, for "
-       "sim_motion rate_table, segments.csv)",
-       {"config", "seed", "output_dir", "plan"},
-       gravcal::cli::RunSimulate},
-      {"plan",
-       "plan a recording before it is made: plan.json with the poses, holds and predicted "
-       "sigmas (least time meeting --target, or best within --max_time)",
-       {"config",
-        "output",
-        "noise",
-        "target",
-        "pose_set",
-        "candidates",
-        "max_time",
-        "overhead",
-        "min_hold",
-        "max_hold",
-        "accel_noise_density",
-        "accel_bias_instability",
-        "accel_random_walk",
-        "pose_disturbance",
-        "report",
-        "gyro_noise_density",
-        "turn_seconds",
-        "attitude_std",
-        "verify",
-        "level"},
-       gravcal::cli::RunPlan},
-      {"check",
-       "what a recorded session determines: predicted sigma per parameter, what is "
-       "undetermined or short of --target, and the extra poses that would help most",
-       {"input", "config", "noise", "target", "pose_set", "candidates", "accel_noise_density",
-        "accel_bias_instability", "accel_random_walk", "pose_disturbance"},
-       gravcal::cli::RunCheck},
-      {"batch",
-       "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
-       "statistics)",
-       {"manifest", "input_dir", "pattern", "config", "output_dir", "threads", "shard",
-        "outlier_sigmas", "outlier_min_units", "input", "topics", "report", "unit_timeout",
-        "limits"},
-       gravcal::cli::RunBatch},
-      {"merge-summaries",
-       "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
-       "shard1/ shard2/ ...",
-       {"output_dir", "outlier_sigmas", "outlier_min_units"},
-       gravcal::cli::RunMergeSummaries,
-       true,
-       false},
-      {"discover",
-       "find the effects the model misses: discovery.json and an HTML report",
-       {"input", "config", "output", "report"},
-       gravcal::cli::RunDiscover},
-      {"noise",
-       "the noise model of a still log (Allan deviation: N, B, K per axis): noise.json, and "
-       "Kalibr's imu.yaml",
-       {"input", "config", "output", "kalibr", "handheld", "report"},
-       gravcal::cli::RunNoise},
-      {"inspect",
-       "what a log file holds: format, topics and types, message counts, rates, time span, gaps",
-       {"input", "config"},
-       gravcal::cli::RunInspect},
-      {"export",
-       "write a calibration for kalibr, openvins, ros, px4, ardupilot or as C source (c)",
-       {"calibration", "noise", "to", "output", "output_dir"},
-       gravcal::cli::RunExport},
-      {"compare",
-       "are two calibrations of the same unchanged unit? per-parameter z, joint test; exit 3 "
-       "when not: gravcal compare a.json b.json",
-       {"level", "space", "output", "input", "config"},
-       gravcal::cli::RunCompare,
-       true},
-      {"verify",
-       "test a short check session against a stored calibration: consistent, or which term "
-       "changed; exit 3 when changed",
-       {"calibration", "input", "config", "level", "output"},
-       gravcal::cli::RunVerify},
-      {"history",
-       "a unit's calibrations in a store: each parameter's trend, a drift test, compare "
-       "between consecutive ones: gravcal history UNIT --store DIR",
-       {"store", "level", "output"},
-       gravcal::cli::RunHistory,
-       true,
-       false},
+      Command<DemoArgs>(
+          "demo",
+          "simulate a twelve-position session in raw counts, calibrate it, print estimate vs "
+          "truth",
+          {ConfigFlag<DemoArgs>(), FlagField<DemoArgs>("seed", &DemoArgs::seed)}, RunDemo),
+      Command<CalibrateArgs>(
+          "calibrate",
+          "calibrate the sensors from a log with the config's method (the config key 'method' "
+          "lists them)",
+          {FlagField<CalibrateArgs>("input", &CalibrateArgs::input), ConfigFlag<CalibrateArgs>(),
+           FlagField<CalibrateArgs>("output", &CalibrateArgs::output),
+           FlagField<CalibrateArgs>("attitudes", &CalibrateArgs::attitudes),
+           FlagField<CalibrateArgs>("segments", &CalibrateArgs::segments),
+           FlagField<CalibrateArgs>("history", &CalibrateArgs::history),
+           FlagField<CalibrateArgs>("noise", &CalibrateArgs::noise),
+           FlagField<CalibrateArgs>("report", &CalibrateArgs::report),
+           FlagField<CalibrateArgs>("check", &CalibrateArgs::check),
+           FlagField<CalibrateArgs>("limits", &CalibrateArgs::limits),
+           FlagField<CalibrateArgs>("certificate", &CalibrateArgs::certificate),
+           FlagField<CalibrateArgs>("unit", &CalibrateArgs::unit),
+           FlagField<CalibrateArgs>("store", &CalibrateArgs::store)},
+          RunCalibrate),
+      Command<ApplyArgs>(
+          "apply",
+          "apply every term of a calibration to a contract CSV log (streaming; - for standard "
+          "input/output), writing SI units",
+          {FlagField<ApplyArgs>("calibration", &ApplyArgs::calibration),
+           FlagField<ApplyArgs>("input", &ApplyArgs::input),
+           FlagField<ApplyArgs>("output", &ApplyArgs::output), ConfigFlag<ApplyArgs>()},
+          RunApply),
+      Command<SimulateArgs>(
+          "simulate",
+          "simulate a session: raw.csv, truth.json, the fixture's attitudes.csv (and, for "
+          "sim_motion rate_table, segments.csv)",
+          {ConfigFlag<SimulateArgs>(), FlagField<SimulateArgs>("seed", &SimulateArgs::seed),
+           FlagField<SimulateArgs>("output_dir", &SimulateArgs::output_dir),
+           FlagField<SimulateArgs>("plan", &SimulateArgs::plan)},
+          RunSimulate),
+      Command<PlanArgs>(
+          "plan",
+          "plan a recording before it is made: plan.json with the poses, holds and predicted "
+          "sigmas (least time meeting --target, or best within --max_time)",
+          {ConfigFlag<PlanArgs>(),
+           FlagField<PlanArgs>("output", &PlanArgs::output),
+           FlagField<PlanArgs>("noise", &PlanArgs::noise),
+           RequestFlag("target", &PlanRequest::targets),
+           RequestFlag("pose_set", &PlanRequest::pose_set),
+           RequestFlag("candidates", &PlanRequest::free_candidates),
+           RequestFlag("max_time", &PlanRequest::max_time_seconds),
+           RequestFlag("overhead", &PlanRequest::overhead_seconds),
+           RequestFlag("min_hold", &PlanRequest::min_hold_seconds),
+           RequestFlag("max_hold", &PlanRequest::max_hold_seconds),
+           RequestFlag("accel_noise_density", &PlanRequest::accel_noise_density),
+           RequestFlag("accel_bias_instability", &PlanRequest::accel_bias_instability),
+           RequestFlag("accel_random_walk", &PlanRequest::accel_random_walk),
+           RequestFlag("pose_disturbance", &PlanRequest::pose_disturbance),
+           FlagField<PlanArgs>("report", &PlanArgs::report),
+           RequestFlag("gyro_noise_density", &PlanRequest::gyro_noise_density),
+           RequestFlag("turn_seconds", &PlanRequest::turn_seconds),
+           RequestFlag("attitude_std", &PlanRequest::attitude_std_deg),
+           FlagField<PlanArgs>("verify", &PlanArgs::verify_calibration),
+           FlagField<PlanArgs>("level", &PlanArgs::level)},
+          RunPlan),
+      Command<PlanArgs>(
+          "check",
+          "what a recorded session determines: predicted sigma per parameter, what is "
+          "undetermined or short of --target, and the extra poses that would help most",
+          {FlagField<PlanArgs>("input", &PlanArgs::input), ConfigFlag<PlanArgs>(),
+           FlagField<PlanArgs>("noise", &PlanArgs::noise),
+           RequestFlag("target", &PlanRequest::targets),
+           RequestFlag("pose_set", &PlanRequest::pose_set),
+           RequestFlag("candidates", &PlanRequest::free_candidates),
+           RequestFlag("accel_noise_density", &PlanRequest::accel_noise_density),
+           RequestFlag("accel_bias_instability", &PlanRequest::accel_bias_instability),
+           RequestFlag("accel_random_walk", &PlanRequest::accel_random_walk),
+           RequestFlag("pose_disturbance", &PlanRequest::pose_disturbance)},
+          RunCheck),
+      Command<BatchArgs>(
+          "batch",
+          "calibrate many units in parallel: <unit>.json, summary.csv, summary.json (fleet "
+          "statistics)",
+          {FlagField<BatchArgs>("manifest", &BatchArgs::manifest),
+           FlagField<BatchArgs>("input_dir", &BatchArgs::input_dir),
+           FlagField<BatchArgs>("pattern", &BatchArgs::pattern), ConfigFlag<BatchArgs>(),
+           FlagField<BatchArgs>("output_dir", &BatchArgs::output_dir),
+           FlagField<BatchArgs>("threads", &BatchArgs::threads),
+           FlagField<BatchArgs>("shard", &BatchArgs::shard),
+           FlagField<BatchArgs>("outlier_sigmas", &BatchArgs::outlier_sigmas),
+           FlagField<BatchArgs>("outlier_min_units", &BatchArgs::outlier_min_units),
+           FlagField<BatchArgs>("input", &BatchArgs::input),
+           FlagField<BatchArgs>("topics", &BatchArgs::topics),
+           FlagField<BatchArgs>("report", &BatchArgs::report),
+           FlagField<BatchArgs>("unit_timeout", &BatchArgs::unit_timeout),
+           FlagField<BatchArgs>("limits", &BatchArgs::limits)},
+          RunBatch),
+      Command<BatchArgs>(
+          "merge-summaries",
+          "merge the summaries of a batch's shards: gravcal merge-summaries --output-dir merged/ "
+          "shard1/ shard2/ ...",
+          {FlagField<BatchArgs>("output_dir", &BatchArgs::output_dir),
+           FlagField<BatchArgs>("outlier_sigmas", &BatchArgs::outlier_sigmas),
+           FlagField<BatchArgs>("outlier_min_units", &BatchArgs::outlier_min_units)},
+          RunMergeSummaries, true, false),
+      Command<LogReportArgs>(
+          "discover", "find the effects the model misses: discovery.json and an HTML report",
+          {FlagField<LogReportArgs>("input", &LogReportArgs::input), ConfigFlag<LogReportArgs>(),
+           FlagField<LogReportArgs>("output", &LogReportArgs::output),
+           FlagField<LogReportArgs>("report", &LogReportArgs::report)},
+          RunDiscover),
+      Command<LogReportArgs>(
+          "noise",
+          "the noise model of a still log (Allan deviation: N, B, K per axis): noise.json, and "
+          "Kalibr's imu.yaml",
+          {FlagField<LogReportArgs>("input", &LogReportArgs::input), ConfigFlag<LogReportArgs>(),
+           FlagField<LogReportArgs>("output", &LogReportArgs::output),
+           FlagField<LogReportArgs>("kalibr", &LogReportArgs::kalibr),
+           FlagField<LogReportArgs>("handheld", &LogReportArgs::handheld),
+           FlagField<LogReportArgs>("report", &LogReportArgs::report)},
+          RunNoise),
+      Command<InspectArgs>(
+          "inspect",
+          "what a log file holds: format, topics and types, message counts, rates, time span, "
+          "gaps",
+          {FlagField<InspectArgs>("input", &InspectArgs::input), ConfigFlag<InspectArgs>()},
+          RunInspect),
+      Command<ExportArgs>(
+          "export",
+          "write a calibration for kalibr, openvins, ros, px4, ardupilot or as C source (c)",
+          {FlagField<ExportArgs>("calibration", &ExportArgs::calibration),
+           FlagField<ExportArgs>("noise", &ExportArgs::noise),
+           FlagField<ExportArgs>("to", &ExportArgs::to),
+           FlagField<ExportArgs>("output", &ExportArgs::output),
+           FlagField<ExportArgs>("output_dir", &ExportArgs::output_dir)},
+          RunExport),
+      Command<CompareArgs>(
+          "compare",
+          "are two calibrations of the same unchanged unit? per-parameter z, joint test; exit 3 "
+          "when not: gravcal compare a.json b.json",
+          {FlagField<CompareArgs>("level", &CompareArgs::level),
+           FlagField<CompareArgs>("space", &CompareArgs::space),
+           FlagField<CompareArgs>("output", &CompareArgs::output),
+           FlagField<CompareArgs>("input", &CompareArgs::input), ConfigFlag<CompareArgs>()},
+          RunCompare, true),
+      Command<VerifyArgs>(
+          "verify",
+          "test a short check session against a stored calibration: consistent, or which term "
+          "changed; exit 3 when changed",
+          {FlagField<VerifyArgs>("calibration", &VerifyArgs::calibration),
+           FlagField<VerifyArgs>("input", &VerifyArgs::input), ConfigFlag<VerifyArgs>(),
+           FlagField<VerifyArgs>("level", &VerifyArgs::level),
+           FlagField<VerifyArgs>("output", &VerifyArgs::output)},
+          RunVerify),
+      Command<HistoryArgs>(
+          "history",
+          "a unit's calibrations in a store: each parameter's trend, a drift test, compare "
+          "between consecutive ones: gravcal history UNIT --store DIR",
+          {FlagField<HistoryArgs>("store", &HistoryArgs::store),
+           FlagField<HistoryArgs>("level", &HistoryArgs::level),
+           FlagField<HistoryArgs>("output", &HistoryArgs::output)},
+          RunHistory, true, false),
       {"help",
        "list commands, or the flags and config keys of one: gravcal help <command>",
        {},
@@ -274,13 +291,11 @@ bool PrintHelp(const std::string& command) {
     if (command != c.name) continue;
     std::printf("gravcal %s: %s\n\nflags:\n", c.name, c.summary);
     for (const char* f : c.flags) {
-      gflags::CommandLineFlagInfo info;
-      gflags::GetCommandLineFlagInfo(f, &info);
       std::string name = f;
       for (char& ch : name) {
         if (ch == '_') ch = '-';
       }
-      std::printf("  --%-22s %s\n", name.c_str(), info.description.c_str());
+      std::printf("  --%-22s %s\n", name.c_str(), FindFlag(f)->help);
     }
     std::printf("\nconfig keys (in the YAML file, or as --key value; default in brackets):\n");
     std::string section;
@@ -389,9 +404,7 @@ bool CheckFlagsOfCommand(const CommandInfo& command, const SplitArguments& split
   }
   for (const std::string& flag : split.flags) {
     const std::string name = flag.substr(2, flag.find('=') - 2);
-    gflags::CommandLineFlagInfo info;
-    if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info) ||
-        info.filename.find("cli/main.cc") == std::string::npos) {
+    if (FindFlag(name) == nullptr) {
       *error = "unknown flag --" + DashedName(name) + " " + listed;
       return false;
     }
@@ -412,7 +425,8 @@ bool CheckFlagsOfCommand(const CommandInfo& command, const SplitArguments& split
 
 // --config, then the config keys given as flags on top of it.
 bool LoadCommandConfig(const SplitArguments& split, gravcal::Config* config, std::string* error) {
-  if (!FLAGS_config.empty() && !gravcal::LoadConfigFile(FLAGS_config, config, error)) return false;
+  const std::string path = FlagText("config");
+  if (!path.empty() && !gravcal::LoadConfigFile(path, config, error)) return false;
   for (const auto& [key, value] : split.overrides) {
     if (!gravcal::SetConfigValue(key, value, config, error)) {
       *error = "command line: " + *error;
@@ -420,56 +434,6 @@ bool LoadCommandConfig(const SplitArguments& split, gravcal::Config* config, std
     }
   }
   return true;
-}
-
-// The parsed gflags values, copied into the command's arguments.
-void CopyFlags(gravcal::cli::CommandArgs* args) {
-  args->config_path = FLAGS_config;
-  args->input = FLAGS_input;
-  args->output = FLAGS_output;
-  args->output_dir = FLAGS_output_dir;
-  args->calibration = FLAGS_calibration;
-  args->seed = FLAGS_seed;
-  args->manifest = FLAGS_manifest;
-  args->input_dir = FLAGS_input_dir;
-  args->pattern = FLAGS_pattern;
-  args->threads = FLAGS_threads;
-  args->shard = FLAGS_shard;
-  args->unit_timeout = FLAGS_unit_timeout;
-  args->outlier_sigmas = FLAGS_outlier_sigmas;
-  args->outlier_min_units = FLAGS_outlier_min_units;
-  args->attitudes = FLAGS_attitudes;
-  args->segments = FLAGS_segments;
-  args->history = FLAGS_history;
-  args->report = FLAGS_report;
-  args->check = FLAGS_check;
-  args->kalibr = FLAGS_kalibr;
-  args->handheld = FLAGS_handheld;
-  args->noise = FLAGS_noise;
-  args->topics = FLAGS_topics;
-  args->to = FLAGS_to;
-  args->plan = FLAGS_plan;
-  args->level = FLAGS_level;
-  args->space = FLAGS_space;
-  args->limits = FLAGS_limits;
-  args->certificate = FLAGS_certificate;
-  args->unit = FLAGS_unit;
-  args->store = FLAGS_store;
-  args->verify_calibration = FLAGS_verify;
-  args->plan_request.targets = FLAGS_target;
-  args->plan_request.pose_set = FLAGS_pose_set;
-  args->plan_request.free_candidates = FLAGS_candidates;
-  args->plan_request.max_time_seconds = FLAGS_max_time;
-  args->plan_request.overhead_seconds = FLAGS_overhead;
-  args->plan_request.min_hold_seconds = FLAGS_min_hold;
-  args->plan_request.max_hold_seconds = FLAGS_max_hold;
-  args->plan_request.accel_noise_density = FLAGS_accel_noise_density;
-  args->plan_request.accel_bias_instability = FLAGS_accel_bias_instability;
-  args->plan_request.accel_random_walk = FLAGS_accel_random_walk;
-  args->plan_request.pose_disturbance = FLAGS_pose_disturbance;
-  args->plan_request.gyro_noise_density = FLAGS_gyro_noise_density;
-  args->plan_request.turn_seconds = FLAGS_turn_seconds;
-  args->plan_request.attitude_std_deg = FLAGS_attitude_std;
 }
 
 const CommandInfo* FindCommand(const std::string& name) {
@@ -480,47 +444,50 @@ const CommandInfo* FindCommand(const std::string& name) {
 }
 
 }  // namespace
+}  // namespace cli
+}  // namespace gravcal
 
 int main(int argc, char** argv) {
+  namespace cli = gravcal::cli;
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   FLAGS_minloglevel = google::GLOG_WARNING;
-  using gravcal::cli::Fail;
   if (argc < 2) {
-    PrintHelp("");
+    cli::PrintHelp("");
     return 1;
   }
   const std::string command = argv[1];
   if (command == "help" || command == "--help" || command == "-h") {
     const std::string topic = argc > 2 ? argv[2] : "";
-    if (!PrintHelp(topic)) return Fail("unknown command '" + topic + "' (gravcal help lists them)");
+    if (!cli::PrintHelp(topic))
+      return cli::Fail("unknown command '" + topic + "' (gravcal help lists them)");
     return 0;
   }
   if (command == "--version" || command == "version") {
-    PrintVersion();
+    cli::PrintVersion();
     return 0;
   }
-  const CommandInfo* info = FindCommand(command);
-  if (info == nullptr) return Fail("unknown command '" + command + "' (gravcal help lists them)");
+  const cli::CommandInfo* info = cli::FindCommand(command);
+  if (info == nullptr)
+    return cli::Fail("unknown command '" + command + "' (gravcal help lists them)");
 
-  SplitArguments split;
+  cli::SplitArguments split;
   std::string error;
-  if (!SplitCommandLine(argc, argv, *info, &split, &error)) return Fail(error);
+  if (!cli::SplitCommandLine(argc, argv, *info, &split, &error)) return cli::Fail(error);
   if (split.help) {
-    PrintHelp(command);
+    cli::PrintHelp(command);
     return 0;
   }
-  if (!CheckFlagsOfCommand(*info, split, &error)) return Fail(error);
+  if (!cli::CheckFlagsOfCommand(*info, split, &error)) return cli::Fail(error);
   std::vector<char*> gflags_argv = {argv[0]};
   for (std::string& f : split.flags) gflags_argv.push_back(f.data());
   int gflags_argc = static_cast<int>(gflags_argv.size());
   char** gflags_args = gflags_argv.data();
   gflags::ParseCommandLineNonHelpFlags(&gflags_argc, &gflags_args, false);
 
-  gravcal::cli::CommandArgs args;
-  if (!LoadCommandConfig(split, &args.config, &error)) return Fail(error);
-  CopyFlags(&args);
-  args.positional = split.positional;
-  if (!gravcal::cli::CheckCommandDestinations(command, args, &error)) return Fail(error);
-  return info->run(args);
+  cli::CommonArgs common;
+  if (!cli::LoadCommandConfig(split, &common.config, &error)) return cli::Fail(error);
+  common.config_path = cli::FlagText("config");
+  common.positional = split.positional;
+  return info->run(std::move(common));
 }

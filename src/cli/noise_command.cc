@@ -30,7 +30,7 @@ void PrintAxis(const char* sensor, char axis, const AxisNoiseModel& m, const std
 
 }  // namespace
 
-int RunNoise(const CommandArgs& args) {
+int RunNoise(const LogReportArgs& args) {
   if (args.input.empty()) return Fail("noise needs --input <still log>");
   if (args.output.empty()) return Fail("noise needs --output <noise.json>");
   std::string error;

@@ -15,13 +15,14 @@ namespace cli {
 
 namespace {
 
-// The request from the flags; reads --noise into *noise (kept alive by the
-// caller). False with *error on an unreadable noise file.
-bool RequestFromArgs(const CommandArgs& args, ImuNoise* noise, PlanRequest* request,
-                     std::string* error) {
-  *request = args.plan_request;
-  if (!args.noise.empty()) {
-    if (!ReadNoiseJson(args.noise, noise, error)) return false;
+// The request from the flags with the noise model of `noise_path` (--noise)
+// read into *noise (kept alive by the caller). False with *error on an
+// unreadable noise file.
+bool RequestWithNoise(const PlanRequest& flags, const std::string& noise_path, ImuNoise* noise,
+                      PlanRequest* request, std::string* error) {
+  *request = flags;
+  if (!noise_path.empty()) {
+    if (!ReadNoiseJson(noise_path, noise, error)) return false;
     request->noise_model = &noise->model;
   }
   return true;
@@ -29,30 +30,30 @@ bool RequestFromArgs(const CommandArgs& args, ImuNoise* noise, PlanRequest* requ
 
 }  // namespace
 
-int RunPlan(const CommandArgs& args) {
+int RunPlan(const PlanArgs& args) {
   if (!args.verify_calibration.empty()) return RunPlanVerify(args);
   if (args.output.empty()) return Fail("plan needs --output <plan.json>");
   std::string error;
   ImuNoise noise;
   PlanRequest request;
-  if (!RequestFromArgs(args, &noise, &request, &error)) return Fail(error);
+  if (!RequestWithNoise(args.request, args.noise, &noise, &request, &error)) return Fail(error);
   RecordingPlan plan;
   if (!MakeRecordingPlan(args.config, request, &plan, &error)) return Fail(error);
-  if (!WritePlanJson(plan, args.output, &error)) return Fail(error);
-  if (!args.report.empty() && !WriteFileAtomically(args.report, PlanToHtml(plan), &error)) {
-    std::remove(args.output.c_str());
+  if (!WriteFilesAtomically({{args.output, PlanToJson(plan)},
+                             {args.report, args.report.empty() ? "" : PlanToHtml(plan)}},
+                            &error)) {
     return Fail(error);
   }
   std::fprintf(stderr, "gravcal: wrote %s: %s\n", args.output.c_str(), plan.message.c_str());
   return 0;
 }
 
-int RunCheck(const CommandArgs& args) {
+int RunCheck(const PlanArgs& args) {
   if (args.input.empty()) return Fail("check needs --input <session.csv>");
   std::string error;
   ImuNoise noise;
   PlanRequest request;
-  if (!RequestFromArgs(args, &noise, &request, &error)) return Fail(error);
+  if (!RequestWithNoise(args.request, args.noise, &noise, &request, &error)) return Fail(error);
   if (!args.config.input.IsValid(&error)) return Fail("input: " + error);
   ImuLog log;
   if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
@@ -62,14 +63,14 @@ int RunCheck(const CommandArgs& args) {
   return 0;
 }
 
-JsonSections CalibrationCheckSections(const CommandArgs& args, const ImuLog& log) {
+JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session) {
   if (!args.check || args.config.method != "twelve_position") return {};
-  std::string error;
-  ImuNoise noise;
+  // The session's noise model (read with the log), its poses (detected once).
   PlanRequest request;
-  if (!RequestFromArgs(args, &noise, &request, &error)) return {};
+  request.noise_model = session.noise_model();
   CoverageReport report;
-  if (!CheckRecording(log, args.config, request, &report, &error)) return {};
+  std::string error;
+  if (!CheckRecording(session, args.config, request, &report, &error)) return {};
   std::fprintf(stderr, "check: %s", CoverageReportText(report).c_str());
   return {{"check", CoverageToJson(report)}};
 }

@@ -5,6 +5,7 @@
 #include <Eigen/QR>
 #include <cmath>
 
+#include "gravcal/core/imu_model.h"
 #include "util/random_vector.h"
 
 namespace gravcal {
@@ -22,7 +23,15 @@ int NumParameters(AccelParameterization p) {
 }
 
 Eigen::Vector3d AccelModel::Apply(const Eigen::Vector3d& raw) const {
-  return rotation * (upper * (raw - bias));
+  double u[6];
+  GetUpper(u);
+  AccelBlocks<double> blocks;
+  blocks.bias = bias.data();
+  blocks.upper = u;
+  blocks.rotation = &rotation;
+  Eigen::Vector3d a;
+  ImuModel<double>(blocks).CorrectAccel(raw, 0.0, 0.0, a.data());
+  return a;
 }
 
 Eigen::Vector3d AccelModel::Invert(const Eigen::Vector3d& specific_force) const {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "gravcal/core/imu_model.h"
+
 namespace gravcal {
 
 namespace {
@@ -21,36 +23,56 @@ bool ImuCorrector::RequiresTime() const {
   return UsesRegressor(active_effects, EffectRegressor::kTime);
 }
 
-bool ImuCorrector::CorrectAccel(const Eigen::Vector3d& raw, double temperature, double time,
-                                Eigen::Vector3d* a) const {
-  const Eigen::Vector3d m = accel.upper * (raw - accel.bias);
-  Eigen::Vector3d s = m;
-  if (!active_effects.empty() &&
-      !gravcal::CorrectAccel(effects, active_effects, m, temperature, time, &s)) {
+namespace {
+
+// a = R h^-1(U (v - b)) and w = M_g (u - b_g - o) of one model's blocks.
+bool AccelOf(const ImuParameters& p, const Eigen::Vector3d& raw, double temperature, double time,
+             Eigen::Vector3d* a) {
+  Eigen::Vector3d out;
+  if (!p.Model().CorrectAccel(raw, p.TemperatureOffset(temperature), p.TimeOffset(time),
+                              out.data())) {
     return false;
   }
-  *a = accel.rotation * s;
+  *a = out;
   return true;
+}
+
+Eigen::Vector3d GyroOf(const ImuParameters& p, const Eigen::Matrix3d& rotation,
+                       const Eigen::Vector3d& raw, const Eigen::Vector3d& accel_housing,
+                       double temperature, double time) {
+  // The effects' G' was fitted against the force in the sensor frame.
+  const Eigen::Vector3d force = rotation.transpose() * accel_housing;
+  Eigen::Vector3d w;
+  p.Model().CorrectGyro(raw, force.data(), p.TemperatureOffset(temperature), p.TimeOffset(time),
+                        w.data());
+  return w;
+}
+
+}  // namespace
+
+bool ImuCorrector::CorrectAccel(const Eigen::Vector3d& raw, double temperature, double time,
+                                Eigen::Vector3d* a) const {
+  return AccelOf(ImuParameters(accel, nullptr, effects, active_effects), raw, temperature, time, a);
 }
 
 Eigen::Vector3d ImuCorrector::CorrectGyro(const Eigen::Vector3d& raw,
                                           const Eigen::Vector3d& accel_housing, double temperature,
                                           double time) const {
   if (!has_gyro) return raw;
-  Eigen::Vector3d u = raw - gyro.bias;
-  if (!active_effects.empty()) {
-    const Eigen::Vector3d force = accel.rotation.transpose() * accel_housing;
-    u -= GyroOffset(effects, active_effects, force, temperature, time);
-  }
-  return gyro.matrix * u;
+  return GyroOf(ImuParameters(accel, &gyro, effects, active_effects), accel.rotation, raw,
+                accel_housing, temperature, time);
 }
 
-bool ImuCorrector::CorrectRow(double temperature, double time, Eigen::Vector3d* accel,
-                              Eigen::Vector3d* gyro) const {
+bool ImuCorrector::CorrectRow(double temperature, double time, Eigen::Vector3d* accel_row,
+                              Eigen::Vector3d* gyro_row) const {
+  // One set of blocks for both sensors.
+  const ImuParameters p(accel, has_gyro ? &gyro : nullptr, effects, active_effects);
   Eigen::Vector3d a;
-  if (!CorrectAccel(*accel, temperature, time, &a)) return false;
-  if (gyro != nullptr) *gyro = CorrectGyro(*gyro, a, temperature, time);
-  *accel = a;
+  if (!AccelOf(p, *accel_row, temperature, time, &a)) return false;
+  if (gyro_row != nullptr && has_gyro) {
+    *gyro_row = GyroOf(p, accel.rotation, *gyro_row, a, temperature, time);
+  }
+  *accel_row = a;
   return true;
 }
 

@@ -8,159 +8,27 @@
 #include <memory>
 #include <sstream>
 
+#include "detection/cut_poses.h"
+#include "detection/static_detector_internal.h"
 #include "util/units.h"
 
 namespace gravcal {
 namespace {
 
-// The median interval and the quantiles are taken on at most this many
-// evenly strided values: exact for logs up to this size, a close estimate
-// (and much faster) beyond.
-constexpr size_t kMaxQuantileValues = size_t{1} << 14;
+using internal::MedianSampleInterval;
+using internal::NoiseFloor;
+using internal::QuietRun;
+using internal::RateScale;
+using internal::SplitOrFlagSpread;
+using internal::SplitRunsAtSteps;
+using internal::StridedQuantile;
+using internal::WindowTrend;
+using internal::WindowVariance;
+
+std::string Num(double v) { return internal::DetectorNumber(v); }
 
 // MakeInterval looks for the accelerometer resolution in this many samples.
 constexpr size_t kResolutionSamples = 256;
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.6g", v);
-  return buf;
-}
-
-// The q quantile of values[0, stride, 2 stride, ...] (all of them when there
-// are at most kMaxQuantileValues); uses `scratch`.
-template <typename T>
-double StridedQuantile(const T* values, size_t size, double q, std::vector<double>* scratch) {
-  if (size == 0) return 0.0;
-  const size_t stride = std::max<size_t>(1, (size + kMaxQuantileValues - 1) / kMaxQuantileValues);
-  scratch->clear();
-  for (size_t i = 0; i < size; i += stride) scratch->push_back(values[i]);
-  const size_t k =
-      std::min(scratch->size() - 1, static_cast<size_t>(q * static_cast<double>(scratch->size())));
-  std::nth_element(scratch->begin(), scratch->begin() + k, scratch->end());
-  return (*scratch)[k];
-}
-
-// Moving-window variance of one 3-axis signal: var[k] = sum over the axes of
-// the (population) variance of x[k, k+w), for k in [0, n - w]. One pass of
-// running sums of deviations from a reference sample that is renewed every
-// block (so neither cancellation nor rounding drift builds up; the block
-// restarts cost 1/16 extra). Returns false when the signal is not finite.
-bool WindowVariance(const std::vector<Eigen::Vector3d>& x, size_t w, float* var) {
-  // x and y in one SSE2 register pair (Array2d), z scalar.
-  using A2 = Eigen::Array2d;
-  const size_t num_windows = x.size() - w + 1;
-  const double* p = x[0].data();  // contiguous: 3 doubles per sample
-  const size_t block = std::max<size_t>(16 * w, 4096);
-  const double inv_w = 1.0 / static_cast<double>(w);
-  const double inv_w2 = inv_w * inv_w;
-  for (size_t k0 = 0; k0 < num_windows; k0 += block) {
-    const A2 r01 = Eigen::Map<const A2>(p + 3 * k0);
-    const double r2 = p[3 * k0 + 2];
-    A2 s01 = A2::Zero(), q01 = A2::Zero();
-    double s2 = 0.0, q2 = 0.0;
-    for (size_t i = k0; i < k0 + w; ++i) {
-      const A2 d01 = Eigen::Map<const A2>(p + 3 * i) - r01;
-      const double d2 = p[3 * i + 2] - r2;
-      s01 += d01;
-      q01 += d01 * d01;
-      s2 += d2;
-      q2 += d2 * d2;
-    }
-    const size_t k_last = std::min(num_windows, k0 + block) - 1;
-    for (size_t k = k0;; ++k) {
-      const A2 m = s01 * s01;
-      const double v = (q01[0] + q01[1] + q2) * inv_w - (m[0] + m[1] + s2 * s2) * inv_w2;
-      var[k] = static_cast<float>(v > 0.0 ? v : 0.0);
-      if (k == k_last) break;
-      const double* out = p + 3 * k;
-      const double* in = p + 3 * (k + w);
-      const A2 o01 = Eigen::Map<const A2>(out) - r01;
-      const A2 i01 = Eigen::Map<const A2>(in) - r01;
-      const double o2 = out[2] - r2, i2 = in[2] - r2;
-      s01 += i01 - o01;
-      q01 += (i01 - o01) * (i01 + o01);
-      s2 += i2 - o2;
-      q2 += (i2 - o2) * (i2 + o2);
-    }
-    // Every sample of the block entered the sums, and NaN and infinity stick.
-    if (!std::isfinite(s01.sum() + s2 + q01.sum() + q2)) return false;
-  }
-  return true;
-}
-
-// Moving-window level change of one 3-axis signal: trend[k] = |m2 - m1|^2
-// (summed over the axes), m1 and m2 the means of x[k, k+h) and x[k+h, k+w),
-// h = w / 2, for k in [0, n - w]. Running sums of deviations from a
-// reference renewed every block, as WindowVariance.
-void WindowTrend(const std::vector<Eigen::Vector3d>& x, size_t w, float* trend) {
-  const size_t num_windows = x.size() - w + 1;
-  const size_t h = w / 2;
-  const double inv1 = 1.0 / static_cast<double>(h);
-  const double inv2 = 1.0 / static_cast<double>(w - h);
-  const size_t block = std::max<size_t>(16 * w, 4096);
-  for (size_t k0 = 0; k0 < num_windows; k0 += block) {
-    const Eigen::Vector3d r = x[k0];
-    Eigen::Vector3d s1 = Eigen::Vector3d::Zero(), s2 = Eigen::Vector3d::Zero();
-    for (size_t i = k0; i < k0 + h; ++i) s1 += x[i] - r;
-    for (size_t i = k0 + h; i < k0 + w; ++i) s2 += x[i] - r;
-    const size_t k_last = std::min(num_windows, k0 + block) - 1;
-    for (size_t k = k0;; ++k) {
-      trend[k] = static_cast<float>((s2 * inv2 - s1 * inv1).squaredNorm());
-      if (k == k_last) break;
-      s1 += x[k + h] - x[k];
-      s2 += x[k + w] - x[k + h];
-    }
-  }
-}
-
-// Half the mean squared sample-to-sample difference (summed over the axes) in
-// non-overlapping blocks of w samples, at most kMaxWhiteBlocks of them evenly
-// spread: the white-noise variance, which smooth motion barely raises.
-constexpr size_t kMaxWhiteBlocks = 1024;
-void WhiteNoise(const std::vector<Eigen::Vector3d>& x, size_t w, std::vector<double>* white) {
-  const size_t num_blocks = x.size() / w;
-  const size_t stride = std::max<size_t>(1, (num_blocks + kMaxWhiteBlocks - 1) / kMaxWhiteBlocks);
-  const double scale = 0.5 / static_cast<double>(w - 1);
-  white->clear();
-  for (size_t b = 0; b < num_blocks; b += stride) {
-    double sum = 0.0;
-    for (size_t i = b * w + 1; i < (b + 1) * w; ++i) sum += (x[i] - x[i - 1]).squaredNorm();
-    white->push_back(sum * scale);
-  }
-}
-
-// Smallest nonzero step between consecutive samples, per axis (0 if none).
-Eigen::Vector3d SmallestStep(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end) {
-  Eigen::Array3d step = Eigen::Array3d::Constant(std::numeric_limits<double>::infinity());
-  for (size_t i = begin + 1; i < end; ++i) {
-    const Eigen::Array3d d = (x[i] - x[i - 1]).array().abs();
-    step = (d > 0.0).select(d.min(step), step);
-  }
-  return (step.isFinite()).select(step, 0.0).matrix();
-}
-
-// The noise floor of one signal: the quantile of the windowed variance, at
-// most max_floor_ratio times the white-noise level, and never zero while the
-// data change at all.
-double NoiseFloor(const float* var, size_t num_windows, const std::vector<Eigen::Vector3d>& x,
-                  size_t w, const StaticDetectorOptions& options, std::vector<double>* scratch) {
-  double floor = StridedQuantile(var, num_windows, options.noise_quantile, scratch);
-  if (options.max_floor_ratio > 0.0) {
-    std::vector<double> white;
-    WhiteNoise(x, w, &white);
-    const double white_floor =
-        StridedQuantile(white.data(), white.size(), options.noise_quantile, scratch);
-    if (white_floor > 0.0) floor = std::min(floor, options.max_floor_ratio * white_floor);
-  }
-  if (floor <= 0.0) {
-    // Quantised data with many identical samples: the variance of uniform
-    // quantisation error, step^2 / 12 per axis.
-    const Eigen::Vector3d step = SmallestStep(x, 0, x.size());
-    floor = step.squaredNorm() / 12.0;
-  }
-  return floor;
-}
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double na = a.norm();
@@ -175,43 +43,6 @@ bool Fail(StaticDetection* detection, const std::string& message) {
 }
 
 }  // namespace
-
-bool StaticDetectorOptions::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& what) {
-    if (error) *error = "StaticDetectorOptions: " + what;
-    return false;
-  };
-  if (!(std::isfinite(window_seconds) && window_seconds > 0.0))
-    return fail("window_seconds must be positive (got " + Num(window_seconds) + ")");
-  if (!(noise_quantile > 0.0 && noise_quantile < 1.0))
-    return fail("noise_quantile must be in (0, 1) (got " + Num(noise_quantile) + ")");
-  if (!(std::isfinite(threshold_factor) && threshold_factor >= 1.0))
-    return fail("threshold_factor must be at least 1 (got " + Num(threshold_factor) + ")");
-  if (!(std::isfinite(gyro_threshold_factor) && gyro_threshold_factor >= 1.0))
-    return fail("gyro_threshold_factor must be at least 1 (got " + Num(gyro_threshold_factor) +
-                ")");
-  if (!(std::isfinite(max_floor_ratio) && max_floor_ratio >= 0.0))
-    return fail("max_floor_ratio must be 0 (off) or positive (got " + Num(max_floor_ratio) + ")");
-  if (!(std::isfinite(min_duration_seconds) && min_duration_seconds >= 0.0))
-    return fail("min_duration_seconds must be >= 0 (got " + Num(min_duration_seconds) + ")");
-  if (!(std::isfinite(settle_seconds) && settle_seconds >= 0.0))
-    return fail("settle_seconds must be >= 0 (got " + Num(settle_seconds) + ")");
-  if (!(merge_angle_deg >= 0.0 && merge_angle_deg <= 180.0))
-    return fail("merge_angle_deg must be in [0, 180] (got " + Num(merge_angle_deg) + ")");
-  if (!(std::isfinite(merge_gap_windows) && merge_gap_windows >= 0.0))
-    return fail("merge_gap_windows must be >= 0 (got " + Num(merge_gap_windows) + ")");
-  if (!(std::isfinite(candidate_factor) && candidate_factor >= 1.0))
-    return fail("candidate_factor must be at least 1 (got " + Num(candidate_factor) + ")");
-  if (!(std::isfinite(trend_factor) && (trend_factor == 0.0 || trend_factor >= 1.0)))
-    return fail("trend_factor must be 0 (off) or at least 1 (got " + Num(trend_factor) + ")");
-  if (!(std::isfinite(spread_factor) && (spread_factor == 0.0 || spread_factor >= 1.0)))
-    return fail("spread_factor must be 0 (off) or at least 1 (got " + Num(spread_factor) + ")");
-  if (!(std::isfinite(step_factor) && (step_factor == 0.0 || step_factor >= 1.0)))
-    return fail("step_factor must be 0 (off) or at least 1 (got " + Num(step_factor) + ")");
-  if (!(step_min_deg >= 0.0 && step_min_deg <= 180.0))
-    return fail("step_min_deg must be in [0, 180] (got " + Num(step_min_deg) + ")");
-  return true;
-}
 
 StaticInterval MakeInterval(const ImuLog& log, size_t begin, size_t end) {
   StaticInterval s;
@@ -306,21 +137,6 @@ bool CheckDetectionInput(const ImuLog& log, const std::string& name, std::string
   return false;
 }
 
-// Median sample interval (on a strided subsample of the intervals).
-double MedianSampleInterval(const std::vector<double>& t, std::vector<double>* scratch) {
-  const size_t n = t.size();
-  scratch->clear();
-  const size_t stride = std::max<size_t>(1, (n - 1 + kMaxQuantileValues - 1) / kMaxQuantileValues);
-  for (size_t i = 1; i < n; i += stride) scratch->push_back(t[i] - t[i - 1]);
-  std::nth_element(scratch->begin(), scratch->begin() + scratch->size() / 2, scratch->end());
-  return (*scratch)[scratch->size() / 2];
-}
-
-// Samples [begin, end) covered by consecutive quiet windows.
-struct QuietRun {
-  size_t begin, end;
-};
-
 // The windowed statistics of one sensor: variance, level change (null when
 // trend_factor is 0) and the noise floor.
 struct SensorWindows {
@@ -334,24 +150,13 @@ struct SensorWindows {
 
 // See TrimLevelEnds' use.
 constexpr double kGyroLevelFraction = 0.01;
+// A step of the rate splits a still run only when the two levels differ by
+// at least this fraction of the log's turn rate (RateScale): a constant turn
+// started or stopped is a large part of it, a hand's sway within a pose a
+// few percent at most (measured: 1 % split a hand-held MPU-6050 pose).
+constexpr double kGyroStepFraction = 0.1;
 // TrimLevelEnds trims at most this many windows from each end of a run.
 constexpr size_t kMaxTrimWindows = 5;
-
-// The 99th percentile of |x - median| (median per axis), on a strided
-// subsample: the scale of the gyroscope's turns.
-double RateScale(const std::vector<Eigen::Vector3d>& x, std::vector<double>* scratch) {
-  Eigen::Vector3d median;
-  std::vector<double> axis;
-  const size_t stride = std::max<size_t>(1, x.size() / kMaxQuantileValues);
-  for (int a = 0; a < 3; ++a) {
-    axis.clear();
-    for (size_t i = 0; i < x.size(); i += stride) axis.push_back(x[i][a]);
-    median[a] = StridedQuantile(axis.data(), axis.size(), 0.5, scratch);
-  }
-  axis.clear();
-  for (size_t i = 0; i < x.size(); i += stride) axis.push_back((x[i] - median).norm());
-  return StridedQuantile(axis.data(), axis.size(), 0.99, scratch);
-}
 
 // The ends of each run where the sensor's level (its window mean) is away
 // from the run's own (the median of its window means, per axis) by more
@@ -460,106 +265,6 @@ std::vector<QuietRun> FindQuietRuns(const SensorWindows& accel, const SensorWind
       std::remove_if(runs.begin(), runs.end(), [](const QuietRun& r) { return r.end <= r.begin; }),
       runs.end());
   return runs;
-}
-
-// Prefix sums over one run for the line fits of SplitRunAtSteps: of x - r,
-// j (x - r) and |x - r|^2 per axis, j the sample's index in the run and r
-// its first sample (small magnitudes: no cancellation with raw counts).
-struct LinePrefix {
-  std::vector<Eigen::Vector3d> s0, s1, s2;
-  LinePrefix(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end) {
-    const size_t n = end - begin;
-    s0.assign(n + 1, Eigen::Vector3d::Zero());
-    s1 = s0;
-    s2 = s0;
-    const Eigen::Vector3d r = x[begin];
-    for (size_t j = 0; j < n; ++j) {
-      const Eigen::Vector3d d = x[begin + j] - r;
-      s0[j + 1] = s0[j] + d;
-      s1[j + 1] = s1[j] + static_cast<double>(j) * d;
-      s2[j + 1] = s2[j] + d.cwiseProduct(d);
-    }
-  }
-  // The line fitted to run samples [a, a + len): its value at local position
-  // t (0 = sample a) and its residual variance summed over the axes; the
-  // samples' mean and variance about it.
-  void Fit(size_t a, size_t len, double t, Eigen::Vector3d* value, double* residual,
-           Eigen::Vector3d* mean, double* variance) const {
-    const double n = static_cast<double>(len);
-    const Eigen::Vector3d sx = s0[a + len] - s0[a];
-    const Eigen::Vector3d sjx = s1[a + len] - s1[a] - static_cast<double>(a) * sx;
-    const Eigen::Vector3d sxx = s2[a + len] - s2[a];
-    const double mean_j = 0.5 * (n - 1.0);
-    const double sjj = n * (n * n - 1.0) / 12.0;
-    const Eigen::Vector3d slope = (sjx - mean_j * sx) / sjj;
-    *value = sx / n + slope * (t - mean_j);
-    const double rss = (sxx - sx.cwiseProduct(sx) / n - slope.cwiseProduct(slope) * sjj).sum();
-    *residual = std::max(rss, 0.0) / std::max(n - 2.0, 1.0);
-    *mean = sx / n;
-    *variance = std::max((sxx - sx.cwiseProduct(sx) / n).sum(), 0.0) / std::max(n - 1.0, 1.0);
-  }
-};
-
-// Splits the still run [begin, end) at steps in the accelerometer level
-// (top of static_detector.h): lines on the w samples either side of each
-// sample, the step statistic T, recursively at its maximum while it is
-// above step_factor and the levels are step_min_deg apart. `floor` (the
-// noise floor, summed over the axes) bounds the residual variances from
-// below (quantised data can fit a line exactly). Appends the parts.
-void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& prefix, size_t base,
-                     size_t begin, size_t end, size_t w, double floor,
-                     const StaticDetectorOptions& options, std::vector<QuietRun>* parts) {
-  if (end - begin < 2 * w) {
-    parts->push_back({begin, end});
-    return;
-  }
-  const double len = static_cast<double>(w);
-  const double c = (4.0 * len - 2.0) / (len * (len + 1.0));
-  const double min_cos = std::cos(options.step_min_deg * internal::kDegToRad);
-  const Eigen::Vector3d r = x[base];
-  double best = options.step_factor;
-  size_t split = 0;
-  for (size_t s = begin + w; s + w <= end; ++s) {
-    Eigen::Vector3d left, right, m1, m2;
-    double r1, r2, v1, v2;
-    prefix.Fit(s - w - base, w, len - 0.5, &left, &r1, &m1, &v1);
-    prefix.Fit(s - base, w, -0.5, &right, &r2, &m2, &v2);
-    const double t_line =
-        (right - left).squaredNorm() / (c * (std::max(r1, floor) + std::max(r2, floor)));
-    const double t_mean =
-        (m2 - m1).squaredNorm() * len / (std::max(v1, floor) + std::max(v2, floor));
-    const double t = std::min(t_line, t_mean);
-    if (!(t > best)) continue;
-    const Eigen::Vector3d a = left + r, b = right + r;
-    if (a.dot(b) > min_cos * a.norm() * b.norm()) continue;
-    best = t;
-    split = s;
-  }
-  if (split == 0) {
-    parts->push_back({begin, end});
-    return;
-  }
-  SplitRunAtSteps(x, prefix, base, begin, split, w, floor, options, parts);
-  SplitRunAtSteps(x, prefix, base, split, end, w, floor, options, parts);
-}
-
-// Every run split at its accelerometer steps (SplitRunAtSteps). Returns the
-// number of steps found.
-size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double floor,
-                        const StaticDetectorOptions& options, std::vector<QuietRun>* runs) {
-  if (options.step_factor <= 0.0) return 0;
-  std::vector<QuietRun> out;
-  for (const QuietRun& run : *runs) {
-    if (run.end - run.begin < 2 * w) {
-      out.push_back(run);
-      continue;
-    }
-    const LinePrefix prefix(x, run.begin, run.end);
-    SplitRunAtSteps(x, prefix, run.begin, run.begin, run.end, w, floor, options, &out);
-  }
-  const size_t steps = out.size() - runs->size();
-  *runs = std::move(out);
-  return steps;
 }
 
 RejectedStretch MakeRejected(const ImuLog& log, size_t begin, size_t end, RejectionReason reason,
@@ -730,79 +435,6 @@ void NearlyStillStretches(const ImuLog& log, const SensorWindows& accel, const S
   }
 }
 
-// Splits samples [begin, end) at steps in the accelerometer mean until every
-// part's variance (summed over the axes) is within `max_var`: at the split
-// point s maximising n1 n2 / n |m1 - m2|^2 (the between-part sum of squares).
-// Parts shorter than min_count are dropped (the few samples a run reaches
-// across a step). Appends the parts' [begin, end) to *parts and returns
-// true, or returns false (and *parts is unspecified) when a part above
-// max_var cannot be split into parts within it: a drift, not steps.
-bool SplitAtSteps(const ImuLog& log, size_t begin, size_t end, double max_var, size_t min_count,
-                  std::vector<QuietRun>* parts) {
-  if (end - begin < min_count) return true;
-  const StaticInterval whole = MakeInterval(log, begin, end);
-  if (whole.accel_cov.trace() <= max_var) {
-    parts->push_back({begin, end});
-    return true;
-  }
-  if (end - begin < 2) return false;
-  // Prefix sums of deviations from the first sample.
-  const Eigen::Vector3d r = log.accel[begin];
-  std::vector<Eigen::Vector3d> prefix(end - begin + 1, Eigen::Vector3d::Zero());
-  for (size_t i = begin; i < end; ++i) prefix[i - begin + 1] = prefix[i - begin] + log.accel[i] - r;
-  const double n = static_cast<double>(end - begin);
-  double best = -1.0;
-  size_t split = begin + 1;
-  for (size_t s = begin + 1; s < end; ++s) {
-    const double n1 = static_cast<double>(s - begin);
-    const double n2 = n - n1;
-    const Eigen::Vector3d m1 = prefix[s - begin] / n1;
-    const Eigen::Vector3d m2 = (prefix.back() - prefix[s - begin]) / n2;
-    const double between = n1 * n2 / n * (m2 - m1).squaredNorm();
-    if (between > best) {
-      best = between;
-      split = s;
-    }
-  }
-  // A split that leaves no part long enough cannot bring this part within.
-  if (split - begin < min_count && end - split < min_count) return false;
-  return SplitAtSteps(log, begin, split, max_var, min_count, parts) &&
-         SplitAtSteps(log, split, end, max_var, min_count, parts);
-}
-
-// Each interval whose variance is above spread_factor times the noise floor
-// is split at its steps (SplitAtSteps) or, when it cannot be, kept and named
-// in detection->warnings. Returns the number of intervals split.
-size_t SplitOrFlagSpread(const ImuLog& log, size_t min_count, const StaticDetectorOptions& options,
-                         StaticDetection* detection) {
-  if (options.spread_factor <= 0.0) return 0;
-  const double max_var = options.spread_factor * detection->accel_noise_floor;
-  std::vector<StaticInterval> out;
-  size_t split = 0;
-  for (const StaticInterval& s : detection->intervals) {
-    const double spread = s.accel_cov.trace();
-    if (spread <= max_var) {
-      out.push_back(s);
-      continue;
-    }
-    std::vector<QuietRun> parts;
-    if (SplitAtSteps(log, s.begin, s.end, max_var, min_count, &parts)) {
-      for (const QuietRun& p : parts) out.push_back(MakeInterval(log, p.begin, p.end));
-      ++split;
-      continue;
-    }
-    out.push_back(s);
-    detection->warnings.push_back(
-        "the position at t " + Num(s.t_begin) + "-" + Num(s.t_end) + " s (samples " +
-        std::to_string(s.begin) + "-" + std::to_string(s.end) + ") is not one still pose: its " +
-        "spread is " + Num(std::sqrt(spread / detection->accel_noise_floor)) +
-        " times the noise (standard deviations) and it is no set of steps between still "
-        "levels: a slow motion or drift; hold the pose still, or drop it");
-  }
-  detection->intervals = std::move(out);
-  return split;
-}
-
 // A time step so long that a window holds fewer than two samples is most
 // likely a time column in another unit; the message names the likely one.
 std::string TimeUnitMessage(const std::string& name, double dt, double window_seconds) {
@@ -824,17 +456,21 @@ std::string TimeUnitMessage(const std::string& name, double dt, double window_se
 
 }  // namespace
 
-bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& options,
+bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& given,
                            StaticDetection* detection) {
   if (detection == nullptr) return false;
   *detection = StaticDetection();
   std::string error;
-  if (!options.IsValid(&error)) return Fail(detection, error);
+  if (!given.IsValid(&error)) return Fail(detection, error);
+  StaticDetectorOptions options = given;
   const std::string name = log.source.empty() ? std::string("log") : log.source;
   if (!CheckDetectionInput(log, name, &error)) return Fail(detection, error);
   const size_t n = log.size();
   std::vector<double> scratch;
   const double dt = MedianSampleInterval(log.t, &scratch);
+  // Holds of poses published with the motion cut out, shorter than the
+  // options keep: the time scales fitted to them (detection/cut_poses.h).
+  const std::string fitted = internal::FitToCutPoses(log, dt, &options);
   // Durations in samples, at most n + 1 (no overflow for absurd durations).
   auto to_samples = [dt, n](double seconds) {
     const double samples = seconds / dt;
@@ -898,7 +534,14 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
   std::vector<QuietRun> runs =
       FindQuietRuns(accel, gyro, num_windows, w, detection->accel_threshold,
                     detection->gyro_threshold, options.trend_factor, options.step_factor > 0.0);
-  const size_t steps = SplitRunsAtSteps(log.accel, w, detection->accel_noise_floor, options, &runs);
+  size_t steps = SplitRunsAtSteps(log.accel, w, detection->accel_noise_floor, 0.0, options, &runs);
+  // A step of the rate alone (a constant turn about gravity started or
+  // stopped with the motion cut out) splits too.
+  if (gyro.trend != nullptr && gyro.min_change2 > 0.0) {
+    const double ratio = kGyroStepFraction / kGyroLevelFraction;
+    steps += SplitRunsAtSteps(log.gyro, w, detection->gyro_noise_floor,
+                              ratio * ratio * gyro.min_change2, options, &runs);
+  }
   if (options.trend_factor > 0.0) {
     TrimLevelEnds(use_gyro ? log.gyro : log.accel, use_gyro ? gyro : accel, w, options.trend_factor,
                   &runs);
@@ -925,6 +568,7 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& optio
   if (split > 0) {
     msg << "; " << split << " split at steps in the mean";
   }
+  if (!fitted.empty()) msg << "; " << fitted;
   if (!detection->rejected.empty()) {
     msg << "; " << detection->rejected.size() << " stretch"
         << (detection->rejected.size() == 1 ? "" : "es") << " rejected";

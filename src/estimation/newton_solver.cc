@@ -1,4 +1,4 @@
-#include "gravcal/estimation/newton_solver.h"
+#include "estimation/newton_solver.h"
 
 #include <Eigen/Cholesky>
 #include <chrono>
@@ -10,6 +10,7 @@
 #include "util/statistics.h"
 
 namespace gravcal {
+namespace internal {
 
 using internal::MagnitudeFitStart;
 using internal::Normalization;
@@ -149,4 +150,5 @@ bool NewtonRefine(const std::vector<Position>& positions, const AccelModel& init
   return true;
 }
 
+}  // namespace internal
 }  // namespace gravcal

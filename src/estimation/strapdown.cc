@@ -1,8 +1,9 @@
-#include "gravcal/estimation/strapdown.h"
+#include "estimation/strapdown.h"
 
 #include "util/units.h"
 
 namespace gravcal {
+namespace internal {
 
 bool StrapdownOptions::IsValid(std::string* error) const {
   if (!(std::isfinite(gravity) && gravity > 0.0)) {
@@ -85,4 +86,5 @@ void Strapdown::Step(double dt, const Eigen::Vector3d& f0, const Eigen::Vector3d
   state_.position += 0.5 * dt * (v0 + state_.velocity);
 }
 
+}  // namespace internal
 }  // namespace gravcal

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "gravcal/core/imu_model.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "io/json_helpers.h"
@@ -186,10 +187,10 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
   return out.dump(2) + "\n";
 }
 
-bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error) {
+bool HistoryToCsv(const Calibration& calibration, std::string* csv, std::string* error) {
   const EstimateHistory& h = calibration.history;
   if (h.rows() == 0) {
-    *error = path + ": method '" + calibration.method + "' has no time history to write";
+    *error = "method '" + calibration.method + "' has no time history to write";
     return false;
   }
   std::ostringstream s;
@@ -202,7 +203,15 @@ bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, st
     }
     s << "\n";
   }
-  return WriteFileAtomically(path, s.str(), error);
+  *csv = s.str();
+  return true;
+}
+
+bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error) {
+  std::string csv;
+  if (!HistoryToCsv(calibration, &csv, error))
+    return internal::SetError(error, path + ": " + *error);
+  return WriteFileAtomically(path, csv, error);
 }
 
 bool WriteCalibrationJson(const Calibration& calibration, bool include_covariance,
@@ -320,6 +329,24 @@ bool CheckUpperTriangular(const Eigen::Matrix3d& u, std::string* why) {
   return true;
 }
 
+// True when `m` has the zeros its model claims (relative to its largest
+// entry): none off the diagonal (`diagonal`), else none below it; else sets
+// `why`, naming the entry.
+bool CheckClaimedZeros(const Eigen::Matrix3d& m, bool diagonal, std::string* why) {
+  const double scale = m.cwiseAbs().maxCoeff();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      if (r == c || (!diagonal && c > r)) continue;
+      if (!(std::abs(m(r, c)) <= kCalibrationRelativeTolerance * scale)) {
+        return internal::SetError(why, "has (" + std::to_string(r) + "," + std::to_string(c) +
+                                           ") = " + internal::ExactNumber(m(r, c)) +
+                                           (diagonal ? " off" : " below") + " the diagonal");
+      }
+    }
+  }
+  return true;
+}
+
 // |a - b| / |b| in the Frobenius norm (|a - b| when b is 0).
 double RelativeDifference(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   const double norm = b.norm();
@@ -384,6 +411,28 @@ bool ReadGyro(const json& j, JsonReader* r, ImuCorrector* c) {
     return false;
   }
   c->has_gyro = true;
+  // gravcal writes no gyro.model; a file that states one is held to it.
+  if (j["gyro"].contains("model")) {
+    const json& m = j["gyro"]["model"];
+    GyroParameterization p;
+    if (!m.is_string() || !FromString(m.get<std::string>(), &p) ||
+        p == GyroParameterization::kNone) {
+      return r->Fail("gyro.model", "must be one of bias, scale, full");
+    }
+    const Eigen::Matrix3d& g = c->gyro.matrix;
+    std::string why;
+    if (p != GyroParameterization::kFull && !CheckClaimedZeros(g, true, &why)) {
+      return r->Fail("gyro.matrix",
+                     why + ", but key 'gyro.model' is '" + ToString(p) + "' (a diagonal matrix)");
+    }
+    if (p == GyroParameterization::kBias &&
+        !(g.diagonal().maxCoeff() - g.diagonal().minCoeff() <=
+          kCalibrationRelativeTolerance * g.diagonal().cwiseAbs().maxCoeff())) {
+      return r->Fail("gyro.matrix",
+                     "has unequal diagonal entries, but key 'gyro.model' is 'bias' (one common "
+                     "scale, M_g = s I)");
+    }
+  }
   return true;
 }
 
@@ -430,33 +479,7 @@ bool ReadEffect(const json& entry, Effect effect, const std::string& key, JsonRe
       v[i] = 0.0;
     }
   }
-  EffectParameters& p = out->corrector.effects;
-  const Eigen::Vector3d three(v[0], v[1], v[2]);
-  switch (effect) {
-    case Effect::kAccelQuadratic:
-      p.accel_quadratic = three;
-      break;
-    case Effect::kAccelTemperatureBias:
-      p.accel_temperature_bias = three;
-      break;
-    case Effect::kAccelTemperatureScale:
-      p.accel_temperature_scale = three;
-      break;
-    case Effect::kAccelBiasDrift:
-      p.accel_bias_drift = three;
-      break;
-    case Effect::kGyroTemperatureBias:
-      p.gyro_temperature_bias = three;
-      break;
-    case Effect::kGyroBiasDrift:
-      p.gyro_bias_drift = three;
-      break;
-    case Effect::kGyroGSensitivity:
-      for (int i = 0; i < 9; ++i) p.gyro_g_sensitivity(i / 3, i % 3) = v[i];
-      break;
-    case Effect::kAccelMisalignment:
-      break;
-  }
+  SetEffectValues(effect, v, &out->corrector.effects);
   if (Info(effect).sensor == EffectSensor::kGyroscope && !out->corrector.has_gyro) {
     return r->Fail(key, "is a gyroscope effect but the file has no 'gyro' section");
   }
@@ -551,6 +574,10 @@ bool CalibrationFromJson(const std::string& text, const std::string& name,
     *error = name + ": not valid JSON (" + e.what() + ")";
     return false;
   }
+  if (const std::string twice = internal::DuplicateJsonKey(text); !twice.empty()) {
+    *error = name + ": key '" + twice + "' appears twice (a key may be set once)";
+    return false;
+  }
   JsonReader r(name, error);
   if (!j.is_object()) return r.Fail("accel", "is missing (the file is not a JSON object)");
   LoadedCalibration out;
@@ -610,6 +637,16 @@ bool CheckCalibrationModels(const LoadedCalibration& c, const std::string& name,
   if (!CheckRotation(accel.rotation, &why)) return fail("accel.rotation", why);
   if (!CheckUpperTriangular(accel.upper, &why)) return fail("accel.upper", why);
   if (!CheckSensorMatrix(accel.matrix(), &why)) return fail("accel.matrix", why);
+  // scale and scale_misalignment hold R = I: the matrix is upper triangular
+  // (diagonal for scale), as the model says.
+  const AccelParameterization p = accel.parameterization;
+  if (p != AccelParameterization::kAffine &&
+      !CheckClaimedZeros(accel.matrix(), p == AccelParameterization::kScale, &why)) {
+    return fail("accel.matrix",
+                why + ", but key 'accel.model' is '" + ToString(p) + "' (" +
+                    (p == AccelParameterization::kScale ? "a diagonal matrix)"
+                                                        : "R = I, an upper-triangular matrix)"));
+  }
   if (c.corrector.has_gyro) {
     if (!c.corrector.gyro.bias.allFinite()) return fail("gyro.bias", "is not finite");
     if (!CheckSensorMatrix(c.corrector.gyro.matrix, &why)) return fail("gyro.matrix", why);

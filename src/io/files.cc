@@ -326,8 +326,8 @@ bool AtomicFile::Write(const char* data, size_t size, std::string* error) {
   return true;
 }
 
-bool AtomicFile::Commit(std::string* error) {
-  if (fd_ < 0) return SetError(error, path_ + ": not open");
+bool AtomicFile::Close(std::string* error) {
+  if (fd_ < 0) return temporary_.empty() ? SetError(error, path_ + ": not open") : true;
   // What is at the destination now: a FIFO or device put there since Open
   // is still never replaced.
   struct stat st;
@@ -343,6 +343,11 @@ bool AtomicFile::Commit(std::string* error) {
     Abort();
     return SetError(error, path_ + ": cannot write: " + ErrnoMessage(errnum));
   }
+  return true;
+}
+
+bool AtomicFile::Commit(std::string* error) {
+  if (!Close(error)) return false;
   if (rename(temporary_.c_str(), target_.c_str()) != 0) {
     const int errnum = errno;
     Abort();
@@ -367,6 +372,43 @@ bool WriteFileAtomically(const std::string& path, const std::string& contents, s
   } catch (const std::exception& e) {
     return SetError(error, path + ": cannot write: " + e.what());
   }
+}
+
+bool WriteFilesAtomically(const std::vector<FileContents>& files, std::string* error) {
+  try {
+    std::vector<std::unique_ptr<AtomicFile>> open;
+    for (const FileContents& f : files) {
+      if (f.path.empty()) continue;
+      open.push_back(std::make_unique<AtomicFile>());
+      AtomicFile& file = *open.back();
+      if (!file.Open(f.path, error) || !file.Write(f.contents.data(), f.contents.size(), error) ||
+          !file.Close(error)) {
+        return false;  // every temporary removed by its destructor
+      }
+    }
+    for (const std::unique_ptr<AtomicFile>& file : open) {
+      if (!file->Commit(error)) return false;
+    }
+    return true;
+  } catch (const std::exception& e) {
+    return SetError(error, std::string("cannot write the outputs: ") + e.what());
+  }
+}
+
+bool MakeFolders(const std::string& path, std::string* error) {
+  for (size_t end = 1; end <= path.size(); ++end) {
+    if (end != path.size() && path[end] != '/') continue;
+    const std::string level = path.substr(0, end);
+    if (mkdir(level.c_str(), 0777) != 0 && errno != EEXIST) {
+      return SetError(error,
+                      path + ": cannot create the folder '" + level + "': " + ErrnoMessage(errno));
+    }
+  }
+  struct stat st;
+  if (stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+    return SetError(error, path + ": is not a folder");
+  }
+  return true;
 }
 
 bool CheckDestinations(const std::vector<Destination>& destinations,

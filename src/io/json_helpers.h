@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <string>
 #include <vector>
 
 namespace gravcal {
@@ -44,6 +46,48 @@ Json JsonMatrix(const Eigen::MatrixBase<Derived>& m) {
     rows.push_back(row);
   }
   return rows;
+}
+
+// The first key that an object of the JSON `text` holds twice, as its path
+// ("accel", "poses[].up"), or "" when none (also when `text` is not JSON:
+// the parser says so). nlohmann keeps one of the two silently; a file must
+// say what it means once, as a config must.
+inline std::string DuplicateJsonKey(const std::string& text) {
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;  // the key being read (objects)
+  };
+  std::vector<Frame> frames;
+  std::string duplicate;
+  auto path = [&frames]() {
+    std::string p;
+    for (const Frame& f : frames) {
+      if (f.object) {
+        if (!f.key.empty()) p += (p.empty() ? "" : ".") + f.key;
+      } else {
+        p += "[]";
+      }
+    }
+    return p;
+  };
+  nlohmann::json::parser_callback_t callback = [&](int, nlohmann::json::parse_event_t event,
+                                                   nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    if (event == Event::object_start || event == Event::array_start) {
+      frames.push_back({event == Event::object_start, {}, ""});
+    } else if ((event == Event::object_end || event == Event::array_end) && !frames.empty()) {
+      frames.pop_back();
+    } else if (event == Event::key && !frames.empty() && parsed.is_string()) {
+      Frame& top = frames.back();
+      top.key = parsed.get<std::string>();
+      if (!top.keys.insert(top.key).second && duplicate.empty()) duplicate = path();
+    }
+    return true;
+  };
+  const nlohmann::json whole = nlohmann::json::parse(text, callback, false);
+  static_cast<void>(whole);
+  return duplicate;
 }
 
 }  // namespace internal

@@ -22,6 +22,7 @@
 #include "io/formats/message_log.h"
 #include "io/log_text.h"
 #include "util/cancellation.h"
+#include "util/content_hash.h"
 #include "util/error.h"
 #include "util/numbers.h"
 
@@ -244,8 +245,13 @@ bool LogReaderOptions::IsValid(std::string* error) const {
   return true;
 }
 
-bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
-                std::string* error) {
+namespace {
+
+// ReadImuLog; `hash`, when not null, gets the content hash of the file's
+// bytes: from the text parsed for a text log, from a second read for a
+// message recording (read message by message).
+bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
+             internal::ContentHash* hash, std::string* error) {
   if (log == nullptr) return SetError(error, path + ": no log to read into");
   try {
     internal::FileFormat format = internal::FileFormat::kText;
@@ -254,8 +260,16 @@ bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog
             internal::NewMessageRecording(format)) {
       std::string why;
       if (!options.IsValid(&why)) return SetError(error, path + ": invalid options: " + why);
-      return recording->Open(path, error) &&
-             internal::ReadMessageLog(recording.get(), path, options, log, error);
+      if (!recording->Open(path, error) ||
+          !internal::ReadMessageLog(recording.get(), path, options, log, error)) {
+        return false;
+      }
+      std::string bytes;
+      if (hash != nullptr) {
+        if (!ReadFileBytes(path, &bytes, error)) return false;
+        hash->Add(bytes);
+      }
+      return true;
     }
     struct stat st;
     if (stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
@@ -265,10 +279,27 @@ bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog
     }
     FileText text;
     if (!text.Read(path, error)) return false;
-    return ParseImpl(text.view(), path, options, log, error);
+    if (!ParseImpl(text.view(), path, options, log, error)) return false;
+    if (hash != nullptr) hash->Add(text.view());
+    return true;
   } catch (const std::exception& e) {
     return SetError(error, path + ": " + e.what());
   }
+}
+
+}  // namespace
+
+bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
+                std::string* error) {
+  return ReadLog(path, options, log, nullptr, error);
+}
+
+bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
+                CalibrationProvenance* provenance, std::string* error) {
+  internal::ContentHash hash;
+  if (!ReadLog(path, options, log, &hash, error)) return false;
+  *provenance = {path, hash.Hex(), GRAVCAL_VERSION};
+  return true;
 }
 
 // With options.gyro_path set, the gyroscope file is read from disk.
@@ -282,10 +313,10 @@ bool ParseImuLog(std::string_view text, const std::string& name, const LogReader
   }
 }
 
-bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* error) {
+bool ImuLogToCsv(const ImuLog& log, std::string* text, std::string* error) {
   try {
     std::string why;
-    if (!CheckWritable(log, &why)) return SetError(error, path + ": cannot write log: " + why);
+    if (!CheckWritable(log, &why)) return SetError(error, "cannot write log: " + why);
     const bool gyro = log.has_gyro();
     const bool temperature = log.has_temperature();
     std::string header = "t,ax,ay,az";
@@ -319,10 +350,17 @@ bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* err
       if (temperature) put(log.temperature[i], '\n');
     }
     contents.resize(static_cast<size_t>(p - contents.data()));
-    return WriteFileAtomically(path, contents, error);
+    *text = std::move(contents);
+    return true;
   } catch (const std::exception& e) {
-    return SetError(error, path + ": cannot write: " + e.what());
+    return SetError(error, std::string("cannot write log: ") + e.what());
   }
+}
+
+bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* error) {
+  std::string contents;
+  if (!ImuLogToCsv(log, &contents, error)) return SetError(error, path + ": " + *error);
+  return WriteFileAtomically(path, contents, error);
 }
 
 }  // namespace gravcal

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "gravcal/io/log_reader.h"
+#include "io/json_helpers.h"
 
 namespace gravcal {
 namespace internal {
@@ -19,19 +20,24 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+// The largest value a noise.json number may have (a term, a rate, a tau):
+// its square stays within double arithmetic.
+constexpr double kMaxNoiseValue = 1e150;
+
 // The rule a value read must meet, for Checked.
 enum class Range { kPositive, kNonNegative, kFinite, kProbability };
 
 // `v` checked against `range`, or a runtime_error naming `where` (the key's
 // path in the file, e.g. accel.x.white_noise.value) and the value.
 double Checked(double v, Range range, const std::string& where) {
-  const bool ok =
-      std::isfinite(v) && (range == Range::kFinite || (range == Range::kPositive && v > 0.0) ||
-                           (range == Range::kNonNegative && v >= 0.0) ||
-                           (range == Range::kProbability && v > 0.0 && v < 1.0));
+  // Beyond kMaxNoiseValue a variance (the square) leaves double arithmetic.
+  const bool ok = std::isfinite(v) && (range == Range::kFinite || std::abs(v) <= kMaxNoiseValue) &&
+                  (range == Range::kFinite || (range == Range::kPositive && v > 0.0) ||
+                   (range == Range::kNonNegative && v >= 0.0) ||
+                   (range == Range::kProbability && v > 0.0 && v < 1.0));
   if (ok) return v;
-  const char* rule = range == Range::kPositive      ? "a positive number"
-                     : range == Range::kNonNegative ? "a number >= 0"
+  const char* rule = range == Range::kPositive      ? "a positive number up to 1e150"
+                     : range == Range::kNonNegative ? "a number >= 0, up to 1e150"
                      : range == Range::kProbability ? "a number between 0 and 1"
                                                     : "a finite number";
   std::ostringstream s;
@@ -45,6 +51,16 @@ double NumberAt(const json& j, const std::string& where, Range range) {
   if (j.is_null()) return kNaN;
   if (!j.is_number()) throw std::runtime_error(where + " must be a number or null");
   return Checked(j.get<double>(), range, where);
+}
+
+// The member `key` of the object `j`, at path `where` (its parent's path):
+// a runtime_error naming the path when `j` is no object or has no `key`.
+const json& Member(const json& j, const char* key, const std::string& where) {
+  const std::string path = where.empty() ? std::string(key) : where + "." + key;
+  if (!j.is_object())
+    throw std::runtime_error((where.empty() ? "the file" : where) + " must be an object");
+  if (!j.contains(key)) throw std::runtime_error(path + " is missing");
+  return j.at(key);
 }
 
 // A number that must be there: `key` of `j`, at path `where`.
@@ -176,7 +192,7 @@ void SensorFromJson(const json& sensor, const std::string& name, double rate_hz,
                     std::array<AllanDeviation, 3>* curves,
                     std::array<std::vector<SpectralLine>, 3>* lines) {
   for (int a = 0; a < 3; ++a) {
-    const json& axis = sensor.at(kAxes[a]);
+    const json& axis = Member(sensor, kAxes[a], name);
     const std::string where = name + "." + kAxes[a];
     if (axis.contains("lines")) {
       for (const json& l : axis.at("lines")) {
@@ -282,11 +298,14 @@ bool NoiseFromJson(const std::string& text, const std::string& name, ImuNoise* n
   ImuNoise parsed;
   try {
     const json in = json::parse(text);
+    if (const std::string twice = internal::DuplicateJsonKey(text); !twice.empty()) {
+      throw std::runtime_error("key '" + twice + "' appears twice (a key may be set once)");
+    }
     ImuNoiseModel& m = parsed.model;
     using internal::Range;
     using internal::Required;
     m.rate_hz = Required(in, "rate_hz", "rate_hz", Range::kPositive);
-    const json& still = in.at("still");
+    const json& still = internal::Member(in, "still", "");
     m.still_begin = internal::StillIndex(still, "begin");
     m.still_end = internal::StillIndex(still, "end");
     if (m.still_end < m.still_begin) {
@@ -301,8 +320,8 @@ bool NoiseFromJson(const std::string& text, const std::string& name, ImuNoise* n
                                   ? Required(in, "confidence", "confidence", Range::kProbability)
                                   : 0.683;
     const size_t samples = m.still_end - m.still_begin;
-    internal::SensorFromJson(in.at("accel"), "accel", m.rate_hz, samples, confidence, &m.accel,
-                             &parsed.accel_curves, &parsed.accel_lines);
+    internal::SensorFromJson(internal::Member(in, "accel", ""), "accel", m.rate_hz, samples,
+                             confidence, &m.accel, &parsed.accel_curves, &parsed.accel_lines);
     if (in.contains("gyro")) {
       internal::SensorFromJson(in.at("gyro"), "gyro", m.rate_hz, samples, confidence, &m.gyro,
                                &parsed.gyro_curves, &parsed.gyro_lines);

@@ -133,7 +133,11 @@ bool PlanPosesFromJson(const std::string& text, const std::string& name,
                        std::vector<PlannedPose>* poses, std::string* error) {
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
-    *error = name + ": not a JSON object";
+    *error = name + (j.is_discarded() ? ": not valid JSON" : ": not a JSON object");
+    return false;
+  }
+  if (const std::string twice = internal::DuplicateJsonKey(text); !twice.empty()) {
+    *error = name + ": key '" + twice + "' appears twice (a key may be set once)";
     return false;
   }
   if (!j.contains("poses") || !j["poses"].is_array() || j["poses"].empty()) {
@@ -175,7 +179,11 @@ bool PlanRotationsFromJson(const std::string& text, const std::string& name, siz
   rotations->clear();
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
-    *error = name + ": not a JSON object";
+    *error = name + (j.is_discarded() ? ": not valid JSON" : ": not a JSON object");
+    return false;
+  }
+  if (const std::string twice = internal::DuplicateJsonKey(text); !twice.empty()) {
+    *error = name + ": key '" + twice + "' appears twice (a key may be set once)";
     return false;
   }
   if (!j.contains("rotations")) return true;

@@ -9,8 +9,8 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "estimation/strapdown.h"
 #include "gravcal/estimation/error_state_layout.h"
-#include "gravcal/estimation/strapdown.h"
 #include "gravcal/methods/handheld_kalman.h"
 
 namespace gravcal {

@@ -3,7 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 
-#include "gravcal/estimation/strapdown.h"
+#include "estimation/strapdown.h"
 #include "methods/handheld_filter.h"
 #include "util/so3.h"
 

@@ -530,16 +530,28 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path
 bool CalibrateKnownAttitude(const ImuLog& log, const std::vector<FixtureAttitude>& rows,
                             const std::string& attitudes_name, const CalibrationOptions& options,
                             Calibration* calibration) {
+  Session session;
+  session.log = log;
+  session.attitudes = rows;
+  session.attitudes_name = attitudes_name;
+  return CalibrateKnownAttitude(session, {options}, calibration);
+}
+
+bool CalibrateKnownAttitude(const Session& session, const KnownAttitudeMethodOptions& method,
+                            Calibration* calibration) {
   CHECK(calibration != nullptr);
   *calibration = Calibration();
   Calibration& c = *calibration;
   c.method = "known_attitude";
+  CalibrationOptions options = method.accel;
+  if (session.noise) options.pose_noise.model = session.noise_model();
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
-  if (!internal::DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
+  if (!internal::DetectStaticPositions(session, options, &c, &intervals, &positions)) return false;
   std::vector<int> row_of_position;
   std::string error;
-  if (!MatchFixtureAttitudes(rows, intervals, attitudes_name, &row_of_position, &error)) {
+  const std::vector<FixtureAttitude>& rows = session.attitudes;
+  if (!MatchFixtureAttitudes(rows, intervals, session.attitudes_name, &row_of_position, &error)) {
     c.message = error;
     return false;
   }
@@ -551,7 +563,7 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::vector<FixtureAttitude
                          r.pitch_std_deg * internal::kDegToRad});
   }
   const bool ok = CalibrateFromKnownAttitudes(positions, attitudes, options, &c);
-  if (!ok) c.message = internal::PrefixSource(log.source, c.message);
+  if (!ok) c.message = internal::PrefixSource(session.log.source, c.message);
   return ok;
 }
 

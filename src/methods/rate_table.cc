@@ -6,6 +6,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/warnings.h"
+
 namespace gravcal {
 namespace {
 
@@ -160,6 +162,24 @@ bool CalibrateRateTable(const ImuLog& log, const std::vector<RateTableSegment>& 
   s << "rate table: gyroscope bias and matrix from " << k_count << " segments";
   r.message = s.str();
   r.success = true;
+  return true;
+}
+
+bool CalibrateRateTable(const Session& session, const RateTableMethodOptions&,
+                        Calibration* calibration) {
+  *calibration = Calibration();
+  calibration->method = "rate_table";
+  RateTableResult result;
+  const bool ok = CalibrateRateTable(session.log, session.segments, &result);
+  calibration->message = result.message;
+  if (!ok) return false;
+  calibration->success = true;
+  calibration->gyro = result.gyro;
+  calibration->solver_name = "weighted linear least squares per gyroscope axis";
+  internal::AddWarning(WarningCode::kMethodScope,
+                       "rate_table calibrates the gyroscope only: the accelerometer model "
+                       "written is the identity, not an estimate",
+                       &calibration->warnings, &calibration->warning_codes);
   return true;
 }
 

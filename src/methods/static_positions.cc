@@ -12,13 +12,24 @@
 namespace gravcal {
 namespace internal {
 
-bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector,
-                        std::vector<StaticInterval>* intervals, std::string* message,
-                        std::vector<std::string>* warnings) {
-  if (!log.Validate(message)) return false;
-  StaticDetection detection;
-  if (!DetectStaticIntervals(log, detector, &detection)) {
-    *message = internal::PrefixSource(log.source, detection.message);
+bool DetectLog(const ImuLog& log, const StaticDetectorOptions& detector,
+               StaticDetection* detection) {
+  if (!log.Validate(&detection->message)) return false;
+  if (!DetectStaticIntervals(log, detector, detection)) {
+    detection->message = internal::PrefixSource(log.source, detection->message);
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// The intervals and warnings of a detection of `log` (done or failed).
+bool TakeIntervals(const ImuLog& log, const StaticDetection& detection, bool ok,
+                   std::vector<StaticInterval>* intervals, std::string* message,
+                   std::vector<std::string>* warnings) {
+  if (!ok) {
+    *message = detection.message;
     return false;
   }
   *intervals = detection.intervals;
@@ -33,20 +44,41 @@ bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector
   return true;
 }
 
-bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
+}  // namespace
+
+bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector,
+                        std::vector<StaticInterval>* intervals, std::string* message,
+                        std::vector<std::string>* warnings) {
+  StaticDetection detection;
+  const bool ok = DetectLog(log, detector, &detection);
+  return TakeIntervals(log, detection, ok, intervals, message, warnings);
+}
+
+bool SessionIntervals(const Session& session, const StaticDetectorOptions& detector,
+                      std::vector<StaticInterval>* intervals, std::string* message,
+                      std::vector<std::string>* warnings) {
+  if (!session.detected) {
+    return DetectLogIntervals(session.log, detector, intervals, message, warnings);
+  }
+  return TakeIntervals(session.log, session.detection, session.detection_ok, intervals, message,
+                       warnings);
+}
+
+bool DetectStaticPositions(const Session& session, const CalibrationOptions& options,
                            Calibration* calibration, std::vector<StaticInterval>* intervals,
                            std::vector<Position>* positions) {
   Calibration& c = *calibration;
   if (!options.IsValid(&c.message)) return false;
   if (!ResolveCalibrationGravity(options.gravity, calibration)) return false;
   std::vector<std::string> data_warnings;
-  if (!DetectLogIntervals(log, options.detector, intervals, &c.message, &data_warnings)) {
+  if (!SessionIntervals(session, options.detector, intervals, &c.message, &data_warnings)) {
     return false;
   }
   for (const std::string& w : data_warnings) {
     AddWarning(WarningCode::kSensorData, w, &c.warnings, &c.warning_codes);
   }
-  const bool ok = PosesFromIntervals(log, *intervals, options, positions, &c.warnings, &c.message);
+  const bool ok =
+      PosesFromIntervals(session.log, *intervals, options, positions, &c.warnings, &c.message);
   CodeNewWarnings(WarningCode::kNoiseModel, c.warnings, &c.warning_codes);
   return ok;
 }

@@ -13,10 +13,17 @@
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/position.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
 namespace internal {
+
+// Checks the log and detects its static intervals. Returns false with
+// detection->message on an invalid log or a detector failure (naming
+// log.source).
+bool DetectLog(const ImuLog& log, const StaticDetectorOptions& detector,
+               StaticDetection* detection);
 
 // Checks the log and detects its static intervals. Returns false with
 // *message on an invalid log or a detector failure (naming log.source).
@@ -26,6 +33,12 @@ bool DetectLogIntervals(const ImuLog& log, const StaticDetectorOptions& detector
                         std::vector<StaticInterval>* intervals, std::string* message,
                         std::vector<std::string>* warnings = nullptr);
 
+// Same on a session: its detection when it has one (DetectSessionPoses),
+// else detected now with `detector`.
+bool SessionIntervals(const Session& session, const StaticDetectorOptions& detector,
+                      std::vector<StaticInterval>* intervals, std::string* message,
+                      std::vector<std::string>* warnings = nullptr);
+
 // The positions of the intervals with the covariance of each mean chosen by
 // options.pose_noise (pose_mean_covariance.h); *notes gets its fallbacks and
 // warnings. False with *message only on invalid pose-noise options.
@@ -33,13 +46,19 @@ bool PosesFromIntervals(const ImuLog& log, const std::vector<StaticInterval>& in
                         const CalibrationOptions& options, std::vector<Position>* positions,
                         std::vector<std::string>* notes, std::string* message);
 
-// Checks the options, then as DetectLogIntervals and PosesFromIntervals (notes into
-// calibration->warnings); also fills calibration->gravity, gravity_source
-// (and the standard-gravity warning). Returns false with calibration->message (naming log.source)
-// on invalid options or log, or a detector failure.
-bool DetectStaticPositions(const ImuLog& log, const CalibrationOptions& options,
+// Checks the options, then as SessionIntervals and PosesFromIntervals (notes
+// into calibration->warnings); also fills calibration->gravity,
+// gravity_source (and the standard-gravity warning). Returns false with
+// calibration->message (naming log.source) on invalid options or log, or a
+// detector failure.
+bool DetectStaticPositions(const Session& session, const CalibrationOptions& options,
                            Calibration* calibration, std::vector<StaticInterval>* intervals,
                            std::vector<Position>* positions);
+
+// CalibrateAccelerometer (twelve_position.h) on a session: its detection
+// when it has one.
+bool CalibrateAccelerometer(const Session& session, const CalibrationOptions& options,
+                            Calibration* calibration, std::vector<StaticInterval>* intervals);
 
 // Samples [begin, end) of the log, times `scale`; `rate` gets the gyroscope
 // times `gyro_scale` (empty without one). Returns the mean sample period.

@@ -191,10 +191,25 @@ bool TenPositionOptions::IsValid(std::string* error) const {
   return true;
 }
 
+bool TenPositionMethodOptions::IsValid(std::string* error) const {
+  return accel.IsValid(error) && alignment.IsValid(error);
+}
+
 bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
                           const TenPositionOptions& ten, Calibration* calibration) {
+  Session session;
+  session.log = log;
+  return CalibrateTenPosition(session, {options, ten}, calibration);
+}
+
+bool CalibrateTenPosition(const Session& session, const TenPositionMethodOptions& method,
+                          Calibration* calibration) {
   CHECK(calibration != nullptr);
   *calibration = Calibration();
+  const ImuLog& log = session.log;
+  const TenPositionOptions& ten = method.alignment;
+  CalibrationOptions options = method.accel;
+  if (session.noise) options.pose_noise.model = session.noise_model();
   Calibration& c = *calibration;
   c.method = "ten_position";
   std::string error;
@@ -204,7 +219,7 @@ bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
   }
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
-  if (!internal::DetectStaticPositions(log, options, &c, &intervals, &positions)) return false;
+  if (!internal::DetectStaticPositions(session, options, &c, &intervals, &positions)) return false;
   const std::string where = log.source.empty() ? "" : log.source + ": ";
   const int n = static_cast<int>(positions.size());
   if (n < kMinTenPositions) {

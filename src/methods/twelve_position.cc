@@ -10,6 +10,7 @@
 #include "core/sensor_checks.h"
 #include "core/warnings.h"
 #include "estimation/accel_uncertainty.h"
+#include "estimation/newton_solver.h"
 #include "gravcal/estimation/housing_rotation.h"
 #include "methods/pose_variance.h"
 #include "methods/static_positions.h"
@@ -20,6 +21,8 @@
 namespace gravcal {
 
 using internal::MaxAbs;
+using internal::NewtonOptions;
+using internal::NewtonRefine;
 using internal::PropagateUncertainty;
 using internal::ResolveCalibrationGravity;
 using internal::Rms;
@@ -207,41 +210,50 @@ bool CalibrateFromPositions(const std::vector<Position>& positions,
 
 bool CalibrateAccelerometer(const ImuLog& log, const CalibrationOptions& options,
                             Calibration* calibration, std::vector<StaticInterval>* intervals) {
+  Session session;
+  session.log = log;
+  return internal::CalibrateAccelerometer(session, options, calibration, intervals);
+}
+
+namespace internal {
+
+bool CalibrateAccelerometer(const Session& session, const CalibrationOptions& options,
+                            Calibration* calibration, std::vector<StaticInterval>* intervals) {
   CHECK(calibration != nullptr);
   *calibration = Calibration();
   std::vector<StaticInterval> detected;
   std::vector<std::string> data_warnings;
   if (!options.IsValid(&calibration->message) ||
-      !internal::DetectLogIntervals(log, options.detector, &detected, &calibration->message,
-                                    &data_warnings)) {
+      !SessionIntervals(session, options.detector, &detected, &calibration->message,
+                        &data_warnings)) {
     return false;
   }
   if (intervals != nullptr) *intervals = detected;
   std::vector<Position> positions;
   std::vector<std::string> notes;
-  if (!internal::PosesFromIntervals(log, detected, options, &positions, &notes,
-                                    &calibration->message)) {
+  if (!PosesFromIntervals(session.log, detected, options, &positions, &notes,
+                          &calibration->message)) {
     return false;
   }
   const bool ok = CalibrateFromPositions(positions, options, calibration);
   for (const std::string& w : data_warnings) {
-    internal::AddWarning(WarningCode::kSensorData, w, &calibration->warnings,
-                         &calibration->warning_codes);
+    AddWarning(WarningCode::kSensorData, w, &calibration->warnings, &calibration->warning_codes);
   }
   if (ok) {
     const std::string handedness =
-        internal::HandednessWarning("accelerometer", calibration->accel.model.matrix());
+        HandednessWarning("accelerometer", calibration->accel.model.matrix());
     if (!handedness.empty()) {
-      internal::AddWarning(WarningCode::kSensorData, handedness, &calibration->warnings,
-                           &calibration->warning_codes);
+      AddWarning(WarningCode::kSensorData, handedness, &calibration->warnings,
+                 &calibration->warning_codes);
     }
   }
   for (const std::string& n : notes) {
-    internal::AddWarning(WarningCode::kNoiseModel, n, &calibration->warnings,
-                         &calibration->warning_codes);
+    AddWarning(WarningCode::kNoiseModel, n, &calibration->warnings, &calibration->warning_codes);
   }
-  if (!ok) calibration->message = internal::PrefixSource(log.source, calibration->message);
+  if (!ok) calibration->message = PrefixSource(session.log.source, calibration->message);
   return ok;
 }
+
+}  // namespace internal
 
 }  // namespace gravcal

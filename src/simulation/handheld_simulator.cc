@@ -5,13 +5,15 @@
 #include <random>
 #include <sstream>
 
-#include "gravcal/estimation/strapdown.h"
+#include "estimation/strapdown.h"
 #include "simulation/sensor_noise.h"
 #include "util/random_vector.h"
 #include "util/units.h"
 
 namespace gravcal {
 namespace {
+
+using internal::RotationVectorToQuaternion;
 
 using Vec3 = Eigen::Vector3d;
 using Quat = Eigen::Quaterniond;

@@ -99,22 +99,21 @@ void RunUnit(const BatchUnit& unit, const Config& base, const SkipFunction& skip
     r->skipped = true;
     return stop("skipped: the stored result has this content hash");
   }
-  PipelineInput input;
-  input.attitudes_path = unit.attitudes_path;
+  SessionFiles files;
+  files.attitudes_path = unit.attitudes_path;
+  Session session;
   if (unit.path.empty()) {
-    input.source = unit.id;
-    input.log = unit.log;
+    session.log = unit.log;
   } else {
     // Exactly what ReadImuLog does after reading the file.
-    input.source = unit.path;
     // Bags and MCAP files are read from the file, message by message.
     const bool read = IsMessageRecording(std::string_view(log_bytes).substr(0, 4096))
-                          ? ReadImuLog(unit.path, config.input, &input.log, &error)
-                          : ParseImuLog(log_bytes, unit.path, config.input, &input.log, &error);
+                          ? ReadImuLog(unit.path, config.input, &session.log, &error)
+                          : ParseImuLog(log_bytes, unit.path, config.input, &session.log, &error);
     if (!read) return stop(error);
   }
   const Clock::time_point read_end = Clock::now();
-  const bool ok = RunCalibration(config, input, &r->calibration);
+  const bool ok = RunCalibration(config, files, &session, &r->calibration);
   // Issue 16: the same provenance as calibrate records.
   if (!unit.path.empty()) r->calibration.provenance = LogProvenanceOfBytes(unit.path, log_bytes);
   const Clock::time_point end = Clock::now();

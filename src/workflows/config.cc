@@ -17,14 +17,33 @@
 namespace gravcal {
 namespace internal {
 
+namespace {
+
+// A part's section as a section of the whole Config: each handler sees its
+// own part of the config only.
+template <typename Part>
+ConfigSection Lift(const SectionOf<Part>& section) {
+  ConfigSection whole{section.name, section.use, {}};
+  for (const KeyHandlerOf<Part>& h : section.keys) {
+    whole.keys.push_back(
+        {h.name, h.help,
+         [set = h.set](const YAML::Node& n, Config* c, std::string* e) { return set(n, c, e); },
+         [get = h.get](const Config& c) { return get(c); }});
+  }
+  return whole;
+}
+
+}  // namespace
+
 const std::vector<ConfigSection>& ConfigSections() {
   // Never destroyed (Google style for static storage): a batch worker abandoned
   // with a hung unit may still read it while the process exits (found by TSan).
   static const std::vector<ConfigSection>& sections = *new std::vector<ConfigSection>{
-      GeneralSection(),   InputSection(),          GravitySection(),         DetectorSection(),
-      PoseNoiseSection(), ModelSection(),          SolverSection(),          GyroSection(),
-      AlignmentSection(), HandheldKalmanSection(), EffectsSection(),         DiscoverySection(),
-      NoiseSection(),     SimulatorSection(),      MotionSimulatorSection(),
+      Lift(GeneralSection()),        Lift(InputSection()),     Lift(GravitySection()),
+      Lift(DetectorSection()),       Lift(PoseNoiseSection()), Lift(ModelSection()),
+      Lift(SolverSection()),         Lift(GyroSection()),      Lift(AlignmentSection()),
+      Lift(HandheldKalmanSection()), Lift(EffectsSection()),   Lift(DiscoverySection()),
+      Lift(NoiseSection()),          Lift(SimulatorSection()), Lift(MotionSimulatorSection()),
   };
   return sections;
 }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/warnings.h"
+#include "gravcal/core/imu_model.h"
 #include "methods/between_pose_rotations.h"
 #include "methods/static_positions.h"
 #include "util/source_prefix.h"
@@ -242,14 +243,7 @@ void CheckRotations(const std::vector<Effect>& baseline_effects,
   // magnitudes: every fit integrates every turn) are left out. The choice
   // follows from the design (poses and parameters), not from the data, so
   // the tests stay honest.
-  int parameters = ctx.parameterization == AccelParameterization::kScale ? 6 : 9;
-  for (Effect e : richest) {
-    if (!IsAccel(e) || (e == Effect::kAccelMisalignment &&
-                        ctx.parameterization != AccelParameterization::kScale)) {
-      continue;
-    }
-    parameters += Info(e).num_parameters;
-  }
+  const int parameters = AccelModelParameterCount(ctx.parameterization, richest);
   if (static_cast<int>(ctx.observations->size()) - parameters >= options.min_dof) {
     ctx.use_rotations = false;
     return;

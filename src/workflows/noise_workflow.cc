@@ -80,26 +80,22 @@ bool WriteNoiseFiles(const ImuNoise& noise, const std::string& source, const Noi
                          {{source, "log"}}, error)) {
     return false;
   }
-  std::vector<std::pair<std::string, std::string>> texts;  // path, text
-  if (!files.json.empty()) texts.emplace_back(files.json, NoiseToJson(noise));
+  std::vector<FileContents> texts;
+  if (!files.json.empty()) texts.push_back({files.json, NoiseToJson(noise)});
   if (!files.kalibr.empty()) {
     std::string yaml;
     if (!NoiseToKalibrYaml(noise.model, &yaml, error)) {
       *error = files.kalibr + ": " + *error;
       return false;
     }
-    texts.emplace_back(files.kalibr, yaml);
+    texts.push_back({files.kalibr, yaml});
   }
-  if (!files.handheld.empty()) texts.emplace_back(files.handheld, NoiseToHandheldYaml(noise.model));
-  if (!files.report.empty()) texts.emplace_back(files.report, NoiseToHtml(noise, source));
+  if (!files.handheld.empty()) texts.push_back({files.handheld, NoiseToHandheldYaml(noise.model)});
+  if (!files.report.empty()) texts.push_back({files.report, NoiseToHtml(noise, source)});
+  // All or none: a failed second file leaves the first as it was.
+  if (!WriteFilesAtomically(texts, error)) return false;
   std::vector<std::string> done;
-  for (const auto& [path, text] : texts) {
-    if (!WriteFileAtomically(path, text, error)) {
-      for (const std::string& w : done) std::remove(w.c_str());
-      return false;
-    }
-    done.push_back(path);
-  }
+  for (const FileContents& f : texts) done.push_back(f.path);
   if (written != nullptr) *written = done;
   return true;
 }

@@ -1,5 +1,7 @@
 #include "gravcal/workflows/pipeline.h"
 
+#include <algorithm>
+
 #include "gravcal/io/noise_io.h"
 #include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/rate_table_segments.h"
@@ -7,33 +9,56 @@
 namespace gravcal {
 namespace {
 
-// Reads the side input `method` needs into `data`.
-bool ReadSideInput(const CalibrationMethod& method, const PipelineInput& input, MethodData* data,
+// Reads the side input `method` needs into `session`.
+bool ReadSideInput(const CalibrationMethod& method, const SessionFiles& files, Session* session,
                    std::string* error) {
   switch (method.side_input) {
     case MethodSideInput::kNone:
       return true;
     case MethodSideInput::kAttitudes:
-      data->side_input_name = input.attitudes_path;
-      if (input.attitudes_path.empty()) {
+      session->attitudes_name = files.attitudes_path;
+      if (files.attitudes_path.empty()) {
         *error = method.name + " needs the attitudes file (--attitudes fixture.csv)";
         return false;
       }
-      return ReadFixtureAttitudes(input.attitudes_path, &data->attitudes, error);
+      return ReadFixtureAttitudes(files.attitudes_path, &session->attitudes, error);
     case MethodSideInput::kSegments:
-      data->side_input_name = input.segments_path;
-      if (input.segments_path.empty()) {
+      session->segments_name = files.segments_path;
+      if (files.segments_path.empty()) {
         *error = method.name + " needs the segments file (--segments segments.csv)";
         return false;
       }
-      return ReadRateTableSegments(input.segments_path, input.log, &data->segments, error);
+      return ReadRateTableSegments(files.segments_path, session->log, &session->segments, error);
   }
+  return true;
+}
+
+// Reads the noise model, when given, for a method that uses one.
+bool ReadNoiseModel(const CalibrationMethod& method, const SessionFiles& files, Session* session,
+                    std::string* error) {
+  if (files.noise_path.empty()) return true;
+  if (method.noise_model.empty()) {
+    *error = "method '" + method.name + "' uses no noise model (remove --noise " +
+             files.noise_path + ")";
+    return false;
+  }
+  ImuNoise noise;
+  if (!ReadNoiseJson(files.noise_path, &noise, error)) return false;
+  session->noise = noise.model;
+  session->noise_name = files.noise_path;
   return true;
 }
 
 }  // namespace
 
 bool RunCalibration(const Config& config, const PipelineInput& input, Calibration* calibration) {
+  Session session;
+  session.log = input.log;
+  return RunCalibration(config, input, &session, calibration);
+}
+
+bool RunCalibration(const Config& config, const SessionFiles& files, Session* session,
+                    Calibration* calibration) {
   *calibration = Calibration();
   std::string error;
   if (!config.IsValid(&error)) {
@@ -41,26 +66,19 @@ bool RunCalibration(const Config& config, const PipelineInput& input, Calibratio
     return false;
   }
   const CalibrationMethod& method = *FindCalibrationMethod(config.method);
-  MethodData data;
-  data.log = &input.log;
-  ImuNoise noise;
-  if (!input.noise_path.empty()) {
-    calibration->method = method.name;
-    if (method.noise_model.empty()) {
-      calibration->message = "method '" + method.name + "' uses no noise model (remove --noise " +
-                             input.noise_path + ")";
-      return false;
-    }
-    if (!ReadNoiseJson(input.noise_path, &noise, &calibration->message)) return false;
-    data.noise = &noise.model;
-    data.noise_name = input.noise_path;
-  }
-  if (!ReadSideInput(method, input, &data, &error)) {
+  if (!ReadNoiseModel(method, files, session, &error) ||
+      !ReadSideInput(method, files, session, &error)) {
     calibration->method = method.name;
     calibration->message = error;
     return false;
   }
-  const bool ok = method.run(config, data, calibration);
+  // Detected once here; the method, the report and the check read it. A
+  // failed detection is the method's to report, at its own step.
+  const std::vector<std::string>& sections = method.sections;
+  if (std::find(sections.begin(), sections.end(), "detector") != sections.end()) {
+    DetectSessionPoses(config.calibration.detector, session);
+  }
+  const bool ok = method.run(config, *session, calibration);
   calibration->method = method.name;
   return ok;
 }

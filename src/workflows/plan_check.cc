@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "gravcal/estimation/coarse_fit.h"
 #include "gravcal/estimation/refinement.h"
 #include "gravcal/workflows/plan.h"
 #include "methods/static_positions.h"
@@ -50,6 +51,14 @@ using internal::Median;
 
 bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& request,
                     CoverageReport* report, std::string* error) {
+  Session session;
+  session.log = log;
+  return CheckRecording(session, config, request, report, error);
+}
+
+bool CheckRecording(const Session& session, const Config& config, const PlanRequest& request,
+                    CoverageReport* report, std::string* error) {
+  const ImuLog& log = session.log;
   internal::PlanStart start;
   if (!internal::StartPlan(config, request, &start, error)) return false;
   const DesignModel& model = start.model;
@@ -61,7 +70,7 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
   Calibration calibration;
   std::vector<StaticInterval> intervals;
   std::vector<Position> positions;
-  if (!internal::DetectStaticPositions(log, options, &calibration, &intervals, &positions)) {
+  if (!internal::DetectStaticPositions(session, options, &calibration, &intervals, &positions)) {
     *error = calibration.message;
     return false;
   }
@@ -69,14 +78,23 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
     *error = log.source + ": no static pose found";
     return false;
   }
-  // The data's own scale (m/s^2 per raw unit) and the poses in scale-free
-  // units at the nominal sensor.
+  // The data's own scale (m/s^2 per raw unit) and each pose's direction,
+  // from the coarse fit when the poses allow one: it separates an offset
+  // (unsigned counts around 32768, volts around 1.65) from gravity, as the
+  // --noise path does (ScaleFromPoses). Else g over the median |raw mean|
+  // and the raw directions, which assume no offset.
   std::vector<double> norms, holds;
   for (const Position& p : positions) {
     norms.push_back(p.raw_mean.norm());
     holds.push_back(p.t_end - p.t_begin);
   }
-  const double scale = model.gravity / Median(norms);
+  CoarseFitResult coarse;
+  double scale = CoarseFit(positions, model.gravity, AccelParameterization::kScale,
+                           CoarseFitOptions(), &coarse)
+                     ? std::cbrt(std::abs(coarse.model.matrix().determinant()))
+                     : 0.0;
+  const bool fitted = std::isfinite(scale) && scale > 0.0;
+  if (!fitted) scale = model.gravity / Median(norms);
   // The nominal sensor sees each pose along its measured direction; a pose
   // within kFaceSnapDeg of a face counts as that face: the placement error
   // of a few degrees (and the bias, which tilts opposite faces alike) carries
@@ -84,7 +102,7 @@ bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& 
   // refinement could not separate from its undetermined directions either.
   std::vector<Position> scaled = positions;
   for (Position& p : scaled) {
-    Eigen::Vector3d up = p.raw_mean.normalized();
+    Eigen::Vector3d up = (fitted ? coarse.model.Apply(p.raw_mean) : p.raw_mean).normalized();
     Eigen::Index axis = 0;
     up.cwiseAbs().maxCoeff(&axis);
     if (std::fabs(up(axis)) > std::cos(kFaceSnapDeg * M_PI / 180.0)) {

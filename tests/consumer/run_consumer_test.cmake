@@ -80,13 +80,15 @@ if(CONSUMER_PACKAGE_DIRS)
 endif()
 run_step("configure of the consumer project" "${CMAKE_COMMAND}" ${configure_args})
 
-# 3. Build it. 4. Run it.
+# 3. Build it. 4. Run its programs: the core alone, then through gravcal::ceres.
 run_step("build of the consumer project" "${CMAKE_COMMAND}" --build "${consumer_build}")
-set(consumer_exe "${consumer_build}/consumer")
-if(NOT EXISTS "${consumer_exe}")
-  message(FATAL_ERROR "ConsumerProject: build produced no ${consumer_exe}")
-endif()
-run_step("run of the consumer" "${consumer_exe}")
-message(STATUS "${step_output}")
+foreach(consumer core_consumer ceres_consumer)
+  set(consumer_exe "${consumer_build}/${consumer}")
+  if(NOT EXISTS "${consumer_exe}")
+    message(FATAL_ERROR "ConsumerProject: build produced no ${consumer_exe}")
+  endif()
+  run_step("run of ${consumer}" "${consumer_exe}")
+  message(STATUS "${step_output}")
+endforeach()
 
 file(REMOVE_RECURSE "${work_dir}")

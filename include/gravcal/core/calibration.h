@@ -162,6 +162,14 @@ struct Calibration {
   ConvergenceReport convergence;
   // Issue 16: the input log (set by the caller that read it).
   CalibrationProvenance provenance;
+
+  // One line: the message and the fit's residual |a| - g before and after
+  // (only after, when the raw data were read without a nominal scale).
+  std::string BriefReport() const;
+  // Several lines: the message, gravity, every estimate with its standard
+  // deviation (or "not determined"), the residuals, the solver and the
+  // warnings.
+  std::string FullReport() const;
 };
 
 }  // namespace gravcal

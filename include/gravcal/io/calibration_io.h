@@ -39,6 +39,8 @@ bool WriteCalibrationJson(const Calibration& calibration, bool include_covarianc
 // CSV: a header row with the column names, then one row per epoch. Fails
 // (naming the path) when there is no history or the file cannot be written.
 bool WriteHistoryCsv(const Calibration& calibration, const std::string& path, std::string* error);
+// The text WriteHistoryCsv writes; false when there is no history.
+bool HistoryToCsv(const Calibration& calibration, std::string* csv, std::string* error);
 
 // One static position as the file records it (positions[k]): the mean raw
 // accelerometer vector, the middle of its interval (s) and its mean

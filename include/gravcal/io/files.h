@@ -33,6 +33,23 @@ bool ReadFileBytes(const std::string& path, std::string* bytes, std::string* err
 // and is not a regular file, and the name "-", are refused.
 bool WriteFileAtomically(const std::string& path, const std::string& contents, std::string* error);
 
+// One file of WriteFilesAtomically.
+struct FileContents {
+  std::string path;  // "" = not written
+  std::string contents;
+};
+
+// Writes several files as one output: every temporary is written and closed
+// before the first is renamed into place, so a failure while writing (a full
+// disk, a folder that cannot take a file) leaves every destination as it was;
+// no file the user had is removed. Only a rename failing after others were
+// done (the folder vanished meanwhile) can leave some files new.
+bool WriteFilesAtomically(const std::vector<FileContents>& files, std::string* error);
+
+// Creates the folder `path` and every missing folder above it (mkdir -p).
+// False with "<path>: cannot create the folder '<level>': <why>".
+bool MakeFolders(const std::string& path, std::string* error);
+
 // A file written in pieces, then put in place at once (the writer behind
 // WriteFileAtomically, for outputs streamed in constant memory).
 class AtomicFile {
@@ -48,7 +65,10 @@ class AtomicFile {
   // take a file.
   bool Open(const std::string& path, std::string* error);
   bool Write(const char* data, size_t size, std::string* error);
-  // Renames the temporary over the destination.
+  // Finishes the temporary (closes it) and checks that the destination is
+  // still no non-regular file; the destination is not touched yet.
+  bool Close(std::string* error);
+  // Renames the temporary over the destination (Close()s first if needed).
   bool Commit(std::string* error);
   // Removes the temporary; the destination is left as it was.
   void Abort();

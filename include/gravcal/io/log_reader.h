@@ -30,6 +30,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gravcal/core/calibration.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/types.h"
 #include "gravcal/io/files.h"
@@ -68,6 +69,12 @@ struct LogReaderOptions {
 bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
                 std::string* error);
 
+// Same, and *provenance gets the file's name, content hash and the
+// library's version (calibration_io.h LogProvenance), hashed from the bytes
+// read for the log: a text log is read once.
+bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
+                CalibrationProvenance* provenance, std::string* error);
+
 // Same as ReadImuLog on text already in memory; `name` is used in messages.
 bool ParseImuLog(std::string_view text, const std::string& name, const LogReaderOptions& options,
                  ImuLog* log, std::string* error);
@@ -75,6 +82,10 @@ bool ParseImuLog(std::string_view text, const std::string& name, const LogReader
 // Writes the log as contract CSV (t,ax,ay,az[,gx,gy,gz][,temp]) with full
 // precision, atomically (temporary file, then rename).
 bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* error);
+
+// The text WriteImuLogCsv writes (for a command that puts several files in
+// place together, WriteFilesAtomically). False with the reason in `error`.
+bool ImuLogToCsv(const ImuLog& log, std::string* contents, std::string* error);
 
 }  // namespace gravcal
 

@@ -186,8 +186,9 @@ struct EffectFitOptions {
 
   // Stopping rules of the Ceres solve.
   SolverTolerances solver = {50, 1e-12, 1e-12, 1e-10};
-  // Robust loss rho on each accelerometer residual block (a position's
-  // magnitude, its within-pose trend, a turn between poses), loss_scale (> 0)
+  // Robust loss rho on each residual block (a position's magnitude, its
+  // within-pose trend, a turn between poses; a position's three gyroscope
+  // mean rates), loss_scale (> 0)
   // in standard deviations, as in the refinement (refinement.h): the solve is
   // graduated from a scale holding every initial residual down to loss_scale,
   // and the covariance weights each block's rows by sqrt(rho'(|r|^2)), the

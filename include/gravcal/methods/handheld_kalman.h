@@ -65,11 +65,13 @@
 #define GRAVCAL_METHODS_HANDHELD_KALMAN_H_
 
 #include <string>
+#include <vector>
 
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/gravity.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/estimation/error_state_layout.h"
+#include "gravcal/methods/session.h"
 
 namespace gravcal {
 
@@ -164,6 +166,26 @@ struct HandheldKalmanOptions {
 // not excite some errors is not a failure: they are reported with their
 // (large) standard deviation and a warning.
 bool CalibrateHandheld(const ImuLog& log, const HandheldKalmanOptions& options,
+                       Calibration* calibration);
+
+// The sections the method reads.
+struct HandheldKalmanMethodOptions {
+  // The filter, its gravity and nominal scales included.
+  HandheldKalmanOptions filter;
+  // The config keys the user set; of the filter's process-noise keys
+  // (hk_accel_noise_density, hk_gyro_noise_density, hk_accel_bias_walk,
+  // hk_gyro_bias_walk) those named here keep their values when the session
+  // has a noise model, and the others come from the model.
+  std::vector<std::string> noise_keys_set;
+
+  bool IsValid(std::string* error) const { return filter.IsValid(error); }
+};
+
+// The same on a session. With a noise model (session.noise), each process
+// noise density not in noise_keys_set is the largest of the model's three
+// axes (as `gravcal noise --handheld` writes them: no axis is trusted more
+// than its noise allows), and a warning says where Q came from.
+bool CalibrateHandheld(const Session& session, const HandheldKalmanMethodOptions& options,
                        Calibration* calibration);
 
 }  // namespace gravcal

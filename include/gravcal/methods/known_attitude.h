@@ -38,6 +38,7 @@
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/position.h"
 #include "gravcal/io/attitude_fixture.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
@@ -72,6 +73,20 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path
 // `attitudes_name` names the file in messages.
 bool CalibrateKnownAttitude(const ImuLog& log, const std::vector<FixtureAttitude>& rows,
                             const std::string& attitudes_name, const CalibrationOptions& options,
+                            Calibration* calibration);
+
+// The sections the method reads.
+struct KnownAttitudeMethodOptions {
+  // Gravity, detector, pose noise, and the solver settings above.
+  CalibrationOptions accel;
+
+  bool IsValid(std::string* error) const { return accel.IsValid(error); }
+};
+
+// The same on a session: the fixture's rows are session.attitudes (named
+// session.attitudes_name), its static detection is used when it has one,
+// its noise model (when given) for the covariance of each pose's mean.
+bool CalibrateKnownAttitude(const Session& session, const KnownAttitudeMethodOptions& options,
                             Calibration* calibration);
 
 }  // namespace gravcal

@@ -24,6 +24,7 @@
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/rate_table_segment.h"
+#include "gravcal/methods/session.h"
 
 namespace gravcal {
 
@@ -43,6 +44,16 @@ struct RateTableResult {
 // example rotations about two axes only).
 bool CalibrateRateTable(const ImuLog& log, const std::vector<RateTableSegment>& segments,
                         RateTableResult* result);
+
+// The method reads no options section: the segments say everything.
+struct RateTableMethodOptions {
+  bool IsValid(std::string*) const { return true; }
+};
+
+// The same on a session's log and segments, as a Calibration: the
+// gyroscope, with the accelerometer left the identity (a warning says so).
+bool CalibrateRateTable(const Session& session, const RateTableMethodOptions& options,
+                        Calibration* calibration);
 
 }  // namespace gravcal
 

@@ -33,6 +33,7 @@
 
 #include "gravcal/core/imu_log.h"
 #include "gravcal/estimation/static_alignment.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
@@ -59,6 +60,21 @@ struct TenPositionOptions {
 // a position the alignment rejects, or a step 4 that does not converge.
 bool CalibrateTenPosition(const ImuLog& log, const CalibrationOptions& options,
                           const TenPositionOptions& ten, Calibration* calibration);
+
+// The sections the method reads.
+struct TenPositionMethodOptions {
+  // Gravity, detector, pose noise, and the step-4 settings above.
+  CalibrationOptions accel;
+  // The static alignment (steps 1-3 and 5).
+  TenPositionOptions alignment;
+
+  bool IsValid(std::string* error) const;
+};
+
+// The same on a session: its static detection when it has one, its noise
+// model (when given) for the covariance of each pose's mean.
+bool CalibrateTenPosition(const Session& session, const TenPositionMethodOptions& options,
+                          Calibration* calibration);
 
 }  // namespace gravcal
 

@@ -22,7 +22,6 @@
 #include "gravcal/core/types.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/coarse_fit.h"
-#include "gravcal/estimation/newton_solver.h"
 #include "gravcal/estimation/pose_mean_covariance.h"
 #include "gravcal/estimation/refinement.h"
 

@@ -50,7 +50,7 @@
 #include <cmath>
 #include <utility>
 
-#include "gravcal/core/model_effects.h"
+#include "gravcal/core/imu_model.h"
 #include "gravcal/residuals/gyro_rotation_residual.h"
 
 namespace gravcal {
@@ -81,11 +81,12 @@ struct AccelRotationResidual {
                   const T* const temperature_bias, const T* const temperature_scale,
                   const T* const drift, const T* const gyro_bias, const T* const gyro_matrix,
                   T* residual) const {
+    const AccelBlocks<T> accel(bias, upper, quadratic, temperature_bias, temperature_scale, drift);
+    const ImuModel<T> model(accel);
     T start[3], end[3];
-    if (!Direction(data_.start_raw, data_.start_temperature_offset, data_.start_time_offset, bias,
-                   upper, quadratic, temperature_bias, temperature_scale, drift, start) ||
-        !Direction(data_.end_raw, data_.end_temperature_offset, data_.end_time_offset, bias, upper,
-                   quadratic, temperature_bias, temperature_scale, drift, end)) {
+    if (!model.Direction(data_.start_raw, data_.start_temperature_offset, data_.start_time_offset,
+                         start) ||
+        !model.Direction(data_.end_raw, data_.end_temperature_offset, data_.end_time_offset, end)) {
       return false;
     }
     T dq[4];
@@ -100,27 +101,6 @@ struct AccelRotationResidual {
   }
 
  private:
-  // d = a / |a| of one pose; false when the quadratic term has no root.
-  template <typename T>
-  static bool Direction(const Eigen::Vector3d& raw, double temperature_offset, double time_offset,
-                        const T* bias, const T* upper, const T* quadratic,
-                        const T* temperature_bias, const T* temperature_scale, const T* drift,
-                        T* d) {
-    const T e0 = T(raw(0)) - bias[0];
-    const T e1 = T(raw(1)) - bias[1];
-    const T e2 = T(raw(2)) - bias[2];
-    T m[3] = {upper[0] * e0 + upper[1] * e1 + upper[2] * e2, upper[3] * e1 + upper[4] * e2,
-              upper[5] * e2};
-    if (!CorrectAccelEffects(quadratic, temperature_bias, temperature_scale, drift,
-                             temperature_offset, time_offset, m)) {
-      return false;
-    }
-    using std::sqrt;
-    const T norm = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-    for (int i = 0; i < 3; ++i) d[i] = m[i] / norm;
-    return true;
-  }
-
   const AccelRotationData data_;
 };
 

@@ -43,6 +43,8 @@
 
 #include <Eigen/Core>
 
+#include "gravcal/core/imu_model.h"
+
 namespace gravcal {
 
 struct AccelTrendResidual {
@@ -66,23 +68,19 @@ struct AccelTrendResidual {
   bool operator()(const T* const bias, const T* const upper, const T* const /*quadratic*/,
                   const T* const temperature_bias, const T* const temperature_scale,
                   const T* const drift, T* residual) const {
-    const T d0 = T(raw_mean_(0)) - bias[0];
-    const T d1 = T(raw_mean_(1)) - bias[1];
-    const T d2 = T(raw_mean_(2)) - bias[2];
-    const T m[3] = {upper[0] * d0 + upper[1] * d1 + upper[2] * d2, upper[3] * d1 + upper[4] * d2,
-                    upper[5] * d2};
+    const AccelBlocks<T> accel(bias, upper, nullptr, temperature_bias, temperature_scale, drift);
+    const ImuModel<T> model(accel);
+    T q[3];
+    model.SensorFrame(raw_mean_, q);
+    model.RemoveLinearEffects(temperature_offset_, time_offset_, q);
     T rate[3];
     for (int i = 0; i < 3; ++i) {
-      const T q =
-          (m[i] - temperature_bias[i] * T(temperature_offset_) - drift[i] * T(time_offset_)) /
-          (T(1.0) + temperature_scale[i] * T(temperature_offset_));
-      rate[i] = (temperature_scale[i] * q + temperature_bias[i]) * T(temperature_slope_) + drift[i];
+      rate[i] =
+          (temperature_scale[i] * q[i] + temperature_bias[i]) * T(temperature_slope_) + drift[i];
     }
-    // U^-1 mdot by back substitution (U upper triangular).
+    // U^-1 mdot.
     T predicted[3];
-    predicted[2] = rate[2] / upper[5];
-    predicted[1] = (rate[1] - upper[4] * predicted[2]) / upper[3];
-    predicted[0] = (rate[0] - upper[1] * predicted[1] - upper[2] * predicted[2]) / upper[0];
+    model.UpperSolve(rate, predicted);
     T e[3];
     for (int i = 0; i < 3; ++i) e[i] = T(slope_(i)) - predicted[i];
     for (int r = 0; r < whitening_.rows(); ++r) {

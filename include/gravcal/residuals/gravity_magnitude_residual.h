@@ -18,9 +18,9 @@
 // Without effects (Create: blocks b, U) a = m, the usual calibration
 // residual. With effects (CreateWithEffects: blocks b, U, k2, beta, c,
 // delta, 3 each; dT_k = T_k - T_ref and dt_k = t_k - t_ref) a is m with the
-// accelerometer effect terms removed (CorrectAccelEffects); an effect that is
-// off has its block held constant at zero, which leaves its term the
-// identity.
+// accelerometer effect terms removed; an effect that is off has its block
+// held constant at zero, which leaves its term the identity. The model is
+// ImuModel (core/imu_model.h) over these blocks.
 //
 // Another estimator can add this residual to its own problem, sharing the
 // bias and upper blocks with its other residuals.
@@ -33,7 +33,7 @@
 #include <Eigen/Core>
 #include <cmath>
 
-#include "gravcal/core/model_effects.h"
+#include "gravcal/core/imu_model.h"
 
 namespace gravcal {
 
@@ -80,13 +80,9 @@ struct GravityMagnitudeResidual {
   template <typename T>
   bool Evaluate(const T* bias, const T* upper, const T* quadratic, const T* temperature_bias,
                 const T* temperature_scale, const T* drift, T* residual) const {
-    const T d0 = T(raw_mean_(0)) - bias[0];
-    const T d1 = T(raw_mean_(1)) - bias[1];
-    const T d2 = T(raw_mean_(2)) - bias[2];
-    T m[3] = {upper[0] * d0 + upper[1] * d1 + upper[2] * d2, upper[3] * d1 + upper[4] * d2,
-              upper[5] * d2};
-    if (!CorrectAccelEffects(quadratic, temperature_bias, temperature_scale, drift,
-                             temperature_offset_, time_offset_, m)) {
+    const AccelBlocks<T> accel(bias, upper, quadratic, temperature_bias, temperature_scale, drift);
+    T m[3];
+    if (!ImuModel<T>(accel).CorrectedSensorFrame(raw_mean_, temperature_offset_, time_offset_, m)) {
       return false;
     }
     using std::sqrt;

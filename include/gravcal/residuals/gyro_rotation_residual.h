@@ -51,6 +51,8 @@
 #include <utility>
 #include <vector>
 
+#include "gravcal/core/imu_model.h"
+
 namespace gravcal {
 
 // The data of one rotation, in the units the parameters use.
@@ -96,16 +98,12 @@ inline void GyroStepWeights(const std::vector<double>& t, size_t i, double weigh
 template <typename T>
 void CalibratedGyroRate(const GyroRotationData& data, size_t i, const T* bias, const T* matrix,
                         const T* g_sensitivity, T* w) {
-  const Eigen::Vector3d& u = data.gyro[i];
-  const T d[3] = {T(u(0)) - bias[0], T(u(1)) - bias[1], T(u(2)) - bias[2]};
-  for (int r = 0; r < 3; ++r) {
-    w[r] = matrix[3 * r] * d[0] + matrix[3 * r + 1] * d[1] + matrix[3 * r + 2] * d[2];
-    if (g_sensitivity != nullptr) {
-      const Eigen::Vector3d& f = data.force[i];
-      w[r] -= g_sensitivity[3 * r] * f(0) + g_sensitivity[3 * r + 1] * f(1) +
-              g_sensitivity[3 * r + 2] * f(2);
-    }
-  }
+  GyroBlocks<T> gyro;
+  gyro.bias = bias;
+  gyro.matrix = matrix;
+  gyro.g_sensitivity = g_sensitivity;
+  const double* force = g_sensitivity != nullptr ? data.force[i].data() : nullptr;
+  ImuModel<T>(gyro).GyroRate(data.gyro[i], force, w);
 }
 
 // phi_i of step i (the scheme above) from the rates of samples i - 1 .. i + 2
@@ -206,11 +204,6 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
   for (size_t k = 0; k < n; ++k) {
     CalibratedGyroRate<double>(data, k, bias, matrix, g_sensitivity, w[k].data());
   }
-  auto cross = [](const Eigen::Vector3d& v) {
-    Eigen::Matrix3d x;
-    x << 0.0, -v(2), v(1), v(2), 0.0, -v(0), -v(1), v(0), 0.0;
-    return x;
-  };
   // Forward: the steps phi_i and the turn.
   std::vector<Eigen::Vector3d> phi(n - 1);
   std::vector<Eigen::Vector4d> steps(n - 1);
@@ -239,7 +232,7 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
       alpha = 2.0 * half * half / t2;
       beta = (t - std::sin(t)) / (t2 * t);
     }
-    const Eigen::Matrix3d k = cross(phi[i]);
+    const Eigen::Matrix3d k = Hat<double>(phi[i]);
     const Eigen::Matrix3d right = Eigen::Matrix3d::Identity() - alpha * k + beta * k * k;
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rotation;
     ceres::QuaternionToRotation(s, rotation.data());
@@ -248,8 +241,8 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
     double c[4];
     GyroStepWeights(data.t, i, c);
     const double coning = step * step / 12.0;
-    h_k[i] += g * (c[1] * Eigen::Matrix3d::Identity() - coning * cross(w[i + 1]));
-    h_k[i + 1] += g * (c[2] * Eigen::Matrix3d::Identity() + coning * cross(w[i]));
+    h_k[i] += g * (c[1] * Eigen::Matrix3d::Identity() - coning * Hat<double>(w[i + 1]));
+    h_k[i + 1] += g * (c[2] * Eigen::Matrix3d::Identity() + coning * Hat<double>(w[i]));
     if (c[0] != 0.0) {
       h_k[i - 1] += c[0] * g;
       h_k[i + 2] += c[3] * g;
@@ -372,27 +365,19 @@ struct GyroRotationResidual {
   }
 
  private:
-  // d = R U (v - b) / |R U (v - b)|.
-  template <typename T>
-  void Direction(const Eigen::Vector3d& raw, const T* accel_bias, const T* upper, T* d) const {
-    const T e0 = T(raw(0)) - accel_bias[0];
-    const T e1 = T(raw(1)) - accel_bias[1];
-    const T e2 = T(raw(2)) - accel_bias[2];
-    const T a[3] = {upper[0] * e0 + upper[1] * e1 + upper[2] * e2, upper[3] * e1 + upper[4] * e2,
-                    upper[5] * e2};
-    using std::sqrt;
-    const T norm = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    const Eigen::Matrix3d& r = data_.accel_rotation;
-    for (int i = 0; i < 3; ++i) d[i] = (r(i, 0) * a[0] + r(i, 1) * a[1] + r(i, 2) * a[2]) / norm;
-  }
-
   template <typename T>
   bool Evaluate(const T* bias, const T* matrix, const T* g_sensitivity, const T* accel_bias,
                 const T* accel_upper, T* residual) const {
     T start[3], end[3];
     if (accel_bias != nullptr) {
-      Direction(data_.start_raw, accel_bias, accel_upper, start);
-      Direction(data_.end_raw, accel_bias, accel_upper, end);
+      // d = R U (v - b) / |U (v - b)|.
+      AccelBlocks<T> accel;
+      accel.bias = accel_bias;
+      accel.upper = accel_upper;
+      accel.rotation = &data_.accel_rotation;
+      const ImuModel<T> model(accel);
+      model.Direction(data_.start_raw, 0.0, 0.0, start);
+      model.Direction(data_.end_raw, 0.0, 0.0, end);
     } else {
       for (int i = 0; i < 3; ++i) {
         start[i] = T(data_.start_direction(i));

@@ -30,7 +30,7 @@
 
 #include <Eigen/Core>
 
-#include "gravcal/core/model_effects.h"
+#include "gravcal/core/imu_model.h"
 
 namespace gravcal {
 
@@ -88,30 +88,26 @@ struct GyroStaticResidual {
   template <bool kEffects, typename T>
   bool Evaluate(const T* bias, const T* matrix, const T* g_sensitivity, const T* temperature_bias,
                 const T* drift, T* residual) const {
+    GyroBlocks<T> gyro;
+    gyro.bias = bias;
+    T e[3];
     if constexpr (kEffects) {
-      T offset[3];
-      GyroEffectOffset(g_sensitivity, temperature_bias, drift, force_.data(), temperature_offset_,
-                       time_offset_, offset);
-      T e[3];
-      for (int i = 0; i < 3; ++i) e[i] = T(raw_mean_(i)) - bias[i] - offset[i];
+      gyro.g_effect = g_sensitivity;
+      gyro.temperature_bias = temperature_bias;
+      gyro.drift = drift;
+      ImuModel<T>(gyro).GyroRestError(raw_mean_, force_.data(), temperature_offset_, time_offset_,
+                                      e);
       for (int r = 0; r < 3; ++r) {
         residual[r] = T(sqrt_information_(r, 0)) * e[0] + T(sqrt_information_(r, 1)) * e[1] +
                       T(sqrt_information_(r, 2)) * e[2];
       }
     } else {
-      const T d[3] = {T(raw_mean_(0)) - bias[0], T(raw_mean_(1)) - bias[1],
-                      T(raw_mean_(2)) - bias[2]};
-      T w[3];
+      gyro.matrix = matrix;
+      gyro.g_sensitivity = g_sensitivity;
+      ImuModel<T>(gyro).GyroRate(raw_mean_, force_.data(), e);
       for (int r = 0; r < 3; ++r) {
-        w[r] = matrix[3 * r] * d[0] + matrix[3 * r + 1] * d[1] + matrix[3 * r + 2] * d[2];
-        if (g_sensitivity != nullptr) {
-          w[r] -= g_sensitivity[3 * r] * force_(0) + g_sensitivity[3 * r + 1] * force_(1) +
-                  g_sensitivity[3 * r + 2] * force_(2);
-        }
-      }
-      for (int r = 0; r < 3; ++r) {
-        residual[r] = sqrt_information_(r, 0) * w[0] + sqrt_information_(r, 1) * w[1] +
-                      sqrt_information_(r, 2) * w[2];
+        residual[r] = sqrt_information_(r, 0) * e[0] + sqrt_information_(r, 1) * e[1] +
+                      sqrt_information_(r, 2) * e[2];
       }
     }
     return true;

@@ -3,7 +3,8 @@
 //
 // Keys are flat, one name per setting, so the same name works in the YAML
 // file and as a command-line flag (`gravity: 9.81744` or `--gravity
-// 9.81744`). Keys come in sections, each owned by the options it fills
+// 9.81744`). Keys come in sections, each owned by one part of the config
+// (calibration, simulation, discovery) and bound to the options it fills
 // (src/workflows/config/*_keys.cc); simulator keys start with `sim_`. A key
 // that does not exist is an error naming it (and the line in a file); so is
 // a value of the wrong type or out of range, and so is a key the user set
@@ -15,44 +16,19 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/estimation/noise_characterisation.h"
-#include "gravcal/io/log_reader.h"
-#include "gravcal/methods/gyro_calibration.h"
-#include "gravcal/methods/handheld_kalman.h"
-#include "gravcal/methods/ten_position.h"
-#include "gravcal/methods/twelve_position.h"
-#include "gravcal/simulation/handheld_simulator.h"
-#include "gravcal/simulation/simulator.h"
-#include "gravcal/workflows/discovery.h"
+#include "gravcal/workflows/calibration_config.h"
+#include "gravcal/workflows/discovery_config.h"
+#include "gravcal/workflows/simulation_config.h"
 
 namespace gravcal {
 
-struct Config {
-  // Calibration method, a name in the method registry (method_registry.h).
-  std::string method = "twelve_position";
-  LogReaderOptions input;
-  CalibrationOptions calibration;
-  SimulatorOptions simulation;
-  // Gyroscope from the rotations between the poses (gyro_model != none).
-  GyroCalibrationOptions gyro;
-  // Issue 3: the ten-position method's alignment settings.
-  TenPositionOptions ten_position;
-  // Write accel.covariance into the calibration JSON.
-  bool output_covariance = true;
-  // Issue 4: the handheld Kalman calibration (method handheld_kalman; its
-  // gravity and accelerometer nominal scale come from `calibration`), and
-  // the motion simulator used by `gravcal simulate` when sim_motion names a
-  // profile (empty = the multi-position scheme).
-  HandheldKalmanOptions handheld;
-  MotionOptions motion;
-  std::string sim_motion;
-  // Issue 6: effects beyond the textbook model fitted by `calibrate` (and
-  // already in the baseline of `discover`), and the discovery workflow.
-  std::vector<Effect> effects;
-  DiscoveryOptions discovery;
-  // Issue 14: `gravcal noise` (its scales and detector come from the keys
-  // nominal_scale, gyro_nominal_scale and the detector section).
-  NoiseOptions noise;
+// The whole configuration: three parts, each owning its config sections
+// (calibration_config.h, simulation_config.h, discovery_config.h), and the
+// record of the keys set. The parts are plain data; Config is made of them
+// so that config.calibration, config.simulation and config.discovery read
+// the same whether a part or the whole is at hand, and a calibration needs
+// only its CalibrationConfig.
+struct Config : CalibrationConfig, SimulationConfig, DiscoveryConfig {
   // The keys set through LoadConfigText/LoadConfigFile/SetConfigValue, in
   // the order set (a key set twice appears once). Only these are checked
   // against the method: defaults never make a config invalid.

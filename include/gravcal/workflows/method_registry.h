@@ -8,8 +8,8 @@
 // list, so a new method is its own file(s) in src/methods, its options
 // section in src/workflows/config/, and one entry in method_registry.cc.
 //
-// Run functions take data already read and parsed (MethodData), never a
-// path: the pipeline (pipeline.h) reads the files.
+// Run functions take data already read and parsed (Session), never a path:
+// the pipeline (pipeline.h) reads the files.
 #ifndef GRAVCAL_WORKFLOWS_METHOD_REGISTRY_H_
 #define GRAVCAL_WORKFLOWS_METHOD_REGISTRY_H_
 
@@ -18,10 +18,7 @@
 #include <vector>
 
 #include "gravcal/core/calibration.h"
-#include "gravcal/core/imu_log.h"
-#include "gravcal/core/noise_model.h"
-#include "gravcal/core/rate_table_segment.h"
-#include "gravcal/io/attitude_fixture.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/workflows/config.h"
 
 namespace gravcal {
@@ -36,22 +33,6 @@ enum class MethodSideInput {
   kSegments,
 };
 
-// What a run function receives, read and parsed by the pipeline.
-struct MethodData {
-  const ImuLog* log = nullptr;
-  // kAttitudes: the rows of the attitudes file, and its name for messages.
-  std::vector<FixtureAttitude> attitudes;
-  // kSegments: the segments, as sample ranges of `log`.
-  std::vector<RateTableSegment> segments;
-  // Name of the side input file, for messages.
-  std::string side_input_name;
-  // The noise model (noise.json, --noise) for a method whose entry says it
-  // uses one; nullptr = none given.
-  const ImuNoiseModel* noise = nullptr;
-  // Its file name, for messages.
-  std::string noise_name;
-};
-
 struct CalibrationMethod {
   std::string name;
   std::string help;
@@ -63,9 +44,10 @@ struct CalibrationMethod {
   // Checks the options the method reads (beyond the shared ones);
   // nullptr = nothing more to check.
   std::function<bool(const Config&, std::string*)> validate;
-  // Fills calibration (calibration->method included). Returns false with a
-  // one-line message.
-  std::function<bool(const Config&, const MethodData&, Calibration*)> run;
+  // Gives the method (src/methods/) the sections of the config it reads and
+  // runs it on the session. Fills calibration (calibration->method
+  // included). Returns false with a one-line message.
+  std::function<bool(const Config&, const Session&, Calibration*)> run;
   // What the method does with a noise model (--noise), for help and notes;
   // empty = it uses none, and giving one is an error.
   std::string noise_model;

@@ -22,6 +22,7 @@
 #include "gravcal/core/noise_model.h"
 #include "gravcal/estimation/experiment_design.h"
 #include "gravcal/estimation/recording_plan.h"
+#include "gravcal/methods/session.h"
 #include "gravcal/workflows/config.h"
 
 namespace gravcal {
@@ -104,6 +105,11 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
 // (g / median |raw mean|). Proposed extra poses come from the request's
 // pose set, held the median recorded hold. False with *error on bad input.
 bool CheckRecording(const ImuLog& log, const Config& config, const PlanRequest& request,
+                    CoverageReport* report, std::string* error);
+
+// The same on a session: its static detection when it has one (the one the
+// calibration used, pipeline.h), else detected now.
+bool CheckRecording(const Session& session, const Config& config, const PlanRequest& request,
                     CoverageReport* report, std::string* error);
 
 // A few lines for a person: per parameter the predicted sigma (readable

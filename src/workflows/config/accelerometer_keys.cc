@@ -6,7 +6,7 @@
 namespace gravcal {
 namespace internal {
 
-ConfigSection GravitySection() {
+SectionOf<CalibrationConfig> GravitySection() {
   return {"gravity",
           ConfigSectionUse::kSomeMethods,
           {
@@ -19,7 +19,7 @@ ConfigSection GravitySection() {
           }};
 }
 
-ConfigSection DetectorSection() {
+SectionOf<CalibrationConfig> DetectorSection() {
   return {"detector",
           ConfigSectionUse::kSomeMethods,
           {
@@ -59,7 +59,7 @@ ConfigSection DetectorSection() {
 
 namespace {
 
-bool ReadNominalUp(const YAML::Node& n, Config* c, std::string* e) {
+bool ReadNominalUp(const YAML::Node& n, CalibrationConfig* c, std::string* e) {
   std::vector<std::string> names;
   if (!ReadStringList(n, &names, e)) return false;
   std::vector<int> axes;
@@ -78,7 +78,7 @@ bool ReadNominalUp(const YAML::Node& n, Config* c, std::string* e) {
   return true;
 }
 
-std::string NominalUpText(const Config& c) {
+std::string NominalUpText(const CalibrationConfig& c) {
   std::vector<std::string> names;
   for (int a : c.calibration.nominal_up) names.push_back(NominalAxisName(a));
   return ListText(names);
@@ -86,7 +86,7 @@ std::string NominalUpText(const Config& c) {
 
 }  // namespace
 
-ConfigSection ModelSection() {
+SectionOf<CalibrationConfig> ModelSection() {
   return {
       "model",
       ConfigSectionUse::kSomeMethods,
@@ -108,7 +108,7 @@ ConfigSection ModelSection() {
       }};
 }
 
-ConfigSection SolverSection() {
+SectionOf<CalibrationConfig> SolverSection() {
   return {
       "solver",
       ConfigSectionUse::kSomeMethods,

@@ -17,39 +17,54 @@
 namespace gravcal {
 namespace internal {
 
-// One key: how to set it from a YAML node and how to print it as YAML.
-struct ConfigKeyHandler {
+// One key of a part of Config (Part: CalibrationConfig, SimulationConfig or
+// DiscoveryConfig, or the whole Config): how to set it from a YAML node and
+// how to print it as YAML.
+template <typename Part>
+struct KeyHandlerOf {
   std::string name;
   std::string help;
-  std::function<bool(const YAML::Node&, Config*, std::string*)> set;
-  std::function<std::string(const Config&)> get;
+  std::function<bool(const YAML::Node&, Part*, std::string*)> set;
+  std::function<std::string(const Part&)> get;
 };
 
-struct ConfigSection {
+// A group of keys, owned by one part: its handlers reach that part's
+// fields only.
+template <typename Part>
+struct SectionOf {
   std::string name;
   ConfigSectionUse use = ConfigSectionUse::kSomeMethods;
-  std::vector<ConfigKeyHandler> keys;
+  std::vector<KeyHandlerOf<Part>> keys;
 };
+
+// Every section lifted to the whole Config (config.cc).
+using ConfigKeyHandler = KeyHandlerOf<Config>;
+using ConfigSection = SectionOf<Config>;
 
 // The sections, in the order `gravcal help` lists them (config.cc).
 const std::vector<ConfigSection>& ConfigSections();
 
-// One function per section file.
-ConfigSection GeneralSection();
-ConfigSection InputSection();
-ConfigSection GravitySection();
-ConfigSection DetectorSection();
-ConfigSection ModelSection();
-ConfigSection SolverSection();
-ConfigSection GyroSection();
-ConfigSection AlignmentSection();
-ConfigSection HandheldKalmanSection();
-ConfigSection PoseNoiseSection();
-ConfigSection NoiseSection();
-ConfigSection EffectsSection();
-ConfigSection DiscoverySection();
-ConfigSection SimulatorSection();
-ConfigSection MotionSimulatorSection();
+// One function per section, in its file, by the part that owns it.
+// calibration (general_keys.cc, accelerometer_keys.cc, gyro_keys.cc,
+// ten_position_keys.cc, handheld_kalman_keys.cc, noise_keys.cc,
+// effects_keys.cc):
+SectionOf<CalibrationConfig> GeneralSection();
+SectionOf<CalibrationConfig> InputSection();
+SectionOf<CalibrationConfig> GravitySection();
+SectionOf<CalibrationConfig> DetectorSection();
+SectionOf<CalibrationConfig> ModelSection();
+SectionOf<CalibrationConfig> SolverSection();
+SectionOf<CalibrationConfig> GyroSection();
+SectionOf<CalibrationConfig> AlignmentSection();
+SectionOf<CalibrationConfig> HandheldKalmanSection();
+SectionOf<CalibrationConfig> PoseNoiseSection();
+SectionOf<CalibrationConfig> NoiseSection();
+SectionOf<CalibrationConfig> EffectsSection();
+// discovery (effects_keys.cc):
+SectionOf<DiscoveryConfig> DiscoverySection();
+// simulation (simulator_keys.cc):
+SectionOf<SimulationConfig> SimulatorSection();
+SectionOf<SimulationConfig> MotionSimulatorSection();
 
 // Value readers: false with `error` saying what the value must be.
 bool ReadDouble(const YAML::Node& n, double* v, std::string* error);  // null = NaN
@@ -71,25 +86,41 @@ bool ReadEnum(const YAML::Node& n, Enum* v, const char* choices, std::string* er
 std::string DoubleText(double v);  // NaN = "null"
 std::string ListText(const std::vector<std::string>& v);
 
+// The reader and printer of a plain field by its type, for tables that bind
+// members (simulation/simulator_fields.h).
+inline bool ReadValue(const YAML::Node& n, double* v, std::string* e) {
+  return ReadDouble(n, v, e);
+}
+inline bool ReadValue(const YAML::Node& n, int* v, std::string* e) { return ReadInt(n, v, e); }
+inline bool ReadValue(const YAML::Node& n, bool* v, std::string* e) { return ReadBool(n, v, e); }
+inline bool ReadValue(const YAML::Node& n, std::string* v, std::string* e) {
+  return ReadString(n, v, e);
+}
+inline std::string ValueText(double v) { return DoubleText(v); }
+inline std::string ValueText(int v) { return std::to_string(v); }
+inline std::string ValueText(bool v) { return v ? "true" : "false"; }
+inline std::string ValueText(const std::string& v) { return v.empty() ? "\"\"" : v; }
+
 }  // namespace internal
 }  // namespace gravcal
 
-// Binders from a key name to a (nested) field of Config, e.g.
-// GRAVCAL_DOUBLE("window", calibration.detector.window_seconds, "help").
-#define GRAVCAL_KEY(name, help, read, print)                                         \
-  ::gravcal::internal::ConfigKeyHandler {                                            \
-    name, help, [](const YAML::Node& n, Config* c, std::string* e) { return read; }, \
-        [](const Config& c) { return print; }                                        \
+// Binders from a key name to a (nested) field of the section's part, e.g.
+// GRAVCAL_DOUBLE("window", calibration.detector.window_seconds, "help"); in
+// `read` and `print`, c is the part (a pointer in read), n the YAML node
+// and e the error.
+#define GRAVCAL_KEY(name, help, read, print)                                       \
+  {                                                                                \
+    name, help, [](const YAML::Node& n, auto* c, std::string* e) { return read; }, \
+        [](const auto& c) { return print; }                                        \
   }
 #define GRAVCAL_DOUBLE(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadDouble(n, &c->field, e), DoubleText(c.field))
+  GRAVCAL_KEY(name, help, ReadDouble(n, &c->field, e), ValueText(c.field))
 #define GRAVCAL_INT(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadInt(n, &c->field, e), std::to_string(c.field))
+  GRAVCAL_KEY(name, help, ReadInt(n, &c->field, e), ValueText(c.field))
 #define GRAVCAL_BOOL(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadBool(n, &c->field, e), std::string(c.field ? "true" : "false"))
-#define GRAVCAL_STRING(name, field, help)              \
-  GRAVCAL_KEY(name, help, ReadString(n, &c->field, e), \
-              c.field.empty() ? std::string("\"\"") : c.field)
+  GRAVCAL_KEY(name, help, ReadBool(n, &c->field, e), ValueText(c.field))
+#define GRAVCAL_STRING(name, field, help) \
+  GRAVCAL_KEY(name, help, ReadString(n, &c->field, e), ValueText(c.field))
 #define GRAVCAL_ENUM(name, field, choices, help) \
   GRAVCAL_KEY(name, help, ReadEnum(n, &c->field, choices, e), std::string(ToString(c.field)))
 

@@ -15,7 +15,7 @@ bool ReadEffects(const YAML::Node& n, std::vector<Effect>* effects, std::string*
 
 }  // namespace
 
-ConfigSection EffectsSection() {
+SectionOf<CalibrationConfig> EffectsSection() {
   return {"effects",
           ConfigSectionUse::kSomeMethods,
           {
@@ -27,7 +27,7 @@ ConfigSection EffectsSection() {
           }};
 }
 
-ConfigSection DiscoverySection() {
+SectionOf<DiscoveryConfig> DiscoverySection() {
   return {
       "discovery",
       ConfigSectionUse::kCommand,

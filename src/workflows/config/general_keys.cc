@@ -9,7 +9,7 @@
 namespace gravcal {
 namespace internal {
 
-ConfigSection GeneralSection() {
+SectionOf<CalibrationConfig> GeneralSection() {
   return {"general",
           ConfigSectionUse::kAllMethods,
           {
@@ -21,7 +21,7 @@ ConfigSection GeneralSection() {
 
 namespace {
 
-bool ReadRename(const YAML::Node& n, Config* c, std::string* e) {
+bool ReadRename(const YAML::Node& n, CalibrationConfig* c, std::string* e) {
   if (n.IsNull()) {
     c->input.rename.clear();
     return true;
@@ -42,7 +42,7 @@ bool ReadRename(const YAML::Node& n, Config* c, std::string* e) {
   return true;
 }
 
-std::string RenameText(const Config& c) {
+std::string RenameText(const CalibrationConfig& c) {
   std::string s = "{";
   for (const auto& kv : c.input.rename) {
     s += (s.size() > 1 ? ", " : "") + kv.first + ": " + kv.second;
@@ -52,7 +52,7 @@ std::string RenameText(const Config& c) {
 
 }  // namespace
 
-ConfigSection InputSection() {
+SectionOf<CalibrationConfig> InputSection() {
   return {
       "input",
       ConfigSectionUse::kAllMethods,

@@ -5,7 +5,7 @@
 namespace gravcal {
 namespace internal {
 
-ConfigSection GyroSection() {
+SectionOf<CalibrationConfig> GyroSection() {
   return {"gyro",
           ConfigSectionUse::kSomeMethods,
           {

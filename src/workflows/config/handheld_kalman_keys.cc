@@ -8,7 +8,7 @@ namespace internal {
 
 namespace {
 
-bool ReadCrossAxis(const YAML::Node& n, Config* c, std::string* e) {
+bool ReadCrossAxis(const YAML::Node& n, CalibrationConfig* c, std::string* e) {
   bool on = false;
   if (!ReadBool(n, &on, e)) return false;
   c->handheld.accel_terms =
@@ -20,7 +20,7 @@ bool ReadCrossAxis(const YAML::Node& n, Config* c, std::string* e) {
 
 }  // namespace
 
-ConfigSection HandheldKalmanSection() {
+SectionOf<CalibrationConfig> HandheldKalmanSection() {
   return {
       "handheld_kalman",
       ConfigSectionUse::kSomeMethods,

@@ -10,7 +10,7 @@ namespace internal {
 
 namespace {
 
-bool ReadNominalOffset(const YAML::Node& n, Config* c, std::string* e) {
+bool ReadNominalOffset(const YAML::Node& n, CalibrationConfig* c, std::string* e) {
   double v = 0.0;
   if (!ReadDouble(n, &v, e)) return false;
   c->noise.accel_offset.setConstant(v);
@@ -19,7 +19,7 @@ bool ReadNominalOffset(const YAML::Node& n, Config* c, std::string* e) {
 
 }  // namespace
 
-ConfigSection PoseNoiseSection() {
+SectionOf<CalibrationConfig> PoseNoiseSection() {
   return {"pose_noise",
           ConfigSectionUse::kSomeMethods,
           {
@@ -32,7 +32,7 @@ ConfigSection PoseNoiseSection() {
           }};
 }
 
-ConfigSection NoiseSection() {
+SectionOf<CalibrationConfig> NoiseSection() {
   return {"noise",
           ConfigSectionUse::kCommand,
           {

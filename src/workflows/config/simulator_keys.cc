@@ -1,102 +1,42 @@
 // Config sections of `gravcal simulate` and `gravcal demo`, never of a
-// calibration method: "simulator" (SimulatorOptions, every sim_* key) and
-// "motion simulator" (sim_motion and MotionOptions, the hh_* keys).
+// calibration method: "simulator" (SimulatorOptions, every sim_* key, made
+// from the options' own table, simulation/simulator_fields.h) and "motion
+// simulator" (sim_motion and MotionOptions, the hh_* keys).
+#include <variant>
+
+#include "simulation/simulator_fields.h"
 #include "workflows/config/config_key.h"
 
 namespace gravcal {
 namespace internal {
 
-ConfigSection SimulatorSection() {
-  return {
-      "simulator",
-      ConfigSectionUse::kCommand,
-      {
-          GRAVCAL_STRING("sim_scheme", simulation.scheme, "six, twelve, ten or random:N"),
-          GRAVCAL_DOUBLE("sim_hold", simulation.hold_seconds, "hold per pose, s"),
-          GRAVCAL_DOUBLE("sim_initial_still", simulation.initial_still_seconds,
-                         "initial still period, s"),
-          GRAVCAL_DOUBLE("sim_rotation_time", simulation.rotation_seconds,
-                         "rotation between poses, s"),
-          GRAVCAL_DOUBLE("sim_sample_rate", simulation.sample_rate, "Hz"),
-          GRAVCAL_DOUBLE("sim_gravity", simulation.gravity, "m/s^2"),
-          GRAVCAL_BOOL("sim_raw_counts", simulation.raw_counts,
-                       "raw output in counts (true) or SI units (false)"),
-          GRAVCAL_DOUBLE("sim_accel_counts_per_g", simulation.accel_counts_per_g,
-                         "accelerometer counts per g"),
-          GRAVCAL_DOUBLE("sim_gyro_counts_per_dps", simulation.gyro_counts_per_dps,
-                         "gyroscope counts per deg/s"),
-          GRAVCAL_DOUBLE("sim_accel_noise", simulation.accel_noise,
-                         "accelerometer white noise per sample, m/s^2"),
-          GRAVCAL_DOUBLE("sim_accel_bias_random_walk", simulation.accel_bias_random_walk,
-                         "m/s^2/sqrt(s)"),
-          GRAVCAL_DOUBLE("sim_gyro_noise", simulation.gyro_noise,
-                         "gyroscope white noise per sample, rad/s"),
-          GRAVCAL_DOUBLE("sim_gyro_bias_random_walk", simulation.gyro_bias_random_walk,
-                         "rad/s/sqrt(s)"),
-          GRAVCAL_DOUBLE("sim_accel_bias", simulation.accel_bias_std,
-                         "truth accelerometer bias spread, m/s^2"),
-          GRAVCAL_DOUBLE("sim_accel_scale", simulation.accel_scale_std,
-                         "truth accelerometer scale error spread (fraction)"),
-          GRAVCAL_DOUBLE("sim_accel_misalignment", simulation.accel_misalignment_std,
-                         "truth accelerometer misalignment spread, rad"),
-          GRAVCAL_DOUBLE("sim_gyro_bias", simulation.gyro_bias_std,
-                         "truth gyroscope bias spread, rad/s"),
-          GRAVCAL_DOUBLE("sim_gyro_scale", simulation.gyro_scale_std,
-                         "truth gyroscope scale error spread (fraction)"),
-          GRAVCAL_DOUBLE("sim_gyro_misalignment", simulation.gyro_misalignment_std,
-                         "truth gyroscope misalignment spread, rad"),
-          GRAVCAL_DOUBLE("sim_placement_error", simulation.placement_error_deg,
-                         "placement error per pose, degrees"),
-          GRAVCAL_DOUBLE("sim_tremor", simulation.tremor,
-                         "hand tremor while still, m/s^2 rms (0 = table)"),
-          GRAVCAL_DOUBLE("sim_pose_disturbance", simulation.pose_disturbance,
-                         "specific-force offset per pose the samples cannot show, m/s^2 per "
-                         "axis (0 = off)"),
-          GRAVCAL_DOUBLE("sim_accel_bias_instability", simulation.accel_bias_instability,
-                         "accelerometer bias instability B, m/s^2 (0 = off)"),
-          GRAVCAL_DOUBLE("sim_gyro_bias_instability", simulation.gyro_bias_instability,
-                         "gyroscope bias instability B, rad/s (0 = off)"),
-          GRAVCAL_DOUBLE("sim_bias_instability_tau_low", simulation.bias_instability_tau_low,
-                         "bias instability flat from this tau, s"),
-          GRAVCAL_DOUBLE("sim_bias_instability_tau_high", simulation.bias_instability_tau_high,
-                         "bias instability flat up to this tau, s"),
-          GRAVCAL_DOUBLE("sim_temperature_start", simulation.temperature_start, "deg C"),
-          GRAVCAL_DOUBLE("sim_temperature_end", simulation.temperature_end, "deg C"),
-          GRAVCAL_DOUBLE("sim_temperature_tau", simulation.temperature_tau,
-                         "warm-up time constant, s"),
-          GRAVCAL_STRING("sim_rotation_profile", simulation.rotation_profile,
-                         "rotations between poses: smooth (fixed axis) or hand (1-4 s, irregular)"),
-          GRAVCAL_DOUBLE("sim_hand_min_rotation", simulation.hand_min_seconds,
-                         "hand profile: shortest rotation, s"),
-          GRAVCAL_DOUBLE("sim_hand_max_rotation", simulation.hand_max_seconds,
-                         "hand profile: longest rotation, s"),
-          GRAVCAL_DOUBLE("sim_hand_wobble", simulation.hand_wobble_deg,
-                         "hand profile: axis wobble, degrees (standard deviation)"),
-          GRAVCAL_DOUBLE("sim_gyro_g_sensitivity", simulation.gyro_g_sensitivity_std,
-                         "truth gyroscope g-sensitivity spread, rad/s per m/s^2"),
-          GRAVCAL_DOUBLE("sim_latitude", simulation.latitude_deg,
-                         "the gyroscope senses Earth rate at this latitude, degrees (null = off)"),
-          GRAVCAL_DOUBLE("sim_attitude_noise", simulation.fixture_attitude_noise_deg,
-                         "noise of the fixture attitudes simulate writes (attitudes.csv), degrees"),
-          GRAVCAL_DOUBLE("sim_accel_quadratic", simulation.accel_quadratic_std,
-                         "truth k2 spread per axis, 1/(m/s^2)"),
-          GRAVCAL_DOUBLE("sim_accel_temperature_bias", simulation.accel_temperature_bias_std,
-                         "truth accelerometer bias tempco spread, m/s^2/degC"),
-          GRAVCAL_DOUBLE("sim_accel_temperature_scale", simulation.accel_temperature_scale_std,
-                         "truth accelerometer scale tempco spread, 1/degC"),
-          GRAVCAL_DOUBLE("sim_accel_bias_drift", simulation.accel_bias_drift_std,
-                         "truth accelerometer bias drift spread, m/s^2/s"),
-          GRAVCAL_DOUBLE("sim_gyro_temperature_bias", simulation.gyro_temperature_bias_std,
-                         "truth gyroscope bias tempco spread, rad/s/degC"),
-          GRAVCAL_DOUBLE("sim_gyro_bias_drift", simulation.gyro_bias_drift_std,
-                         "truth gyroscope bias drift spread, rad/s/s"),
-          GRAVCAL_DOUBLE("sim_effect_reference_temperature",
-                         simulation.effect_reference_temperature,
-                         "temperature at which the simulated temperature terms are zero, degC"),
-      }};
+namespace {
+
+// The handler of one field of SimulatorOptions (simulator_fields.h).
+KeyHandlerOf<SimulationConfig> FieldHandler(const SimulatorField& field) {
+  KeyHandlerOf<SimulationConfig> h;
+  h.name = field.key;
+  h.help = field.help;
+  std::visit(
+      [&h](auto member) {
+        h.set = [member](const YAML::Node& n, SimulationConfig* c, std::string* e) {
+          return ReadValue(n, &(c->simulation.*member), e);
+        };
+        h.get = [member](const SimulationConfig& c) { return ValueText(c.simulation.*member); };
+      },
+      field.member);
+  return h;
 }
 
-ConfigSection MotionSimulatorSection() {
+}  // namespace
+
+SectionOf<SimulationConfig> SimulatorSection() {
+  SectionOf<SimulationConfig> section{"simulator", ConfigSectionUse::kCommand, {}};
+  for (const SimulatorField& field : SimulatorFields()) section.keys.push_back(FieldHandler(field));
+  return section;
+}
+
+SectionOf<SimulationConfig> MotionSimulatorSection() {
   return {
       "motion simulator",
       ConfigSectionUse::kCommand,

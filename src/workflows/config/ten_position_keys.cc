@@ -8,7 +8,7 @@ namespace internal {
 
 namespace {
 
-bool ReadGyroNominalScale(const YAML::Node& n, Config* c, std::string* e) {
+bool ReadGyroNominalScale(const YAML::Node& n, CalibrationConfig* c, std::string* e) {
   double v = 0.0;
   if (!ReadDouble(n, &v, e)) return false;
   c->ten_position.gyro_nominal_scale = v;
@@ -18,7 +18,7 @@ bool ReadGyroNominalScale(const YAML::Node& n, Config* c, std::string* e) {
 
 }  // namespace
 
-ConfigSection AlignmentSection() {
+SectionOf<CalibrationConfig> AlignmentSection() {
   return {"alignment",
           ConfigSectionUse::kSomeMethods,
           {

@@ -132,6 +132,9 @@ std::string RenderHeatMap(const std::string& title, const std::vector<std::strin
 std::string RenderSphere(const std::string& title, const std::vector<Eigen::Vector3d>& directions,
                          const std::vector<std::string>& labels);
 
+// A pixel coordinate with one decimal: enough for the screen, small files.
+std::string Px(double v);
+
 // Colours of the x, y, z axes and a palette for other series.
 extern const char* const kAxisColors[3];
 const char* PaletteColor(int i);

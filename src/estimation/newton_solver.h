@@ -1,4 +1,4 @@
-// gravcal/estimation/newton_solver.h: the seed's hand-written Newton iteration (Chen et
+// estimation/newton_solver.h (private): the seed's hand-written Newton iteration (Chen et
 // al. 2012, section 3.1), no Ceres. The baseline the Ceres refinement is
 // benchmarked against.
 //
@@ -13,8 +13,8 @@
 //
 // Same parameterisation as the refinement: b and the free entries of U; the
 // rotation of the initial model is kept (the magnitude cannot see it).
-#ifndef GRAVCAL_ESTIMATION_NEWTON_SOLVER_H_
-#define GRAVCAL_ESTIMATION_NEWTON_SOLVER_H_
+#ifndef GRAVCAL_SRC_ESTIMATION_NEWTON_SOLVER_H_
+#define GRAVCAL_SRC_ESTIMATION_NEWTON_SOLVER_H_
 
 #include <string>
 #include <vector>
@@ -25,6 +25,7 @@
 #include "gravcal/estimation/refinement.h"
 
 namespace gravcal {
+namespace internal {
 
 struct NewtonOptions {
   AccelParameterization parameterization = AccelParameterization::kScaleMisalignment;
@@ -42,6 +43,7 @@ struct NewtonOptions {
 bool NewtonRefine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
                   const NewtonOptions& options, RefinementResult* result);
 
+}  // namespace internal
 }  // namespace gravcal
 
-#endif  // GRAVCAL_ESTIMATION_NEWTON_SOLVER_H_
+#endif  // GRAVCAL_SRC_ESTIMATION_NEWTON_SOLVER_H_

@@ -1,4 +1,4 @@
-// gravcal/estimation/strapdown.h: strapdown inertial navigation in a local level frame.
+// estimation/strapdown.h (private): strapdown inertial navigation in a local level frame.
 //
 // Frames and units:
 // - body b: the sensor axes (after calibration);
@@ -23,8 +23,8 @@
 //   p_k = p_{k-1} + (v_{k-1} + v_k) dt / 2
 // Sculling (rotation during the step acting on the specific force) and
 // higher-order coning are neglected.
-#ifndef GRAVCAL_ESTIMATION_STRAPDOWN_H_
-#define GRAVCAL_ESTIMATION_STRAPDOWN_H_
+#ifndef GRAVCAL_SRC_ESTIMATION_STRAPDOWN_H_
+#define GRAVCAL_SRC_ESTIMATION_STRAPDOWN_H_
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -34,6 +34,7 @@
 #include "gravcal/core/gravity.h"
 
 namespace gravcal {
+namespace internal {
 
 struct StrapdownOptions {
   // Local gravity, m/s^2.
@@ -106,6 +107,7 @@ class Strapdown {
   Eigen::Vector3d gravity_;
 };
 
+}  // namespace internal
 }  // namespace gravcal
 
-#endif  // GRAVCAL_ESTIMATION_STRAPDOWN_H_
+#endif  // GRAVCAL_SRC_ESTIMATION_STRAPDOWN_H_

@@ -1,0 +1,28 @@
+// gravcal/workflows/simulation_config.h: the simulation part of a Config
+// (config.h): what `gravcal simulate` and `gravcal demo` read. Its config
+// sections are "simulator" (every sim_* key, made from SimulatorOptions'
+// own table) and "motion simulator" (sim_motion and the hh_* keys); no
+// calibration method reads them.
+#ifndef GRAVCAL_WORKFLOWS_SIMULATION_CONFIG_H_
+#define GRAVCAL_WORKFLOWS_SIMULATION_CONFIG_H_
+
+#include <string>
+
+#include "gravcal/simulation/handheld_simulator.h"
+#include "gravcal/simulation/simulator.h"
+
+namespace gravcal {
+
+struct SimulationConfig {
+  // The multi-position simulator (sim_scheme and the other sim_* keys).
+  SimulatorOptions simulation;
+  // Issue 4: the motion simulator used when sim_motion names a profile
+  // (handheld, turntable, vertical, rate_table; empty = the multi-position
+  // scheme).
+  MotionOptions motion;
+  std::string sim_motion;
+};
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_WORKFLOWS_SIMULATION_CONFIG_H_

@@ -1,0 +1,151 @@
+// The command-line flags of the gravcal tool, declared once: GRAVCAL_FLAGS
+// below is the one table. flags.cc turns it into the gflags definitions and
+// into FindFlag's table (help and validation); main.cc binds each command's
+// flags to the fields of its args struct (commands.h) with FlagField.
+#ifndef GRAVCAL_SRC_CLI_FLAGS_H_
+#define GRAVCAL_SRC_CLI_FLAGS_H_
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <type_traits>
+
+#include "gravcal/workflows/fleet_summary.h"
+#include "gravcal/workflows/plan.h"
+
+// X(gflags type, name, default, help), one line per flag.
+#define GRAVCAL_FLAGS(X)                                                                         \
+  X(string, input, "", "raw log to read")                                                        \
+  X(string, output, "", "file to write (calibration JSON or corrected CSV)")                     \
+  X(string, output_dir, "",                                                                      \
+    "folder to write into (simulate: raw.csv, truth.json; batch: results)")                      \
+  X(string, config, "", "YAML config file (configs/*.yaml)")                                     \
+  X(string, calibration, "", "calibration JSON to apply")                                        \
+  X(uint64, seed, 1, "random seed of the simulator")                                             \
+  X(string, manifest, "", "batch: CSV with columns unit, path and optional config keys")         \
+  X(string, input_dir, "", "batch: every file matching --pattern in this folder is a unit")      \
+  X(string, pattern, "*.csv", "batch: file name pattern for --input-dir")                        \
+  X(int32, threads, 0, "batch: worker threads, 0 = one per core")                                \
+  X(string, shard, "",                                                                           \
+    "batch: K/N, calibrate only units i with i mod N = K - 1; auto or auto/N: K and N "          \
+    "from the scheduler's job array (Slurm, Kubernetes, AWS Batch)")                             \
+  X(double, unit_timeout, 0.0,                                                                   \
+    "batch: seconds one unit may take; a unit over it fails with a message and the "             \
+    "batch goes on (0 = no limit)")                                                              \
+  X(double, outlier_sigmas, gravcal::FleetOptions().outlier_sigmas,                              \
+    "batch: outlier threshold, robust standard deviations from the fleet median")                \
+  X(int32, outlier_min_units, gravcal::FleetOptions().min_units,                                 \
+    "batch: fewest calibrated units for the outlier check")                                      \
+  X(string, attitudes, "",                                                                       \
+    "CSV of each static position's roll and pitch (methods that need the fixture's "             \
+    "attitudes)")                                                                                \
+  X(string, segments, "",                                                                        \
+    "CSV of the constant-rate segments, t_begin, t_end, rates (methods that need a rate "        \
+    "table)")                                                                                    \
+  X(string, history, "", "calibrate: write the estimates' time history (CSV) here")              \
+  X(string, report, "", "HTML report to write (calibrate, batch, noise, discover)")              \
+  X(string, kalibr, "", "noise: also write Kalibr's imu.yaml (continuous-time densities) here")  \
+  X(string, handheld, "", "noise: also write the handheld filter's hk_* noise keys (YAML) here") \
+  X(string, topics, "",                                                                          \
+    "batch: 'all' makes one unit per sensor_msgs/Imu topic of the bag --input")                  \
+  X(string, noise, "",                                                                           \
+    "noise.json from 'gravcal noise': the variance of each pose's mean, and the "                \
+    "handheld filter's noise, from the noise model")                                             \
+  X(string, target, "",                                                                          \
+    "plan, check: targets, e.g. \"accel_bias=0.5mg accel_scale=50ppm "                           \
+    "accel_misalignment=0.1mrad\" (or parameter names bias_x ... u_zz)")                         \
+  X(string, pose_set, gravcal::PlanRequest().pose_set,                                           \
+    "plan, check: candidate orientations: faces, faces+45 or free")                              \
+  X(int32, candidates, gravcal::PlanRequest().free_candidates,                                   \
+    "plan, check: directions of the free pose set (besides faces+45)")                           \
+  X(double, max_time, 0.0, "plan: the session may not take longer, seconds (0 = no limit)")      \
+  X(double, overhead, gravcal::PlanRequest().overhead_seconds,                                   \
+    "plan: seconds to move and settle the housing before each pose")                             \
+  X(double, min_hold, gravcal::PlanRequest().min_hold_seconds, "plan: shortest hold, s")         \
+  X(double, max_hold, gravcal::PlanRequest().max_hold_seconds, "plan: longest hold, s")          \
+  X(double, accel_noise_density, 0.0,                                                            \
+    "plan, check: accelerometer white noise N, m/s^2/sqrt(Hz) (datasheet; instead of "           \
+    "--noise)")                                                                                  \
+  X(double, accel_bias_instability, 0.0, "plan, check: accelerometer bias instability B, m/s^2") \
+  X(double, accel_random_walk, 0.0, "plan, check: accelerometer random walk K, m/s^3/sqrt(Hz)")  \
+  X(double, pose_disturbance, 0.0,                                                               \
+    "plan, check: per-pose disturbance of |a|, m/s^2 rms (0 = none)")                            \
+  X(double, gyro_noise_density, 0.0,                                                             \
+    "plan: gyroscope white noise N, rad/s/sqrt(Hz) (datasheet; instead of --noise): "            \
+    "plans the turns between poses for the gyroscope")                                           \
+  X(double, attitude_std, 0.0,                                                                   \
+    "plan (method known_attitude): the fixture's roll and pitch standard deviation, "            \
+    "degrees")                                                                                   \
+  X(bool, check, false,                                                                          \
+    "calibrate: add what the session lacks (as gravcal check says it) to the output "            \
+    "and the calibration JSON ('check')")                                                        \
+  X(double, turn_seconds, gravcal::PlanRequest().turn_seconds,                                   \
+    "plan: seconds a half turn takes (shorter turns proportionally less)")                       \
+  X(string, plan, "", "simulate: plan.json from gravcal plan (its poses replace sim_scheme)")    \
+  X(double, level, 0.01,                                                                         \
+    "compare, verify, history, plan --verify: significance level of the test")                   \
+  X(string, space, "model",                                                                      \
+    "compare: model (the calibrations' own parameters, same mounting) or intrinsic "             \
+    "(mount-invariant, Geist and Gaitan)")                                                       \
+  X(string, limits, "", "calibrate, batch: acceptance limits (YAML); exit 4 when one fails")     \
+  X(string, certificate, "",                                                                     \
+    "calibrate: write the calibration certificate to <prefix>.json and <prefix>.html")           \
+  X(string, unit, "",                                                                            \
+    "calibrate: the unit's name on the certificate and in the store (default: the log's name)")  \
+  X(string, store, "",                                                                           \
+    "calibrate: file the calibration in this store (a folder, per unit and date); "              \
+    "history: the store to read")                                                                \
+  X(string, verify, "",                                                                          \
+    "plan: design the shortest check session for this stored calibration (JSON) "                \
+    "instead: four poses, detecting 10 stored sigmas in any one parameter with power "           \
+    "0.9 at --level (needs --accel_noise_density)")                                              \
+  X(string, to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)")
+
+namespace gravcal {
+namespace cli {
+
+struct FlagInfo {
+  const char* name;
+  const char* help;
+};
+
+// The flag of GRAVCAL_FLAGS named `name` ("output_dir"); null when none.
+const FlagInfo* FindFlag(const std::string& name);
+
+// The flag's value after gflags parsed the command line, as text.
+std::string FlagText(const char* name);
+
+// Text to value, for the types of GRAVCAL_FLAGS (gflags checked the text).
+void ParseFlagText(const std::string& text, std::string* value);
+void ParseFlagText(const std::string& text, bool* value);
+void ParseFlagText(const std::string& text, int* value);
+void ParseFlagText(const std::string& text, uint64_t* value);
+void ParseFlagText(const std::string& text, double* value);
+
+// A command's use of one flag: its name, and where its value goes in the
+// command's args struct.
+template <typename Args>
+struct FlagBinding {
+  const char* name;
+  std::function<void(const std::string& text, Args* args)> set;
+};
+
+// The flag `name` into the field `field` of Args (or of its base).
+template <typename Args, typename Class, typename T>
+FlagBinding<Args> FlagField(const char* name, T Class::*field) {
+  static_assert(std::is_base_of_v<Class, Args>, "the field is not one of the args struct");
+  return {name,
+          [field](const std::string& text, Args* args) { ParseFlagText(text, &(args->*field)); }};
+}
+
+// The flag `name` into the field that `at` returns a pointer to (a field of
+// a nested struct: &args->request.targets).
+template <typename Args, typename At>
+FlagBinding<Args> FlagAt(const char* name, At at) {
+  return {name, [at](const std::string& text, Args* args) { ParseFlagText(text, at(args)); }};
+}
+
+}  // namespace cli
+}  // namespace gravcal
+
+#endif  // GRAVCAL_SRC_CLI_FLAGS_H_

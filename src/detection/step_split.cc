@@ -1,0 +1,205 @@
+// Splitting at steps in the accelerometer level (static_detector.h): a
+// still run whose level jumps between two holds (SplitRunsAtSteps), and an
+// interval whose spread says it is not one pose (SplitOrFlagSpread)
+// (detection/static_detector_internal.h).
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "detection/static_detector_internal.h"
+#include "util/units.h"
+
+namespace gravcal {
+namespace internal {
+namespace {
+
+// Prefix sums over one run for the line fits of SplitRunAtSteps: of x - r,
+// j (x - r) and |x - r|^2 per axis, j the sample's index in the run and r
+// its first sample (small magnitudes: no cancellation with raw counts).
+struct LinePrefix {
+  std::vector<Eigen::Vector3d> s0, s1, s2;
+  LinePrefix(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end) {
+    const size_t n = end - begin;
+    s0.assign(n + 1, Eigen::Vector3d::Zero());
+    s1 = s0;
+    s2 = s0;
+    const Eigen::Vector3d r = x[begin];
+    for (size_t j = 0; j < n; ++j) {
+      const Eigen::Vector3d d = x[begin + j] - r;
+      s0[j + 1] = s0[j] + d;
+      s1[j + 1] = s1[j] + static_cast<double>(j) * d;
+      s2[j + 1] = s2[j] + d.cwiseProduct(d);
+    }
+  }
+  // The line fitted to run samples [a, a + len): its value at local position
+  // t (0 = sample a) and its residual variance summed over the axes; the
+  // samples' mean and variance about it.
+  void Fit(size_t a, size_t len, double t, Eigen::Vector3d* value, double* residual,
+           Eigen::Vector3d* mean, double* variance) const {
+    const double n = static_cast<double>(len);
+    const Eigen::Vector3d sx = s0[a + len] - s0[a];
+    const Eigen::Vector3d sjx = s1[a + len] - s1[a] - static_cast<double>(a) * sx;
+    const Eigen::Vector3d sxx = s2[a + len] - s2[a];
+    const double mean_j = 0.5 * (n - 1.0);
+    const double sjj = n * (n * n - 1.0) / 12.0;
+    const Eigen::Vector3d slope = (sjx - mean_j * sx) / sjj;
+    *value = sx / n + slope * (t - mean_j);
+    const double rss = (sxx - sx.cwiseProduct(sx) / n - slope.cwiseProduct(slope) * sjj).sum();
+    *residual = std::max(rss, 0.0) / std::max(n - 2.0, 1.0);
+    *mean = sx / n;
+    *variance = std::max((sxx - sx.cwiseProduct(sx) / n).sum(), 0.0) / std::max(n - 1.0, 1.0);
+  }
+};
+
+// Splits the still run [begin, end) at steps in the level of `x` (top of
+// static_detector.h): lines on the w samples either side of each sample,
+// the step statistic T, recursively at its maximum while it is above
+// step_factor and the levels are step_min_deg apart (the accelerometer) or,
+// with min_change2 > 0 (the gyroscope, whose still level is near zero and
+// has no direction), |b - a|^2 >= min_change2 apart. `floor` (the noise
+// floor, summed over the axes) bounds the residual variances from below
+// (quantised data can fit a line exactly). Appends the parts.
+void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& prefix, size_t base,
+                     size_t begin, size_t end, size_t w, double floor, double min_change2,
+                     const StaticDetectorOptions& options, std::vector<QuietRun>* parts) {
+  if (end - begin < 2 * w) {
+    parts->push_back({begin, end});
+    return;
+  }
+  const double len = static_cast<double>(w);
+  const double c = (4.0 * len - 2.0) / (len * (len + 1.0));
+  const double min_cos = std::cos(options.step_min_deg * internal::kDegToRad);
+  const Eigen::Vector3d r = x[base];
+  double best = options.step_factor;
+  size_t split = 0;
+  for (size_t s = begin + w; s + w <= end; ++s) {
+    Eigen::Vector3d left, right, m1, m2;
+    double r1, r2, v1, v2;
+    prefix.Fit(s - w - base, w, len - 0.5, &left, &r1, &m1, &v1);
+    prefix.Fit(s - base, w, -0.5, &right, &r2, &m2, &v2);
+    const double t_line =
+        (right - left).squaredNorm() / (c * (std::max(r1, floor) + std::max(r2, floor)));
+    const double t_mean =
+        (m2 - m1).squaredNorm() * len / (std::max(v1, floor) + std::max(v2, floor));
+    const double t = std::min(t_line, t_mean);
+    if (!(t > best)) continue;
+    const Eigen::Vector3d a = left + r, b = right + r;
+    if (min_change2 > 0.0 ? (b - a).squaredNorm() < min_change2
+                          : a.dot(b) > min_cos * a.norm() * b.norm()) {
+      continue;
+    }
+    best = t;
+    split = s;
+  }
+  if (split == 0) {
+    parts->push_back({begin, end});
+    return;
+  }
+  SplitRunAtSteps(x, prefix, base, begin, split, w, floor, min_change2, options, parts);
+  SplitRunAtSteps(x, prefix, base, split, end, w, floor, min_change2, options, parts);
+}
+
+}  // namespace
+
+// Every run split at the steps of `x` (SplitRunAtSteps). Returns the number
+// of steps found.
+size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double floor,
+                        double min_change2, const StaticDetectorOptions& options,
+                        std::vector<QuietRun>* runs) {
+  if (options.step_factor <= 0.0) return 0;
+  std::vector<QuietRun> out;
+  for (const QuietRun& run : *runs) {
+    if (run.end - run.begin < 2 * w) {
+      out.push_back(run);
+      continue;
+    }
+    const LinePrefix prefix(x, run.begin, run.end);
+    SplitRunAtSteps(x, prefix, run.begin, run.begin, run.end, w, floor, min_change2, options, &out);
+  }
+  const size_t steps = out.size() - runs->size();
+  *runs = std::move(out);
+  return steps;
+}
+
+namespace {
+
+// Splits samples [begin, end) at steps in the accelerometer mean until every
+// part's variance (summed over the axes) is within `max_var`: at the split
+// point s maximising n1 n2 / n |m1 - m2|^2 (the between-part sum of squares).
+// Parts shorter than min_count are dropped (the few samples a run reaches
+// across a step). Appends the parts' [begin, end) to *parts and returns
+// true, or returns false (and *parts is unspecified) when a part above
+// max_var cannot be split into parts within it: a drift, not steps.
+bool SplitAtSteps(const ImuLog& log, size_t begin, size_t end, double max_var, size_t min_count,
+                  std::vector<QuietRun>* parts) {
+  if (end - begin < min_count) return true;
+  const StaticInterval whole = MakeInterval(log, begin, end);
+  if (whole.accel_cov.trace() <= max_var) {
+    parts->push_back({begin, end});
+    return true;
+  }
+  if (end - begin < 2) return false;
+  // Prefix sums of deviations from the first sample.
+  const Eigen::Vector3d r = log.accel[begin];
+  std::vector<Eigen::Vector3d> prefix(end - begin + 1, Eigen::Vector3d::Zero());
+  for (size_t i = begin; i < end; ++i) prefix[i - begin + 1] = prefix[i - begin] + log.accel[i] - r;
+  const double n = static_cast<double>(end - begin);
+  double best = -1.0;
+  size_t split = begin + 1;
+  for (size_t s = begin + 1; s < end; ++s) {
+    const double n1 = static_cast<double>(s - begin);
+    const double n2 = n - n1;
+    const Eigen::Vector3d m1 = prefix[s - begin] / n1;
+    const Eigen::Vector3d m2 = (prefix.back() - prefix[s - begin]) / n2;
+    const double between = n1 * n2 / n * (m2 - m1).squaredNorm();
+    if (between > best) {
+      best = between;
+      split = s;
+    }
+  }
+  // A split that leaves no part long enough cannot bring this part within.
+  if (split - begin < min_count && end - split < min_count) return false;
+  return SplitAtSteps(log, begin, split, max_var, min_count, parts) &&
+         SplitAtSteps(log, split, end, max_var, min_count, parts);
+}
+
+}  // namespace
+
+// Each interval whose variance is above spread_factor times the noise floor
+// is split at its steps (SplitAtSteps) or, when it cannot be, kept and named
+// in detection->warnings. Returns the number of intervals split.
+size_t SplitOrFlagSpread(const ImuLog& log, size_t min_count, const StaticDetectorOptions& options,
+                         StaticDetection* detection) {
+  if (options.spread_factor <= 0.0) return 0;
+  const double max_var = options.spread_factor * detection->accel_noise_floor;
+  std::vector<StaticInterval> out;
+  size_t split = 0;
+  for (const StaticInterval& s : detection->intervals) {
+    const double spread = s.accel_cov.trace();
+    if (spread <= max_var) {
+      out.push_back(s);
+      continue;
+    }
+    std::vector<QuietRun> parts;
+    if (SplitAtSteps(log, s.begin, s.end, max_var, min_count, &parts)) {
+      for (const QuietRun& p : parts) out.push_back(MakeInterval(log, p.begin, p.end));
+      ++split;
+      continue;
+    }
+    out.push_back(s);
+    detection->warnings.push_back(
+        "the position at t " + DetectorNumber(s.t_begin) + "-" + DetectorNumber(s.t_end) +
+        " s (samples " + std::to_string(s.begin) + "-" + std::to_string(s.end) +
+        ") is not one still pose: its " + "spread is " +
+        DetectorNumber(std::sqrt(spread / detection->accel_noise_floor)) +
+        " times the noise (standard deviations) and it is no set of steps between still "
+        "levels: a slow motion or drift; hold the pose still, or drop it");
+  }
+  detection->intervals = std::move(out);
+  return split;
+}
+
+}  // namespace internal
+}  // namespace gravcal
