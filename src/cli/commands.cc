@@ -14,6 +14,7 @@
 #include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/pipeline.h"
 #include "gravcal/workflows/report.h"
 #include "gravcal/workflows/simulation_workflow.h"
@@ -109,6 +110,12 @@ int RunCalibrate(const CalibrateArgs& args) {
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
+  // --history only for a method that keeps one, said before the work.
+  const CalibrationMethod* method = FindCalibrationMethod(args.config.method);
+  if (!args.history.empty() && method != nullptr && !method->keeps_history) {
+    return Fail("--history: method '" + args.config.method +
+                "' keeps no estimate history (handheld_kalman does)");
+  }
   // The log is read once: its provenance hash comes from the same bytes.
   Session session;
   CalibrationProvenance provenance;
@@ -142,10 +149,11 @@ int RunCalibrate(const CalibrateArgs& args) {
   std::vector<FileContents> outputs;
   if (!args.history.empty()) {
     outputs.push_back({args.history, ""});
-    if (!HistoryToCsv(c, &outputs.back().contents, &error)) return Fail(args.history + ": " + error);
+    if (!HistoryToCsv(c, &outputs.back().contents, &error))
+      return Fail(args.history + ": " + error);
   }
-  const std::string json = CalibrationToJson(c, args.config.output_covariance,
-                                             CalibrationCheckSections(args, session));
+  const std::string json =
+      CalibrationToJson(c, args.config.output_covariance, CalibrationCheckSections(args, session));
   if (args.output != "-") outputs.push_back({args.output, json});
   if (!WriteFilesAtomically(outputs, &error) ||
       (args.output == "-" && !WriteOutput(args.output, json, &error))) {
