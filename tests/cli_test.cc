@@ -290,9 +290,14 @@ TEST_F(CliTest, HandheldKalmanWritesCalibrationAndHistory) {
   r = Run("calibrate --input " + Simulated() + " --config " + Config() + " --output " + calib2 +
           " --history " + history2);
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(OneLine(r).find("no time history"), std::string::npos) << r.err;
+  EXPECT_NE(OneLine(r).find("keeps no estimate history"), std::string::npos) << r.err;
   EXPECT_FALSE(Exists(calib2));
   EXPECT_FALSE(Exists(history2));
+  // ... said before any work: before the log is even read.
+  r = Run("calibrate --input " + dir_ + "/no_such_log.csv --config " + Config() + " --output " +
+          calib2 + " --history " + history2);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(OneLine(r).find("--history: method"), std::string::npos) << r.err;
   // A history that cannot be written: no calibration file either.
   r = Run("calibrate --input " + sim + "/raw.csv --config " + config + scales + "--output " +
           calib2 + " --history " + dir_ + "/missing/history.csv");

@@ -72,6 +72,20 @@ TEST(Config, UnknownKeyNamesFileLineAndKey) {
   EXPECT_EQ(error.find('\n'), std::string::npos) << "one line: " << error;
 }
 
+// A key with nothing after it ('gravity:') was read as a null and failed
+// later in validation, with a message naming neither the file nor the line.
+TEST(Config, AKeyWithNoValueNamesFileLineAndKey) {
+  for (const std::string key : {"gravity", "loss", "method", "effects"}) {
+    Config config;
+    const std::string before = ConfigValueText(config, "gravity");
+    std::string error;
+    EXPECT_FALSE(LoadConfigText("gravity: 9.8\n" + key + ":\n", "c.yaml", &config, &error));
+    EXPECT_NE(error.find("c.yaml:2"), std::string::npos) << error;
+    EXPECT_NE(error.find("'" + key + "' has no value"), std::string::npos) << error;
+    EXPECT_EQ(ConfigValueText(config, "gravity"), before) << "the config is left unchanged";
+  }
+}
+
 TEST(Config, WrongTypeOrBadEnumNamesTheKeyAndLeavesConfigUnchanged) {
   Config config;
   const std::string before = ConfigValueText(config, "gravity");

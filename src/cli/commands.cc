@@ -14,6 +14,7 @@
 #include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/pipeline.h"
 #include "gravcal/workflows/report.h"
 #include "gravcal/workflows/simulation_workflow.h"
@@ -110,6 +111,12 @@ int RunCalibrate(const CalibrateArgs& args) {
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
   if (!CheckLimitsFile(args.limits, &error)) return Fail(error);
+  // --history only for a method that keeps one, said before the work.
+  const CalibrationMethod* method = FindCalibrationMethod(args.config.method);
+  if (!args.history.empty() && method != nullptr && !method->keeps_history) {
+    return Fail("--history: method '" + args.config.method +
+                "' keeps no estimate history (handheld_kalman does)");
+  }
   // The log is read once: its provenance hash comes from the same bytes.
   Session session;
   CalibrationProvenance provenance;

@@ -370,7 +370,9 @@ bool LoadConfigText(const std::string& text, const std::string& name, Config* co
   for (const auto& kv : root) {
     std::string what;
     const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "?";
-    if (!SetNode(key, kv.second, &updated, &what)) {
+    // 'gravity:' with nothing after it is a value forgotten, not a default.
+    if (kv.second.IsNull()) what = "key '" + key + "' has no value (give one, or remove the line)";
+    if (!what.empty() || !SetNode(key, kv.second, &updated, &what)) {
       std::ostringstream s;
       s << name << ":" << kv.first.Mark().line + 1 << ": " << what;
       *error = s.str();

@@ -51,6 +51,9 @@ struct CalibrationMethod {
   // What the method does with a noise model (--noise), for help and notes;
   // empty = it uses none, and giving one is an error.
   std::string noise_model;
+  // Whether the method keeps an estimate history (Calibration::history,
+  // calibrate --history): checked before the method runs.
+  bool keeps_history = false;
 };
 
 // Every method, in the order help lists them.
