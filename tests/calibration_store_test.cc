@@ -93,6 +93,24 @@ TEST(CalibrationStore, HistoryFindsAPlantedDriftAndOnlyIt) {
   EXPECT_NE(error.find("nobody"), std::string::npos);
 }
 
+// Two filings of one unit within the same second: both are kept, each in
+// its own file (the second used to replace the first).
+TEST(CalibrationStore, TwoFilingsInOneSecondAreBothKept) {
+  ScratchDir dir;
+  const std::string store = dir / "store";
+  std::string error;
+  const std::string first = StoredCalibration(0.05, 1, nullptr);
+  const std::string second = StoredCalibration(0.06, 2, nullptr);
+  ASSERT_TRUE(FileCalibration(store, "u1", kDates[0], first, &error)) << error;
+  ASSERT_TRUE(FileCalibration(store, "u1", kDates[0], second, &error)) << error;
+  std::vector<StoreEntry> entries;
+  ASSERT_TRUE(ReadStoreIndex(store, &entries, &error)) << error;
+  ASSERT_EQ(entries.size(), 2u);
+  EXPECT_NE(entries[0].file, entries[1].file);
+  EXPECT_EQ(testing_util::Slurp(store + "/" + entries[0].file), first);
+  EXPECT_EQ(testing_util::Slurp(store + "/" + entries[1].file), second);
+}
+
 TEST(CalibrationStore, BadNamesDatesAndIndexAreRefused) {
   ScratchDir dir;
   const std::string store = dir / "store";
