@@ -122,7 +122,7 @@ TEST(CalibrationStore, BadNamesDatesAndIndexAreRefused) {
   EXPECT_NE(error.find("date"), std::string::npos);
   EXPECT_FALSE(FileCalibration(store, "u1", kDates[0], "not json", &error));
   ASSERT_TRUE(FileCalibration(store, "u1", kDates[0], cal, &error)) << error;
-  // Filing the same unit and date again replaces it.
+  // Filing the same calibration of a unit and date again keeps one entry.
   ASSERT_TRUE(FileCalibration(store, "u1", kDates[0], cal, &error)) << error;
   std::vector<StoreEntry> entries;
   ASSERT_TRUE(ReadStoreIndex(store, &entries, &error));

@@ -77,12 +77,12 @@ TEST(Config, UnknownKeyNamesFileLineAndKey) {
 TEST(Config, AKeyWithNoValueNamesFileLineAndKey) {
   for (const std::string key : {"gravity", "loss", "method", "effects"}) {
     Config config;
-    const std::string before = ConfigValueText(config, "gravity");
+    const std::string before = ConfigValueText(config, "nominal_scale");
     std::string error;
-    EXPECT_FALSE(LoadConfigText("gravity: 9.8\n" + key + ":\n", "c.yaml", &config, &error));
+    EXPECT_FALSE(LoadConfigText("nominal_scale: 2.0\n" + key + ":\n", "c.yaml", &config, &error));
     EXPECT_NE(error.find("c.yaml:2"), std::string::npos) << error;
     EXPECT_NE(error.find("'" + key + "' has no value"), std::string::npos) << error;
-    EXPECT_EQ(ConfigValueText(config, "gravity"), before) << "the config is left unchanged";
+    EXPECT_EQ(ConfigValueText(config, "nominal_scale"), before) << "the config is left unchanged";
   }
 }
 

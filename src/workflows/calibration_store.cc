@@ -142,13 +142,19 @@ bool FileCalibration(const std::string& store, const std::string& unit, const st
   StoreEntry entry;
   entry.unit = unit;
   entry.date = date;
-  // Two filings within one second get their own files (stem, stem-2, ...):
-  // a calibration filed is never replaced by a later one.
+  // Two different calibrations filed within one second get their own files
+  // (stem, stem-2, ...): a calibration filed is never replaced by another.
+  // The same calibration filed again stays one entry.
   const std::string stem = unit + "/" + FileStem(date);
   entry.file = stem + ".json";
-  for (int k = 2; std::any_of(entries.begin(), entries.end(),
-                              [&](const StoreEntry& e) { return e.file == entry.file; });
-       ++k) {
+  for (int k = 2;; ++k) {
+    const bool taken = std::any_of(entries.begin(), entries.end(),
+                                   [&](const StoreEntry& e) { return e.file == entry.file; });
+    std::string stored, ignored;
+    if (!taken || (ReadFileBytes(store + "/" + entry.file, &stored, &ignored) &&
+                   stored == calibration_json)) {
+      break;
+    }
     entry.file = stem + "-" + std::to_string(k) + ".json";
   }
   if (cal.contains("method") && cal["method"].is_string()) entry.method = cal["method"];
@@ -157,6 +163,9 @@ bool FileCalibration(const std::string& store, const std::string& unit, const st
     entry.log_hash = cal["provenance"]["log_hash"];
   }
   if (!WriteFileAtomically(store + "/" + entry.file, calibration_json, error)) return false;
+  entries.erase(std::remove_if(entries.begin(), entries.end(),
+                               [&](const StoreEntry& e) { return e.file == entry.file; }),
+                entries.end());
   entries.push_back(entry);
   nlohmann::ordered_json index;
   index["calibrations"] = nlohmann::ordered_json::array();
