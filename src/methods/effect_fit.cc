@@ -94,6 +94,20 @@ void WeightRowsByLoss(const std::vector<int>& block_rows, const EffectFitOptions
   }
 }
 
+ceres::Problem::Options ProblemKeepingOwnership() {
+  ceres::Problem::Options keep;
+  keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  keep.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return keep;
+}
+
+std::unique_ptr<ceres::LossFunctionWrapper> GraduatedLoss(const EffectFitOptions& options,
+                                                          double first_scale) {
+  if (options.loss == LossType::kNone) return nullptr;
+  return std::make_unique<ceres::LossFunctionWrapper>(MakeLoss(options.loss, first_scale),
+                                                      ceres::TAKE_OWNERSHIP);
+}
+
 }  // namespace internal
 
 namespace {

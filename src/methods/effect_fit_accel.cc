@@ -323,15 +323,9 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   const std::vector<double> scales = internal::GraduatedLossScales(
       options.loss, options.loss_scale,
       options.loss == LossType::kNone ? 0.0 : LargestBlockNorm(residuals, params));
-  ceres::Problem::Options keep;
-  keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  keep.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(keep);
-  std::unique_ptr<ceres::LossFunctionWrapper> loss;
-  if (options.loss != LossType::kNone) {
-    loss = std::make_unique<ceres::LossFunctionWrapper>(
-        internal::MakeLoss(options.loss, scales.back()), ceres::TAKE_OWNERSHIP);
-  }
+  ceres::Problem problem(internal::ProblemKeepingOwnership());
+  std::unique_ptr<ceres::LossFunctionWrapper> loss =
+      internal::GraduatedLoss(options, scales.back());
   int num_rows = 0, trend_rows = 0, rotation_rows_count = 0;
   for (const AccelBlock& b : residuals) {
     if (b.rotation) {

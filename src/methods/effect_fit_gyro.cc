@@ -110,15 +110,8 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
     }
   }
   const std::vector<double> scales = GraduatedLossScales(options.loss, options.loss_scale, largest);
-  ceres::Problem::Options keep;
-  keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  keep.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(keep);
-  std::unique_ptr<ceres::LossFunctionWrapper> loss;
-  if (options.loss != LossType::kNone) {
-    loss = std::make_unique<ceres::LossFunctionWrapper>(MakeLoss(options.loss, scales.back()),
-                                                        ceres::TAKE_OWNERSHIP);
-  }
+  ceres::Problem problem(ProblemKeepingOwnership());
+  std::unique_ptr<ceres::LossFunctionWrapper> loss = GraduatedLoss(options, scales.back());
   for (const auto& cost : owned) {
     problem.AddResidualBlock(cost.get(), loss.get(), bias, g, temperature_bias, drift);
   }

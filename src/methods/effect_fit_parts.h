@@ -9,6 +9,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "gravcal/methods/effect_fit.h"
@@ -44,6 +45,14 @@ Eigen::Matrix3d InverseCholesky(const Eigen::Matrix3d& covariance);
 // the covariance counts a block the loss set aside as the solve did.
 void WeightRowsByLoss(const std::vector<int>& block_rows, const EffectFitOptions& options,
                       Eigen::MatrixXd* jacobian, Eigen::VectorXd* residual_rows);
+
+// A problem that owns neither its cost functions nor its loss (the fit keeps
+// them to evaluate again), and the loss of a graduated solve at its first
+// scale: options.loss at first_scale behind a wrapper whose scale the
+// later steps of the solve lower; nullptr with no loss.
+ceres::Problem::Options ProblemKeepingOwnership();
+std::unique_ptr<ceres::LossFunctionWrapper> GraduatedLoss(const EffectFitOptions& options,
+                                                          double first_scale);
 
 // The accelerometer part, in normalised raw units (normalization.h), with
 // `extra_variance` added to every magnitude's sigma_k^2; the whitened
