@@ -10,9 +10,13 @@
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/batch_folder.h"
 #include "gravcal/workflows/batch_manifest.h"
-#include "gravcal/workflows/batch_scheduler_shard.h"
+#include "workflows/batch_scheduler_shard.h"
 
 namespace gravcal {
+
+using internal::IsSchedulerShard;
+using internal::ProcessEnvironment;
+using internal::ShardFromScheduler;
 namespace python {
 namespace {
 

@@ -1,7 +1,7 @@
 // Issue 20: --shard auto takes K/N from the scheduler's job array (Slurm,
 // Kubernetes Indexed Jobs, AWS Batch); the same fleet run as N processes
 // with those variables set and merged equals one run.
-#include "gravcal/workflows/batch_scheduler_shard.h"
+#include "workflows/batch_scheduler_shard.h"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
@@ -19,6 +19,9 @@
 #include "test_util.h"
 
 namespace gravcal {
+
+using internal::EnvironmentLookup;
+using internal::ShardFromScheduler;
 namespace {
 
 using Env = std::map<std::string, std::string>;

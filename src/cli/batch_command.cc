@@ -10,10 +10,14 @@
 
 #include "cli/commands.h"
 #include "gravcal/workflows/batch_folder.h"
-#include "gravcal/workflows/batch_scheduler_shard.h"
 #include "util/error.h"
+#include "workflows/batch_scheduler_shard.h"
 
 namespace gravcal {
+
+using internal::IsSchedulerShard;
+using internal::ProcessEnvironment;
+using internal::ShardFromScheduler;
 namespace cli {
 namespace {
 

@@ -1,9 +1,10 @@
-#include "gravcal/workflows/batch_scheduler_shard.h"
+#include "workflows/batch_scheduler_shard.h"
 
 #include <cstdlib>
 #include <vector>
 
 namespace gravcal {
+namespace internal {
 namespace {
 
 // A whole decimal number of at most 9 digits.
@@ -163,4 +164,5 @@ EnvironmentLookup ProcessEnvironment() {
   };
 }
 
+}  // namespace internal
 }  // namespace gravcal

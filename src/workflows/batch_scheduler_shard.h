@@ -1,4 +1,4 @@
-// gravcal/workflows/batch_scheduler_shard.h: a batch's shard (K/N) from the
+// workflows/batch_scheduler_shard.h (private): a batch's shard (K/N) from the
 // job array of the cluster scheduler that started the process.
 //
 // `--shard auto` (or `auto/N`) asks for this. Each scheduler names the
@@ -13,8 +13,8 @@
 //               AWS_BATCH_JOB_ARRAY_SIZE (the job definition sets it).
 // It is an error when none is set, when N is unknown, when K is outside
 // 1..N, and when two of them (or `auto/N`) disagree.
-#ifndef GRAVCAL_WORKFLOWS_BATCH_SCHEDULER_SHARD_H_
-#define GRAVCAL_WORKFLOWS_BATCH_SCHEDULER_SHARD_H_
+#ifndef GRAVCAL_SRC_WORKFLOWS_BATCH_SCHEDULER_SHARD_H_
+#define GRAVCAL_SRC_WORKFLOWS_BATCH_SCHEDULER_SHARD_H_
 
 #include <functional>
 #include <string>
@@ -22,6 +22,7 @@
 #include "gravcal/workflows/batch_manifest.h"
 
 namespace gravcal {
+namespace internal {
 
 // An environment variable's value; false when it is not set.
 using EnvironmentLookup = std::function<bool(const std::string& name, std::string* value)>;
@@ -38,6 +39,7 @@ bool ShardFromScheduler(const std::string& text, const EnvironmentLookup& enviro
 // The process's environment (getenv).
 EnvironmentLookup ProcessEnvironment();
 
+}  // namespace internal
 }  // namespace gravcal
 
-#endif  // GRAVCAL_WORKFLOWS_BATCH_SCHEDULER_SHARD_H_
+#endif  // GRAVCAL_SRC_WORKFLOWS_BATCH_SCHEDULER_SHARD_H_
