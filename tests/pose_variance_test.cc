@@ -36,8 +36,8 @@ AccelModel RandomScaleSensor(std::mt19937_64* rng, double misalignment) {
 }
 
 // `copies` times the twelve directions, each pose disturbed by `disturbance`.
-std::vector<Position> Session(const AccelModel& truth, int copies, double disturbance,
-                              std::mt19937_64* rng) {
+std::vector<Position> PoseSession(const AccelModel& truth, int copies, double disturbance,
+                                  std::mt19937_64* rng) {
   std::vector<Eigen::Vector3d> directions;
   for (int i = 0; i < copies; ++i) {
     for (const Eigen::Vector3d& d : testing_util::TwelveDirections()) directions.push_back(d);
@@ -82,7 +82,7 @@ TEST(PoseVariance, HonestSigmasWithPerPoseDisturbances) {
   for (int seed = 0; seed < seeds; ++seed) {
     std::mt19937_64 rng(7000 + seed);
     const AccelModel truth = RandomScaleSensor(&rng, 0.0);
-    const std::vector<Position> positions = Session(truth, 2, kDisturbance, &rng);
+    const std::vector<Position> positions = PoseSession(truth, 2, kDisturbance, &rng);
     Calibration c, w;
     ASSERT_TRUE(CalibrateFromPositions(positions, ScaleOptions(true), &c)) << c.message;
     ASSERT_TRUE(CalibrateFromPositions(positions, ScaleOptions(false), &w)) << w.message;
@@ -120,7 +120,7 @@ TEST(PoseVariance, WhiteNoiseSessionsAreMostlyUnchanged) {
   for (int seed = 0; seed < 50; ++seed) {
     std::mt19937_64 rng(9000 + seed);
     const AccelModel truth = RandomScaleSensor(&rng, 0.0);
-    const std::vector<Position> positions = Session(truth, 1, 0.0, &rng);
+    const std::vector<Position> positions = PoseSession(truth, 1, 0.0, &rng);
     Calibration c;
     ASSERT_TRUE(CalibrateFromPositions(positions, ScaleOptions(true), &c)) << c.message;
     if (c.accel.pose_variance.at_boundary) ++boundary;
@@ -134,7 +134,7 @@ TEST(PoseVariance, WhiteNoiseSessionsAreMostlyUnchanged) {
 TEST(PoseVariance, NonOrthogonalityIsNotAbsorbedAsNoise) {
   std::mt19937_64 rng(42);
   const AccelModel truth = RandomScaleSensor(&rng, 0.003);
-  const std::vector<Position> positions = Session(truth, 1, 0.0, &rng);
+  const std::vector<Position> positions = PoseSession(truth, 1, 0.0, &rng);
   Calibration c, w;
   ASSERT_TRUE(CalibrateFromPositions(positions, ScaleOptions(true), &c)) << c.message;
   ASSERT_TRUE(CalibrateFromPositions(positions, ScaleOptions(false), &w)) << w.message;
@@ -186,7 +186,7 @@ TEST(PoseVariance, PooledStructureTestHoldsItsLevelWhenThePriorIsTrue) {
   for (int seed = 0; seed < seeds; ++seed) {
     std::mt19937_64 rng(30000 + seed);
     const AccelModel truth = RandomScaleSensor(&rng, 0.0);
-    const std::vector<Position> positions = Session(truth, 1, kDisturbance, &rng);
+    const std::vector<Position> positions = PoseSession(truth, 1, kDisturbance, &rng);
     CalibrationOptions o = ScaleOptions(true);
     o.refinement.structure_test_level = 0.05;
     DrawPrior(kDisturbance, 11.0, &rng, &o);
@@ -215,7 +215,7 @@ TEST(PoseVariance, PriorGivesTheStructureTestPowerWithTwelvePoses) {
   for (int seed = 0; seed < seeds; ++seed) {
     std::mt19937_64 rng(40000 + seed);
     const AccelModel truth = RandomScaleSensor(&rng, 0.002);
-    const std::vector<Position> positions = Session(truth, 1, kDisturbance, &rng);
+    const std::vector<Position> positions = PoseSession(truth, 1, kDisturbance, &rng);
     CalibrationOptions o = ScaleOptions(true);
     Calibration plain, pooled;
     ASSERT_TRUE(CalibrateFromPositions(positions, o, &plain)) << plain.message;
@@ -246,7 +246,7 @@ TEST(PoseVariance, WrongPriorIsSetAside) {
     for (int seed = 0; seed < seeds; ++seed) {
       std::mt19937_64 rng(50000 + seed);
       const AccelModel truth = RandomScaleSensor(&rng, 0.0);
-      const std::vector<Position> positions = Session(truth, 2, kDisturbance, &rng);
+      const std::vector<Position> positions = PoseSession(truth, 2, kDisturbance, &rng);
       CalibrationOptions o = ScaleOptions(true);
       o.refinement.pose_disturbance_prior = factor * kDisturbance;
       o.refinement.pose_disturbance_prior_dof = 11.0;
