@@ -71,7 +71,7 @@ TEST(ReportWarnings, AWarningWithoutACodeIsMarkedUnexplained) {
   EXPECT_EQ(RowCodes(html), (std::vector<std::string>{"standard_gravity", "unclassified"}));
 }
 
-struct Session {
+struct WarningSession {
   std::string name;
   std::string config;
   // Extra flags of `simulate` and of `calibrate`.
@@ -81,7 +81,7 @@ struct Session {
   std::string real_file;
 };
 
-std::vector<Session> Sessions() {
+std::vector<WarningSession> Sessions() {
   const std::vector<std::string> handheld_scales = {
       "--nominal_scale", "0.00059855", "--gyro_nominal_scale",
       "0.000133231",     "--gravity",  "9.80665"};
@@ -117,7 +117,7 @@ TEST(ReportWarnings, EveryWarningOfEveryMethodIsExplained) {
   ScratchDir dir;
   std::set<std::string> seen;
   size_t warnings = 0;
-  for (const Session& s : Sessions()) {
+  for (const WarningSession& s : Sessions()) {
     SCOPED_TRACE(s.name);
     const std::string config = testing_util::SourceDir() + "/configs/" + s.config;
     std::string input;
