@@ -2,6 +2,8 @@
 
 #include <charconv>
 
+#include "util/numbers.h"
+
 namespace gravcal {
 namespace {
 
@@ -96,7 +98,7 @@ bool ParseCsvRecords(std::string_view text, const std::string& name,
 bool ParseCsvNumber(std::string_view text, double* value) {
   const char* first = text.data();
   const char* last = first + text.size();
-  const auto result = std::from_chars(first, last, *value);
+  const auto result = internal::ParseNumber(first, last, value);
   return result.ec == std::errc() && result.ptr == last;
 }
 

@@ -46,9 +46,9 @@ bool ParseCsvRecords(std::string_view text, const std::string& name,
 // "<name>:<line>:<column>: " for messages.
 std::string CsvWhere(const std::string& name, size_t line, size_t column);
 
-// A cell that is one number and nothing else (std::from_chars: no blanks,
-// no leading '+'); false otherwise. "nan" and "inf" parse: callers that need
-// a finite value check it.
+// A cell that is one number and nothing else (util/numbers.h ParseNumber,
+// as std::from_chars: no blanks, no leading '+'); false otherwise. "nan" and
+// "inf" parse: callers that need a finite value check it.
 bool ParseCsvNumber(std::string_view text, double* value);
 
 // The field as written to a CSV file: quoted when it holds a comma, a quote,

@@ -28,12 +28,12 @@ class FileText {
 // the free physical pages); 0 when unknown.
 uint64_t AvailableMemoryBytes();
 
-// A log of `file_bytes` parsed in memory needs the text and the samples
-// (8 doubles a row): about kLogMemoryPerFileByte times its size for raw
-// counts (rows of ~40 bytes). False with a message saying how large the file
-// is, what it needs and what to do, when that exceeds `available_bytes`
+// A log of `file_bytes` parsed in memory needs its samples (8 doubles a
+// row; the text is read block by block, never whole): about
+// kLogMemoryPerFileByte times its size for raw counts (rows of ~40 bytes). False with a message
+// saying how large the file is, what it needs and what to do, when that exceeds `available_bytes`
 // (0 = unknown: no check).
-constexpr double kLogMemoryPerFileByte = 2.7;
+constexpr double kLogMemoryPerFileByte = 1.7;
 bool CheckLogFitsInMemory(const std::string& path, uint64_t file_bytes, uint64_t available_bytes,
                           std::string* error);
 

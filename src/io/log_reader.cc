@@ -3,9 +3,11 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -13,6 +15,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -63,34 +66,38 @@ bool CheckColumnNames(const std::vector<std::string>& names, const char* what, s
   return true;
 }
 
-// Rows in `text`, estimated from the line length of its first 64 KiB.
-size_t EstimateRows(std::string_view text) {
+// Rows in the `total` bytes left of a text, estimated from the line length
+// of the first 64 KiB of `rest` (its start).
+size_t EstimateRows(std::string_view rest, uint64_t total) {
   constexpr size_t kSample = size_t{1} << 16;
-  const size_t sample = std::min(text.size(), kSample);
-  const size_t newlines = static_cast<size_t>(std::count(text.data(), text.data() + sample, '\n'));
-  if (sample == text.size()) return newlines + 1;
+  const size_t sample = std::min(rest.size(), kSample);
+  const size_t newlines = static_cast<size_t>(std::count(rest.data(), rest.data() + sample, '\n'));
+  if (sample == total) return newlines + 1;
   if (newlines == 0) return 16;
-  const double rows = static_cast<double>(text.size()) * static_cast<double>(newlines) /
-                      static_cast<double>(sample);
+  const double rows =
+      static_cast<double>(total) * static_cast<double>(newlines) / static_cast<double>(sample);
   return static_cast<size_t>(rows * 1.02) + 16;
 }
 
-// Parses one file in memory through the checked line reader (io/log_text.h):
-// the main log, or (`reference` not null) the second file holding the
-// gyroscope, whose times must match the main log's sample for sample.
-// Fills out->t, accel, gyro, temperature (only out->gyro for the gyroscope
-// file); does not check for an empty result. *lines is the number of lines.
-bool ParseText(std::string_view text, const std::string& name, const LogReaderOptions& options,
-               const ImuLog* reference, const std::string& reference_name, ImuLog* out,
-               size_t* lines, std::string* error) {
-  internal::LogLines source(text, name);
+// Parses the lines of one text log (io/log_text.h; text in memory or a file
+// read block by block, `bytes` long, 0 for text in memory): the main log, or
+// (`reference` not null) the second file holding the gyroscope, whose times
+// must match the main log's sample for sample. `euroc`: the '#' opening the
+// first line is dropped (an EuRoC / TUM-VI header is the header row without
+// it). Fills out->t, accel, gyro, temperature (only out->gyro for the
+// gyroscope file); does not check for an empty result. *lines is the number
+// of lines.
+bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std::string& name,
+               const LogReaderOptions& options, const ImuLog* reference,
+               const std::string& reference_name, ImuLog* out, size_t* lines, std::string* error) {
   internal::LogRowParser parser(name, options, reference != nullptr);
   std::string_view line;
   std::string why;
   bool reserved = false;
-  while (source.Next(&line, &why)) {
+  while (source->Next(&line, &why)) {
+    if (euroc && source->number() == 1 && !line.empty() && line[0] == '#') line.remove_prefix(1);
     bool row = false;
-    if (!parser.Line(line, source.number(), &row, &why)) break;
+    if (!parser.Line(line, source->number(), &row, &why)) break;
     if (!row) continue;
     const size_t index = parser.rows() - 1;
     if (reference != nullptr) {
@@ -98,7 +105,7 @@ bool ParseText(std::string_view text, const std::string& name, const LogReaderOp
       if (!reserved) out->gyro.reserve(reference_t.size());
       reserved = true;
       if (index >= reference_t.size()) {
-        return SetError(error, LogWhere(name, source.number()) + "more samples than " +
+        return SetError(error, LogWhere(name, source->number()) + "more samples than " +
                                    reference_name + " (" + std::to_string(reference_t.size()) +
                                    ")");
       }
@@ -106,7 +113,7 @@ bool ParseText(std::string_view text, const std::string& name, const LogReaderOp
         const double t = parser.value(kT);
         const double r = reference_t[index];
         if (!(std::fabs(t - r) <= kRelativeTimeTolerance * std::max(std::fabs(t), std::fabs(r)))) {
-          return SetError(error, LogWhere(name, source.number()) + "time " + ExactNumber(t) +
+          return SetError(error, LogWhere(name, source->number()) + "time " + ExactNumber(t) +
                                      " differs from time " + ExactNumber(r) + " of sample " +
                                      std::to_string(index) + " in " + reference_name);
         }
@@ -115,7 +122,9 @@ bool ParseText(std::string_view text, const std::string& name, const LogReaderOp
       continue;
     }
     if (!reserved) {
-      const size_t rows = EstimateRows(source.rest()) + 1;
+      const std::string_view rest = source->rest();
+      const uint64_t left = bytes == 0 ? rest.size() : bytes - (source->bytes_read() - rest.size());
+      const size_t rows = EstimateRows(rest, left) + 1;
       out->t.reserve(rows);
       out->accel.reserve(rows);
       if (parser.has(kGx)) out->gyro.reserve(rows);
@@ -130,7 +139,58 @@ bool ParseText(std::string_view text, const std::string& name, const LogReaderOp
     if (parser.has(kTemp)) out->temperature.push_back(parser.value(kTemp));
   }
   if (!why.empty()) return SetError(error, why);
-  *lines = source.number();
+  *lines = source->number();
+  return true;
+}
+
+// A file opened for reading, closed when it goes.
+struct FileCloser {
+  void operator()(std::FILE* file) const { std::fclose(file); }
+};
+using OpenFile = std::unique_ptr<std::FILE, FileCloser>;
+
+bool OpenForReading(const std::string& path, OpenFile* file, std::string* error) {
+  file->reset(std::fopen(path.c_str(), "rb"));
+  if (*file == nullptr) {
+    return SetError(error, path + ": cannot open: " + std::generic_category().message(errno));
+  }
+  return true;
+}
+
+// The log in the lines of `source` (a text of `format`, `bytes` long as in
+// ParseText), and the gyroscope file options.gyro_path names, read block by
+// block.
+bool ParseLog(internal::LogLines* source, uint64_t bytes, internal::FileFormat format,
+              const std::string& name, const LogReaderOptions& options, ImuLog* log,
+              std::string* error) {
+  const bool euroc = format == internal::FileFormat::kEuroc && internal::LayoutFromFile(options);
+  const LogReaderOptions& layout = euroc ? internal::EurocOptions(options) : options;
+  ImuLog parsed;
+  size_t lines = 0;
+  if (!ParseText(source, bytes, euroc, name, layout, nullptr, name, &parsed, &lines, error)) {
+    return false;
+  }
+  if (parsed.t.empty()) return SetError(error, name + ": no samples");
+
+  if (!options.gyro_path.empty()) {
+    OpenFile file;
+    if (!OpenForReading(options.gyro_path, &file, error)) return false;
+    internal::LogLines gyro_lines(file.get(), options.gyro_path);
+    ImuLog gyro;
+    size_t gyro_lines_read = 0;
+    if (!ParseText(&gyro_lines, 0, false, options.gyro_path, options, &parsed, name, &gyro,
+                   &gyro_lines_read, error)) {
+      return false;
+    }
+    if (gyro.gyro.size() != parsed.t.size()) {
+      return SetError(error, LogWhere(options.gyro_path, std::max<size_t>(gyro_lines_read, 1)) +
+                                 "ends after " + std::to_string(gyro.gyro.size()) + " samples; " +
+                                 name + " has " + std::to_string(parsed.t.size()));
+    }
+    parsed.gyro = std::move(gyro.gyro);
+  }
+  parsed.source = name;
+  *log = std::move(parsed);
   return true;
 }
 
@@ -146,34 +206,8 @@ bool ParseImpl(std::string_view text, const std::string& name, const LogReaderOp
     return SetError(error, name + ": a " + internal::FileFormatName(format) +
                                " is read from its file, not from memory");
   }
-  // An EuRoC / TUM-VI header is the header row once its '#' is dropped.
-  const bool euroc = format == internal::FileFormat::kEuroc && internal::LayoutFromFile(options);
-  const LogReaderOptions& layout = euroc ? internal::EurocOptions(options) : options;
-  if (euroc) text.remove_prefix(1);
-  ImuLog parsed;
-  size_t lines = 0;
-  if (!ParseText(text, name, layout, nullptr, name, &parsed, &lines, error)) return false;
-  if (parsed.t.empty()) return SetError(error, name + ": no samples");
-
-  if (!options.gyro_path.empty()) {
-    FileText gyro_text;
-    if (!gyro_text.Read(options.gyro_path, error)) return false;
-    ImuLog gyro;
-    size_t gyro_lines = 0;
-    if (!ParseText(gyro_text.view(), options.gyro_path, options, &parsed, name, &gyro, &gyro_lines,
-                   error)) {
-      return false;
-    }
-    if (gyro.gyro.size() != parsed.t.size()) {
-      return SetError(error, LogWhere(options.gyro_path, std::max<size_t>(gyro_lines, 1)) +
-                                 "ends after " + std::to_string(gyro.gyro.size()) + " samples; " +
-                                 name + " has " + std::to_string(parsed.t.size()));
-    }
-    parsed.gyro = std::move(gyro.gyro);
-  }
-  parsed.source = name;
-  *log = std::move(parsed);
-  return true;
+  internal::LogLines source(text, name);
+  return ParseLog(&source, 0, format, name, options, log, error);
 }
 
 // Checks what the writer needs without ImuLog::Validate's per-sample cost.
@@ -271,16 +305,37 @@ bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* l
       }
       return true;
     }
+    std::string why;
+    if (!options.IsValid(&why)) return SetError(error, path + ": invalid options: " + why);
+    OpenFile file;
+    if (!OpenForReading(path, &file, error)) return false;
     struct stat st;
-    if (stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
-        !internal::CheckLogFitsInMemory(path, static_cast<uint64_t>(st.st_size),
-                                        internal::AvailableMemoryBytes(), error)) {
+    if (fstat(fileno(file.get()), &st) != 0 || !S_ISREG(st.st_mode)) {
+      // A pipe or device: its length is known only at its end, which the
+      // content hash needs first; read whole.
+      file.reset();
+      FileText text;
+      if (!text.Read(path, error)) return false;
+      if (!ParseImpl(text.view(), path, options, log, error)) return false;
+      if (hash != nullptr) hash->Add(text.view());
+      return true;
+    }
+    const uint64_t bytes = static_cast<uint64_t>(st.st_size);
+    if (!internal::CheckLogFitsInMemory(path, bytes, internal::AvailableMemoryBytes(), error)) {
       return false;
     }
-    FileText text;
-    if (!text.Read(path, error)) return false;
-    if (!ParseImpl(text.view(), path, options, log, error)) return false;
-    if (hash != nullptr) hash->Add(text.view());
+    // Block by block (io/log_text.h LogLines): no copy of the whole text.
+    internal::LogLines source(file.get(), path);
+    if (hash != nullptr) {
+      hash->Begin(bytes);
+      source.HashInto(hash);
+    }
+    if (!ParseLog(&source, bytes, format, path, options, log, error)) return false;
+    if (source.bytes_read() != bytes) {
+      return SetError(error, path + ": changed while it was read (" + std::to_string(bytes) +
+                                 " bytes, then " + std::to_string(source.bytes_read()) + ")");
+    }
+    if (hash != nullptr) hash->End();
     return true;
   } catch (const std::exception& e) {
     return SetError(error, path + ": " + e.what());

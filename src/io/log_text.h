@@ -17,6 +17,7 @@
 #define GRAVCAL_SRC_IO_LOG_TEXT_H_
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -25,6 +26,7 @@
 #include <vector>
 
 #include "gravcal/io/log_reader.h"
+#include "util/content_hash.h"
 
 namespace gravcal {
 namespace internal {
@@ -65,6 +67,11 @@ class LogLines {
   // The first bytes of the file (up to `bytes`, fewer at its end), read
   // without consuming them; for a file they are read into the buffer.
   std::string_view Head(size_t bytes, std::string* error);
+  // A file: every byte read from now on is appended to *hash (Begin'd by
+  // the caller; call before the first read).
+  void HashInto(ContentHash* hash) { hash_ = hash; }
+  // A file: the bytes read from it so far.
+  uint64_t bytes_read() const { return bytes_read_; }
 
  private:
   // Reads more of the file into the buffer; false on a read error.
@@ -75,6 +82,8 @@ class LogLines {
 
   std::string name_;
   std::FILE* file_ = nullptr;
+  ContentHash* hash_ = nullptr;
+  uint64_t bytes_read_ = 0;
   std::vector<char> buffer_;
   const char* data_ = nullptr;
   size_t begin_ = 0;

@@ -21,16 +21,37 @@ namespace internal {
 class ContentHash {
  public:
   void Add(std::string_view bytes) {
-    Absorb(0, static_cast<uint64_t>(bytes.size()));
+    Begin(bytes.size());
+    Append(bytes);
+    End();
+  }
+
+  // The same as Add(bytes) for bytes that come in pieces (a file read block
+  // by block): Begin with their total size, Append the pieces in order, End.
+  void Begin(uint64_t size) {
+    Absorb(0, size);
+    pending_size_ = 0;
+  }
+  void Append(std::string_view bytes) {
     const char* p = bytes.data();
     size_t left = bytes.size();
-    while (left >= 32) {
-      uint64_t w[4];
-      std::memcpy(w, p, 32);
-      for (int lane = 0; lane < 4; ++lane) Absorb(lane, w[lane]);
-      p += 32;
-      left -= 32;
+    if (pending_size_ > 0) {
+      const size_t n = left < 32 - pending_size_ ? left : 32 - pending_size_;
+      std::memcpy(pending_ + pending_size_, p, n);
+      pending_size_ += n;
+      p += n;
+      left -= n;
+      if (pending_size_ < 32) return;
+      AbsorbBlock(pending_);
+      pending_size_ = 0;
     }
+    for (; left >= 32; p += 32, left -= 32) AbsorbBlock(p);
+    if (left > 0) std::memcpy(pending_, p, left);
+    pending_size_ = left;
+  }
+  void End() {
+    const char* p = pending_;
+    size_t left = pending_size_;
     for (int lane = 0; left > 0; ++lane) {
       uint64_t w = 0;
       const size_t n = left < 8 ? left : 8;
@@ -39,6 +60,7 @@ class ContentHash {
       p += n;
       left -= n;
     }
+    pending_size_ = 0;
   }
 
   // 32 lower-case hex digits.
@@ -61,6 +83,11 @@ class ContentHash {
     x ^= x >> 33;
     return x;
   }
+  void AbsorbBlock(const char* p) {
+    uint64_t w[4];
+    std::memcpy(w, p, 32);
+    for (int lane = 0; lane < 4; ++lane) Absorb(lane, w[lane]);
+  }
   void Absorb(int lane, uint64_t w) {
     static constexpr uint64_t kMultiplier[4] = {0x9e3779b97f4a7c15ULL, 0xc2b2ae3d27d4eb4fULL,
                                                 0x165667b19e3779f9ULL, 0x27d4eb2f165667c5ULL};
@@ -70,6 +97,9 @@ class ContentHash {
 
   uint64_t h_[4] = {0x243f6a8885a308d3ULL, 0x13198a2e03707344ULL, 0xa4093822299f31d0ULL,
                     0x082efa98ec4e6c89ULL};
+  // Bytes of an Append not yet absorbed (fewer than 32).
+  char pending_[32];
+  size_t pending_size_ = 0;
 };
 
 }  // namespace internal
