@@ -582,7 +582,7 @@ void SinglePose(const std::vector<PlateImuData>& data, const MultiImuOptions& op
     up[i] = a.normalized();
     PlateImuResult& r = result->imus[i];
     r.up_offset = a.norm() - options.gravity;
-    r.up_offset_std = pose.accel_sigma * s;
+    r.up_offset_std = pose.accel_sigma;
     Calibration& c = r.calibration;
     c.success = true;
     c.method = "multi_imu";
@@ -784,16 +784,10 @@ bool CalibrateImpl(const std::vector<PlateImu>& imus, const MultiImuOptions& opt
       data[i].turns[k].tangent = TangentBasis(own_dirs[i][k + 1]);
     }
     GroupFactors f;
-    const bool run_cov = options.separate;
-    if (!Fit(data, {static_cast<int>(i)}, static_cast<int>(i), options.gravity, f, false,
-             options.max_iterations, &separate, &own_dirs[i], &separate_out[i])) {
+    if (!FitWithFactors(data, {static_cast<int>(i)}, static_cast<int>(i), options.gravity,
+                        options.max_iterations, &separate, &own_dirs[i], &f, &separate_out[i])) {
       result->message = imus[i].name + ": " + separate_out[i].message;
       return false;
-    }
-    if (run_cov) {
-      FitWithFactors(data, {static_cast<int>(i)}, static_cast<int>(i), options.gravity,
-                     options.max_iterations, &separate, &own_dirs[i], &f, &separate_out[i]);
-      result->imus[i].separate_std = StdsOf(separate_out[i].covariance[0], data[i].has_gyro);
     }
   }
   // The joint start: intrinsics from the separate fits, rotations by Wahba
@@ -837,6 +831,18 @@ bool CalibrateImpl(const std::vector<PlateImu>& imus, const MultiImuOptions& opt
                         &factors, &out)) {
       result->message = out.message;
       return false;
+    }
+  }
+  // The separate calibrations' sigmas with the joint fit's weights (the
+  // same variance factors), so that the comparison shows what sharing the
+  // poses gains.
+  if (options.separate) {
+    for (size_t i = 0; i < imus.size(); ++i) {
+      FitOutput sep;
+      if (Fit(data, {static_cast<int>(i)}, static_cast<int>(i), options.gravity, factors, true,
+              options.max_iterations, &separate, &own_dirs[i], &sep)) {
+        result->imus[i].separate_std = StdsOf(sep.covariance[0], data[i].has_gyro);
+      }
     }
   }
   result->accel_factor = factors.accel;
