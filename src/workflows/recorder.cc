@@ -168,6 +168,9 @@ struct Recorder::State {
   // planned yet.
   double plan_hold = 0.0;
   int plan_poses = 0;
+  // The done event's body and sentence (Finish).
+  Json done_body;
+  std::string done_text;
 
   // Rows of the information.
   Eigen::RowVectorXd Row(const Eigen::Vector3d& up, double kept_seconds,
@@ -670,11 +673,21 @@ bool Recorder::Finish(const std::string& reason, const std::vector<std::string>&
                      std::to_string(s.log.size()) + " samples";
   if (!reasons.empty())
     text += "; " + std::to_string(reasons.size()) + " parameter(s) undetermined";
+  s.done_body = body;
+  s.done_text = text;
   out.done = MakeEvent(RecorderEventType::kDone, s.log.t.back(), body, text);
   s.status.done = true;
   s.status.done_reason = reason;
   *result = std::move(out);
   return true;
+}
+
+RecorderEvent Recorder::DoneEvent(const std::vector<std::string>& files) const {
+  const State& s = *state_;
+  Json body = s.done_body;
+  body["files"] = files;
+  return MakeEvent(RecorderEventType::kDone, s.log.t.empty() ? 0.0 : s.log.t.back(), body,
+                   s.done_text);
 }
 
 }  // namespace gravcal

@@ -191,6 +191,9 @@ class Recorder {
   // written.
   bool Finish(const std::string& reason, const std::vector<std::string>& files,
               RecorderResult* result, std::string* error);
+  // The done event of the last Finish with other files (those actually
+  // written, known only after it).
+  RecorderEvent DoneEvent(const std::vector<std::string>& files) const;
 
  private:
   struct State;
