@@ -166,6 +166,10 @@ int RunCalibrate(const CalibrateArgs& args) {
 }
 
 int RunSimulate(const SimulateArgs& args) {
+  if (!args.stream.empty()) return RunSimulateStream(args);
+  if (args.rate != 0.0 || !args.follow_events.empty()) {
+    return Fail("--rate and --follow-events go with simulate --stream");
+  }
   if (args.output_dir.empty()) return Fail("simulate needs --output-dir <folder>");
   std::string error;
   SimulationRequest request;

@@ -63,6 +63,23 @@ struct SimulateArgs : CommonArgs {
   std::string output_dir;
   // plan.json from gravcal plan.
   std::string plan;
+  // Issue 37: --stream - (standard output) or pty (a new pseudo-terminal)
+  // writes a virtual hand's session as contract CSV lines at --rate times
+  // real time (0 = as fast as it can), following the suggest events of
+  // --follow-events (gravcal record --events) when given.
+  std::string stream;
+  double rate = 0.0;
+  std::string follow_events;
+};
+
+// Issue 37: gravcal record (record_command.cc).
+struct RecordArgs : CommonArgs {
+  std::string input;
+  int baud = 0;
+  std::string output_dir;
+  std::string events;
+  std::string noise;
+  PlanRequest request;
 };
 
 // plan and check: the request from --target, --pose_set, ... (not the noise
@@ -152,6 +169,11 @@ int RunDemo(const DemoArgs& args);
 int RunCalibrate(const CalibrateArgs& args);
 int RunApply(const ApplyArgs& args);
 int RunSimulate(const SimulateArgs& args);
+// simulate --stream (simulate_stream.cc): 0 streamed, 1 bad input.
+int RunSimulateStream(const SimulateArgs& args);
+// record_command.cc: 0 written with a calibration, 2 the log and report
+// written but the calibration failed, 1 bad input (nothing written).
+int RunRecord(const RecordArgs& args);
 // batch_command.cc. Exit codes: 0 every unit calibrated; 1 bad invocation
 // or manifest (nothing written), or at least one unit failed as calibrate
 // would with exit 1; 2 the only failures are units that did not converge.

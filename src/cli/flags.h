@@ -99,7 +99,15 @@
     "plan: design the shortest check session for this stored calibration (JSON) "                \
     "instead: four poses, detecting 10 stored sigmas in any one parameter with power "           \
     "0.9 at --level (needs --accel_noise_density)")                                              \
-  X(string, to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)")
+  X(string, to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)")             \
+  X(string, events, "", "record: write the events as JSON lines here (- = standard output)")     \
+  X(int32, baud, 0, "record: baud rate of a serial --input (0 = the device's setting)")          \
+  X(string, stream, "",                                                                          \
+    "simulate: stream a virtual hand's session as CSV lines to - (standard output) or pty "      \
+    "(a new pseudo-terminal, its name on stderr)")                                               \
+  X(double, rate, 0.0, "simulate --stream: times real time (0 = as fast as possible)")           \
+  X(string, follow_events, "",                                                                   \
+    "simulate --stream: follow the suggest events gravcal record writes to this file")
 
 namespace gravcal {
 namespace cli {

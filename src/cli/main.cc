@@ -114,8 +114,30 @@ const std::vector<CommandInfo>& Commands() {
           "sim_motion rate_table, segments.csv)",
           {ConfigFlag<SimulateArgs>(), FlagField<SimulateArgs>("seed", &SimulateArgs::seed),
            FlagField<SimulateArgs>("output_dir", &SimulateArgs::output_dir),
-           FlagField<SimulateArgs>("plan", &SimulateArgs::plan)},
+           FlagField<SimulateArgs>("plan", &SimulateArgs::plan),
+           FlagField<SimulateArgs>("stream", &SimulateArgs::stream),
+           FlagField<SimulateArgs>("rate", &SimulateArgs::rate),
+           FlagField<SimulateArgs>("follow_events", &SimulateArgs::follow_events)},
           RunSimulate),
+      Command<RecordArgs>(
+          "record",
+          "guided live calibration: reads a sensor's text lines (-, serial device, udp://:PORT, "
+          "tcp://HOST:PORT), says which pose to take next, stops when --target is met; writes "
+          "record.csv, calibration.json and report.html to --output-dir",
+          {FlagField<RecordArgs>("input", &RecordArgs::input),
+           FlagField<RecordArgs>("baud", &RecordArgs::baud), ConfigFlag<RecordArgs>(),
+           FlagField<RecordArgs>("output_dir", &RecordArgs::output_dir),
+           FlagField<RecordArgs>("events", &RecordArgs::events),
+           FlagField<RecordArgs>("noise", &RecordArgs::noise),
+           FlagAt<RecordArgs>("target", [](RecordArgs* a) { return &a->request.targets; }),
+           FlagAt<RecordArgs>("pose_set", [](RecordArgs* a) { return &a->request.pose_set; }),
+           FlagAt<RecordArgs>("max_time",
+                              [](RecordArgs* a) { return &a->request.max_time_seconds; }),
+           FlagAt<RecordArgs>("accel_noise_density",
+                              [](RecordArgs* a) { return &a->request.accel_noise_density; }),
+           FlagAt<RecordArgs>("pose_disturbance",
+                              [](RecordArgs* a) { return &a->request.pose_disturbance; })},
+          RunRecord),
       Command<PlanArgs>(
           "plan",
           "plan a recording before it is made: plan.json with the poses, holds and predicted "

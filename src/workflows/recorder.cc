@@ -1,0 +1,693 @@
+// gravcal record's core: live detection, capture, prediction, suggestion
+// (workflows/recorder.h).
+#include "gravcal/workflows/recorder.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "core/sensor_checks.h"
+#include "gravcal/detection/static_detector.h"
+#include "gravcal/estimation/experiment_design.h"
+#include "gravcal/io/log_reader.h"
+#include "gravcal/workflows/pipeline.h"
+#include "gravcal/workflows/report.h"
+#include "io/json_helpers.h"
+#include "util/numbers.h"
+#include "util/statistics.h"
+#include "util/units.h"
+#include "workflows/plan_start.h"
+
+namespace gravcal {
+
+namespace {
+
+using internal::JsonNumber;
+using internal::JsonVector;
+using internal::kDegToRad;
+using internal::kInf;
+using internal::kRadToDeg;
+using Json = nlohmann::json;
+
+// A captured pose's up direction counts as a face within this (as check).
+constexpr double kFaceSnapDeg = 10.0;
+// A suggestion is worded as a face within this.
+constexpr double kFaceWordDeg = 2.0;
+// Holds on the needed-hold grid.
+constexpr int kHoldGrid = 24;
+// Warnings of one kind after which the rest are only counted.
+constexpr int kMaxWarningsPerKind = 5;
+
+std::string Num(double v, int digits = 3) {
+  std::ostringstream s;
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+std::string AxisName(int axis, bool positive) {
+  static const char* kAxes[3] = {"X", "Y", "Z"};
+  return std::string(positive ? "+" : "-") + kAxes[axis];
+}
+
+struct CapturedPose {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d raw_mean = Eigen::Vector3d::Zero();
+  double kept_seconds = 0.0;
+  size_t begin = 0;
+  size_t end = 0;
+  // Scale-free white-noise density per axis, m/s^2/sqrt(Hz).
+  Eigen::Vector3d density = Eigen::Vector3d::Zero();
+};
+
+}  // namespace
+
+PoseSuggestion DescribeUp(const Eigen::Vector3d& given) {
+  PoseSuggestion s;
+  s.up = given.normalized();
+  Eigen::Index face = 0;
+  s.up.cwiseAbs().maxCoeff(&face);
+  const bool positive = s.up(face) > 0.0;
+  s.face = AxisName(static_cast<int>(face), positive);
+  s.tilt_deg = std::acos(std::min(1.0, std::abs(s.up(face)))) * kRadToDeg;
+  std::ostringstream words;
+  words << s.face << " up";
+  if (s.tilt_deg > kFaceWordDeg) {
+    // The part of up across the face: the axes that rise.
+    Eigen::Vector3d across = s.up;
+    across(face) = 0.0;
+    across.normalize();
+    for (int a = 0; a < 3; ++a) {
+      if (std::abs(across(a)) > 0.3) s.toward += AxisName(a, across(a) > 0.0);
+    }
+    words << ", then tilt about " << std::lround(s.tilt_deg) << " degrees toward " << s.toward
+          << " (" << s.toward << " rises)";
+  }
+  s.instruction = words.str();
+  return s;
+}
+
+bool RecorderOptions::IsValid(std::string* error) const {
+  std::string e;
+  if (!request.IsValid(&e)) {
+  } else if (!(detect_interval_seconds > 0.0)) {
+    e = "detect_interval_seconds must be positive";
+  } else if (!(lookback_seconds >= 10.0)) {
+    e = "lookback_seconds must be at least 10";
+  } else if (!(min_hold_seconds > 0.0) || !(max_hold_seconds >= min_hold_seconds)) {
+    e = "holds: need 0 < min_hold_seconds <= max_hold_seconds";
+  } else if (!(hold_tolerance > 0.0 && hold_tolerance < 1.0)) {
+    e = "hold_tolerance must be in (0, 1)";
+  } else if (!(prior_factor > 1.0)) {
+    e = "prior_factor must be above 1";
+  } else if (redundancy < 0) {
+    e = "redundancy must not be negative";
+  } else if (!(max_time_seconds >= 0.0)) {
+    e = "max_time_seconds must not be negative";
+  } else if (!(new_pose_deg > 0.0)) {
+    e = "new_pose_deg must be positive";
+  } else {
+    return true;
+  }
+  if (error) *error = e;
+  return false;
+}
+
+const char* RecorderEventName(RecorderEventType type) {
+  switch (type) {
+    case RecorderEventType::kPoseCaptured:
+      return "pose_captured";
+    case RecorderEventType::kSuggest:
+      return "suggest";
+    case RecorderEventType::kSigma:
+      return "sigma";
+    case RecorderEventType::kWarning:
+      return "warning";
+    case RecorderEventType::kDone:
+      return "done";
+  }
+  return "warning";
+}
+
+struct Recorder::State {
+  Config config;
+  RecorderOptions options;
+  internal::PlanStart start;
+  // Parameters, weights W = 1 / target^2 and the prior information.
+  Eigen::Index p = 0;
+  Eigen::VectorXd weight;
+  Eigen::MatrixXd prior;
+  std::vector<Eigen::Vector3d> candidates;
+  // The request's noise (noise model or densities) when it gives one.
+  bool given_noise = false;
+  DesignNoise noise;
+
+  ImuLog log;
+  bool started = false;
+  bool has_gyro = false;
+  bool has_temperature = false;
+  double next_detect_t = 0.0;
+  // Detection starts here (the end of the last captured pose).
+  size_t detect_from = 0;
+  // Nominal scale (m/s^2 per raw unit), from the first hold.
+  double scale = 0.0;
+  std::vector<CapturedPose> poses;
+  Eigen::MatrixXd fisher;
+  // Holds not captured (saturated), by their first sample.
+  std::set<size_t> refused_holds;
+  std::map<std::string, int> warning_counts;
+  std::set<std::string> warned;
+  RecorderStatus status;
+  bool sent_first = false;
+  // The offline plan's typical kept hold (for the measured noise), the
+  // shortest hold asked for while a parameter is undetermined; 0 = not
+  // planned yet.
+  double plan_hold = 0.0;
+  int plan_poses = 0;
+  // The done event's body and sentence (Finish).
+  Json done_body;
+  std::string done_text;
+
+  // Rows of the information.
+  Eigen::RowVectorXd Row(const Eigen::Vector3d& up, double kept_seconds,
+                         const Eigen::Vector3d& density) const {
+    DesignNoise n = noise;
+    if (!given_noise) {
+      for (int a = 0; a < 3; ++a) n.accel[a].white_noise.value = density(a);
+    }
+    const Eigen::MatrixXd j =
+        DesignJacobian({{up, kept_seconds + start.model.trimmed_seconds}}, start.model, n);
+    return j.row(0);
+  }
+
+  double Phi(const Eigen::MatrixXd& f) const {
+    const Eigen::MatrixXd cov = (f + prior).ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+    return (weight.asDiagonal() * cov).trace();
+  }
+
+  bool TargetsMet(const Eigen::MatrixXd& f, int pose_count) const {
+    if (pose_count < static_cast<int>(p) + options.redundancy) return false;
+    const Eigen::VectorXd std = DeterminedStd(f, start.limits);
+    for (Eigen::Index i = 0; i < p; ++i) {
+      if (start.targeted[i] && !(std(i) <= start.targets(i))) return false;
+    }
+    return true;
+  }
+
+  // The typical density of the poses so far (median per axis), or of
+  // `fallback` before any.
+  Eigen::Vector3d TypicalDensity(const Eigen::Vector3d& fallback) const {
+    if (poses.empty()) return fallback;
+    Eigen::Vector3d out;
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double> v;
+      for (const CapturedPose& c : poses) v.push_back(c.density(a));
+      out(a) = internal::Median(v);
+    }
+    return out;
+  }
+
+  // The shortest kept hold of `up` that gives (1 - hold_tolerance) of what
+  // max_hold would, or meets the targets.
+  double NeededHold(const Eigen::Vector3d& up, const Eigen::Vector3d& density) const {
+    const Eigen::VectorXd std = DeterminedStd(fisher, start.limits);
+    const double t0 = std.allFinite() ? options.min_hold_seconds
+                                      : std::clamp(plan_hold, options.min_hold_seconds,
+                                                   options.max_hold_seconds),
+                 t1 = options.max_hold_seconds;
+    const Eigen::RowVectorXd r1 = Row(up, t1, density);
+    const double phi_now = Phi(fisher);
+    const double phi_best = Phi(fisher + r1.transpose() * r1);
+    const int count = static_cast<int>(poses.size()) + 1;
+    for (int k = 0; k <= kHoldGrid; ++k) {
+      const double t = t0 * std::pow(t1 / t0, static_cast<double>(k) / kHoldGrid);
+      const Eigen::RowVectorXd r = Row(up, t, density);
+      const Eigen::MatrixXd f = fisher + r.transpose() * r;
+      if (Phi(f) <= phi_best + options.hold_tolerance * (phi_now - phi_best) ||
+          TargetsMet(f, count)) {
+        return t;
+      }
+    }
+    return t1;
+  }
+
+  // The candidate that lowers phi most (ties: the nearest +Z up).
+  PoseSuggestion Suggest(const Eigen::Vector3d& density) const {
+    const double hold = std::max(options.min_hold_seconds, 10.0);
+    const double phi_now = Phi(fisher);
+    double best_phi = kInf;
+    int best = 0;
+    for (size_t c = 0; c < candidates.size(); ++c) {
+      const Eigen::RowVectorXd r = Row(candidates[c], hold, density);
+      const double phi = Phi(fisher + r.transpose() * r);
+      const double z = candidates[c].z();
+      if (phi < best_phi * (1.0 - 1e-9) ||
+          (phi <= best_phi * (1.0 + 1e-9) && z > candidates[best].z())) {
+        best_phi = std::min(best_phi, phi);
+        best = static_cast<int>(c);
+      }
+    }
+    PoseSuggestion s = DescribeUp(candidates[best]);
+    s.hold_seconds = NeededHold(candidates[best], density);
+    const Eigen::RowVectorXd r = Row(candidates[best], s.hold_seconds, density);
+    s.expected_gain = phi_now > 0.0 ? 1.0 - Phi(fisher + r.transpose() * r) / phi_now : 0.0;
+    return s;
+  }
+
+  // The offline plan for the noise of the first hold (or the request's):
+  // its median hold, less what the detector trims.
+  void Plan(const Eigen::Vector3d& density) {
+    PlanRequest request = options.request;
+    if (!given_noise) request.accel_noise_density = density.maxCoeff();
+    request.min_hold_seconds = options.min_hold_seconds + start.model.trimmed_seconds;
+    request.max_hold_seconds = options.max_hold_seconds + start.model.trimmed_seconds;
+    RecordingPlan plan;
+    std::string error;
+    plan_hold = options.min_hold_seconds;
+    if (!MakeRecordingPlan(config, request, &plan, &error) || plan.poses.empty()) return;
+    std::vector<double> holds;
+    for (const PlannedPose& pose : plan.poses) holds.push_back(pose.hold_seconds);
+    plan_hold =
+        std::max(options.min_hold_seconds, internal::Median(holds) - start.model.trimmed_seconds);
+    plan_poses = static_cast<int>(plan.poses.size());
+  }
+
+  // Why each undetermined parameter is: the parameters a null direction of
+  // the information mixes it with, and the up directions seen so far.
+  std::map<std::string, std::string> Reasons(const Eigen::VectorXd& std) const {
+    std::map<std::string, std::string> out;
+    std::map<std::string, int> faces;
+    for (const CapturedPose& c : poses) ++faces[DescribeUp(c.up).instruction];
+    std::string seen;
+    for (const auto& [face, count] : faces) {
+      seen += (seen.empty() ? "" : ", ") + face + (count > 1 ? " x" + std::to_string(count) : "");
+    }
+    if (seen.empty()) seen = "none";
+    // Null directions of the information in target units (S F S, S =
+    // diag(target)), so that the threshold is unit-free.
+    const Eigen::VectorXd t = start.targets;
+    const Eigen::MatrixXd g = t.asDiagonal() * fisher * t.asDiagonal();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(g);
+    const double top = std::max(eig.eigenvalues().maxCoeff(), 1e-300);
+    const std::vector<std::string>& names = start.names;
+    for (Eigen::Index i = 0; i < p; ++i) {
+      if (std::isfinite(std(i))) continue;
+      std::set<std::string> mixed;
+      bool in_null = false;
+      for (Eigen::Index k = 0; k < p; ++k) {
+        if (eig.eigenvalues()(k) > 1e-9 * top) continue;
+        const Eigen::VectorXd v = eig.eigenvectors().col(k);
+        if (std::abs(v(i)) < 0.1) continue;
+        in_null = true;
+        for (Eigen::Index j = 0; j < p; ++j) {
+          if (j != i && std::abs(v(j)) >= 0.1) mixed.insert(names[j]);
+        }
+      }
+      std::string why;
+      if (poses.empty()) {
+        why = "no pose yet";
+      } else if (in_null) {
+        why = "the " + std::to_string(poses.size()) + " pose(s) so far (" + seen +
+              ") cannot tell it apart";
+        if (!mixed.empty()) {
+          why += " from ";
+          size_t n = 0;
+          for (const std::string& m : mixed) why += (n++ ? ", " : "") + m;
+        }
+        why += ": it needs poses with other up directions";
+      } else {
+        why = "its sigma is beyond the calibration's limit with the poses so far (" + seen + ")";
+      }
+      out[names[i]] = why;
+    }
+    return out;
+  }
+};
+
+Recorder::Recorder() : state_(new State) {}
+Recorder::~Recorder() = default;
+
+bool Recorder::Start(const Config& config, const RecorderOptions& options, std::string* error) {
+  state_.reset(new State);
+  State& s = *state_;
+  if (!options.IsValid(error)) return false;
+  if (!config.calibration.detector.IsValid(error)) return false;
+  s.config = config;
+  s.options = options;
+  if (!internal::StartPlan(config, options.request, &s.start, error)) return false;
+  if (s.start.model.known_attitude) {
+    *error =
+        "record guides the magnitude model; method " + config.method + " needs fixture attitudes";
+    return false;
+  }
+  if (std::none_of(s.start.targeted.begin(), s.start.targeted.end(), [](bool t) { return t; })) {
+    *error = "record needs --target (e.g. accel_bias=0.5mg accel_scale=100ppm)";
+    return false;
+  }
+  s.given_noise =
+      options.request.noise_model != nullptr || options.request.accel_noise_density > 0.0;
+  if (s.given_noise) {
+    std::string source;
+    if (!PlanDesignNoise(options.request, &s.noise, &source, error)) return false;
+  }
+  s.noise.pose_disturbance = options.request.pose_disturbance;
+  if (!CandidateDirections(options.request.pose_set, options.request.free_candidates,
+                           &s.candidates)) {
+    *error = "unknown pose set '" + options.request.pose_set + "' (faces, faces+45 or free)";
+    return false;
+  }
+  s.p = static_cast<Eigen::Index>(s.start.names.size());
+  s.weight = s.start.targets.cwiseInverse().cwiseAbs2();
+  s.prior = (s.weight / (options.prior_factor * options.prior_factor)).asDiagonal();
+  s.fisher = Eigen::MatrixXd::Zero(s.p, s.p);
+  s.log.source = "record";
+  s.status.names = s.start.names;
+  for (Eigen::Index i = 0; i < s.p; ++i) {
+    const ReadableUnit u = ReadableUnitOf(s.start.names[i]);
+    s.status.units.push_back(u.unit);
+    s.status.target.push_back(s.start.targeted[i] ? s.start.targets(i) * u.factor : NAN);
+    s.status.sigma.push_back(kInf);
+  }
+  s.started = true;
+  return true;
+}
+
+bool Recorder::done() const { return state_->status.done; }
+const RecorderStatus& Recorder::status() const { return state_->status; }
+const ImuLog& Recorder::log() const { return state_->log; }
+void Recorder::CountGarbage() { ++state_->status.garbage_lines; }
+
+namespace {
+
+RecorderEvent MakeEvent(RecorderEventType type, double t, Json body, const std::string& text) {
+  RecorderEvent e;
+  e.type = type;
+  e.t = t;
+  Json j;
+  j["event"] = RecorderEventName(type);
+  j["t"] = JsonNumber(t);
+  for (auto it = body.begin(); it != body.end(); ++it) j[it.key()] = it.value();
+  e.json = j.dump();
+  e.text = text;
+  return e;
+}
+
+}  // namespace
+
+RecorderEvent Recorder::Warn(const std::string& kind, const std::string& message) {
+  State& s = *state_;
+  const double t = s.log.t.empty() ? 0.0 : s.log.t.back();
+  s.status.warnings.push_back(message);
+  if (s.status.warnings.size() > 20) s.status.warnings.erase(s.status.warnings.begin());
+  return MakeEvent(RecorderEventType::kWarning, t, {{"kind", kind}, {"message", message}},
+                   "warning: " + message);
+}
+
+std::vector<RecorderEvent> Recorder::Feed(double t, const Eigen::Vector3d& accel,
+                                          const Eigen::Vector3d& gyro, double temperature,
+                                          bool has_gyro) {
+  std::vector<RecorderEvent> events;
+  State& s = *state_;
+  if (!s.started || s.status.done) return events;
+  ImuLog& log = s.log;
+  auto warn = [&](const std::string& kind, const std::string& message) {
+    if (++s.warning_counts[kind] <= kMaxWarningsPerKind) events.push_back(Warn(kind, message));
+  };
+  if (!std::isfinite(t) || !accel.allFinite() || (has_gyro && !gyro.allFinite())) {
+    warn("bad_sample", "a sample with a value that is not finite was dropped");
+    return events;
+  }
+  if (log.size() == 0) {
+    s.has_gyro = has_gyro;
+    s.has_temperature = std::isfinite(temperature);
+    s.next_detect_t = t + s.options.detect_interval_seconds;
+  } else if (!(t > log.t.back())) {
+    warn("time", "a sample at t = " + Num(t, 10) + " s, not after the previous one (" +
+                     Num(log.t.back(), 10) + " s), was dropped");
+    return events;
+  }
+  log.t.push_back(t);
+  log.accel.push_back(accel);
+  if (s.has_gyro) log.gyro.push_back(has_gyro ? gyro : Eigen::Vector3d::Zero());
+  if (s.has_temperature) log.temperature.push_back(temperature);
+  RecorderStatus& st = s.status;
+  st.samples = log.size();
+  st.stream_seconds = t - log.t.front();
+  {
+    const auto it = std::lower_bound(log.t.begin(), log.t.end(), t - 1.0);
+    const double span = t - *it;
+    const double n = static_cast<double>(log.t.end() - it) - 1.0;
+    st.sample_rate = span > 0.0 ? n / span : 0.0;
+  }
+  if (!s.sent_first) {
+    s.sent_first = true;
+    const Eigen::Vector3d unit_density = Eigen::Vector3d::Constant(0.01);
+    st.suggestion = s.Suggest(unit_density);
+    st.has_suggestion = true;
+  }
+  if (s.options.max_time_seconds > 0.0 && st.stream_seconds >= s.options.max_time_seconds) {
+    st.done = true;
+    st.done_reason = "max_time";
+    return events;
+  }
+  if (t < s.next_detect_t) return events;
+  s.next_detect_t = t + s.options.detect_interval_seconds;
+
+  // The detector on the samples since the last pose (at most lookback).
+  const size_t n = log.size();
+  size_t from = s.detect_from;
+  while (from < n && log.t[from] < t - s.options.lookback_seconds) ++from;
+  const StaticDetectorOptions& detector = s.config.calibration.detector;
+  if (n - from < 3 || log.t[n - 1] - log.t[from] < 2.0 * detector.window_seconds) return events;
+  ImuLog tail;
+  tail.source = "record";
+  tail.t.assign(log.t.begin() + from, log.t.end());
+  tail.accel.assign(log.accel.begin() + from, log.accel.end());
+  if (s.has_gyro) tail.gyro.assign(log.gyro.begin() + from, log.gyro.end());
+  StaticDetection detection;
+  st.holding = false;
+  if (!DetectStaticIntervals(tail, detector, &detection)) return events;
+  // In progress: the last interval reaches the newest samples up to what
+  // the detector trims at an end.
+  const double reach = detector.window_seconds + detector.settle_seconds + 0.25;
+  for (const RejectedStretch& r : detection.rejected) {
+    if (r.reason == RejectionReason::kTooShort || t - r.t_end > reach) continue;
+    const std::string key = "moving@" + std::to_string(from + r.begin);
+    if (s.warned.insert(key).second) {
+      warn("moving_hold", "the unit is not still (since t = " + Num(r.t_begin, 6) +
+                              " s): " + r.detail + "; hold it still, or rest it on a table");
+    }
+  }
+  if (detection.intervals.empty()) return events;
+  const StaticInterval& last = detection.intervals.back();
+  if (t - last.t_end > reach) return events;
+  const size_t begin = from + last.begin;
+  const size_t end = from + last.end;
+  const Eigen::Vector3d raw_up = last.accel_mean.normalized();
+  // A new pose only after motion or a new direction.
+  if (!s.poses.empty()) {
+    const CapturedPose& prev = s.poses.back();
+    const double rate =
+        static_cast<double>(last.count()) / std::max(last.t_end - last.t_begin, 1e-9);
+    const bool moved = begin > prev.end + static_cast<size_t>(detector.window_seconds * rate);
+    const double angle =
+        std::acos(std::clamp(raw_up.dot(prev.raw_mean.normalized()), -1.0, 1.0)) * kRadToDeg;
+    if (!moved && angle < s.options.new_pose_deg) return events;
+  }
+  if (s.refused_holds.count(begin)) return events;
+  // Saturation: the hold's samples pile up at an axis's limit.
+  {
+    ImuLog hold;
+    hold.source = "record";
+    hold.t.assign(log.t.begin() + begin, log.t.begin() + end);
+    hold.accel.assign(log.accel.begin() + begin, log.accel.begin() + end);
+    const std::vector<std::string> saturated = internal::SaturationWarnings(hold);
+    if (!saturated.empty()) {
+      s.refused_holds.insert(begin);
+      warn("saturation",
+           "the hold at t = " + Num(last.t_begin, 6) + " s is not used: " + saturated.front());
+      return events;
+    }
+  }
+  // The hold's direction (a face within kFaceSnapDeg) and noise.
+  if (!(s.scale > 0.0)) s.scale = s.start.model.gravity / last.accel_mean.norm();
+  Eigen::Vector3d up = raw_up;
+  Eigen::Index axis = 0;
+  up.cwiseAbs().maxCoeff(&axis);
+  if (std::abs(up(axis)) > std::cos(kFaceSnapDeg * kDegToRad)) {
+    up = Eigen::Vector3d::Unit(axis) * (up(axis) > 0.0 ? 1.0 : -1.0);
+  }
+  const double kept = last.t_end - last.t_begin;
+  const double dt = kept / std::max<double>(1.0, static_cast<double>(last.count()) - 1.0);
+  Eigen::Vector3d density;
+  for (int a = 0; a < 3; ++a) {
+    density(a) = std::sqrt(std::max(last.accel_cov(a, a), 0.0) * dt) * s.scale;
+  }
+  // Batch means (ten batches) when they show more than white noise.
+  if (last.count() >= 100) {
+    const size_t batch = last.count() / 10;
+    std::vector<Eigen::Vector3d> means;
+    for (size_t b = 0; b < 10; ++b) {
+      Eigen::Vector3d m = Eigen::Vector3d::Zero();
+      for (size_t i = 0; i < batch; ++i) m += log.accel[begin + b * batch + i];
+      means.push_back(m / static_cast<double>(batch));
+    }
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& m : means) mean += m / 10.0;
+    for (int a = 0; a < 3; ++a) {
+      double v = 0.0;
+      for (const Eigen::Vector3d& m : means) v += (m(a) - mean(a)) * (m(a) - mean(a)) / 9.0;
+      // Variance of one batch mean times its duration.
+      const double d = std::sqrt(v * static_cast<double>(batch) * dt) * s.scale;
+      density(a) = std::max(density(a), d);
+    }
+  }
+  if (!(s.plan_hold > 0.0)) {
+    s.Plan(density);
+    st.plan_poses = s.plan_poses;
+  }
+  st.holding = true;
+  st.hold_seconds = kept;
+  st.hold_needed_seconds = s.NeededHold(up, density);
+  if (kept < st.hold_needed_seconds) return events;
+
+  // Capture.
+  CapturedPose pose;
+  pose.up = up;
+  pose.raw_mean = last.accel_mean;
+  pose.kept_seconds = kept;
+  pose.begin = begin;
+  pose.end = end;
+  pose.density = density;
+  const Eigen::RowVectorXd row = s.Row(up, kept, density);
+  s.fisher += row.transpose() * row;
+  s.poses.push_back(pose);
+  s.detect_from = end;
+  st.holding = false;
+  st.poses.push_back(up);
+  const PoseSuggestion words = DescribeUp(raw_up);
+  events.push_back(MakeEvent(RecorderEventType::kPoseCaptured, t,
+                             {{"index", s.poses.size() - 1},
+                              {"up", JsonVector(raw_up)},
+                              {"up_words", words.instruction},
+                              {"t_begin", JsonNumber(last.t_begin)},
+                              {"duration", JsonNumber(kept)},
+                              {"samples", last.count()}},
+                             "pose " + std::to_string(s.poses.size()) +
+                                 " captured: " + words.instruction + ", " + Num(kept) + " s, " +
+                                 std::to_string(last.count()) + " samples"));
+
+  // Sigmas.
+  const Eigen::VectorXd std = DeterminedStd(s.fisher, s.start.limits);
+  const std::map<std::string, std::string> reasons = s.Reasons(std);
+  Json params = Json::array();
+  std::vector<std::string> short_of_target;
+  for (Eigen::Index i = 0; i < s.p; ++i) {
+    const std::string& name = s.start.names[i];
+    const ReadableUnit u = ReadableUnitOf(name);
+    st.sigma[i] = std(i) * u.factor;
+    Json j = {
+        {"name", name},
+        {"unit", u.unit},
+        {"sigma", JsonNumber(std(i) * u.factor)},
+        {"target", s.start.targeted[i] ? JsonNumber(s.start.targets(i) * u.factor) : Json(nullptr)},
+        {"determined", std::isfinite(std(i))}};
+    if (reasons.count(name)) j["reason"] = reasons.at(name);
+    if (s.start.targeted[i] && !(std(i) <= s.start.targets(i))) short_of_target.push_back(name);
+    params.push_back(j);
+  }
+  const bool met = s.TargetsMet(s.fisher, static_cast<int>(s.poses.size()));
+  std::string text = "sigma: " + std::to_string(reasons.size()) + " undetermined, " +
+                     std::to_string(short_of_target.size()) + " short of target";
+  if (!met && short_of_target.empty()) {
+    text += " (" + std::to_string(s.p + s.options.redundancy - s.poses.size()) +
+            " more pose(s) for redundancy)";
+  }
+  events.push_back(MakeEvent(RecorderEventType::kSigma, t,
+                             {{"poses", s.poses.size()},
+                              {"plan_poses", s.plan_poses},
+                              {"parameters", params},
+                              {"undetermined", reasons.size()},
+                              {"short_of_target", short_of_target},
+                              {"targets_met", met}},
+                             text));
+  if (met) {
+    st.done = true;
+    st.done_reason = "targets_met";
+    st.has_suggestion = false;
+    return events;
+  }
+  const PoseSuggestion next = s.Suggest(s.TypicalDensity(density));
+  st.suggestion = next;
+  st.has_suggestion = true;
+  events.push_back(
+      MakeEvent(RecorderEventType::kSuggest, t,
+                {{"up", JsonVector(next.up)},
+                 {"face", next.face},
+                 {"tilt_deg", JsonNumber(next.tilt_deg)},
+                 {"toward", next.toward},
+                 {"hold_seconds", JsonNumber(next.hold_seconds)},
+                 {"expected_gain", JsonNumber(next.expected_gain)},
+                 {"instruction", next.instruction}},
+                "next: " + next.instruction + ", hold " + Num(next.hold_seconds, 2) + " s"));
+  return events;
+}
+
+bool Recorder::Finish(const std::string& reason, const std::vector<std::string>& files,
+                      RecorderResult* result, std::string* error) {
+  State& s = *state_;
+  if (s.log.size() == 0) {
+    *error = "record: no sample was received";
+    return false;
+  }
+  RecorderResult out;
+  if (!ImuLogToCsv(s.log, &out.log_csv, error)) return false;
+  // The calibration of the CSV read back, with the contract layout: what
+  // calibrate gives on the written log.
+  Config config = s.config;
+  config.input = LogReaderOptions();
+  Session session;
+  if (!ParseImuLog(out.log_csv, "record.csv", config.input, &session.log, error)) return false;
+  out.ok = RunCalibration(config, SessionFiles(), &session, &out.calibration);
+  out.report_html =
+      !out.calibration.positions.empty() && session.detection_ok
+          ? CalibrationToHtml(out.calibration, session.log, "record.csv", session.detection)
+          : CalibrationToHtml(out.calibration, session.log, "record.csv");
+  const Eigen::VectorXd std = DeterminedStd(s.fisher, s.start.limits);
+  const std::map<std::string, std::string> reasons = s.Reasons(std);
+  Json undetermined = Json::array();
+  for (const auto& [name, why] : reasons) undetermined.push_back({{"name", name}, {"reason", why}});
+  Json body = {{"reason", reason},
+               {"files", files},
+               {"poses", s.poses.size()},
+               {"samples", s.log.size()},
+               {"garbage_lines", s.status.garbage_lines},
+               {"undetermined", undetermined},
+               {"calibration_ok", out.ok},
+               {"calibration_message", out.calibration.message}};
+  std::string text = "done: " + reason + "; " + std::to_string(s.poses.size()) + " poses, " +
+                     std::to_string(s.log.size()) + " samples";
+  if (!reasons.empty())
+    text += "; " + std::to_string(reasons.size()) + " parameter(s) undetermined";
+  s.done_body = body;
+  s.done_text = text;
+  out.done = MakeEvent(RecorderEventType::kDone, s.log.t.back(), body, text);
+  s.status.done = true;
+  s.status.done_reason = reason;
+  *result = std::move(out);
+  return true;
+}
+
+RecorderEvent Recorder::DoneEvent(const std::vector<std::string>& files) const {
+  const State& s = *state_;
+  Json body = s.done_body;
+  body["files"] = files;
+  return MakeEvent(RecorderEventType::kDone, s.log.t.empty() ? 0.0 : s.log.t.back(), body,
+                   s.done_text);
+}
+
+}  // namespace gravcal
