@@ -90,6 +90,8 @@ bool ReadNoise(const std::string& path, const std::string& text, ImuNoise* noise
 void BindCalibration(py::module_& m);
 void BindBatch(py::module_& m);
 void BindRecordings(py::module_& m);
+// compare, verify, the store, limits and the certificate (verify_bindings.cc).
+void BindVerify(py::module_& m);
 
 }  // namespace python
 }  // namespace gravcal

@@ -644,3 +644,116 @@ def export(calibration, to, *, noise=None, name=None):
                              *_noise_source(noise))
     result["files"] = [Result(f) for f in result["files"]]
     return Result(result)
+
+
+# ---------------------------------------------------------------------------
+# Is the calibration still good? (issue 36: compare, verify, the calibration
+# store and its history, acceptance limits and the certificate.)
+
+def _calibration(calibration, what="calibration"):
+    if isinstance(calibration, (str, bytes, _os.PathLike)):
+        calibration = Calibration.from_json(calibration)
+    if not isinstance(calibration, Calibration):
+        raise Error("%s: expected a gravcal.Calibration or a calibration JSON path, got %s"
+                    % (what, type(calibration).__name__))
+    return calibration
+
+
+def compare(a, b, *, level=0.01, space="model", output=None):
+    """Are two calibrations of the same unchanged unit? As ``gravcal compare
+    a.json b.json``: a :class:`Result` with ``consistent``, ``p_value``,
+    ``level``, ``parameters`` (each ``name``, ``difference``, ``std``,
+    ``z``), ``changed``, ``undetermined``... (compare.json). ``space`` is
+    model or intrinsic (mount-invariant). ``a`` and ``b`` are
+    :class:`Calibration` objects or calibration JSON paths."""
+    text = _gravcal.compare(_calibration(a, "a")._core, _calibration(b, "b")._core, float(level),
+                            str(space))
+    if output is not None:
+        _gravcal.write_file(_os.fspath(output), text)
+    return _result(text)
+
+
+def verify(calibration, log=None, *, config=None, level=0.01, output=None, t=None, accel=None,
+           gyro=None, temp=None, **keys):
+    """A short check session (a log, a path or arrays) against a stored
+    calibration, as ``gravcal verify``: ``consistent``, or ``changed`` with
+    the term, and each parameter's ``minimal_detectable_change``
+    (verify.json)."""
+    cfg = _config(config, **keys)
+    text = _gravcal.verify(_calibration(calibration)._core, cfg,
+                           _as_log(log, cfg, t, accel, gyro, temp), float(level))
+    if output is not None:
+        _gravcal.write_file(_os.fspath(output), text)
+    return _result(text)
+
+
+def history(unit, store, *, level=0.01):
+    """The unit's calibrations in a store, as ``gravcal history UNIT --store
+    DIR --output``: ``calibrations``, ``parameters`` (values, stds, slope and
+    the drift test) and ``steps`` (compare with the one before)."""
+    return _result(_gravcal.history(_os.fspath(store), str(unit), float(level)))
+
+
+def file_calibration(store, unit, calibration, *, date=None):
+    """Files a calibration in a store under ``unit`` and ``date`` (ISO 8601
+    UTC, default now), as ``calibrate --store``."""
+    _gravcal.file_calibration(_os.fspath(store), str(unit), "" if date is None else str(date),
+                              _calibration(calibration)._core)
+
+
+def closest_calibration(store, unit, *, date=None, max_age_days=0.0):
+    """The unit's stored calibration closest to ``date`` (default now), as
+    ``apply --store --unit --at`` picks it: a :class:`Calibration` with
+    ``.store_entry`` (``date``, ``file``, ``warning``: non-empty when older
+    than ``max_age_days``)."""
+    entry = _gravcal.closest_calibration(_os.fspath(store), str(unit),
+                                         "" if date is None else str(date), float(max_age_days))
+    if entry["warning"]:
+        _warnings.warn(entry["warning"])
+    return Calibration.from_json(entry["file"]), Result(entry)
+
+
+def _limits_source(limits):
+    """(path, YAML text) of limits given as a path or a dict."""
+    if isinstance(limits, dict):
+        return "", _json.dumps(limits)  # JSON is YAML
+    return _os.fspath(limits), ""
+
+
+def check_limits(calibration, limits):
+    """The calibration against acceptance limits (a limits YAML path, or a
+    dict of the same keys: ``parameters``, ``residual_rms``,
+    ``accel_noise_density``, ``temperature``...): a :class:`Result` with
+    ``verdict`` (pass or fail), ``message`` and ``limits`` (each ``name``,
+    ``measured``, ``min``, ``max``, ``pass``, ``checked``, ``why``)."""
+    return _result(_gravcal.check_limits(_calibration(calibration)._core,
+                                         *_limits_source(limits)))
+
+
+def certificate(calibration, *, limits=None, unit="", station=None, date=None, input_file="",
+                config_file="", coverage_factor=2.0, output=None):
+    """The calibration certificate, as ``calibrate --certificate PREFIX``
+    writes it: returns ``(certificate, html)``, the certificate JSON as a
+    :class:`Result` and the self-contained HTML page. With ``output`` (a
+    path prefix) writes ``<output>.json`` and ``<output>.html``. The
+    station defaults to the host name; ``config_file`` is recorded with its
+    text."""
+    import socket
+    config_text = ""
+    if config_file:
+        with open(config_file, encoding="utf-8") as f:
+            config_text = f.read()
+    path, text = ("", "") if limits is None else _limits_source(limits)
+    json_text, html = _gravcal.certificate(
+        _calibration(calibration)._core, limits is not None, path, text, str(unit),
+        socket.gethostname() if station is None else str(station), "" if date is None else date,
+        _os.fspath(input_file), _os.fspath(config_file) if config_file else "(defaults)",
+        config_text, float(coverage_factor))
+    if output is not None:
+        _gravcal.write_file(_os.fspath(output) + ".json", json_text)
+        _gravcal.write_file(_os.fspath(output) + ".html", html)
+    return _result(json_text), html
+
+
+__all__ += ["compare", "verify", "history", "file_calibration", "closest_calibration",
+            "check_limits", "certificate"]

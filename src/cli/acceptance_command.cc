@@ -1,7 +1,9 @@
 // calibrate --limits limits.yaml and --certificate PREFIX (issue 36): the
 // pass/fail verdict against acceptance limits, and the calibration
 // certificate (PREFIX.json, PREFIX.html). Exit code 4 when a limit fails
-// (the calibration and the certificate are written: they record it).
+// (the calibration and the certificate are written: they record it). Also
+// batch's limits, certificates and store, and apply's and export's
+// calibration taken from a store.
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -16,10 +18,13 @@
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/calibration_store.h"
 #include "util/content_hash.h"
+#include "util/error.h"
 
 namespace gravcal {
 namespace cli {
 namespace {
+
+using internal::SetError;
 
 constexpr int kOutOfLimits = 4;
 
@@ -38,6 +43,20 @@ std::string UnitName(const CalibrateArgs& args) {
   if (!args.unit.empty()) return args.unit;
   std::string stem = args.input.substr(args.input.find_last_of('/') + 1);
   return stem.substr(0, stem.find_last_of('.'));
+}
+
+// What a certificate records of this run: station, date, software, config.
+CertificateInfo StationInfo(const std::string& config_path) {
+  CertificateInfo info;
+  char host[256] = {0};
+  if (gethostname(host, sizeof(host) - 1) == 0) info.station = host;
+  info.date = NowUtc();
+  info.software_version = GravcalVersion();
+  info.software_hash = ProgramHash();
+  info.config_name = config_path.empty() ? "(defaults)" : config_path;
+  std::string error;
+  if (!config_path.empty()) ReadFileBytes(config_path, &info.config_text, &error);
+  return info;
 }
 
 }  // namespace
@@ -66,17 +85,10 @@ int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration) 
   AcceptanceResult acceptance;
   if (has_limits) CheckAcceptance(calibration, limits, &acceptance);
   if (!args.certificate.empty()) {
-    CertificateInfo info;
+    CertificateInfo info = StationInfo(args.config_path);
     info.unit = UnitName(args);
-    char host[256] = {0};
-    if (gethostname(host, sizeof(host) - 1) == 0) info.station = host;
-    info.date = NowUtc();
-    info.software_version = GravcalVersion();
-    info.software_hash = ProgramHash();
     info.input_file = args.input;
     info.input_hash = calibration.provenance.log_hash;
-    info.config_name = args.config_path.empty() ? "(defaults)" : args.config_path;
-    if (!args.config_path.empty()) ReadFileBytes(args.config_path, &info.config_text, &error);
     Certificate certificate;
     if (!MakeCertificate(calibration, info, has_limits ? &limits : nullptr, &certificate, &error)) {
       return Fail(error);
@@ -91,38 +103,68 @@ int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration) 
   return acceptance.pass ? 0 : kOutOfLimits;
 }
 
-int FinishBatchAcceptance(const BatchArgs& args, const std::vector<std::string>& units, int code) {
-  if (args.limits.empty()) return code;
+int FinishBatchAcceptance(const BatchArgs& args,
+                          const std::vector<std::pair<std::string, std::string>>& units, int code) {
+  if (args.limits.empty() && args.certificate.empty() && args.store.empty()) return code;
   std::string error;
   AcceptanceLimits limits;
-  if (!ReadAcceptanceLimits(args.limits, &limits, &error)) return Fail(error);
-  std::string csv = "unit,verdict,failed\n";
-  std::string failed_units;
-  int checked = 0, failed = 0;
-  for (const std::string& unit : units) {
-    const std::string path = args.output_dir + "/" + unit + ".json";
-    Calibration c;
-    struct stat st;
-    if (stat(path.c_str(), &st) != 0) continue;  // the unit failed: the batch says why
-    if (!ReadCalibrationUncertainty(path, &c, nullptr, &error)) return Fail(error);
-    AcceptanceResult result;
-    CheckAcceptance(c, limits, &result);
-    ++checked;
-    std::string why;
-    for (const LimitCheck& check : result.checks) {
-      if (!check.pass) why += (why.empty() ? "" : "; ") + check.name + " " + check.why;
-    }
-    csv += unit + "," + (result.pass ? "pass" : "fail") + ",\"" + why + "\"\n";
-    if (!result.pass) {
-      ++failed;
-      failed_units += (failed_units.empty() ? "" : ", ") + unit + " (" + why + ")";
-    }
+  if (!args.limits.empty() && !ReadAcceptanceLimits(args.limits, &limits, &error)) {
+    return Fail(error);
   }
-  if (!WriteFileAtomically(args.output_dir + "/limits.csv", csv, &error)) return Fail(error);
-  std::fprintf(stderr, "gravcal: limits %s: %d of %d calibrated units pass%s%s\n",
-               args.limits.c_str(), checked - failed, checked, failed > 0 ? "; fail: " : "",
-               failed_units.c_str());
-  return code != 0 ? code : (failed > 0 ? kOutOfLimits : 0);
+  BatchAcceptanceOptions options;
+  options.limits = args.limits.empty() ? nullptr : &limits;
+  options.limits_name = args.limits;
+  options.certificate_dir = args.certificate;
+  options.store = args.store;
+  options.report = args.report;
+  options.info = StationInfo(args.config_path);
+  BatchAcceptance result;
+  if (!AcceptBatchFolder(args.output_dir, units, options, &result, &error)) return Fail(error);
+  if (result.filed > 0) {
+    std::fprintf(stderr, "gravcal: filed %zu calibrations in %s (%s)\n", result.filed,
+                 args.store.c_str(), options.info.date.c_str());
+  }
+  if (result.certificates > 0) {
+    std::fprintf(stderr, "gravcal: wrote %zu certificates in %s\n", result.certificates,
+                 args.certificate.c_str());
+  }
+  if (args.limits.empty()) return code;
+  std::string failed_units;
+  for (const auto& [unit, why] : result.failed) {
+    failed_units += (failed_units.empty() ? "" : ", ") + unit + " (" + why + ")";
+  }
+  std::fprintf(stderr, "gravcal: limits %s: %zu of %zu calibrated units pass%s%s\n",
+               args.limits.c_str(), result.passed, result.checked,
+               result.failed.empty() ? "" : "; fail: ", failed_units.c_str());
+  return code != 0 ? code : (result.failed.empty() ? 0 : kOutOfLimits);
+}
+
+bool ResolveCalibrationPath(const std::string& calibration, const StoredCalibrationArgs& stored,
+                            std::string* path, std::string* error) {
+  const bool from_store = !stored.store.empty() || !stored.unit.empty();
+  if (!from_store) {
+    if (!stored.at.empty()) return SetError(error, "--at needs --store and --unit");
+    *path = calibration;
+    return true;
+  }
+  if (!calibration.empty()) {
+    return SetError(error, "give either --calibration or --store with --unit, not both");
+  }
+  if (stored.store.empty() || stored.unit.empty()) {
+    return SetError(error, "the calibration from a store needs both --store and --unit");
+  }
+  const std::string at = stored.at.empty() ? NowUtc() : stored.at;
+  StoreEntry entry;
+  std::string warning;
+  if (!ClosestCalibration(stored.store, stored.unit, at, stored.max_age_days, &entry, &warning,
+                          error)) {
+    return false;
+  }
+  *path = stored.store + "/" + entry.file;
+  std::fprintf(stderr, "gravcal: unit %s: the calibration closest to %s is %s (%s)\n",
+               stored.unit.c_str(), at.c_str(), entry.date.c_str(), path->c_str());
+  if (!warning.empty()) std::fprintf(stderr, "gravcal: warning: %s\n", warning.c_str());
+  return true;
 }
 
 }  // namespace cli

@@ -35,17 +35,22 @@ std::vector<std::string> OutputComment(const std::string& calibration_path,
 }  // namespace
 
 int RunApply(const ApplyArgs& args) {
-  if (args.calibration.empty()) return Fail("apply needs --calibration <calib.json>");
+  std::string calibration_path, error;
+  if (!ResolveCalibrationPath(args.calibration, args.stored, &calibration_path, &error)) {
+    return Fail(error);
+  }
+  if (calibration_path.empty()) {
+    return Fail("apply needs --calibration <calib.json> (or --store DIR --unit SN)");
+  }
   if (args.input.empty()) return Fail("apply needs --input <raw log, or - for standard input>");
   if (args.output.empty())
     return Fail("apply needs --output <corrected.csv, or - for standard output>");
-  std::string error;
   LoadedCalibration calibration;
-  if (!ReadCalibrationJson(args.calibration, &calibration, &error)) return Fail(error);
+  if (!ReadCalibrationJson(calibration_path, &calibration, &error)) return Fail(error);
   for (const std::string& key : calibration.undetermined) {
     std::fprintf(stderr,
                  "gravcal: warning: %s: %s is undetermined in the calibration; applied as 0\n",
-                 args.calibration.c_str(), key.c_str());
+                 calibration_path.c_str(), key.c_str());
   }
   const ImuCorrector& corrector = calibration.corrector;
   if (!args.config.IsValid(&error)) return Fail(error);
@@ -68,7 +73,7 @@ int RunApply(const ApplyArgs& args) {
   if (!reader.Next(&sample, &error)) return Fail(error);
   ImuCsvStreamWriter writer;
   if (!writer.Open(args.output, reader.has_gyro(), reader.has_temperature(),
-                   OutputComment(args.calibration, calibration, reader.has_gyro()), &error)) {
+                   OutputComment(calibration_path, calibration, reader.has_gyro()), &error)) {
     return Fail(error);
   }
   size_t count = 0;

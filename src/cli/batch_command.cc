@@ -177,8 +177,8 @@ int RunBatch(const BatchArgs& args) {
   summary.shard_source = shard_source;
   PrintLines(summary.BriefReport());
   if (!summary.stop.empty()) return Fail("batch " + summary.stop);
-  std::vector<std::string> ids;
-  for (const BatchUnit& u : units.units) ids.push_back(u.id);
+  std::vector<std::pair<std::string, std::string>> ids;
+  for (const BatchUnit& u : units.units) ids.emplace_back(u.id, u.path);
   return FinishBatchAcceptance(args, ids, ExitCode(summary.statistics));
 }
 

@@ -52,10 +52,20 @@ struct CalibrateArgs : CommonArgs {
   std::string store;
 };
 
+// apply and export: the calibration by file (--calibration) or, with
+// --store and --unit, the unit's stored calibration closest to --at.
+struct StoredCalibrationArgs {
+  std::string store;
+  std::string unit;
+  std::string at;
+  double max_age_days = 0.0;
+};
+
 struct ApplyArgs : CommonArgs {
   std::string calibration;
   std::string input;
   std::string output;
+  StoredCalibrationArgs stored;
 };
 
 struct SimulateArgs : CommonArgs {
@@ -112,8 +122,11 @@ struct BatchArgs : CommonArgs {
   double unit_timeout = 0.0;
   double outlier_sigmas = 5.0;
   int outlier_min_units = 5;
-  // Acceptance limits (YAML, issue 36): each calibrated unit against them.
+  // Acceptance limits (YAML, issue 36): each calibrated unit against them;
+  // the certificates' folder and the calibration store.
   std::string limits;
+  std::string certificate;
+  std::string store;
 };
 
 // discover and noise.
@@ -137,6 +150,7 @@ struct ExportArgs : CommonArgs {
   std::string to;
   std::string output;
   std::string output_dir;
+  StoredCalibrationArgs stored;
 };
 
 // compare a.json b.json (the two calibrations are the positional
@@ -207,7 +221,13 @@ int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration);
 // the limits, <output-dir>/limits.csv (unit, verdict, failed), the count and
 // the failing units named on stderr; returns `code` when it is not 0, else 4
 // when a unit fails.
-int FinishBatchAcceptance(const BatchArgs& args, const std::vector<std::string>& units, int code);
+int FinishBatchAcceptance(const BatchArgs& args,
+                          const std::vector<std::pair<std::string, std::string>>& units, int code);
+// The calibration file apply and export use: --calibration, or the unit's
+// stored calibration closest to --at (said on standard error, with a warning
+// when older than --max-age-days). False with a one-line message.
+bool ResolveCalibrationPath(const std::string& calibration, const StoredCalibrationArgs& stored,
+                            std::string* path, std::string* error);
 // history_command.cc: 0 listed; 1 bad input.
 int RunHistory(const HistoryArgs& args);
 

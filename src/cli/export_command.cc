@@ -17,7 +17,13 @@ namespace gravcal {
 namespace cli {
 
 int RunExport(const ExportArgs& args) {
-  if (args.calibration.empty()) return Fail("export needs --calibration <calib.json>");
+  std::string calibration_path, error;
+  if (!ResolveCalibrationPath(args.calibration, args.stored, &calibration_path, &error)) {
+    return Fail(error);
+  }
+  if (calibration_path.empty()) {
+    return Fail("export needs --calibration <calib.json> (or --store DIR --unit SN)");
+  }
   ExportOptions options;
   if (!FromString(args.to, &options.target)) {
     return Fail("export needs --to <target>, one of " + ExportTargetNames() +
@@ -28,15 +34,14 @@ int RunExport(const ExportArgs& args) {
     return Fail("export --to c needs --output-dir <folder> (writes gravcal_correct.h and .c)");
   }
   if (!c_target && args.output.empty()) return Fail("export needs --output <file>");
-  std::string error;
   LoadedCalibration calibration;
-  if (!ReadCalibrationJson(args.calibration, &calibration, &error)) return Fail(error);
+  if (!ReadCalibrationJson(calibration_path, &calibration, &error)) return Fail(error);
   ImuNoise noise;
   if (!args.noise.empty()) {
     if (!ReadNoiseJson(args.noise, &noise, &error)) return Fail(error);
     options.noise = &noise.model;
   }
-  options.calibration_name = args.calibration;
+  options.calibration_name = calibration_path;
   ExportResult result;
   if (!ExportCalibration(calibration, options, &result, &error)) return Fail(error);
   for (const std::string& line : result.dropped) {

@@ -89,12 +89,20 @@
     "(mount-invariant, Geist and Gaitan)")                                                       \
   X(string, limits, "", "calibrate, batch: acceptance limits (YAML); exit 4 when one fails")     \
   X(string, certificate, "",                                                                     \
-    "calibrate: write the calibration certificate to <prefix>.json and <prefix>.html")           \
+    "calibrate: write the calibration certificate to <prefix>.json and <prefix>.html; "          \
+    "batch: one per unit, <folder>/<unit>.json and .html")                                       \
   X(string, unit, "",                                                                            \
-    "calibrate: the unit's name on the certificate and in the store (default: the log's name)")  \
+    "calibrate: the unit's name on the certificate and in the store (default: the log's name); " \
+    "apply, export: the unit whose stored calibration closest to --at is used")                  \
   X(string, store, "",                                                                           \
-    "calibrate: file the calibration in this store (a folder, per unit and date); "              \
-    "history: the store to read")                                                                \
+    "calibrate, batch: file the calibration in this store (a folder, per unit and date); "       \
+    "history: the store to read; apply, export: take the calibration from it (with --unit)")     \
+  X(string, at, "",                                                                              \
+    "apply, export with --store: the date (ISO 8601 UTC, default now) whose closest "            \
+    "calibration is used")                                                                       \
+  X(double, max_age_days, 0.0,                                                                   \
+    "apply, export with --store: warn when the calibration used is older than this (days; "      \
+    "0: never)")                                                                                 \
   X(string, verify, "",                                                                          \
     "plan: design the shortest check session for this stored calibration (JSON) "                \
     "instead: four poses, detecting 10 stored sigmas in any one parameter with power "           \

@@ -64,6 +64,12 @@ FlagBinding<Args> ConfigFlag() {
   return FlagField<Args>("config", &CommonArgs::config_path);
 }
 
+// apply's and export's --store, --unit, --at, --max-age-days.
+template <typename Args, typename T>
+FlagBinding<Args> StoredFlag(const char* name, T StoredCalibrationArgs::*field) {
+  return FlagAt<Args>(name, [field](Args* a) { return &(a->stored.*field); });
+}
+
 // The flags of plan and check that fill the plan request.
 FlagBinding<PlanArgs> RequestFlag(const char* name, std::string gravcal::PlanRequest::*field) {
   return FlagAt<PlanArgs>(name, [field](PlanArgs* a) { return &(a->request.*field); });
@@ -106,7 +112,11 @@ const std::vector<CommandInfo>& Commands() {
           "input/output), writing SI units",
           {FlagField<ApplyArgs>("calibration", &ApplyArgs::calibration),
            FlagField<ApplyArgs>("input", &ApplyArgs::input),
-           FlagField<ApplyArgs>("output", &ApplyArgs::output), ConfigFlag<ApplyArgs>()},
+           FlagField<ApplyArgs>("output", &ApplyArgs::output), ConfigFlag<ApplyArgs>(),
+           StoredFlag<ApplyArgs>("store", &StoredCalibrationArgs::store),
+           StoredFlag<ApplyArgs>("unit", &StoredCalibrationArgs::unit),
+           StoredFlag<ApplyArgs>("at", &StoredCalibrationArgs::at),
+           StoredFlag<ApplyArgs>("max_age_days", &StoredCalibrationArgs::max_age_days)},
           RunApply),
       Command<SimulateArgs>(
           "simulate",
@@ -193,7 +203,9 @@ const std::vector<CommandInfo>& Commands() {
            FlagField<BatchArgs>("topics", &BatchArgs::topics),
            FlagField<BatchArgs>("report", &BatchArgs::report),
            FlagField<BatchArgs>("unit_timeout", &BatchArgs::unit_timeout),
-           FlagField<BatchArgs>("limits", &BatchArgs::limits)},
+           FlagField<BatchArgs>("limits", &BatchArgs::limits),
+           FlagField<BatchArgs>("certificate", &BatchArgs::certificate),
+           FlagField<BatchArgs>("store", &BatchArgs::store)},
           RunBatch),
       Command<BatchArgs>(
           "merge-summaries",
@@ -232,7 +244,11 @@ const std::vector<CommandInfo>& Commands() {
            FlagField<ExportArgs>("noise", &ExportArgs::noise),
            FlagField<ExportArgs>("to", &ExportArgs::to),
            FlagField<ExportArgs>("output", &ExportArgs::output),
-           FlagField<ExportArgs>("output_dir", &ExportArgs::output_dir)},
+           FlagField<ExportArgs>("output_dir", &ExportArgs::output_dir),
+           StoredFlag<ExportArgs>("store", &StoredCalibrationArgs::store),
+           StoredFlag<ExportArgs>("unit", &StoredCalibrationArgs::unit),
+           StoredFlag<ExportArgs>("at", &StoredCalibrationArgs::at),
+           StoredFlag<ExportArgs>("max_age_days", &StoredCalibrationArgs::max_age_days)},
           RunExport),
       Command<CompareArgs>(
           "compare",
@@ -318,6 +334,10 @@ bool PrintHelp(const std::string& command) {
         if (ch == '_') ch = '-';
       }
       std::printf("  --%-22s %s\n", name.c_str(), FindFlag(f)->help);
+    }
+    if (!c.config_keys) {
+      std::printf("\nconfig keys: none (this command reads no config)\n");
+      return true;
     }
     std::printf("\nconfig keys (in the YAML file, or as --key value; default in brackets):\n");
     std::string section;

@@ -147,6 +147,30 @@ bool CalibrationUncertaintyFromJson(const std::string& text, const std::string& 
   } else {
     out.residual_refined.rms = NAN;
   }
+  // The holds as far as acceptance limits need them (noise density,
+  // temperature); CalibrationFromJson checked raw_mean, t_begin and t_end.
+  if (j.contains("positions") && j["positions"].is_array()) {
+    for (const json& p : j["positions"]) {
+      PositionReport r;
+      r.position.t_begin = p["t_begin"].get<double>();
+      r.position.t_end = p["t_end"].get<double>();
+      for (int i = 0; i < 3; ++i) r.position.raw_mean(i) = p["raw_mean"][i].get<double>();
+      if (p.contains("samples") && p["samples"].is_number_unsigned()) {
+        r.position.sample_count = p["samples"].get<size_t>();
+      }
+      r.raw_std.setConstant(NAN);
+      if (p.contains("raw_std") && p["raw_std"].is_array() && p["raw_std"].size() == 3) {
+        for (int i = 0; i < 3; ++i) {
+          if (p["raw_std"][i].is_number()) r.raw_std(i) = p["raw_std"][i].get<double>();
+        }
+      }
+      r.position.temperature = NAN;
+      if (p.contains("temperature") && p["temperature"].is_number()) {
+        r.position.temperature = p["temperature"].get<double>();
+      }
+      out.positions.push_back(r);
+    }
+  }
   const json& accel = j["accel"];
   if (!ReadStd(accel, name, "accel", &out.accel.bias_std, &out.accel.matrix_std, error) ||
       !ReadCovariance(accel, name, "accel", &out.accel.covariance, &out.accel.covariance_names,

@@ -116,7 +116,9 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
     return false;
   }
   if (!root.IsMap()) {
-    *error = name + ": must be a map with 'parameters', 'residual_rms', 'gravity_std'";
+    *error = name +
+             ": must be a map with 'parameters', 'residual_rms', 'gravity_std', "
+             "'accel_noise_density', 'temperature'";
     return false;
   }
   AcceptanceLimits out;
@@ -127,6 +129,26 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
     } else if (key == "gravity_std") {
       if (!ReadNumber(entry.second, name, key, &out.gravity_std, error)) return false;
       if (!(out.gravity_std > 0.0)) return KeyError(name, key, "must be positive", error);
+    } else if (key == "accel_noise_density") {
+      if (!ReadNumber(entry.second, name, key, &out.max_accel_noise_density, error)) return false;
+      if (!(out.max_accel_noise_density > 0.0)) {
+        return KeyError(name, key, "must be positive", error);
+      }
+    } else if (key == "temperature") {
+      if (!entry.second.IsMap() || entry.second.size() == 0) {
+        return KeyError(name, key, "must be a map with min and/or max (degC)", error);
+      }
+      for (const auto& field : entry.second) {
+        const std::string f = field.first.as<std::string>();
+        double* target = f == "min"   ? &out.min_temperature
+                         : f == "max" ? &out.max_temperature
+                                      : nullptr;
+        if (target == nullptr) return KeyError(name, key + "." + f, "unknown (min, max)", error);
+        if (!ReadNumber(field.second, name, key + "." + f, target, error)) return false;
+      }
+      if (out.min_temperature > out.max_temperature) {
+        return KeyError(name, key, "min is above max", error);
+      }
     } else if (key == "parameters") {
       if (!entry.second.IsMap()) return KeyError(name, key, "must be a map of parameters", error);
       for (const auto& p : entry.second) {
@@ -153,11 +175,42 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
         out.parameters.push_back(limit);
       }
     } else {
-      return KeyError(name, key, "unknown (parameters, residual_rms, gravity_std)", error);
+      return KeyError(name, key,
+                      "unknown (parameters, residual_rms, gravity_std, accel_noise_density, "
+                      "temperature)",
+                      error);
     }
   }
   *limits = out;
   return true;
+}
+
+Eigen::Vector3d MeasuredAccelNoiseDensity(const Calibration& c) {
+  const Eigen::Matrix3d m = c.accel.model.matrix();
+  std::vector<double> per_axis[3];
+  for (const PositionReport& p : c.positions) {
+    const double duration = p.position.t_end - p.position.t_begin;
+    if (p.position.sample_count < 2 || !(duration > 0.0) || !p.raw_std.allFinite() ||
+        !(p.raw_std.maxCoeff() > 0.0)) {
+      continue;
+    }
+    const double rate = (p.position.sample_count - 1) / duration;
+    const Eigen::Matrix3d cov =
+        m * p.raw_std.array().square().matrix().asDiagonal() * m.transpose();
+    for (int i = 0; i < 3; ++i) per_axis[i].push_back(std::sqrt(cov(i, i) / rate));
+  }
+  Eigen::Vector3d out = Eigen::Vector3d::Constant(NAN);
+  for (int i = 0; i < 3; ++i) {
+    std::vector<double>& v = per_axis[i];
+    if (v.empty()) continue;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    double median = v[v.size() / 2];
+    if (v.size() % 2 == 0) {
+      median = 0.5 * (median + *std::max_element(v.begin(), v.begin() + v.size() / 2));
+    }
+    out(i) = median;
+  }
+  return out;
 }
 
 bool ReadAcceptanceLimits(const std::string& path, AcceptanceLimits* limits, std::string* error) {
@@ -198,14 +251,49 @@ void CheckAcceptance(const Calibration& calibration, const AcceptanceLimits& lim
     result->checks.push_back(
         Range("residual_rms", calibration.residual_refined.rms, 0.0, limits.max_residual_rms));
   }
+  if (std::isfinite(limits.max_accel_noise_density)) {
+    const Eigen::Vector3d n = MeasuredAccelNoiseDensity(calibration);
+    result->checks.push_back(Range("accel_noise_density", n.allFinite() ? n.maxCoeff() : NAN, 0.0,
+                                   limits.max_accel_noise_density));
+    if (!n.allFinite()) result->checks.back().why = "not measured (no hold with samples)";
+  }
+  if (std::isfinite(limits.min_temperature) || std::isfinite(limits.max_temperature)) {
+    // The hold farthest outside [min, max] (or the coldest when all inside).
+    double coldest = NAN, hottest = NAN;
+    for (const PositionReport& p : calibration.positions) {
+      const double t = p.position.temperature;
+      if (!std::isfinite(t)) continue;
+      coldest = std::isfinite(coldest) ? std::min(coldest, t) : t;
+      hottest = std::isfinite(hottest) ? std::max(hottest, t) : t;
+    }
+    if (!std::isfinite(coldest)) {
+      LimitCheck c;
+      c.name = "temperature";
+      c.min = limits.min_temperature;
+      c.max = limits.max_temperature;
+      c.pass = true;
+      c.checked = false;
+      c.why = "not checked: the log has no temperature";
+      result->checks.push_back(c);
+    } else {
+      const bool too_hot = hottest > limits.max_temperature;
+      result->checks.push_back(Range("temperature", too_hot ? hottest : coldest,
+                                     limits.min_temperature, limits.max_temperature));
+    }
+  }
   std::string failed;
   for (const LimitCheck& c : result->checks) {
     if (c.pass) continue;
     result->pass = false;
     failed += (failed.empty() ? "" : "; ") + c.name + " " + c.why;
   }
-  result->message = result->pass ? "pass (" + std::to_string(result->checks.size()) + " limits)"
-                                 : "fail: " + failed;
+  size_t unchecked = 0;
+  for (const LimitCheck& c : result->checks) unchecked += c.checked ? 0 : 1;
+  result->message =
+      result->pass
+          ? "pass (" + std::to_string(result->checks.size() - unchecked) + " limits" +
+                (unchecked > 0 ? ", " + std::to_string(unchecked) + " not checked" : "") + ")"
+          : "fail: " + failed;
 }
 
 bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
@@ -221,6 +309,13 @@ bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
   out.gravity_std = GravityStd(c.gravity_source, limits != nullptr ? limits->gravity_std : 0.0);
   out.method = c.method;
   out.residual_rms = c.residual_refined.rms;
+  out.accel_noise_density = MeasuredAccelNoiseDensity(c);
+  for (const PositionReport& p : c.positions) {
+    const double t = p.position.temperature;
+    if (!std::isfinite(t)) continue;
+    out.temperature_min = std::isfinite(out.temperature_min) ? std::min(out.temperature_min, t) : t;
+    out.temperature_max = std::isfinite(out.temperature_max) ? std::max(out.temperature_max, t) : t;
+  }
   // The split of the fit variance between noise of the mean and pose scatter.
   double noise = 0.0;
   int poses = 0;
@@ -280,6 +375,34 @@ bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
   return true;
 }
 
+namespace {
+
+nlohmann::ordered_json ChecksJson(const AcceptanceResult& result) {
+  using Json = nlohmann::ordered_json;
+  using internal::JsonNumber;
+  Json checks = Json::array();
+  for (const LimitCheck& c : result.checks) {
+    checks.push_back({{"name", c.name},
+                      {"measured", JsonNumber<Json>(c.measured)},
+                      {"min", JsonNumber<Json>(c.min)},
+                      {"max", JsonNumber<Json>(c.max)},
+                      {"pass", c.pass},
+                      {"checked", c.checked},
+                      {"why", c.why}});
+  }
+  return checks;
+}
+
+}  // namespace
+
+std::string AcceptanceToJson(const AcceptanceResult& result) {
+  nlohmann::ordered_json j;
+  j["verdict"] = result.pass ? "pass" : "fail";
+  j["message"] = result.message;
+  j["limits"] = ChecksJson(result);
+  return j.dump(2) + "\n";
+}
+
 std::string CertificateToJson(const Certificate& cert) {
   using Json = nlohmann::ordered_json;
   using internal::JsonNumber;
@@ -297,6 +420,12 @@ std::string CertificateToJson(const Certificate& cert) {
                   {"source", cert.gravity_source},
                   {"standard_uncertainty", cert.gravity_std}};
   j["residual_rms"] = JsonNumber<Json>(cert.residual_rms);
+  j["measured"] = {{"accel_noise_density",
+                    {JsonNumber<Json>(cert.accel_noise_density(0)),
+                     JsonNumber<Json>(cert.accel_noise_density(1)),
+                     JsonNumber<Json>(cert.accel_noise_density(2))}},
+                   {"temperature_min", JsonNumber<Json>(cert.temperature_min)},
+                   {"temperature_max", JsonNumber<Json>(cert.temperature_max)}};
   j["coverage_factor"] = cert.info.coverage_factor;
   Json parameters = Json::array();
   for (const CertificateEntry& e : cert.parameters) {
@@ -316,17 +445,8 @@ std::string CertificateToJson(const Certificate& cert) {
   j["parameters"] = parameters;
   j["notes"] = cert.notes;
   if (cert.has_limits) {
-    Json checks = Json::array();
-    for (const LimitCheck& c : cert.acceptance.checks) {
-      checks.push_back({{"name", c.name},
-                        {"measured", JsonNumber<Json>(c.measured)},
-                        {"min", JsonNumber<Json>(c.min)},
-                        {"max", JsonNumber<Json>(c.max)},
-                        {"pass", c.pass},
-                        {"why", c.why}});
-    }
     j["verdict"] = cert.acceptance.pass ? "pass" : "fail";
-    j["limits"] = checks;
+    j["limits"] = ChecksJson(cert.acceptance);
     j["verdict_message"] = cert.acceptance.message;
   } else {
     j["verdict"] = nullptr;
@@ -353,7 +473,16 @@ std::string CertificateToHtml(const Certificate& cert) {
       {"Method", cert.method},
       {"Gravity", Number(cert.gravity) + " m/s^2 (" + cert.gravity_source +
                       "), u = " + Number(cert.gravity_std) + " m/s^2"},
-      {"Residual |a| - g rms", Number(cert.residual_rms) + " m/s^2"}};
+      {"Residual |a| - g rms", Number(cert.residual_rms) + " m/s^2"},
+      {"Accelerometer noise density (holds)",
+       cert.accel_noise_density.allFinite()
+           ? Number(cert.accel_noise_density(0)) + ", " + Number(cert.accel_noise_density(1)) +
+                 ", " + Number(cert.accel_noise_density(2)) + " m/s^2/sqrt(Hz)"
+           : "not measured"},
+      {"Temperature (holds)",
+       std::isfinite(cert.temperature_min)
+           ? Number(cert.temperature_min) + " to " + Number(cert.temperature_max) + " degC"
+           : "not in the log"}};
   for (const auto& [k, v] : rows)
     h += "<tr><th>" + std::string(k) + "</th><td>" + internal::HtmlEscape(v) + "</td></tr>\n";
   h += "</table>\n<h2>Parameters (expanded uncertainty, coverage factor k = " +
@@ -388,7 +517,10 @@ std::string CertificateToHtml(const Certificate& cert) {
     for (const LimitCheck& c : cert.acceptance.checks) {
       h += "<tr><td>" + internal::HtmlEscape(c.name) + "</td><td>" + Number(c.measured) +
            "</td><td>" + Number(c.min) + "</td><td>" + Number(c.max) + "</td><td class='" +
-           (c.pass ? "pass'>pass" : "fail'>fail: " + internal::HtmlEscape(c.why)) + "</td></tr>\n";
+           (!c.checked ? "pass'>" + internal::HtmlEscape(c.why)
+            : c.pass   ? "pass'>pass"
+                       : "fail'>fail: " + internal::HtmlEscape(c.why)) +
+           "</td></tr>\n";
     }
     h += "</table>\n";
   } else {

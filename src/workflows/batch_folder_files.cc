@@ -66,6 +66,9 @@ bool OwnFilesInInput(const std::string& input_dir, const std::string& output_dir
          std::string why;
          return ParseFleetInfo(text, "", &info, &why);
        }},
+      // Written by AcceptBatchFolder (workflows/acceptance.h) with --limits.
+      {output_dir + "/limits.csv",
+       [](const std::string& text) { return text.compare(0, 20, "unit,verdict,failed\n") == 0; }},
       {report, [](const std::string& text) {
          return text.compare(0, 15, "<!DOCTYPE html>") == 0 || text.compare(0, 5, "<html") == 0;
        }}};

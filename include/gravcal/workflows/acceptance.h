@@ -9,12 +9,29 @@
 //     accel.nonorth_xy: {max_std: 0.001}      # intrinsic names too
 //   residual_rms: 0.005     # |a| - g rms after calibration, m/s^2
 //   gravity_std: 0.0001     # standard uncertainty of the gravity used, m/s^2
+//   accel_noise_density: 0.002   # m/s^2/sqrt(Hz), the largest axis, measured in the holds
+//   temperature: {min: 15, max: 35}   # degC, every hold, where the log has temperature
 //
 // Parameter names are compare's (estimation/calibration_comparison.h):
 // model names (accel.bias_x, accel.u_xy, accel.rot_z, gyro.m_xy) and the
 // intrinsic ones (accel.sensitivity_x, accel.nonorth_yz). A limit on a
 // parameter the calibration does not estimate, or on the sigma of one it
 // does not determine, fails with that said.
+//
+// Noise density: from the variance of each hold's mean that the fit used
+// (the position's raw_mean_cov, as the config's pose_noise estimated it:
+// white, or batch means that include correlated noise), taken through the
+// calibrated matrix, sigma_mean_i^2 = (M diag(raw_mean_cov) M^T)_ii, m/s^2,
+// and the hold's duration T: N_i = sigma_mean_i sqrt(T) (white noise of
+// density N has a mean over T of variance N^2 / T). The calibration JSON
+// keeps raw_std = sqrt(samples diag(raw_mean_cov)), so
+// N_i^2 = (M diag(raw_std^2) M^T)_ii / f_s with f_s = (samples - 1) / T.
+// The median over the holds per axis; the limit applies to the largest axis.
+// Hand tremor in a hold raises it: it is the noise the calibration saw.
+//
+// Temperature: every hold's mean temperature must lie in [min, max]. A log
+// without temperature leaves the limit not checked (listed as such, not
+// failed): the limit applies where the data carry temperature.
 //
 // Certificate: each parameter with its standard uncertainty u_c and the
 // expanded uncertainty U = k u_c (k = 2), and the budget whose squares sum to
@@ -34,6 +51,7 @@
 #ifndef GRAVCAL_WORKFLOWS_ACCEPTANCE_H_
 #define GRAVCAL_WORKFLOWS_ACCEPTANCE_H_
 
+#include <Eigen/Core>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -56,7 +74,17 @@ struct AcceptanceLimits {
   double max_residual_rms = std::numeric_limits<double>::infinity();
   // <= 0: by the gravity's source (above).
   double gravity_std = 0.0;
+  // m/s^2/sqrt(Hz), the largest axis of MeasuredAccelNoiseDensity.
+  double max_accel_noise_density = std::numeric_limits<double>::infinity();
+  // degC, every hold's mean temperature.
+  double min_temperature = -std::numeric_limits<double>::infinity();
+  double max_temperature = std::numeric_limits<double>::infinity();
 };
+
+// The accelerometer's white-noise density per axis measured in the holds
+// (above), m/s^2/sqrt(Hz); NaN where no hold has a sample count, a duration
+// and a raw standard deviation.
+Eigen::Vector3d MeasuredAccelNoiseDensity(const Calibration& calibration);
 
 // Parses the limits YAML; `name` is used in messages. Errors are one line
 // naming the file and key ("limits.yaml: key 'parameters.accel.bias_z.min':
@@ -73,6 +101,9 @@ struct LimitCheck {
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
   bool pass = false;
+  // False for a limit the data cannot be checked against (temperature of a
+  // log without temperature): it passes, and `why` says so.
+  bool checked = true;
   // Why it failed ("0.31 above max 0.2", "not estimated"), "" when passed.
   std::string why;
 };
@@ -123,6 +154,11 @@ struct Certificate {
   double gravity_std = NAN;
   std::string method;
   double residual_rms = NAN;
+  // Measured in the holds: MeasuredAccelNoiseDensity, and the coldest and
+  // hottest hold (NaN without temperature).
+  Eigen::Vector3d accel_noise_density = Eigen::Vector3d::Constant(NAN);
+  double temperature_min = NAN;
+  double temperature_max = NAN;
   std::vector<CertificateEntry> parameters;
   // Notes on the budget (temperature not modelled, the split rule).
   std::vector<std::string> notes;
@@ -135,8 +171,48 @@ bool MakeCertificate(const Calibration& calibration, const CertificateInfo& info
                      const AcceptanceLimits* limits, Certificate* certificate, std::string* error);
 
 std::string CertificateToJson(const Certificate& certificate);
+// The verdict and each limit as JSON ({"verdict", "message", "limits": [...]}),
+// the shape of the certificate's "limits" (Python's check_limits).
+std::string AcceptanceToJson(const AcceptanceResult& result);
 // A self-contained HTML page (no script, no external resource).
 std::string CertificateToHtml(const Certificate& certificate);
+
+// After a batch (workflows/batch_folder.h) wrote <output_dir>/<unit>.json:
+// each calibrated unit against the limits (when given), its certificate
+// (when certificate_dir is given: <certificate_dir>/<unit>.json and .html),
+// and its calibration filed in the store (when given, under the unit's id
+// and `info.date`). Writes <output_dir>/limits.csv (unit, verdict, failed)
+// and adds "acceptance" to <output_dir>/summary.json ({limits, checked,
+// pass, fail, failed: [{unit, why}]}) and a section to the fleet report
+// (`report`, when it exists). A unit without <unit>.json failed in the batch
+// (summary.json says why) and is skipped.
+struct BatchAcceptanceOptions {
+  // Not owned; null: no limits (certificates and the store only).
+  const AcceptanceLimits* limits = nullptr;
+  // The limits file's name (in summary.json and the report).
+  std::string limits_name;
+  std::string certificate_dir;
+  std::string store;
+  std::string report;
+  // station, date, software, config; unit and input are filled per unit.
+  CertificateInfo info;
+};
+
+struct BatchAcceptance {
+  size_t checked = 0;
+  size_t passed = 0;
+  // (unit, the failed limits).
+  std::vector<std::pair<std::string, std::string>> failed;
+  size_t certificates = 0;
+  size_t filed = 0;
+};
+
+// `units`: (unit id, its log's path). False with a one-line message naming
+// the file on a read or write error.
+bool AcceptBatchFolder(const std::string& output_dir,
+                       const std::vector<std::pair<std::string, std::string>>& units,
+                       const BatchAcceptanceOptions& options, BatchAcceptance* result,
+                       std::string* error);
 
 }  // namespace gravcal
 
