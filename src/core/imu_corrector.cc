@@ -25,52 +25,94 @@ bool ImuCorrector::RequiresTime() const {
 
 namespace {
 
-// a = R h^-1(U (v - b)) and w = M_g (u - b_g - o) of one model's blocks.
-bool AccelOf(const ImuParameters& p, const Eigen::Vector3d& raw, double temperature, double time,
-             Eigen::Vector3d* a) {
-  Eigen::Vector3d out;
-  if (!p.Model().CorrectAccel(raw, p.TemperatureOffset(temperature), p.TimeOffset(time),
-                              out.data())) {
+// a = R h^-1((I + D(x))^-1 U (v - b - db(x))): the thermal terms (none when
+// the model is inactive), then the effects, then the housing rotation.
+bool AccelOf(const ImuParameters& p, const ThermalBlocks<double>& thermal, double x,
+             const Eigen::Vector3d& raw, double temperature, double time, Eigen::Vector3d* a) {
+  const ImuModel<double> model = p.Model();
+  double db[3];
+  thermal.BiasChange(x, db);
+  const Eigen::Vector3d shifted = raw - Eigen::Vector3d(db[0], db[1], db[2]);
+  double s[3];
+  model.SensorFrame(shifted, s);
+  thermal.RemoveScale(x, s);
+  const AccelBlocks<double>& b = model.accel();
+  if (!CorrectAccelEffects(b.quadratic, b.temperature_bias, b.temperature_scale, b.drift,
+                           p.TemperatureOffset(temperature), p.TimeOffset(time), s)) {
     return false;
   }
-  *a = out;
+  double out[3];
+  model.ToHousing(s, out);
+  *a = Eigen::Vector3d(out[0], out[1], out[2]);
   return true;
 }
 
-Eigen::Vector3d GyroOf(const ImuParameters& p, const Eigen::Matrix3d& rotation,
-                       const Eigen::Vector3d& raw, const Eigen::Vector3d& accel_housing,
-                       double temperature, double time) {
+// w = (I + D_g(x))^-1 M_g (u - db_g(x) - b_g - o) - G f.
+Eigen::Vector3d GyroOf(const ImuParameters& p, const ThermalBlocks<double>& thermal, double x,
+                       const Eigen::Matrix3d& rotation, const Eigen::Vector3d& raw,
+                       const Eigen::Vector3d& accel_housing, double temperature, double time) {
   // The effects' G' was fitted against the force in the sensor frame.
   const Eigen::Vector3d force = rotation.transpose() * accel_housing;
-  Eigen::Vector3d w;
-  p.Model().CorrectGyro(raw, force.data(), p.TemperatureOffset(temperature), p.TimeOffset(time),
-                        w.data());
-  return w;
+  const ImuModel<double> model = p.Model();
+  double db[3];
+  thermal.BiasChange(x, db);
+  const Eigen::Vector3d shifted = raw - Eigen::Vector3d(db[0], db[1], db[2]);
+  double e[3];
+  model.GyroRestError(shifted, force.data(), p.TemperatureOffset(temperature), p.TimeOffset(time),
+                      e);
+  // M_g e, then the thermal scale removed, then the g-sensitivity.
+  double w[3];
+  GyroBlocks<double> linear = model.gyro();
+  linear.g_sensitivity = nullptr;
+  ImuModel<double>(linear).GyroRateFrom(e, force.data(), w);
+  thermal.RemoveScale(x, w);
+  Eigen::Vector3d out(w[0], w[1], w[2]);
+  if (model.gyro().g_sensitivity != nullptr) {
+    const double* g = model.gyro().g_sensitivity;
+    for (int r = 0; r < 3; ++r) {
+      out(r) -= g[3 * r] * force(0) + g[3 * r + 1] * force(1) + g[3 * r + 2] * force(2);
+    }
+  }
+  return out;
 }
 
 }  // namespace
 
 bool ImuCorrector::CorrectAccel(const Eigen::Vector3d& raw, double temperature, double time,
                                 Eigen::Vector3d* a) const {
-  return AccelOf(ImuParameters(accel, nullptr, effects, active_effects), raw, temperature, time, a);
+  const double x = thermal.Offset(temperature, NAN, nullptr);
+  return AccelOf(ImuParameters(accel, nullptr, effects, active_effects),
+                 thermal.Blocks(ThermalSensor::kAccel), x, raw, temperature, time, a);
 }
 
 Eigen::Vector3d ImuCorrector::CorrectGyro(const Eigen::Vector3d& raw,
                                           const Eigen::Vector3d& accel_housing, double temperature,
                                           double time) const {
   if (!has_gyro) return raw;
-  return GyroOf(ImuParameters(accel, &gyro, effects, active_effects), accel.rotation, raw,
-                accel_housing, temperature, time);
+  const double x = thermal.Offset(temperature, NAN, nullptr);
+  return GyroOf(ImuParameters(accel, &gyro, effects, active_effects),
+                thermal.Blocks(ThermalSensor::kGyro), x, accel.rotation, raw, accel_housing,
+                temperature, time);
 }
 
 bool ImuCorrector::CorrectRow(double temperature, double time, Eigen::Vector3d* accel_row,
                               Eigen::Vector3d* gyro_row) const {
+  return CorrectRow(temperature, NAN, time, accel_row, gyro_row, nullptr);
+}
+
+bool ImuCorrector::CorrectRow(double temperature, double temperature_rate, double time,
+                              Eigen::Vector3d* accel_row, Eigen::Vector3d* gyro_row,
+                              bool* clamped) const {
   // One set of blocks for both sensors.
   const ImuParameters p(accel, has_gyro ? &gyro : nullptr, effects, active_effects);
+  const double x = thermal.Offset(temperature, temperature_rate, clamped);
   Eigen::Vector3d a;
-  if (!AccelOf(p, *accel_row, temperature, time, &a)) return false;
+  if (!AccelOf(p, thermal.Blocks(ThermalSensor::kAccel), x, *accel_row, temperature, time, &a)) {
+    return false;
+  }
   if (gyro_row != nullptr && has_gyro) {
-    *gyro_row = GyroOf(p, accel.rotation, *gyro_row, a, temperature, time);
+    *gyro_row = GyroOf(p, thermal.Blocks(ThermalSensor::kGyro), x, accel.rotation, *gyro_row, a,
+                       temperature, time);
   }
   *accel_row = a;
   return true;

@@ -66,6 +66,7 @@ bool ModelsFromCalibration(const Calibration& calibration, const std::string& na
     p.temperature = report.position.temperature;
     out.positions.push_back(p);
   }
+  out.corrector.thermal = calibration.thermal;
   out.gravity = calibration.gravity;
   out.method = calibration.method;
   out.provenance = calibration.provenance;

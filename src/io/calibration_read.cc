@@ -10,6 +10,7 @@
 #include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "io/json_helpers.h"
+#include "io/thermal_json.h"
 #include "util/error.h"
 #include "util/numbers.h"
 
@@ -371,6 +372,13 @@ bool CalibrationFromJson(const std::string& text, const std::string& name,
     if (!j["gravity"].contains("value")) return r.Fail("gravity.value", "is missing");
     if (!r.Number(j["gravity"]["value"], "gravity.value", false, &out.gravity)) return false;
     if (!(out.gravity > 0.0)) return r.Fail("gravity.value", "must be positive");
+  }
+  if (j.contains("thermal") &&
+      !internal::ThermalFromJson(j["thermal"], name, &out.corrector.thermal, error)) {
+    return false;
+  }
+  if (out.corrector.thermal.gyro.active() && !out.corrector.has_gyro) {
+    return r.Fail("thermal.gyro", "is a gyroscope thermal model but there is no gyroscope model");
   }
   if (j.contains("method") && j["method"].is_string()) out.method = j["method"].get<std::string>();
   if (!CheckCalibrationModels(out, name, error)) return false;

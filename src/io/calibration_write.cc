@@ -10,6 +10,7 @@
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/files.h"
 #include "io/json_helpers.h"
+#include "io/thermal_json.h"
 #include "util/content_hash.h"
 #include "util/error.h"
 #include "util/units.h"
@@ -169,6 +170,9 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
   out["accel"] = AccelJson(c.accel, include_covariance);
   if (c.gyro.estimated) out["gyro"] = GyroJson(c.gyro, include_covariance);
   if (!c.effects.estimates.empty()) out["effects"] = EffectsJson(c.effects);
+  if (c.thermal.active() || !c.thermal.notes.empty()) {
+    out["thermal"] = internal::ThermalJson(c.thermal);
+  }
   out["gravity"] = {{"value", c.gravity}, {"source", c.gravity_source}};
   out["residual"] = ResidualJson(c);
   json positions = json::array();

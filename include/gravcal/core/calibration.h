@@ -17,6 +17,7 @@
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/position.h"
 #include "gravcal/core/solver_result.h"
+#include "gravcal/core/thermal_model.h"
 #include "gravcal/core/types.h"
 
 namespace gravcal {
@@ -139,6 +140,10 @@ struct Calibration {
   // Effects beyond the textbook model (config key `effects`); empty when
   // none were asked for.
   EffectCalibration effects;
+  // Issue 35: bias, scale and misalignment against temperature
+  // (thermal_model.h; calibration JSON key `thermal`). Inactive (all orders
+  // 0) unless a thermal method filled it.
+  ThermalModel thermal;
   // The method that produced this result (config key `method`).
   std::string method = "twelve_position";
   double gravity = kStandardGravity;

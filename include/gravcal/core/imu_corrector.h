@@ -21,6 +21,10 @@
 // G, gamma, eta in raw gyroscope units (model_effects.h); R^T a is the
 // specific force in the sensor frame G was fitted in. Effects that are not
 // switched on are zero; all zero = the textbook model M (v - b), M_g (u - b_g).
+// Issue 35: with an active thermal model (thermal_model.h) the linear model
+// becomes m = (I + D(x))^-1 U (v - b - db(x)) and the gyroscope's
+// M_g (u - ...) becomes (I + D_g(x))^-1 M_g (u - db_g(x) - ...), x the
+// clamped, lag-corrected temperature offset; the effects act after it.
 // A temperature of NaN contributes no temperature term (callers that need a
 // temperature check RequiresTemperature() first).
 #ifndef GRAVCAL_CORE_IMU_CORRECTOR_H_
@@ -33,6 +37,7 @@
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/model_effects.h"
+#include "gravcal/core/thermal_model.h"
 
 namespace gravcal {
 
@@ -43,10 +48,14 @@ struct ImuCorrector {
   // The values of the effects (zero = off) and which are switched on.
   EffectParameters effects;
   std::vector<Effect> active_effects;
+  // Issue 35: the thermal model (inactive = none).
+  ThermalModel thermal;
 
   // True when an active effect uses the temperature (T) or the time (t).
   bool RequiresTemperature() const;
   bool RequiresTime() const;
+  // True when the thermal model is active (it then uses the temperature).
+  bool HasThermal() const { return thermal.active(); }
 
   // a from v. False (a unchanged) only when the quadratic term has no real
   // root for this reading (a reading far outside the sensor's range).
@@ -61,6 +70,12 @@ struct ImuCorrector {
   // Python's Calibration.apply, so the two give the same numbers.
   bool CorrectRow(double temperature, double time, Eigen::Vector3d* accel,
                   Eigen::Vector3d* gyro) const;
+  // The same with the temperature's rate of change (degrees C per s; NaN =
+  // unknown, no lag term), which the thermal model's lag uses; `clamped`
+  // (may be null) is set when the temperature lay outside the thermal
+  // model's valid range and was clamped.
+  bool CorrectRow(double temperature, double temperature_rate, double time, Eigen::Vector3d* accel,
+                  Eigen::Vector3d* gyro, bool* clamped) const;
 
   // The same model with only the terms a target can hold: the effects in
   // `keep` (others dropped). Used to measure what an export truncates.

@@ -1,0 +1,236 @@
+#include "io/thermal_export.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "util/numbers.h"
+
+namespace gravcal {
+namespace internal {
+
+namespace {
+
+// ArduPilot's fixed reference temperature (degC) and the factor its TCAL
+// coefficients are stored with (AP_InertialSensor_tempcal.cpp).
+constexpr double kArduPilotReference = 35.0;
+constexpr double kArduPilotScale = 1e6;
+// Both targets hold a cubic.
+constexpr int kTargetOrder = 3;
+// Points of the even grid over the range (fits and truncation maxima).
+constexpr int kGridPoints = 101;
+
+double Clamp(double t, double lo, double hi) { return std::min(std::max(t, lo), hi); }
+
+double GridPoint(double lo, double hi, int i) {
+  return lo + (hi - lo) * static_cast<double>(i) / (kGridPoints - 1);
+}
+
+double Binomial(int n, int k) {
+  double b = 1.0;
+  for (int i = 1; i <= k; ++i) b = b * (n - k + i) / i;
+  return b;
+}
+
+// The curve's columns 0..3 (zero where it has none). Order <= 3 checked by
+// the caller.
+PolynomialCoefficients Cubic(const ThermalCurve& c) {
+  PolynomialCoefficients p = PolynomialCoefficients::Zero(3, kTargetOrder + 1);
+  p.leftCols(c.coefficients.cols()) = c.coefficients;
+  return p;
+}
+
+bool CheckCurve(const ThermalCurve& c, const char* target, const char* sensor, std::string* error) {
+  if (!(std::isfinite(c.t_min) && std::isfinite(c.t_max) && std::isfinite(c.t_ref) &&
+        c.t_max > c.t_min && c.coefficients.allFinite())) {
+    *error = std::string(target) + ": the " + sensor +
+             " thermal model has no valid temperature range (T_min " + ExactNumber(c.t_min) +
+             ", T_max " + ExactNumber(c.t_max) + ")";
+    return false;
+  }
+  if (c.Order() > kTargetOrder) {
+    *error = std::string(target) + ": the " + sensor + " thermal bias is of order " +
+             std::to_string(c.Order()) + "; the target holds a cubic (reduce it first)";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Eigen::Vector3d ThermalCurve::At(double temperature) const {
+  const double d = Clamp(temperature, t_min, t_max) - t_ref;
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  for (Eigen::Index k = coefficients.cols() - 1; k >= 0; --k) v = v * d + coefficients.col(k);
+  return v;
+}
+
+bool ThermalCurve::Varies() const {
+  return coefficients.cols() > 1 &&
+         (coefficients.rightCols(coefficients.cols() - 1).array() != 0.0).any();
+}
+
+PolynomialCoefficients ShiftPolynomial(const PolynomialCoefficients& p, double shift) {
+  // p(x) = sum_k c_k x^k with x = y + shift: q_j = sum_{k >= j} c_k C(k, j) shift^(k - j).
+  PolynomialCoefficients q = PolynomialCoefficients::Zero(3, p.cols());
+  for (int j = 0; j < p.cols(); ++j) {
+    for (int k = j; k < p.cols(); ++k) {
+      q.col(j) += p.col(k) * Binomial(k, j) * std::pow(shift, k - j);
+    }
+  }
+  return q;
+}
+
+ThermalCurve ReduceOrder(const ThermalCurve& curve, int max_order, double* max_error) {
+  *max_error = 0.0;
+  if (curve.Order() <= max_order) return curve;
+  // Least squares on the grid, in x = (T - t_ref) / half-width for
+  // conditioning, then back to powers of (T - t_ref).
+  const double half = 0.5 * (curve.t_max - curve.t_min);
+  const double scale = half > 0.0 ? half : 1.0;
+  Eigen::MatrixXd a(kGridPoints, max_order + 1);
+  Eigen::MatrixXd b(kGridPoints, 3);
+  for (int i = 0; i < kGridPoints; ++i) {
+    const double t = GridPoint(curve.t_min, curve.t_max, i);
+    const double x = (t - curve.t_ref) / scale;
+    for (int k = 0; k <= max_order; ++k) a(i, k) = std::pow(x, k);
+    b.row(i) = curve.At(t).transpose();
+  }
+  const Eigen::MatrixXd solution = a.colPivHouseholderQr().solve(b);  // (order+1) x 3
+  ThermalCurve reduced = curve;
+  reduced.coefficients.resize(3, max_order + 1);
+  for (int k = 0; k <= max_order; ++k) {
+    reduced.coefficients.col(k) = solution.row(k).transpose() / std::pow(scale, k);
+  }
+  for (int i = 0; i < kGridPoints; ++i) {
+    const double t = GridPoint(curve.t_min, curve.t_max, i);
+    *max_error = std::max(*max_error, (reduced.At(t) - curve.At(t)).cwiseAbs().maxCoeff());
+  }
+  return reduced;
+}
+
+bool Px4ThermalLines(
+    const AutopilotThermal& thermal,
+    const std::function<std::string(const std::string&, const std::string&, bool)>& line,
+    std::string* text, std::string* error) {
+  std::string s;
+  struct Sensor {
+    const ThermalCurve* curve;
+    int64_t id;
+    const char* enable;  // TC_A_ENABLE
+    const char* prefix;  // TC_A0_
+    const char* flag;
+    const char* vehicle_id;
+    const char* name;
+  };
+  std::vector<Sensor> sensors = {{&thermal.accel, thermal.accel_device_id, "TC_A_ENABLE", "TC_A0_",
+                                  "--accel_device_id", "CAL_ACC0_ID", "accelerometer"}};
+  if (thermal.has_gyro) {
+    sensors.push_back({&thermal.gyro, thermal.gyro_device_id, "TC_G_ENABLE", "TC_G0_",
+                       "--gyro_device_id", "CAL_GYRO0_ID", "gyroscope"});
+  }
+  for (const Sensor& sensor : sensors) {
+    if (!sensor.curve->Varies()) continue;
+    if (!CheckCurve(*sensor.curve, "px4", sensor.name, error)) return false;
+    if (sensor.id <= 0 || sensor.id > 0xffffffffLL) {
+      *error = std::string("px4: PX4 applies ") + sensor.prefix + "* only to the " + sensor.name +
+               " whose device id equals " + sensor.prefix + "ID, so without it the thermal terms " +
+               "would do nothing: give " + sensor.flag + " (the vehicle's " + sensor.vehicle_id +
+               "), or --drop_thermal";
+      return false;
+    }
+    const ThermalCurve& c = *sensor.curve;
+    const PolynomialCoefficients p = Cubic(c);
+    // PX4 keeps the id in an int32 parameter and compares it as uint32.
+    const int32_t id = static_cast<int32_t>(static_cast<uint32_t>(sensor.id));
+    s += line(sensor.enable, "1", true);
+    s += line(std::string(sensor.prefix) + "ID", std::to_string(id), true);
+    s += line(std::string(sensor.prefix) + "TREF", ExactNumber(c.t_ref), false);
+    s += line(std::string(sensor.prefix) + "TMIN", ExactNumber(c.t_min), false);
+    s += line(std::string(sensor.prefix) + "TMAX", ExactNumber(c.t_max), false);
+    for (int k = 0; k <= kTargetOrder; ++k) {
+      for (int axis = 0; axis < 3; ++axis) {
+        s += line(std::string(sensor.prefix) + "X" + std::to_string(k) + "_" + std::to_string(axis),
+                  ExactNumber(p(axis, k)), false);
+      }
+    }
+  }
+  *text = s;
+  return true;
+}
+
+bool ArduPilotThermalLines(
+    const AutopilotThermal& thermal,
+    const std::function<std::string(const std::string&, const std::string&)>& line,
+    std::string* text, std::string* error) {
+  const bool gyro = thermal.has_gyro && thermal.gyro.Varies();
+  if (!thermal.accel.Varies() && !gyro) {
+    *text = "";
+    return true;
+  }
+  // One TCAL block per IMU: one range for both sensors. The accelerometer's
+  // range when it varies, else the gyroscope's.
+  const ThermalCurve& range = thermal.accel.Varies() ? thermal.accel : thermal.gyro;
+  if (!CheckCurve(thermal.accel, "ardupilot", "accelerometer", error) ||
+      (thermal.has_gyro && !CheckCurve(thermal.gyro, "ardupilot", "gyroscope", error))) {
+    return false;
+  }
+  if (gyro && thermal.accel.Varies() &&
+      (thermal.gyro.t_min != range.t_min || thermal.gyro.t_max != range.t_max)) {
+    *error =
+        "ardupilot: INS_TCAL1 holds one temperature range for both sensors; the "
+        "accelerometer's [" +
+        ExactNumber(range.t_min) + ", " + ExactNumber(range.t_max) + "] and the gyroscope's [" +
+        ExactNumber(thermal.gyro.t_min) + ", " + ExactNumber(thermal.gyro.t_max) + "] degC differ";
+    return false;
+  }
+  std::string s;
+  s += line("INS_TCAL1_ENABLE", "1");
+  s += line("INS_TCAL1_TMIN", ExactNumber(range.t_min));
+  s += line("INS_TCAL1_TMAX", ExactNumber(range.t_max));
+  auto coefficients = [&](const ThermalCurve& c, bool on, const char* name) {
+    // ArduPilot's polynomial is in (T - 35 degC) without a constant: the
+    // constant of the shifted curve cancels between P(T) and P(Tcal).
+    PolynomialCoefficients q = PolynomialCoefficients::Zero(3, kTargetOrder + 1);
+    if (on) q = ShiftPolynomial(Cubic(c), kArduPilotReference - c.t_ref);
+    for (int k = 1; k <= kTargetOrder; ++k) {
+      for (int axis = 0; axis < 3; ++axis) {
+        s += line(std::string("INS_TCAL1_") + name + std::to_string(k) + "_" + "XYZ"[axis],
+                  ExactNumber(kArduPilotScale * q(axis, k)));
+      }
+    }
+  };
+  coefficients(thermal.accel, thermal.accel.Varies(), "ACC");
+  coefficients(thermal.gyro, gyro, "GYR");
+  // The offsets in the file hold at t_ref (c_0 = 0): Tcal = t_ref, inside
+  // the range so ArduPilot's clamp leaves it.
+  s += line("INS_ACC1_CALTEMP", ExactNumber(Clamp(thermal.accel.t_ref, range.t_min, range.t_max)));
+  if (thermal.has_gyro) {
+    s += line("INS_GYR1_CALTEMP", ExactNumber(Clamp(thermal.gyro.t_ref, range.t_min, range.t_max)));
+  }
+  *text = s;
+  return true;
+}
+
+ThermalTruncation MeasureThermalTruncation(
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&, double)>& full,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&, double)>& target,
+    const std::vector<Eigen::Vector3d>& raws, const std::vector<double>& temperatures, double t_min,
+    double t_max) {
+  ThermalTruncation r;
+  double sum = 0.0;
+  for (size_t i = 0; i < raws.size() && i < temperatures.size(); ++i) {
+    if (!std::isfinite(temperatures[i])) continue;
+    sum += (target(raws[i], temperatures[i]) - full(raws[i], temperatures[i])).squaredNorm();
+    ++r.readings;
+    for (int g = 0; g < kGridPoints && t_max > t_min; ++g) {
+      const double t = GridPoint(t_min, t_max, g);
+      r.range_max = std::max(r.range_max, (target(raws[i], t) - full(raws[i], t)).norm());
+    }
+  }
+  r.session_rms = r.readings ? std::sqrt(sum / r.readings) : NAN;
+  return r;
+}
+
+}  // namespace internal
+}  // namespace gravcal
