@@ -3,6 +3,7 @@
 # measured on the same file in the same run, and its peak memory.
 #
 #   benchmarks/reading_throughput.sh BUILD_DIR [GB] [WORK_DIR] [GRAVCAL]
+#   COMMANDS="inspect calibrate" benchmarks/reading_throughput.sh ...  (a subset)
 #
 # Makes two logs of about GB gigabytes (default 1) with `gravcal simulate`
 # in WORK_DIR (default $TMPDIR/gravcal_reading; never in the repository):
@@ -68,6 +69,7 @@ printf '%-10s %-10s %6s %7s %7s %7s %9s %9s %8s\n' command file MB "cpu s" "wall
 run() {  # name file command...
   local name=$1 file=$2
   shift 2
+  case " ${COMMANDS:-inspect noise calibrate} " in *" $name "*) ;; *) return 0 ;; esac
   local mb
   mb=$(python3 -c "import os; print(os.path.getsize('$file') / 1e6)")
   cat "$file" >/dev/null  # from the page cache for every run below

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -21,6 +22,7 @@
 
 #include "gravcal/core/imu_log.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/io/recording.h"
 #include "test_util.h"
 #include "util/content_hash.h"
 #include "util/numbers.h"
@@ -248,6 +250,51 @@ TEST(LogReaderNumbers, AFileReadBlockByBlockEqualsTheTextParsedInMemory) {
   hash.Add(text);
   EXPECT_EQ(provenance.log_hash, hash.Hex());
   std::remove(path.c_str());
+}
+
+TEST(LogReaderNumbers, InspectStreamsTheLogAndGivesTheStatisticsOfAllItsIntervals) {
+  // 70000 samples (more than one block of the interval statistics) at a
+  // jittering 100 Hz with gaps: what InspectRecording streams equals the
+  // statistics of the whole log read into memory.
+  std::string text = "t,ax,ay,az\n";
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> jitter(-3, 3), gap(0, 999);
+  double t = 0.0;
+  char row[100];
+  for (int i = 0; i < 70000; ++i) {
+    t += 0.01 + 0.0001 * jitter(rng) + (gap(rng) == 0 ? 0.05 : 0.0);
+    std::snprintf(row, sizeof(row), "%.4f,1,2,3\n", t);
+    text += row;
+  }
+  std::string path = testing_util::ScratchFileTemplate("inspect");
+  const int fd = mkstemp(path.data());
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  close(fd);
+  RecordingSummary summary;
+  ImuLog log;
+  std::string error;
+  ASSERT_TRUE(InspectRecording(path, {}, &summary, &error)) << error;
+  ASSERT_TRUE(ReadImuLog(path, {}, &log, &error)) << error;
+  std::remove(path.c_str());
+  ASSERT_EQ(summary.topics.size(), 1u);
+  const TopicSummary& s = summary.topics[0];
+  std::vector<double> dt;
+  for (size_t i = 1; i < log.size(); ++i) dt.push_back(log.t[i] - log.t[i - 1]);
+  std::vector<double> sorted = dt;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  EXPECT_EQ(s.messages, 70000);
+  EXPECT_EQ(s.first_s, log.t.front());
+  EXPECT_EQ(s.last_s, log.t.back());
+  EXPECT_EQ(s.median_interval_s, median);
+  EXPECT_EQ(s.longest_interval_s, sorted.back());
+  EXPECT_EQ(s.gaps, std::count_if(dt.begin(), dt.end(), [&](double d) { return d > 2 * median; }));
+  EXPECT_GT(s.gaps, 20);
+  EXPECT_LT(s.gaps, 140);
+  // A file that cannot be read is named.
+  EXPECT_FALSE(InspectRecording(path + "-missing", {}, &summary, &error));
+  EXPECT_NE(error.find("-missing"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -26,6 +26,13 @@ inline std::string ExactNumber(double v) {
 // ParseNumber's general path (numbers.cc): fast_float, with the outcome
 // std::from_chars gives.
 std::from_chars_result ParseNumberSlow(const char* first, const char* last, double* x);
+// The nearest double to (-1)^negative mantissa 10^exponent, the number
+// [first, end) that ParseNumber read as at most 19 digits, by fast_float's
+// Eisel-Lemire step (the rare case it cannot decide goes to ParseNumberSlow,
+// which reads the text again).
+std::from_chars_result ParseNumberDigits(const char* first, const char* last, const char* end,
+                                         uint64_t mantissa, long exponent, bool negative,
+                                         double* x);
 
 // Reads the number at the start of [first, last) and says where it ends,
 // exactly as std::from_chars(first, last, *x) does (chars_format::general):
@@ -40,8 +47,9 @@ std::from_chars_result ParseNumberSlow(const char* first, const char* last, doub
 // "3.3108000e+04"): those with at most 19 digits, a value below 2^53 and a
 // decimal exponent within +-22 are read here in one pass, exactly (Clinger:
 // the digits and the power of ten are exact doubles, so one correctly
-// rounded multiply or divide is the nearest double); the rest go to
-// fast_float (Lemire's algorithm, exact for every input).
+// rounded multiply or divide is the nearest double); other numbers of at
+// most 19 digits go on to fast_float's Eisel-Lemire step with the digits
+// read here, the rest to fast_float from the start (exact for every input).
 inline std::from_chars_result ParseNumber(const char* first, const char* last, double* x) {
   static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                       1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
@@ -78,7 +86,7 @@ inline std::from_chars_result ParseNumber(const char* first, const char* last, d
     }  // else "1e", "1e+": the number ends before the 'e', as in from_chars.
   }
   if (mantissa > (uint64_t{1} << 53) || exponent < -22 || exponent > 22) {
-    return ParseNumberSlow(first, last, x);
+    return ParseNumberDigits(first, last, p, mantissa, exponent, negative, x);
   }
   const double value = static_cast<double>(mantissa);
   const double scaled = exponent < 0 ? value / kPow10[-exponent] : value * kPow10[exponent];
