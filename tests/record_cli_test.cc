@@ -81,22 +81,7 @@ std::string Joined(const std::vector<std::string>& lines) {
 
 // Starts the CLI with standard input from `stdin_fd`.
 pid_t SpawnWithInput(const std::vector<std::string>& args, int stdin_fd, const ScratchDir& dir) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int out = open((dir / "stdout.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int err = open((dir / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(stdin_fd, 0);
-    dup2(out, 1);
-    dup2(err, 2);
-    std::vector<std::string> copy = args;
-    std::string program = GRAVCAL_CLI_PATH;
-    std::vector<char*> argv = {program.data()};
-    for (std::string& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(program.c_str(), argv.data());
-    _exit(127);
-  }
-  return pid;
+  return testing_util::SpawnCli(args, dir / "stdout.txt", dir / "stderr.txt", stdin_fd);
 }
 
 std::vector<nlohmann::json> Events(const ScratchDir& dir) {
