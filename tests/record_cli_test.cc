@@ -237,6 +237,57 @@ TEST(RecordCli, TcpDisconnectEndsCleanlyWithWhatWasRecorded) {
   ExpectValidLog(dir, events.back());
 }
 
+TEST(RecordCli, UdpDatagramsAreLinesAndMaxTimeEndsTheSession) {
+  ScratchDir dir;
+  // A free port: bound, read, released.
+  int probe = socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(probe, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
+  socklen_t length = sizeof(address);
+  getsockname(probe, reinterpret_cast<sockaddr*>(&address), &length);
+  close(probe);
+  std::vector<std::string> args =
+      RecordArgs(dir, "udp://127.0.0.1:" + std::to_string(ntohs(address.sin_port)));
+  args.insert(args.end(), {"--max-time", "15"});
+  const int null = open("/dev/null", O_RDONLY);
+  const pid_t pid = SpawnWithInput(args, null, dir);
+  close(null);
+  // Until the recorder listens, datagrams are refused or lost: the header
+  // goes again until it answers with a file of events.
+  const int out = socket(AF_INET, SOCK_DGRAM, 0);
+  const std::vector<std::string> lines = ScriptedLines(16, 5.0);
+  for (int i = 0; i < 100 && !testing_util::FileExists(dir / "events.jsonl"); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  // Twenty lines a datagram.
+  for (size_t i = 0; i < lines.size() && i < 2000; i += 20) {
+    const std::string text =
+        Joined({lines.begin() + i, lines.begin() + std::min(i + 20, lines.size())});
+    sendto(out, text.data(), text.size(), 0, reinterpret_cast<sockaddr*>(&address),
+           sizeof(address));
+    if (i % 400 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  close(out);
+  // Lost datagrams would leave it waiting: interrupted after 5 s (and the
+  // reason below fails).
+  int status = 0;
+  for (int i = 0; i < 250 && waitpid(pid, &status, WNOHANG) == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (waitpid(pid, &status, WNOHANG) == 0) {
+    kill(pid, SIGINT);
+    testing_util::WaitForExit(pid);
+  }
+  const std::vector<nlohmann::json> events = Events(dir);
+  ASSERT_FALSE(events.empty()) << Slurp(dir / "stderr.txt");
+  EXPECT_EQ(events.back()["reason"], "max_time");
+  EXPECT_EQ(events.back()["garbage_lines"].get<int>(), 0);
+  ExpectValidLog(dir, events.back());
+}
+
 TEST(RecordCli, CtrlCWritesWhatWasRecorded) {
   ScratchDir dir;
   int p[2];
