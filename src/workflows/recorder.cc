@@ -162,7 +162,8 @@ struct Recorder::State {
   // Holds not captured (saturated), by their first sample.
   std::set<size_t> refused_holds;
   std::map<std::string, int> warning_counts;
-  std::set<std::string> warned;
+  // The end (sample index) of the last moving stretch warned about.
+  size_t moving_warned_until = 0;
   RecorderStatus status;
   bool sent_first = false;
   // The offline plan's typical kept hold (for the measured noise), the
@@ -480,8 +481,11 @@ std::vector<RecorderEvent> Recorder::Feed(double t, const Eigen::Vector3d& accel
   const double reach = detector.window_seconds + detector.settle_seconds + 0.25;
   for (const RejectedStretch& r : detection.rejected) {
     if (r.reason == RejectionReason::kTooShort || t - r.t_end > reach) continue;
-    const std::string key = "moving@" + std::to_string(from + r.begin);
-    if (s.warned.insert(key).second) {
+    // One warning per stretch: a stretch that began before the end of the
+    // last one warned about is that one, seen again.
+    const bool fresh = from + r.begin > s.moving_warned_until || s.moving_warned_until == 0;
+    s.moving_warned_until = std::max(s.moving_warned_until, from + r.end);
+    if (fresh) {
       warn("moving_hold", "the unit is not still (since t = " + Num(r.t_begin, 6) +
                               " s): " + r.detail + "; hold it still, or rest it on a table");
     }
