@@ -92,6 +92,7 @@ void BindBatch(py::module_& m);
 void BindRecordings(py::module_& m);
 // compare, verify, the store, limits and the certificate (verify_bindings.cc).
 void BindVerify(py::module_& m);
+void BindRecorder(py::module_& m);
 
 }  // namespace python
 }  // namespace gravcal

@@ -89,13 +89,14 @@ struct CliResult {
   std::string err;
 };
 
-// Starts the CLI with `args` (no shell), stdin from /dev/null, stdout and
-// stderr into the given files; returns the child's pid.
+// Starts the CLI with `args` (no shell), stdin from /dev/null (or the
+// descriptor stdin_fd), stdout and stderr into the given files; returns the
+// child's pid.
 inline pid_t SpawnCli(const std::vector<std::string>& args, const std::string& out_path,
-                      const std::string& err_path) {
+                      const std::string& err_path, int stdin_fd = -1) {
   const pid_t pid = fork();
   if (pid == 0) {
-    const int null = open("/dev/null", O_RDWR);
+    const int null = stdin_fd >= 0 ? stdin_fd : open("/dev/null", O_RDWR);
     const int out = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     const int err = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(null, 0);

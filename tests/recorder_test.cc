@@ -194,3 +194,36 @@ TEST(Recorder, RefusesBadOptionsAndMissingTargets) {
 
 }  // namespace
 }  // namespace gravcal
+
+namespace gravcal {
+namespace {
+
+TEST(Recorder, AHoldThatMovesIsNamed) {
+  Recorder recorder;
+  std::string error;
+  RecorderOptions options = Options();
+  ASSERT_TRUE(recorder.Start(RecordConfig(), options, &error)) << error;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const double g = 16384.0;
+  std::vector<std::string> kinds;
+  // Still on +Z for 8 s, then "held" while it turns slowly about x (2
+  // degrees a second) for 20 s.
+  for (int k = 0; k < 2800; ++k) {
+    const double t = k * 0.01;
+    const double angle = t < 8.0 ? 0.0 : (t - 8.0) * 2.0 * M_PI / 180.0;
+    const Eigen::Vector3d accel(30.0 * n(rng), g * std::sin(angle) + 30.0 * n(rng),
+                                g * std::cos(angle) + 30.0 * n(rng));
+    const Eigen::Vector3d gyro(t < 8.0 ? 0.0 : 2.0 * 131.0, 0.0, 0.0);
+    for (const RecorderEvent& e :
+         recorder.Feed(t, accel, gyro + Eigen::Vector3d(n(rng), n(rng), n(rng)))) {
+      const nlohmann::json j = nlohmann::json::parse(e.json);
+      if (j["event"] == "warning") kinds.push_back(j["kind"]);
+    }
+  }
+  // Named once for the one stretch.
+  EXPECT_EQ(std::count(kinds.begin(), kinds.end(), "moving_hold"), 1);
+}
+
+}  // namespace
+}  // namespace gravcal

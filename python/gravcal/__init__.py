@@ -30,7 +30,7 @@ __version__ = _gravcal.__version__
 __all__ = [
     "Error", "Log", "Calibration", "Result", "BatchResult", "BatchResults", "Config", "config",
     "read_log", "log", "calibrate", "simulate", "batch", "noise", "discover", "plan", "check", "export",
-    "config_keys", "__version__",
+    "Recorder", "config_keys", "__version__",
 ]
 
 Config = _gravcal.Config
@@ -757,3 +757,55 @@ def certificate(calibration, *, limits=None, unit="", station=None, date=None, i
 
 __all__ += ["compare", "verify", "history", "file_calibration", "closest_calibration",
             "check_limits", "certificate"]
+class Recorder:
+    """Guided live calibration from your own acquisition loop, as ``gravcal
+    record`` does it (docs/workflows/record.md).
+
+    ``Recorder(config, targets)``: ``config`` a config path, dict or
+    :class:`Config`; ``targets`` as ``gravcal plan --target``
+    ("accel_bias=0.3mg accel_scale=100ppm"). ``feed(t, accel, gyro=None)``
+    takes one sample (raw units, t in seconds) and returns the events it
+    caused, as dicts (docs/data_contract.md, "Record events"): most samples
+    cause none; a ``suggest`` event says where to put the unit next.
+    ``done`` turns true when the targets are met (or at ``max_time``
+    seconds of stream time). ``finish(reason)`` calibrates what was fed
+    (exactly ``calibrate`` on :attr:`log_csv`) and returns the
+    :class:`Calibration` (raises :class:`Error` with the reason when it
+    fails); :attr:`done_event` is then the ``done`` event either way."""
+
+    def __init__(self, config=None, targets="", *, pose_set="faces+45", max_time=0.0,
+                 accel_noise_density=0.0, noise=None, **keys):
+        self._core = _gravcal.Recorder(_config(config, **keys), str(targets), str(pose_set),
+                                       float(max_time), float(accel_noise_density),
+                                       *_noise_source(noise))
+        self.done_event = None
+
+    def feed(self, t, accel, gyro=None, temp=None):
+        """One sample; returns the list of events (dicts) it caused."""
+        accel = _np.asarray(accel, dtype=float).reshape(3)
+        if gyro is not None:
+            gyro = _np.asarray(gyro, dtype=float).reshape(3)
+        events = self._core.feed(float(t), accel, gyro, _math.nan if temp is None else float(temp))
+        return [_json.loads(e) for e in events]
+
+    @property
+    def done(self):
+        """True once the session is over (targets met or max_time)."""
+        return self._core.done
+
+    @property
+    def log_csv(self):
+        """The recorded log as contract CSV text (after :meth:`finish`)."""
+        return self._core.log_csv
+
+    def finish(self, reason=None):
+        """Ends the session and returns the :class:`Calibration` of what was
+        fed; ``reason`` defaults to the recorder's own ("targets_met") or
+        "end_of_input"."""
+        if reason is None:
+            reason = self._core.done_reason or "end_of_input"
+        calibration, done, message = self._core.finish(str(reason))
+        self.done_event = _json.loads(done)
+        if calibration is None:
+            raise Error(message)
+        return Calibration(calibration)

@@ -4,11 +4,12 @@
 // the unit where gravcal record's suggest events (--follow-events) say.
 //
 // Following: the hand holds each pose until a new suggest event comes. As
-// fast as it can, it runs ahead of the recorder by what the pipe holds; so
-// once a hold has lasted the suggested hold plus kAheadSeconds it streams
-// on only in steps of kStepSeconds, each after waiting up to kWaitMs for a
-// new event (the recorder then has read everything and is waiting for more
-// samples, or has answered).
+// fast as it can, it would run ahead of the recorder by what the pipe
+// holds; so once a hold has lasted the suggested hold plus kAheadSeconds it
+// stops and waits up to kWaitMs for a new event, then streams kStepSeconds
+// more and waits again (the recorder wants a longer hold). The moves thus
+// depend on the events, not on how fast either side runs, unless the
+// recorder needs more than kWaitMs to read kAheadSeconds of samples.
 #include <fcntl.h>
 #include <signal.h>
 #include <stdlib.h>
@@ -31,9 +32,10 @@ namespace cli {
 
 namespace {
 
-constexpr double kAheadSeconds = 2.0;
-constexpr double kStepSeconds = 0.25;
-constexpr int kWaitMs = 50;
+constexpr double kAheadSeconds = 1.0;
+constexpr double kStepSeconds = 1.0;
+constexpr int kWaitMs = 300;
+constexpr int kPollMs = 2;
 // A stream without an end (following, no done event) stops here.
 constexpr double kMaxStreamSeconds = 3600.0;
 
@@ -151,7 +153,7 @@ int RunSimulateStream(const SimulateArgs& args) {
         was_moving = true;
       }
     } else {
-      bool waited = false;
+      int waited_ms = 0;
       for (;;) {
         for (const std::string& e : events.Lines()) {
           const nlohmann::json j = nlohmann::json::parse(e, nullptr, false);
@@ -163,13 +165,17 @@ int RunSimulateStream(const SimulateArgs& args) {
                                         j["up"][2].get<double>()));
             suggested_hold = j.value("hold_seconds", sim.hold_seconds);
             was_moving = true;
+            next_step = 0.0;
           }
         }
         const bool ahead = !hand.moving() && s.t - hold_start > suggested_hold + kAheadSeconds;
-        if (done || !ahead || waited || args.rate > 0.0 || s.t < next_step) break;
-        std::this_thread::sleep_for(std::chrono::milliseconds(kWaitMs));
-        waited = true;
-        next_step = s.t + kStepSeconds;
+        if (done || !ahead || args.rate > 0.0 || s.t < next_step) break;
+        if (waited_ms >= kWaitMs) {
+          next_step = s.t + kStepSeconds;
+          break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(kPollMs));
+        waited_ms += kPollMs;
       }
     }
     if (args.rate > 0.0) {

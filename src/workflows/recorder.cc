@@ -10,7 +10,6 @@
 #include <set>
 #include <sstream>
 
-#include "core/sensor_checks.h"
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/experiment_design.h"
 #include "gravcal/io/log_reader.h"
@@ -157,10 +156,14 @@ struct Recorder::State {
   double scale = 0.0;
   std::vector<CapturedPose> poses;
   Eigen::MatrixXd fisher;
+  // The largest and smallest raw accelerometer values so far.
+  Eigen::Vector3d accel_max = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_min = Eigen::Vector3d::Zero();
   // Holds not captured (saturated), by their first sample.
   std::set<size_t> refused_holds;
   std::map<std::string, int> warning_counts;
-  std::set<std::string> warned;
+  // The end (sample index) of the last moving stretch warned about.
+  size_t moving_warned_until = 0;
   RecorderStatus status;
   bool sent_first = false;
   // The offline plan's typical kept hold (for the measured noise), the
@@ -432,6 +435,8 @@ std::vector<RecorderEvent> Recorder::Feed(double t, const Eigen::Vector3d& accel
   }
   log.t.push_back(t);
   log.accel.push_back(accel);
+  s.accel_max = log.size() == 1 ? accel : s.accel_max.cwiseMax(accel);
+  s.accel_min = log.size() == 1 ? accel : s.accel_min.cwiseMin(accel);
   if (s.has_gyro) log.gyro.push_back(has_gyro ? gyro : Eigen::Vector3d::Zero());
   if (s.has_temperature) log.temperature.push_back(temperature);
   RecorderStatus& st = s.status;
@@ -476,8 +481,11 @@ std::vector<RecorderEvent> Recorder::Feed(double t, const Eigen::Vector3d& accel
   const double reach = detector.window_seconds + detector.settle_seconds + 0.25;
   for (const RejectedStretch& r : detection.rejected) {
     if (r.reason == RejectionReason::kTooShort || t - r.t_end > reach) continue;
-    const std::string key = "moving@" + std::to_string(from + r.begin);
-    if (s.warned.insert(key).second) {
+    // One warning per stretch: a stretch that began before the end of the
+    // last one warned about is that one, seen again.
+    const bool fresh = from + r.begin > s.moving_warned_until || s.moving_warned_until == 0;
+    s.moving_warned_until = std::max(s.moving_warned_until, from + r.end);
+    if (fresh) {
       warn("moving_hold", "the unit is not still (since t = " + Num(r.t_begin, 6) +
                               " s): " + r.detail + "; hold it still, or rest it on a table");
     }
@@ -499,17 +507,23 @@ std::vector<RecorderEvent> Recorder::Feed(double t, const Eigen::Vector3d& accel
     if (!moved && angle < s.options.new_pose_deg) return events;
   }
   if (s.refused_holds.count(begin)) return events;
-  // Saturation: the hold's samples pile up at an axis's limit.
-  {
-    ImuLog hold;
-    hold.source = "record";
-    hold.t.assign(log.t.begin() + begin, log.t.begin() + end);
-    hold.accel.assign(log.accel.begin() + begin, log.accel.begin() + end);
-    const std::vector<std::string> saturated = internal::SaturationWarnings(hold);
-    if (!saturated.empty()) {
+  // Saturation: at least half the hold's samples of an axis sit at one
+  // value, the largest (or smallest) that axis has shown in the stream: a
+  // signal with noise does not pile up at its extreme, a clipped one does.
+  for (int a = 0; a < 3; ++a) {
+    for (const double sign : {1.0, -1.0}) {
+      const double limit = sign > 0.0 ? s.accel_max(a) : s.accel_min(a);
+      size_t at_limit = 0;
+      for (size_t i = begin; i < end; ++i) at_limit += log.accel[i](a) == limit;
+      if (at_limit < 3 || 2 * at_limit < end - begin) continue;
       s.refused_holds.insert(begin);
-      warn("saturation",
-           "the hold at t = " + Num(last.t_begin, 6) + " s is not used: " + saturated.front());
+      static const char* kAxes = "xyz";
+      warn("saturation", "the hold at t = " + Num(last.t_begin, 6) +
+                             " s is not used: the accelerometer's " + kAxes[a] + " axis sits at " +
+                             Num(limit, 10) + " (its " + (sign > 0.0 ? "largest" : "smallest") +
+                             " value so far) in " + std::to_string(at_limit) + " of " +
+                             std::to_string(end - begin) +
+                             " samples: it is saturated; use a wider range or another pose");
       return events;
     }
   }
