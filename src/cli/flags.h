@@ -99,7 +99,13 @@
     "plan: design the shortest check session for this stored calibration (JSON) "                \
     "instead: four poses, detecting 10 stored sigmas in any one parameter with power "           \
     "0.9 at --level (needs --accel_noise_density)")                                              \
-  X(string, to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)")
+  X(string, to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)")               \
+  X(uint64, accel_device_id, 0,                                                                  \
+    "export --to px4: the accelerometer's device id (CAL_ACC0_ID), which TC_A0_ID must match")   \
+  X(uint64, gyro_device_id, 0,                                                                   \
+    "export --to px4: the gyroscope's device id (CAL_GYRO0_ID), which TC_G0_ID must match")      \
+  X(bool, drop_thermal, false,                                                                   \
+    "export: leave the thermal model out of a px4 or ardupilot file (said in the file)")
 
 namespace gravcal {
 namespace cli {

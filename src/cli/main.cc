@@ -210,7 +210,10 @@ const std::vector<CommandInfo>& Commands() {
            FlagField<ExportArgs>("noise", &ExportArgs::noise),
            FlagField<ExportArgs>("to", &ExportArgs::to),
            FlagField<ExportArgs>("output", &ExportArgs::output),
-           FlagField<ExportArgs>("output_dir", &ExportArgs::output_dir)},
+           FlagField<ExportArgs>("output_dir", &ExportArgs::output_dir),
+           FlagField<ExportArgs>("accel_device_id", &ExportArgs::accel_device_id),
+           FlagField<ExportArgs>("gyro_device_id", &ExportArgs::gyro_device_id),
+           FlagField<ExportArgs>("drop_thermal", &ExportArgs::drop_thermal)},
           RunExport),
       Command<CompareArgs>(
           "compare",
