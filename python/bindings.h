@@ -90,6 +90,8 @@ bool ReadNoise(const std::string& path, const std::string& text, ImuNoise* noise
 void BindCalibration(py::module_& m);
 void BindBatch(py::module_& m);
 void BindRecordings(py::module_& m);
+// thermal_bindings.cc (issue 35): thermal_model, thermal_evaluate.
+void BindThermal(py::module_& m);
 
 }  // namespace python
 }  // namespace gravcal
