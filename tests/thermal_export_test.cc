@@ -384,6 +384,15 @@ TEST(ThermalExport, ExportThatWouldDoNothingIsRefusedOrDroppedOutLoud) {
   bool said = false;
   for (const std::string& d : result.dropped) said |= d.find("not held") != std::string::npos;
   EXPECT_TRUE(said);
+  // A gyroscope without a thermal term: PX4's TC_G_* are not written, and
+  // the file says what an old TC_G_ENABLE on the vehicle would do.
+  LoadedCalibration no_gyro_term = c;
+  no_gyro_term.corrector.thermal.gyro = ThermalSensorModel();
+  std::string px4;
+  ExportOrDie(no_gyro_term, ExportTarget::kPx4, &px4);
+  EXPECT_EQ(px4.find("\tTC_G0_ID\t"), std::string::npos);
+  EXPECT_NE(px4.find("TC_G0_* not written"), std::string::npos) << px4;
+  EXPECT_NE(px4.find("\tTC_A0_ID\t"), std::string::npos);
   // The C target holds the whole model (no lag here): nothing dropped.
   options = ExportOptions();
   options.target = ExportTarget::kC;

@@ -461,7 +461,7 @@ bool ExportCalibration(const LoadedCalibration& calibration, const ExportOptions
   ImuCorrector truncated = TruncatedCorrector(calibration.corrector, options.target);
   if (options.drop_thermal) truncated.thermal = ThermalModel();
   const internal::AutopilotThermal thermal =
-      internal::ToAutopilotThermal(truncated.thermal, options);
+      internal::ToAutopilotThermal(truncated.thermal, truncated.has_gyro, options);
   std::string thermal_lines;
   switch (options.target) {
     case ExportTarget::kKalibr:

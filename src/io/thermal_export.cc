@@ -135,8 +135,19 @@ bool Px4ThermalLines(
     sensors.push_back({&thermal.gyro, thermal.gyro_device_id, "TC_G_ENABLE", "TC_G0_",
                        "--gyro_device_id", "CAL_GYRO0_ID", "gyroscope"});
   }
+  bool any = false;
+  for (const Sensor& sensor : sensors) any |= sensor.curve->Varies();
   for (const Sensor& sensor : sensors) {
-    if (!sensor.curve->Varies()) continue;
+    if (!sensor.curve->Varies()) {
+      // Only said beside a thermal export: a non-thermal one never was.
+      if (any) {
+        s += std::string("# ") + sensor.prefix + "* not written: the " + sensor.name +
+             " has no thermal term. A " + sensor.enable +
+             " = 1 left on the vehicle\n# would still add its old offsets: set it to 0 there "
+             "unless other sensors need it.\n";
+      }
+      continue;
+    }
     if (!CheckCurve(*sensor.curve, "px4", sensor.name, error)) return false;
     if (sensor.id <= 0 || sensor.id > 0xffffffffLL) {
       *error = std::string("px4: PX4 applies ") + sensor.prefix + "* only to the " + sensor.name +
@@ -161,7 +172,7 @@ bool Px4ThermalLines(
       }
     }
   }
-  if (!s.empty()) {
+  if (any) {
     s = "# Thermal compensation (PX4 src/modules/temperature_compensation): the offset\n"
         "#   X0 + X1 d + X2 d^2 + X3 d^3,  d = min(max(T, TMIN), TMAX) - TREF  (degC)\n"
         "# is subtracted from the raw reading before CAL_*_OFF and SCALE. PX4 applies it only\n"
@@ -381,11 +392,12 @@ void DescribeThermalTruncation(const LoadedCalibration& calibration, const ImuCo
       (range ? ", up to " + Format("%.3g", m.range_max) + " m/s^2 in those poses" + over : ""));
 }
 
-AutopilotThermal ToAutopilotThermal(const ThermalModel& held, const ExportOptions& options) {
+AutopilotThermal ToAutopilotThermal(const ThermalModel& held, bool has_gyro,
+                                    const ExportOptions& options) {
   AutopilotThermal t;
   t.accel = BiasCurve(held, ThermalSensor::kAccel);
   t.gyro = BiasCurve(held, ThermalSensor::kGyro);
-  t.has_gyro = t.gyro.Varies();
+  t.has_gyro = has_gyro;
   t.accel_device_id = options.accel_device_id;
   t.gyro_device_id = options.gyro_device_id;
   return t;

@@ -122,9 +122,10 @@ ThermalModel AutopilotHeldThermal(const ThermalModel& full, double reduction[2])
 void DescribeThermalTruncation(const LoadedCalibration& calibration, const ImuCorrector& held,
                                std::vector<std::string>* dropped);
 
-// The AutopilotThermal of a calibration (its held model) and the options'
-// device ids.
-AutopilotThermal ToAutopilotThermal(const ThermalModel& held, const ExportOptions& options);
+// The AutopilotThermal of a calibration (its held model, whether it has a
+// gyroscope) and the options' device ids.
+AutopilotThermal ToAutopilotThermal(const ThermalModel& held, bool has_gyro,
+                                    const ExportOptions& options);
 
 }  // namespace internal
 }  // namespace gravcal
