@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include "gravcal/simulation/thermal_simulator.h"
+#include "gravcal/workflows/thermal_discovery.h"
 
 namespace gravcal {
 namespace {
@@ -165,6 +166,14 @@ TEST(ThermalCalibration, LagIsFoundWhereHeatingAndCoolingDisagree) {
   // = 64 s.
   EXPECT_NEAR(c.thermal.lag_time_constant, 64.0,
               std::max(10.0, 4.0 * c.thermal.lag_time_constant_std));
+  // Discovery (issue 35 part 7) names the hysteresis, and the higher order
+  // of the bias (the truth is cubic).
+  const ThermalDiscovery found = DiscoverThermal(truth.log, OptionsFor(truth));
+  ASSERT_TRUE(found.tried) << found.reason;
+  EXPECT_NE(std::find(found.named.begin(), found.named.end(), "thermal_hysteresis"),
+            found.named.end());
+  EXPECT_NE(std::find(found.named.begin(), found.named.end(), "temperature_higher_order"),
+            found.named.end());
   sim.lag_time_constant = 0.0;
   ASSERT_TRUE(Calibrate(sim, 42, nullptr, &truth, &c));
   EXPECT_FALSE(c.thermal.lag_estimated) << c.message;
