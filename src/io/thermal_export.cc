@@ -316,8 +316,8 @@ void DescribeThermalTruncation(const LoadedCalibration& calibration, const ImuCo
   if (!full.active()) return;
   const size_t before = dropped->size();
   const bool range = full.max_temperature > full.min_temperature;
-  const std::string over = range ? " over [" + ExactNumber(full.min_temperature) + ", " +
-                                       ExactNumber(full.max_temperature) + "] degC"
+  const std::string over = range ? " over [" + Format("%.4g", full.min_temperature) + ", " +
+                                       Format("%.4g", full.max_temperature) + "] degC"
                                  : " (the model has no valid range: size unknown)";
   const ThermalSensor sensors[2] = {ThermalSensor::kAccel, ThermalSensor::kGyro};
   for (ThermalSensor s : sensors) {
