@@ -93,6 +93,8 @@ void BindRecordings(py::module_& m);
 // compare, verify, the store, limits and the certificate (verify_bindings.cc).
 void BindVerify(py::module_& m);
 void BindRecorder(py::module_& m);
+// thermal_bindings.cc (issue 35): thermal_model, thermal_evaluate.
+void BindThermal(py::module_& m);
 
 }  // namespace python
 }  // namespace gravcal

@@ -202,8 +202,12 @@ std::unique_ptr<PyCalibration> CalibrateFile(const Config& config, const std::st
 // `gravcal export`: the files' names and texts, what the target drops, the
 // truncation's residuals.
 py::dict Export(const PyCalibration& c, const std::string& to, const std::string& name,
-                const std::string& noise_path, const std::string& noise_text) {
+                const std::string& noise_path, const std::string& noise_text,
+                uint64_t accel_device_id, uint64_t gyro_device_id, bool drop_thermal) {
   ExportOptions options;
+  options.accel_device_id = static_cast<int64_t>(accel_device_id);
+  options.gyro_device_id = static_cast<int64_t>(gyro_device_id);
+  options.drop_thermal = drop_thermal;
   Check(FromString(to, &options.target),
         "to: expected one of " + ExportTargetNames() + ", not '" + to + "'");
   ImuNoise noise;
@@ -291,7 +295,8 @@ void BindCalibration(py::module_& m) {
   m.def("calibrate_file", &CalibrateFile, py::arg("config"), py::arg("path"), py::arg("attitudes"),
         py::arg("segments"), py::arg("noise"));
   m.def("export", &Export, py::arg("calibration"), py::arg("to"), py::arg("name"),
-        py::arg("noise_path"), py::arg("noise_text"));
+        py::arg("noise_path"), py::arg("noise_text"), py::arg("accel_device_id") = 0,
+        py::arg("gyro_device_id") = 0, py::arg("drop_thermal") = false);
   m.def("_time_calibrate", &TimeCalibrate, py::arg("config"), py::arg("log"), py::arg("path"),
         py::arg("repeats"));
 }

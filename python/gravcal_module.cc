@@ -235,6 +235,7 @@ PYBIND11_MODULE(_gravcal, m) {
   BindRecordings(m);
   BindVerify(m);
   BindRecorder(m);
+  BindThermal(m);
   // The destination contract (io/files.h), checked before any work:
   // outputs and inputs as (path, name in messages) pairs.
   m.def("check_destinations", [](const std::vector<std::pair<std::string, std::string>>& outputs,

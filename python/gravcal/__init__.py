@@ -31,6 +31,8 @@ __all__ = [
     "Error", "Log", "Calibration", "Result", "BatchResult", "BatchResults", "Config", "config",
     "read_log", "log", "calibrate", "simulate", "batch", "noise", "discover", "plan", "check", "export",
     "Recorder", "config_keys", "__version__",
+    "thermal_model", "thermal_evaluate",
+    "config_keys", "__version__",
 ]
 
 Config = _gravcal.Config
@@ -623,7 +625,38 @@ def check(log=None, *, config=None, noise=None, t=None, accel=None, gyro=None, t
                                  *_noise_source(noise)))
 
 
-def export(calibration, to, *, noise=None, name=None):
+def _calibration_of(calibration):
+    if isinstance(calibration, (str, bytes, _os.PathLike)):
+        calibration = Calibration.from_json(calibration)
+    if not isinstance(calibration, Calibration):
+        raise Error("calibration: expected a gravcal.Calibration or a calibration JSON path, "
+                    "got %s" % type(calibration).__name__)
+    return calibration
+
+
+def thermal_model(calibration):
+    """The calibration's thermal model (issue 35) as a dict: ``active``,
+    ``reference_temperature``, ``min_temperature``, ``max_temperature``
+    (degC), ``lag_time_constant`` (s) and its ``_std``, ``notes``, and per
+    sensor (``accel``, ``gyro``) and term (``bias``, ``scale``,
+    ``misalignment``): ``order``, ``components``, ``coefficients``
+    (components x order, column k-1 the coefficient of (T - T_ref)^k; NaN =
+    undetermined by the session) and ``units``."""
+    return Result(_gravcal.thermal_model(_calibration_of(calibration)._core))
+
+
+def thermal_evaluate(calibration, sensor, quantity, temperatures):
+    """One thermal term's change from T_ref at ``temperatures`` (degC,
+    clamped to the valid range as the correction clamps): ``(values,
+    std)``, each of shape (N, components); std NaN where unknown.
+    ``sensor`` accel or gyro; ``quantity`` bias (raw units), scale
+    (fraction) or misalignment (rad)."""
+    return _gravcal.thermal_evaluate(_calibration_of(calibration)._core, str(sensor),
+                                     str(quantity), _np.asarray(temperatures, dtype=float))
+
+
+def export(calibration, to, *, noise=None, name=None, accel_device_id=0, gyro_device_id=0,
+           drop_thermal=False):
     """A calibration for another tool, as ``gravcal export --to`` writes
     it: ``to`` is kalibr, openvins, ros, px4, ardupilot or c;
     ``calibration`` a :class:`Calibration` or a calibration JSON path;
@@ -634,14 +667,14 @@ def export(calibration, to, *, noise=None, name=None):
     single-file target, gravcal_correct.h and .c for c), ``dropped`` (what
     the target cannot hold, one line each), ``full_rms`` and
     ``truncated_rms`` (m/s^2 over the recorded positions) and
-    ``message``."""
-    if isinstance(calibration, (str, bytes, _os.PathLike)):
-        calibration = Calibration.from_json(calibration)
-    if not isinstance(calibration, Calibration):
-        raise Error("calibration: expected a gravcal.Calibration or a calibration JSON path, "
-                    "got %s" % type(calibration).__name__)
+    ``message``. With a thermal model, px4 needs ``accel_device_id`` and
+    ``gyro_device_id`` (the vehicle's CAL_ACC0_ID, CAL_GYRO0_ID, which
+    TC_A0_ID / TC_G0_ID must match); ``drop_thermal`` leaves the thermal
+    model out of px4 and ardupilot files."""
+    calibration = _calibration_of(calibration)
     result = _gravcal.export(calibration._core, str(to), "" if name is None else str(name),
-                             *_noise_source(noise))
+                             *_noise_source(noise), accel_device_id=int(accel_device_id),
+                             gyro_device_id=int(gyro_device_id), drop_thermal=bool(drop_thermal))
     result["files"] = [Result(f) for f in result["files"]]
     return Result(result)
 

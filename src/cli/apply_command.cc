@@ -3,12 +3,14 @@
 // in constant memory), "-" for standard input and output. Exit 0 written; 1
 // bad input (no output file; on standard output nothing is written when the
 // problem shows before the first sample).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "cli/commands.h"
+#include "gravcal/core/thermal_rate.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/imu_stream.h"
 #include "gravcal/io/log_reader.h"
@@ -62,6 +64,10 @@ int RunApply(const ApplyArgs& args) {
     return Fail(reader.name() +
                 ": the calibration has temperature effects and needs a 'temp' column");
   }
+  if (corrector.HasThermal() && !reader.has_temperature()) {
+    return Fail(reader.name() +
+                ": the calibration has a thermal model (key 'thermal') and needs a 'temp' column");
+  }
   if (corrector.has_gyro && !reader.has_gyro()) {
     std::fprintf(stderr,
                  "gravcal: warning: %s has no gx, gy, gz: only the accelerometer is corrected\n",
@@ -77,9 +83,16 @@ int RunApply(const ApplyArgs& args) {
     return Fail(error);
   }
   size_t count = 0;
+  // Issue 35: the thermal model's lag needs the temperature's rate; its
+  // range is clamped (and counted for one warning).
+  ThermalRate rate;
+  size_t clamped_count = 0;
+  double lowest = INFINITY, highest = -INFINITY;
   for (bool more = true; more; more = reader.Next(&sample, &error)) {
-    if (!corrector.CorrectRow(sample.temperature, sample.t, &sample.accel,
-                              reader.has_gyro() ? &sample.gyro : nullptr)) {
+    bool clamped = false;
+    const double temperature_rate = rate.Add(sample.t, sample.temperature);
+    if (!corrector.CorrectRow(sample.temperature, temperature_rate, sample.t, &sample.accel,
+                              reader.has_gyro() ? &sample.gyro : nullptr, &clamped)) {
       writer.Abort();
       return Fail(reader.where() +
                   ": the quadratic term has no real root (reading outside the calibrated range)");
@@ -94,12 +107,25 @@ int RunApply(const ApplyArgs& args) {
     }
     if (!writer.Write(sample, &error)) return Fail(error);
     ++count;
+    if (clamped) {
+      ++clamped_count;
+      lowest = std::min(lowest, sample.temperature);
+      highest = std::max(highest, sample.temperature);
+    }
   }
   if (!error.empty()) {
     writer.Abort();
     return Fail(error);
   }
   if (!writer.Commit(&error)) return Fail(error);
+  if (clamped_count > 0) {
+    std::fprintf(stderr,
+                 "gravcal: warning: %zu samples (temperatures %.1f to %.1f degC) lie outside the "
+                 "thermal model's range [%.1f, %.1f] degC; the correction there is clamped at the "
+                 "range's ends, as PX4 does\n",
+                 clamped_count, lowest, highest, corrector.thermal.min_temperature,
+                 corrector.thermal.max_temperature);
+  }
   if (args.output != "-") {
     std::fprintf(stderr, "gravcal: corrected %zu samples; wrote %s\n", count, args.output.c_str());
   }

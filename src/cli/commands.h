@@ -151,6 +151,10 @@ struct ExportArgs : CommonArgs {
   std::string output;
   std::string output_dir;
   StoredCalibrationArgs stored;
+  // px4 with a thermal model: the device ids TC_A0_ID / TC_G0_ID get.
+  uint64_t accel_device_id = 0;
+  uint64_t gyro_device_id = 0;
+  bool drop_thermal = false;
 };
 
 // compare a.json b.json (the two calibrations are the positional

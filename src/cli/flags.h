@@ -115,7 +115,13 @@
     "(a new pseudo-terminal, its name on stderr)")                                               \
   X(double, rate, 0.0, "simulate --stream: times real time (0 = as fast as possible)")           \
   X(string, follow_events, "",                                                                   \
-    "simulate --stream: follow the suggest events gravcal record writes to this file")
+    "simulate --stream: follow the suggest events gravcal record writes to this file")           \
+  X(uint64, accel_device_id, 0,                                                                  \
+    "export --to px4: the accelerometer's device id (CAL_ACC0_ID), which TC_A0_ID must match")   \
+  X(uint64, gyro_device_id, 0,                                                                   \
+    "export --to px4: the gyroscope's device id (CAL_GYRO0_ID), which TC_G0_ID must match")      \
+  X(bool, drop_thermal, false,                                                                   \
+    "export: leave the thermal model out of a px4 or ardupilot file (said in the file)")
 
 namespace gravcal {
 namespace cli {

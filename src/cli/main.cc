@@ -248,7 +248,10 @@ const std::vector<CommandInfo>& Commands() {
            StoredFlag<ExportArgs>("store", &StoredCalibrationArgs::store),
            StoredFlag<ExportArgs>("unit", &StoredCalibrationArgs::unit),
            StoredFlag<ExportArgs>("at", &StoredCalibrationArgs::at),
-           StoredFlag<ExportArgs>("max_age_days", &StoredCalibrationArgs::max_age_days)},
+           StoredFlag<ExportArgs>("max_age_days", &StoredCalibrationArgs::max_age_days),
+           FlagField<ExportArgs>("accel_device_id", &ExportArgs::accel_device_id),
+           FlagField<ExportArgs>("gyro_device_id", &ExportArgs::gyro_device_id),
+           FlagField<ExportArgs>("drop_thermal", &ExportArgs::drop_thermal)},
           RunExport),
       Command<CompareArgs>(
           "compare",

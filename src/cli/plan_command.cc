@@ -64,7 +64,11 @@ int RunCheck(const PlanArgs& args) {
 }
 
 JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session) {
-  if (!args.check || args.config.method != "twelve_position") return {};
+  // Issue 35: the thermal method's check adds what the temperature span
+  // allows (CoverageReport::temperature).
+  if (!args.check || (args.config.method != "twelve_position" && args.config.method != "thermal")) {
+    return {};
+  }
   // The session's noise model (read with the log), its poses (detected once).
   PlanRequest request;
   request.noise_model = session.noise_model();

@@ -7,14 +7,13 @@
 namespace gravcal {
 namespace internal {
 
-namespace {
-
-// A C literal of v (exact for double; rounded by the compiler for float).
 std::string CNumber(double v, bool f) {
   std::string s = ExactNumber(v);
   if (s.find_first_of(".en") == std::string::npos) s += ".0";
   return s + (f ? "f" : "");
 }
+
+namespace {
 
 // "{a, b, c}", row-major.
 template <typename Derived>
@@ -62,6 +61,9 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
     << CNumber(c.RequiresTemperature() ? e.reference_temperature : 0.0, f) << ";\n"
     << "static const " << real << " " << p
     << "REFERENCE_TIME = " << CNumber(c.RequiresTime() ? e.reference_time : 0.0, f) << ";\n\n";
+  const CPrecision precision = {f, real, p, suffix};
+  s << CThermalDefinitions(c, precision);
+  const std::string accel_scale = CThermalRemoveScale(c, precision, ThermalSensor::kAccel, "m");
   const std::string zero = f ? "0.0f" : "0.0";
   const std::string one = f ? "1.0f" : "1.0";
   // dT and dt: zero when the model has no such term (the argument is
@@ -75,13 +77,15 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
     << " temp_c, " << real << " t_s, " << real << " out[3]) {\n"
     << "  const " << real << " dT = gravcal_temperature_offset" << suffix << "(temp_c);\n"
     << "  const " << real << " dt = gravcal_time_offset" << suffix << "(t_s);\n"
-    << "  " << real << " d[3], m[3];\n"
+    << CThermalOffsetLine(c, precision, ThermalSensor::kAccel) << "  " << real << " d[3], m[3];\n"
     << "  int i, j;\n"
     << "  for (i = 0; i < 3; ++i) d[i] = raw[i] - " << p << "ACCEL_BIAS[i];\n"
-    << "  for (i = 0; i < 3; ++i) {\n"
+    << CThermalBias(c, precision, ThermalSensor::kAccel, "d") << "  for (i = 0; i < 3; ++i) {\n"
     << "    m[i] = " << zero << ";\n"
-    << "    for (j = i; j < 3; ++j) m[i] += " << p << "ACCEL_UPPER[3 * i + j] * d[j];\n"
-    << "    m[i] -= " << p << "ACCEL_TEMP_BIAS[i] * dT;\n"
+    << "    for (j = i; j < 3; ++j) m[i] += " << p << "ACCEL_UPPER[3 * i + j] * d[j];\n";
+  // The thermal scale acts on all of m before the effect terms.
+  if (!accel_scale.empty()) s << "  }\n" << accel_scale << "  for (i = 0; i < 3; ++i) {\n";
+  s << "    m[i] -= " << p << "ACCEL_TEMP_BIAS[i] * dT;\n"
     << "    m[i] -= " << p << "ACCEL_DRIFT[i] * dt;\n"
     << "    m[i] /= " << one << " + " << p << "ACCEL_TEMP_SCALE[i] * dT;\n";
   if (quadratic) {
@@ -97,7 +101,8 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
     << " accel[3], " << real << " temp_c, " << real << " t_s, " << real << " out[3]) {\n"
     << "  const " << real << " dT = gravcal_temperature_offset" << suffix << "(temp_c);\n"
     << "  const " << real << " dt = gravcal_time_offset" << suffix << "(t_s);\n"
-    << "  " << real << " force[3], u[3];\n"
+    << CThermalOffsetLine(c, precision, ThermalSensor::kGyro) << "  " << real
+    << " force[3], u[3];\n"
     << "  int i, j;\n"
     << "  /* The specific force in the sensor frame: R^T accel. */\n"
     << "  for (i = 0; i < 3; ++i) {\n"
@@ -112,10 +117,11 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
     << "    offset += " << p << "GYRO_DRIFT[i] * dt;\n"
     << "    u[i] = raw[i] - " << p << "GYRO_BIAS[i] - offset;\n"
     << "  }\n"
-    << "  for (i = 0; i < 3; ++i) {\n"
+    << CThermalBias(c, precision, ThermalSensor::kGyro, "u") << "  for (i = 0; i < 3; ++i) {\n"
     << "    out[i] = " << zero << ";\n"
     << "    for (j = 0; j < 3; ++j) out[i] += " << p << "GYRO_MATRIX[3 * i + j] * u[j];\n"
-    << "  }\n}\n\n";
+    << "  }\n"
+    << CThermalRemoveScale(c, precision, ThermalSensor::kGyro, "out") << "}\n\n";
 }
 
 }  // namespace

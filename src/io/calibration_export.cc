@@ -8,6 +8,7 @@
 #include "gravcal/io/noise_io.h"
 #include "io/c_corrector_export.h"
 #include "io/export_format.h"
+#include "io/thermal_export.h"
 #include "util/join.h"
 
 namespace gravcal {
@@ -74,9 +75,11 @@ std::vector<std::string> EffectNamesOf(const std::vector<Effect>& effects,
 using internal::Join;
 
 // The lines of `dropped` for the target, from the full and truncated models.
-void DescribeTruncation(const LoadedCalibration& c, ExportTarget target, ExportResult* result) {
+void DescribeTruncation(const LoadedCalibration& c, const ExportOptions& options,
+                        ExportResult* result) {
   const ImuCorrector& full = c.corrector;
-  const ImuCorrector truncated = TruncatedCorrector(full, target);
+  ImuCorrector truncated = TruncatedCorrector(full, options.target);
+  if (options.drop_thermal) truncated.thermal = ThermalModel();
   std::vector<std::string>& dropped = result->dropped;
   const std::vector<std::string> effects =
       EffectNamesOf(full.active_effects, truncated.active_effects);
@@ -93,6 +96,7 @@ void DescribeTruncation(const LoadedCalibration& c, ExportTarget target, ExportR
                   100.0 * d.cwiseAbs().rowwise().sum().maxCoeff());
     dropped.push_back(text);
   }
+  internal::DescribeThermalTruncation(c, truncated, &dropped);
   if (c.positions.empty()) {
     if (!dropped.empty()) {
       dropped.push_back("the calibration records no static positions: truncation error unknown");
@@ -102,7 +106,7 @@ void DescribeTruncation(const LoadedCalibration& c, ExportTarget target, ExportR
   result->full_rms = PositionResidualRms(full, c.positions, c.gravity);
   result->truncated_rms = PositionResidualRms(truncated, c.positions, c.gravity);
   const bool temperature_unknown =
-      full.RequiresTemperature() &&
+      (full.RequiresTemperature() || full.HasThermal()) &&
       std::any_of(c.positions.begin(), c.positions.end(),
                   [](const RecordedPosition& p) { return !std::isfinite(p.temperature); });
   if (!dropped.empty()) {
@@ -416,15 +420,26 @@ double PositionResidualRms(const ImuCorrector& corrector,
 
 ImuCorrector TruncatedCorrector(const ImuCorrector& full, ExportTarget target) {
   switch (target) {
-    case ExportTarget::kC:
     case ExportTarget::kRos:
       return full;
+    case ExportTarget::kC: {
+      // The C functions take no temperature rate: no thermal lag.
+      ImuCorrector t = full;
+      t.thermal.lag_time_constant = 0.0;
+      return t;
+    }
     case ExportTarget::kKalibr:
-    case ExportTarget::kOpenVins:
-      return full.WithEffects({Effect::kGyroGSensitivity});
+    case ExportTarget::kOpenVins: {
+      ImuCorrector t = full.WithEffects({Effect::kGyroGSensitivity});
+      t.thermal = ThermalModel();
+      return t;
+    }
     case ExportTarget::kPx4:
     case ExportTarget::kArduPilot: {
       ImuCorrector t = full.WithEffects({});
+      // The thermal bias as a cubic; no thermal scale, misalignment or lag.
+      double reduction[2];
+      t.thermal = internal::AutopilotHeldThermal(full.thermal, reduction);
       // Per-axis scale: the diagonal of M; no rotation, no cross-axis terms.
       const Eigen::Matrix3d m = full.accel.matrix();
       t.accel.upper = m.diagonal().asDiagonal();
@@ -441,9 +456,13 @@ bool ExportCalibration(const LoadedCalibration& calibration, const ExportOptions
   *result = ExportResult();
   if (!options.IsValid(error)) return false;
   // ros writes covariances only: no correction to truncate.
-  if (options.target != ExportTarget::kRos) DescribeTruncation(calibration, options.target, result);
+  if (options.target != ExportTarget::kRos) DescribeTruncation(calibration, options, result);
   std::string text;
-  const ImuCorrector truncated = TruncatedCorrector(calibration.corrector, options.target);
+  ImuCorrector truncated = TruncatedCorrector(calibration.corrector, options.target);
+  if (options.drop_thermal) truncated.thermal = ThermalModel();
+  const internal::AutopilotThermal thermal =
+      internal::ToAutopilotThermal(truncated.thermal, truncated.has_gyro, options);
+  std::string thermal_lines;
   switch (options.target) {
     case ExportTarget::kKalibr:
       if (!KalibrYaml(calibration, options, *result, &text, error)) return false;
@@ -456,11 +475,25 @@ bool ExportCalibration(const LoadedCalibration& calibration, const ExportOptions
       break;
     case ExportTarget::kPx4:
       if (!AutopilotScales(truncated, "px4", error)) return false;
-      text = AutopilotParameters(calibration, options, *result, truncated, Px4Format());
+      if (!internal::Px4ThermalLines(
+              thermal,
+              [](const std::string& name, const std::string& value, bool integer) {
+                return "1\t1\t" + name + "\t" + value + "\t" + (integer ? "6" : "9") + "\n";
+              },
+              &thermal_lines, error)) {
+        return false;
+      }
+      text = AutopilotParameters(calibration, options, *result, truncated, Px4Format()) +
+             thermal_lines;
       break;
     case ExportTarget::kArduPilot:
       if (!AutopilotScales(truncated, "ardupilot", error)) return false;
-      text = AutopilotParameters(calibration, options, *result, truncated, ArduPilotFormat());
+      if (!internal::ArduPilotThermalLines(thermal, ArduPilotFormat().line, &thermal_lines,
+                                           error)) {
+        return false;
+      }
+      text = AutopilotParameters(calibration, options, *result, truncated, ArduPilotFormat()) +
+             thermal_lines;
       break;
     case ExportTarget::kC: {
       std::vector<std::string> comment = Provenance(calibration, options);

@@ -121,6 +121,10 @@ std::string CoverageToJson(const CoverageReport& r) {
   out["short_of_target"] = r.short_of_target;
   out["proposed"] = proposed;
   out["undetermined_with_proposed"] = r.undetermined_with_proposed;
+  if (std::isfinite(r.temperature_span)) {
+    out["temperature_span"] = r.temperature_span;
+    out["temperature"] = r.temperature;
+  }
   out["message"] = r.message;
   return out.dump();
 }

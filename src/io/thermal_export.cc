@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "util/numbers.h"
 
@@ -84,23 +85,28 @@ PolynomialCoefficients ShiftPolynomial(const PolynomialCoefficients& p, double s
 ThermalCurve ReduceOrder(const ThermalCurve& curve, int max_order, double* max_error) {
   *max_error = 0.0;
   if (curve.Order() <= max_order) return curve;
-  // Least squares on the grid, in x = (T - t_ref) / half-width for
+  if (!(curve.t_max > curve.t_min)) {
+    *max_error = NAN;  // no range to fit over (the exports refuse it)
+    return curve;
+  }
+  // Least squares on the grid over the powers 1..max_order (the value at
+  // t_ref stays the base model's), in x = (T - t_ref) / half-width for
   // conditioning, then back to powers of (T - t_ref).
   const double half = 0.5 * (curve.t_max - curve.t_min);
   const double scale = half > 0.0 ? half : 1.0;
-  Eigen::MatrixXd a(kGridPoints, max_order + 1);
+  Eigen::MatrixXd a(kGridPoints, max_order);
   Eigen::MatrixXd b(kGridPoints, 3);
   for (int i = 0; i < kGridPoints; ++i) {
     const double t = GridPoint(curve.t_min, curve.t_max, i);
     const double x = (t - curve.t_ref) / scale;
-    for (int k = 0; k <= max_order; ++k) a(i, k) = std::pow(x, k);
+    for (int k = 1; k <= max_order; ++k) a(i, k - 1) = std::pow(x, k);
     b.row(i) = curve.At(t).transpose();
   }
-  const Eigen::MatrixXd solution = a.colPivHouseholderQr().solve(b);  // (order+1) x 3
+  const Eigen::MatrixXd solution = a.colPivHouseholderQr().solve(b);  // max_order x 3
   ThermalCurve reduced = curve;
-  reduced.coefficients.resize(3, max_order + 1);
-  for (int k = 0; k <= max_order; ++k) {
-    reduced.coefficients.col(k) = solution.row(k).transpose() / std::pow(scale, k);
+  reduced.coefficients = PolynomialCoefficients::Zero(3, max_order + 1);
+  for (int k = 1; k <= max_order; ++k) {
+    reduced.coefficients.col(k) = solution.row(k - 1).transpose() / std::pow(scale, k);
   }
   for (int i = 0; i < kGridPoints; ++i) {
     const double t = GridPoint(curve.t_min, curve.t_max, i);
@@ -129,8 +135,19 @@ bool Px4ThermalLines(
     sensors.push_back({&thermal.gyro, thermal.gyro_device_id, "TC_G_ENABLE", "TC_G0_",
                        "--gyro_device_id", "CAL_GYRO0_ID", "gyroscope"});
   }
+  bool any = false;
+  for (const Sensor& sensor : sensors) any |= sensor.curve->Varies();
   for (const Sensor& sensor : sensors) {
-    if (!sensor.curve->Varies()) continue;
+    if (!sensor.curve->Varies()) {
+      // Only said beside a thermal export: a non-thermal one never was.
+      if (any) {
+        s += std::string("# ") + sensor.prefix + "* not written: the " + sensor.name +
+             " has no thermal term. A " + sensor.enable +
+             " = 1 left on the vehicle\n# would still add its old offsets: set it to 0 there "
+             "unless other sensors need it.\n";
+      }
+      continue;
+    }
     if (!CheckCurve(*sensor.curve, "px4", sensor.name, error)) return false;
     if (sensor.id <= 0 || sensor.id > 0xffffffffLL) {
       *error = std::string("px4: PX4 applies ") + sensor.prefix + "* only to the " + sensor.name +
@@ -154,6 +171,14 @@ bool Px4ThermalLines(
                   ExactNumber(p(axis, k)), false);
       }
     }
+  }
+  if (any) {
+    s = "# Thermal compensation (PX4 src/modules/temperature_compensation): the offset\n"
+        "#   X0 + X1 d + X2 d^2 + X3 d^3,  d = min(max(T, TMIN), TMAX) - TREF  (degC)\n"
+        "# is subtracted from the raw reading before CAL_*_OFF and SCALE. PX4 applies it only\n"
+        "# to the sensor whose device id equals TC_A0_ID / TC_G0_ID, and reads TC_*_ENABLE at\n"
+        "# boot: reboot after loading. T is the IMU's own temperature reading.\n" +
+        s;
   }
   *text = s;
   return true;
@@ -184,7 +209,12 @@ bool ArduPilotThermalLines(
         ExactNumber(thermal.gyro.t_min) + ", " + ExactNumber(thermal.gyro.t_max) + "] degC differ";
     return false;
   }
-  std::string s;
+  std::string s =
+      "# Thermal compensation (ArduPilot AP_InertialSensor_tempcal.cpp), first IMU:\n"
+      "#   v = raw - P(T) + P(CALTEMP),  P(T) = 1e-6 (c1 e + c2 e^2 + c3 e^3),  e = T - 35 degC\n"
+      "# with T and CALTEMP clamped to [TMIN, TMAX], before INS_ACCOFFS / INS_GYROFFS. The\n"
+      "# CALTEMPs say where the offsets of this file hold. Needs a firmware built with\n"
+      "# temperature calibration (HAL_INS_TEMPERATURE_CAL_ENABLE) and a reboot.\n";
   s += line("INS_TCAL1_ENABLE", "1");
   s += line("INS_TCAL1_TMIN", ExactNumber(range.t_min));
   s += line("INS_TCAL1_TMAX", ExactNumber(range.t_max));
@@ -230,6 +260,147 @@ ThermalTruncation MeasureThermalTruncation(
   }
   r.session_rms = r.readings ? std::sqrt(sum / r.readings) : NAN;
   return r;
+}
+
+ThermalCurve BiasCurve(const ThermalModel& model, ThermalSensor sensor) {
+  const ThermalPolynomial& b = model.Sensor(sensor).bias;
+  ThermalCurve c;
+  c.t_ref = model.reference_temperature;
+  c.t_min = model.min_temperature;
+  c.t_max = model.max_temperature;
+  c.coefficients = PolynomialCoefficients::Zero(3, b.active() ? b.order + 1 : 1);
+  for (int k = 1; b.active() && k <= b.order; ++k)
+    c.coefficients.col(k) = b.coefficients.col(k - 1);
+  return c;
+}
+
+ThermalModel AutopilotHeldThermal(const ThermalModel& full, double reduction[2]) {
+  ThermalModel held;
+  held.reference_temperature = full.reference_temperature;
+  held.min_temperature = full.min_temperature;
+  held.max_temperature = full.max_temperature;
+  const ThermalSensor sensors[2] = {ThermalSensor::kAccel, ThermalSensor::kGyro};
+  for (int i = 0; i < 2; ++i) {
+    const ThermalCurve c = ReduceOrder(BiasCurve(full, sensors[i]), kTargetOrder, &reduction[i]);
+    if (!c.Varies()) continue;
+    ThermalPolynomial& b = held.MutableSensor(sensors[i])->bias;
+    b.Resize(3, c.Order());
+    b.coefficients = c.coefficients.rightCols(c.Order());
+  }
+  return held;
+}
+
+namespace {
+
+// The largest |p_i(x)| of a term over the range, every component.
+double LargestOverRange(const ThermalModel& m, const ThermalPolynomial& p, int components) {
+  double largest = 0.0;
+  for (int g = 0; g < kGridPoints; ++g) {
+    const double x = GridPoint(m.min_temperature, m.max_temperature, g) - m.reference_temperature;
+    for (int i = 0; i < components; ++i) largest = std::max(largest, std::abs(p.Value(i, x)));
+  }
+  return largest;
+}
+
+std::string Format(const char* format, double v) {
+  char text[64];
+  std::snprintf(text, sizeof(text), format, v);
+  return text;
+}
+
+}  // namespace
+
+void DescribeThermalTruncation(const LoadedCalibration& calibration, const ImuCorrector& held,
+                               std::vector<std::string>* dropped) {
+  const ThermalModel& full = calibration.corrector.thermal;
+  if (!full.active()) return;
+  const size_t before = dropped->size();
+  const bool range = full.max_temperature > full.min_temperature;
+  const std::string over = range ? " over [" + Format("%.4g", full.min_temperature) + ", " +
+                                       Format("%.4g", full.max_temperature) + "] degC"
+                                 : " (the model has no valid range: size unknown)";
+  const ThermalSensor sensors[2] = {ThermalSensor::kAccel, ThermalSensor::kGyro};
+  for (ThermalSensor s : sensors) {
+    if (s == ThermalSensor::kGyro && !calibration.corrector.has_gyro) continue;
+    const std::string name = s == ThermalSensor::kAccel ? "accelerometer" : "gyroscope";
+    const ThermalSensorModel& f = full.Sensor(s);
+    const ThermalSensorModel& h = held.thermal.Sensor(s);
+    if (f.bias.active() && f.bias.order > h.bias.order) {
+      double change = 0.0;
+      const ThermalCurve fc = BiasCurve(full, s), hc = BiasCurve(held.thermal, s);
+      for (int g = 0; range && g < kGridPoints; ++g) {
+        const double t = GridPoint(full.min_temperature, full.max_temperature, g);
+        change = std::max(change, (fc.At(t) - hc.At(t)).cwiseAbs().maxCoeff());
+      }
+      dropped->push_back(
+          name + " bias against temperature, order " + std::to_string(f.bias.order) +
+          (h.bias.active() ? " held as order " + std::to_string(h.bias.order) : " not held") +
+          ": changes the bias by up to " + Format("%.3g", change) + " raw units" + over);
+    }
+    if (f.scale.active() && !h.scale.active()) {
+      dropped->push_back(
+          name + " scale against temperature (order " + std::to_string(f.scale.order) +
+          "): up to " + Format("%.3g", 100.0 * (range ? LargestOverRange(full, f.scale, 3) : NAN)) +
+          "% of the reading" + over);
+    }
+    if (f.misalignment.active() && !h.misalignment.active()) {
+      const int n = ThermalComponents(s, ThermalQuantity::kMisalignment);
+      dropped->push_back(
+          name + " misalignment against temperature (order " +
+          std::to_string(f.misalignment.order) + "): up to " +
+          Format("%.3g", 1e3 * (range ? LargestOverRange(full, f.misalignment, n) : NAN)) +
+          " mrad" + over);
+    }
+  }
+  if (full.lag_time_constant != 0.0 && held.thermal.lag_time_constant == 0.0) {
+    dropped->push_back("thermal lag tau = " + Format("%.3g", full.lag_time_constant) +
+                       " s: the target uses the logged temperature as it is (on a 1 degC/min "
+                       "ramp it takes the bias " +
+                       Format("%.3g", std::abs(full.lag_time_constant) / 60.0) + " degC off)");
+  }
+  if (dropped->size() == before || calibration.positions.empty()) return;
+  // The thermal part alone: the same base model with each thermal model.
+  ImuCorrector only_held = calibration.corrector;
+  only_held.thermal = held.thermal;
+  std::vector<Eigen::Vector3d> raws;
+  std::vector<double> temperatures;
+  for (const RecordedPosition& p : calibration.positions) {
+    raws.push_back(p.raw_mean);
+    temperatures.push_back(p.temperature);
+  }
+  auto correct = [&](const ImuCorrector& k) {
+    return [&k](const Eigen::Vector3d& raw, double t) {
+      Eigen::Vector3d a = Eigen::Vector3d::Constant(NAN);
+      k.CorrectAccel(raw, t, 0.0, &a);
+      return a;
+    };
+  };
+  const ThermalTruncation m = MeasureThermalTruncation(
+      correct(calibration.corrector), correct(only_held), raws, temperatures,
+      range ? full.min_temperature : 0.0, range ? full.max_temperature : 0.0);
+  if (m.readings == 0) {
+    dropped->push_back(
+        "the static positions record no temperature: the thermal terms' share of "
+        "the error is not measured");
+    return;
+  }
+  dropped->push_back(
+      "accelerometer output with the thermal terms this file holds against the "
+      "full thermal model: rms " +
+      Format("%.3g", m.session_rms) + " m/s^2 over the calibration's " +
+      std::to_string(m.readings) + " static positions" +
+      (range ? ", up to " + Format("%.3g", m.range_max) + " m/s^2 in those poses" + over : ""));
+}
+
+AutopilotThermal ToAutopilotThermal(const ThermalModel& held, bool has_gyro,
+                                    const ExportOptions& options) {
+  AutopilotThermal t;
+  t.accel = BiasCurve(held, ThermalSensor::kAccel);
+  t.gyro = BiasCurve(held, ThermalSensor::kGyro);
+  t.has_gyro = has_gyro;
+  t.accel_device_id = options.accel_device_id;
+  t.gyro_device_id = options.gyro_device_id;
+  return t;
 }
 
 }  // namespace internal

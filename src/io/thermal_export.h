@@ -24,6 +24,11 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/core/imu_corrector.h"
+#include "gravcal/core/thermal_model.h"
+#include "gravcal/io/calibration_export.h"
+#include "gravcal/io/calibration_io.h"
+
 namespace gravcal {
 namespace internal {
 
@@ -49,8 +54,8 @@ struct ThermalCurve {
 PolynomialCoefficients ShiftPolynomial(const PolynomialCoefficients& p, double shift);
 
 // The curve of order <= max_order closest in least squares over an even
-// grid of [t_min, t_max] (the curve itself when its order is already low
-// enough). *max_error: the largest |difference| over that grid and the
+// grid of [t_min, t_max], its value at t_ref kept (the curve itself when its
+// order is already low enough). *max_error: the largest |difference| over that grid and the
 // three axes.
 ThermalCurve ReduceOrder(const ThermalCurve& curve, int max_order, double* max_error);
 
@@ -96,6 +101,31 @@ ThermalTruncation MeasureThermalTruncation(
     const std::function<Eigen::Vector3d(const Eigen::Vector3d&, double)>& target,
     const std::vector<Eigen::Vector3d>& raws, const std::vector<double>& temperatures, double t_min,
     double t_max);
+
+// ---------------------------------------------------------------------------
+// From the calibration's thermal model (core/thermal_model.h).
+
+// The bias term of one sensor as a curve (t_ref, range and coefficients of
+// the model; no coefficients when the term is off).
+ThermalCurve BiasCurve(const ThermalModel& model, ThermalSensor sensor);
+
+// The thermal model a PX4 or ArduPilot file holds: the bias terms only, of
+// order <= 3 (ReduceOrder when higher), no scale, misalignment or lag.
+// reduction[s]: ReduceOrder's largest change of sensor s's bias (raw
+// units), 0 when none.
+ThermalModel AutopilotHeldThermal(const ThermalModel& full, double reduction[2]);
+
+// The lines ExportResult::dropped gets for the thermal model: what `held`
+// (the thermal model the target holds, TruncatedCorrector) leaves out, each
+// with its size over the range, and |a_held - a_full| over the session's
+// static positions and over the range. Nothing when the model is inactive.
+void DescribeThermalTruncation(const LoadedCalibration& calibration, const ImuCorrector& held,
+                               std::vector<std::string>* dropped);
+
+// The AutopilotThermal of a calibration (its held model, whether it has a
+// gyroscope) and the options' device ids.
+AutopilotThermal ToAutopilotThermal(const ThermalModel& held, bool has_gyro,
+                                    const ExportOptions& options);
 
 }  // namespace internal
 }  // namespace gravcal

@@ -44,6 +44,7 @@ const std::vector<ConfigSection>& ConfigSections() {
       Lift(SolverSection()),         Lift(GyroSection()),      Lift(AlignmentSection()),
       Lift(HandheldKalmanSection()), Lift(EffectsSection()),   Lift(DiscoverySection()),
       Lift(NoiseSection()),          Lift(SimulatorSection()), Lift(MotionSimulatorSection()),
+      Lift(ThermalSection()),        Lift(ThermalSimulatorSection()),
   };
   return sections;
 }

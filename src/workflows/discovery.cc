@@ -439,6 +439,18 @@ bool DiscoverEffects(const ImuLog& log, const CalibrationOptions& calibration,
   const bool ok =
       DiscoverFromObservations(observations, calibration, baseline_effects, options, result);
   if (!ok) result->message = internal::PrefixSource(log.source, result->message);
+  // Issue 35: higher-order temperature terms and hysteresis, beside the
+  // catalogue.
+  if (ok && log.has_temperature()) {
+    ThermalCalibrationOptions thermal;
+    thermal.detector = calibration.detector;
+    thermal.detector.trend_factor = 0.0;
+    thermal.detector.spread_factor = 0.0;
+    thermal.accel_nominal_scale = calibration.nominal_scale;
+    thermal.gravity = result->gravity;
+    result->thermal = DiscoverThermal(log, thermal);
+    for (const std::string& f : result->thermal.findings) result->verdict += "; " + f;
+  }
   return ok;
 }
 

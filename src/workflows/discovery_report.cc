@@ -398,6 +398,22 @@ std::string DiscoveryToJson(const DiscoveryResult& r) {
                        {"verdict", v.verdict}});
   }
   out["sensors"] = sensors;
+  // Issue 35: temperature beyond the catalogue (thermal_discovery.h).
+  if (r.thermal.tried || !r.thermal.reason.empty()) {
+    const ThermalDiscovery& t = r.thermal;
+    out["thermal"] = {{"tried", t.tried},
+                      {"reason", t.reason},
+                      {"span_degC", Number(t.span)},
+                      {"accel_bias_order", t.accel_bias_order},
+                      {"accel_scale_order", t.accel_scale_order},
+                      {"gyro_bias_order", t.gyro_bias_order},
+                      {"lag", t.lag},
+                      {"lag_time_constant_s", Number(t.lag_time_constant)},
+                      {"lag_time_constant_std_s", Number(t.lag_time_constant_std)},
+                      {"named", t.named},
+                      {"findings", t.findings},
+                      {"steps", t.steps}};
+  }
   out["warnings"] = r.warnings;
   OrderedJson codes = OrderedJson::array();
   for (size_t i = 0; i < r.warnings.size(); ++i) {

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 
+#include "gravcal/core/gravity.h"
 #include "gravcal/methods/handheld_kalman.h"
 #include "gravcal/methods/known_attitude.h"
 #include "gravcal/methods/rate_table.h"
 #include "gravcal/methods/ten_position.h"
+#include "gravcal/methods/thermal_calibration.h"
 #include "gravcal/methods/twelve_position_method.h"
 
 namespace gravcal {
@@ -42,6 +44,36 @@ bool RunHandheldKalman(const Config& config, const Session& session, Calibration
 
 bool RunRateTable(const Config&, const Session& session, Calibration* calibration) {
   return CalibrateRateTable(session, RateTableMethodOptions(), calibration);
+}
+
+// Issue 35: gravity, nominal scales, detector and iterations come from the
+// shared sections; the detector's level checks stay off unless set (a pose
+// held through a warm-up drifts).
+ThermalCalibrationOptions ThermalOptions(const Config& config) {
+  ThermalCalibrationOptions options = config.thermal;
+  options.accel_nominal_scale = config.calibration.nominal_scale;
+  options.gyro_nominal_scale = config.handheld.gyro_nominal_scale;
+  options.max_iterations = config.calibration.refinement.solver.max_iterations;
+  options.detector = config.calibration.detector;
+  const auto set = [&config](const char* key) {
+    return std::find(config.keys_set.begin(), config.keys_set.end(), key) != config.keys_set.end();
+  };
+  if (!set("trend_factor")) options.detector.trend_factor = 0.0;
+  if (!set("spread_factor")) options.detector.spread_factor = 0.0;
+  return options;
+}
+
+bool RunThermal(const Config& config, const Session& session, Calibration* calibration) {
+  ThermalCalibrationOptions options = ThermalOptions(config);
+  std::string source, error;
+  if (!ResolveGravity(config.calibration.gravity, &options.gravity, &source, &error)) {
+    calibration->success = false;
+    calibration->message = error;
+    return false;
+  }
+  const bool ok = CalibrateThermal(session, options, calibration);
+  calibration->gravity_source = source;
+  return ok;
 }
 
 constexpr char kPoseNoiseUse[] =
@@ -96,6 +128,14 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
        MethodSideInput::kSegments,
        nullptr,
        RunRateTable},
+      {"thermal",
+       "bias, scale and misalignment against temperature (issue 35)",
+       {"gravity", "detector", "thermal"},
+       {"nominal_scale", "gyro_nominal_scale", "max_iterations"},
+       MethodSideInput::kNone,
+       [](const Config& c, std::string* e) { return ThermalOptions(c).IsValid(e); },
+       RunThermal,
+       ""},
   };
   return methods;
 }

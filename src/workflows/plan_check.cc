@@ -187,6 +187,23 @@ bool CheckRecording(const Session& session, const Config& config, const PlanRequ
   }
   out.predicted_std_with_proposed = current;
   out.undetermined_with_proposed = Undetermined(names, current);
+  // Issue 35: the temperature span the static poses cover, against the
+  // orders the thermal method would fit.
+  if (log.has_temperature() && config.method == "thermal") {
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Position& p : positions) {
+      lo = std::min(lo, p.temperature);
+      hi = std::max(hi, p.temperature);
+    }
+    out.temperature_span = hi - lo;
+    out.temperature = ThermalSpanMessages(out.temperature_span, config.thermal);
+    if (positions.size() == 1 || out.positions == 1) {
+      out.temperature.push_back(
+          "one static pose: a ramp determines only the bias change along gravity; turn the unit "
+          "through its poses while it warms (configs/thermal_warmup.yaml) for the other axes, "
+          "scale and misalignment");
+    }
+  }
   std::ostringstream s;
   s << positions.size() << " poses; " << out.undetermined.size() << " parameter(s) undetermined, "
     << out.short_of_target.size() << " short of target; " << out.proposed.size()
@@ -228,6 +245,10 @@ std::string CoverageReportText(const CoverageReport& r) {
                   undetermined ? "UNDETERMINED" : (short_of ? "short of target" : "ok"));
     s << line;
   }
+  if (std::isfinite(r.temperature_span)) {
+    s << "temperature span of the poses: " << r.temperature_span << " degC\n";
+  }
+  for (const std::string& t : r.temperature) s << "temperature: " << t << "\n";
   if (!r.undetermined.empty()) {
     s << "undetermined: ";
     for (size_t i = 0; i < r.undetermined.size(); ++i) s << (i ? ", " : "") << r.undetermined[i];

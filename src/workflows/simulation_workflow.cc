@@ -1,12 +1,15 @@
 #include "gravcal/workflows/simulation_workflow.h"
 
+#include <nlohmann/json.hpp>
 #include <utility>
 
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/plan_io.h"
 #include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/simulation/simulated_attitudes.h"
+#include "gravcal/simulation/thermal_simulator.h"
 #include "gravcal/workflows/rate_table_segments.h"
+#include "io/thermal_json.h"
 
 namespace gravcal {
 
@@ -32,6 +35,30 @@ bool SimulateFromConfig(const Config& config, const SimulationRequest& request,
     sim.initial_still_seconds = 0.0;
   }
   files->segments.clear();
+  if (!config.sim_thermal.empty()) {
+    // Issue 35: a session across temperature; truth.json gains "thermal".
+    ThermalSimulatorOptions thermal = config.thermal_simulation;
+    FromString(config.sim_thermal, &thermal.profile);
+    thermal.gravity = sim.gravity;
+    ThermalSimulatedSession session;
+    if (!SimulateThermal(thermal, request.seed, &session, error)) return false;
+    SimulatedSession& out = files->session;
+    out.log = std::move(session.log);
+    out.accel_truth = session.accel;
+    out.gyro_truth = session.gyro;
+    out.gravity = thermal.gravity;
+    out.accel_units_per_si = session.accel_units_per_si;
+    out.gyro_units_per_si = session.gyro_units_per_si;
+    out.seed = request.seed;
+    nlohmann::json truth = nlohmann::json::parse(TruthToJson(out, sim));
+    truth["thermal"] = internal::ThermalJson(session.thermal);
+    truth["thermal_profile"] = config.sim_thermal;
+    truth["thermal_datasheet"] = "Bosch BMI088 (BST-BMI088-DS001) magnitudes unless overridden";
+    files->truth_json = truth.dump(2) + "\n";
+    files->attitudes_csv = FixtureAttitudesToCsv(std::vector<FixtureAttitude>());
+    files->segments_csv.clear();
+    return true;
+  }
   if (!config.sim_motion.empty()) {
     MotionOptions motion = config.motion;
     FromString(config.sim_motion, &motion.profile);

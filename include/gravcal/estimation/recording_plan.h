@@ -12,6 +12,7 @@
 #define GRAVCAL_ESTIMATION_RECORDING_PLAN_H_
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,11 @@ struct CoverageReport {
   std::vector<PlannedPose> proposed;
   Eigen::VectorXd predicted_std_with_proposed;
   std::vector<std::string> undetermined_with_proposed;
+  // Issue 35: what the temperature span allows the thermal method (its
+  // orders, thermal_calibration.h ThermalSpanMessages) and the span itself,
+  // degrees C (NaN: no temperature column, or another method).
+  std::vector<std::string> temperature;
+  double temperature_span = NAN;
   std::string message;
 };
 

@@ -6,8 +6,10 @@
 //   openvins   kalibr_imu_chain.yaml for OpenVINS's "rpng" IMU model (Tw, Ta,
 //              R_IMUtoGYRO, R_IMUtoACC, Tg) and the noise densities
 //   ros        sensor_msgs/Imu covariances (discrete-time, at the log's rate)
-//   px4        CAL_ACC0_*, CAL_GYRO0_* in QGroundControl's .params format
-//   ardupilot  INS_ACCOFFS_*, INS_ACCSCAL_*, INS_GYROFFS_* as a .parm file
+//   px4        CAL_ACC0_*, CAL_GYRO0_* in QGroundControl's .params format, and
+//              with a thermal model TC_A0_* / TC_G0_* (bias polynomials)
+//   ardupilot  INS_ACCOFFS_*, INS_ACCSCAL_*, INS_GYROFFS_* as a .parm file,
+//              and with a thermal model INS_TCAL1_* and the CALTEMPs
 //   c          gravcal_correct.h / gravcal_correct.c, a C99 corrector with the
 //              coefficients embedded
 //
@@ -18,6 +20,7 @@
 #define GRAVCAL_IO_CALIBRATION_EXPORT_H_
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -42,6 +45,13 @@ struct ExportOptions {
   std::string calibration_name;
   // Required when NeedsNoise(target).
   const ImuNoiseModel* noise = nullptr;
+  // px4 with a thermal model: the device ids PX4 matches TC_A0_ID and
+  // TC_G0_ID against (the vehicle's CAL_ACC0_ID, CAL_GYRO0_ID); 0 = not
+  // given, and then the export is refused (it would do nothing).
+  int64_t accel_device_id = 0;
+  int64_t gyro_device_id = 0;
+  // px4, ardupilot: leave the thermal model out (said in the file).
+  bool drop_thermal = false;
   bool IsValid(std::string* error) const;
 };
 

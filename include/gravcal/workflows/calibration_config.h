@@ -18,6 +18,7 @@
 #include "gravcal/methods/gyro_calibration.h"
 #include "gravcal/methods/handheld_kalman.h"
 #include "gravcal/methods/ten_position.h"
+#include "gravcal/methods/thermal_calibration.h"
 #include "gravcal/methods/twelve_position.h"
 
 namespace gravcal {
@@ -42,6 +43,8 @@ struct CalibrationConfig {
   // Issue 14: `gravcal noise` (its scales and detector come from the keys
   // nominal_scale, gyro_nominal_scale and the detector section).
   NoiseOptions noise;
+  // Issue 35: the thermal calibration (method thermal).
+  ThermalCalibrationOptions thermal;
 };
 
 }  // namespace gravcal

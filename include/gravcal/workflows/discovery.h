@@ -70,6 +70,7 @@
 #include "gravcal/core/types.h"
 #include "gravcal/methods/effect_fit.h"
 #include "gravcal/methods/twelve_position.h"
+#include "gravcal/workflows/thermal_discovery.h"
 
 namespace gravcal {
 
@@ -325,6 +326,9 @@ struct DiscoveryResult {
   std::vector<std::string> warnings;
   // The code of each warning (core/types.h), same index.
   std::vector<WarningCode> warning_codes;
+  // Issue 35: temperature beyond the catalogue's linear terms (higher order,
+  // hysteresis), from a raw log with a temperature column (DiscoverEffects).
+  ThermalDiscovery thermal;
   double seconds = 0.0;
   std::string message = "Discover was not called";
 

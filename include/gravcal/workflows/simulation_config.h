@@ -10,6 +10,7 @@
 
 #include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/simulation/simulator.h"
+#include "gravcal/simulation/thermal_simulator.h"
 
 namespace gravcal {
 
@@ -21,6 +22,11 @@ struct SimulationConfig {
   // scheme).
   MotionOptions motion;
   std::string sim_motion;
+  // Issue 35: the thermal simulator (thermal_simulator.h), used when
+  // sim_thermal names a profile (soak_steps, warm_up, cool_down,
+  // warm_up_poses, warm_cool_poses; empty = off).
+  ThermalSimulatorOptions thermal_simulation;
+  std::string sim_thermal;
 };
 
 }  // namespace gravcal

@@ -60,6 +60,9 @@ SectionOf<CalibrationConfig> HandheldKalmanSection();
 SectionOf<CalibrationConfig> PoseNoiseSection();
 SectionOf<CalibrationConfig> NoiseSection();
 SectionOf<CalibrationConfig> EffectsSection();
+// thermal_keys.cc (issue 35):
+SectionOf<CalibrationConfig> ThermalSection();
+SectionOf<SimulationConfig> ThermalSimulatorSection();
 // discovery (effects_keys.cc):
 SectionOf<DiscoveryConfig> DiscoverySection();
 // simulation (simulator_keys.cc):

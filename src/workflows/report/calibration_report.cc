@@ -6,6 +6,7 @@
 #include "gravcal/workflows/report.h"
 #include "util/statistics.h"
 #include "workflows/report/svg_plot.h"
+#include "workflows/report/thermal_report.h"
 #include "workflows/report/warning_advice.h"
 
 namespace gravcal {
@@ -523,6 +524,7 @@ std::string CalibrationReport(const Calibration& c, const ImuLog& log, const std
          "both halves and all around.</p>";
     h << "<h2 id='residuals'>Residuals per pose</h2>" << ResidualPlots(c) << PoseTable(c);
   }
+  h << internal::ThermalReportSection(c, log);
 
   h << "<h2 id='parameters'>Parameters</h2>" << ParameterTable(c);
   const std::string ca = Correlation("Accelerometer parameter correlation", c.accel.covariance,

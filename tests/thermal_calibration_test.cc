@@ -1,0 +1,222 @@
+#include "gravcal/methods/thermal_calibration.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "gravcal/simulation/thermal_simulator.h"
+#include "gravcal/workflows/thermal_discovery.h"
+
+namespace gravcal {
+namespace {
+
+// Options matching the simulator's raw units.
+ThermalCalibrationOptions OptionsFor(const ThermalSimulatedSession& s) {
+  ThermalCalibrationOptions o;
+  o.accel_nominal_scale = 1.0 / s.accel_units_per_si;
+  o.gyro_nominal_scale = 1.0 / s.gyro_units_per_si;
+  return o;
+}
+
+bool Calibrate(const ThermalSimulatorOptions& sim, uint64_t seed,
+               const ThermalCalibrationOptions* given, ThermalSimulatedSession* truth,
+               Calibration* c) {
+  std::string error;
+  if (!SimulateThermal(sim, seed, truth, &error)) {
+    ADD_FAILURE() << error;
+    return false;
+  }
+  Session session;
+  session.log = truth->log;
+  const ThermalCalibrationOptions o = given != nullptr ? *given : OptionsFor(*truth);
+  if (!CalibrateThermal(session, o, c)) {
+    ADD_FAILURE() << c->message;
+    return false;
+  }
+  return true;
+}
+
+// The raw bias at temperature T: b + db(T - T_ref).
+double BiasAt(const AccelModel& a, const GyroModel& g, const ThermalModel& m, ThermalSensor s,
+              int axis, double temperature) {
+  const double base = s == ThermalSensor::kAccel ? a.bias(axis) : g.bias(axis);
+  return base + m.Sensor(s).bias.Value(axis, temperature - m.reference_temperature);
+}
+
+// Issue 35, must show: the bias's reported sigma at five temperatures is
+// honest over seeds (rms z in [0.7, 1.4]), on multi-pose soak sessions.
+TEST(ThermalCalibration, BiasSigmaHonestAtFiveTemperatures) {
+  const ThermalSimulatorOptions sim;  // BMI088 magnitudes, soaks -10..50 degC
+  double sum_z2 = 0.0;
+  int count = 0;
+  // GRAVCAL_THERMAL_SEEDS=N runs N seeds instead of the default four (the
+  // larger count measured for docs/workflows/thermal.md).
+  const char* more = std::getenv("GRAVCAL_THERMAL_SEEDS");
+  const int seeds = more != nullptr ? std::max(1, std::atoi(more)) : 4;
+  for (uint64_t seed = 11; seed < 11 + static_cast<uint64_t>(seeds); ++seed) {
+    ThermalSimulatedSession truth;
+    Calibration c;
+    ASSERT_TRUE(Calibrate(sim, seed, nullptr, &truth, &c));
+    const ThermalModel& m = c.thermal;
+    EXPECT_GE(m.accel.bias.order, 1) << c.message;
+    for (double temperature : {-5.0, 5.0, 20.0, 35.0, 45.0}) {
+      const double x = temperature - m.reference_temperature;
+      for (ThermalSensor s : {ThermalSensor::kAccel, ThermalSensor::kGyro}) {
+        for (int axis = 0; axis < 3; ++axis) {
+          const double estimate = BiasAt(c.accel.model, c.gyro.model, m, s, axis, temperature);
+          const double want = BiasAt(truth.accel, truth.gyro, truth.thermal, s, axis, temperature);
+          const double sigma = m.Sensor(s).bias.Std(axis, x, true);
+          ASSERT_TRUE(std::isfinite(sigma) && sigma > 0.0) << ToString(s) << axis;
+          const double z = (estimate - want) / sigma;
+          sum_z2 += z * z;
+          ++count;
+        }
+      }
+    }
+  }
+  const double rms = std::sqrt(sum_z2 / count);
+  RecordProperty("rms_z", std::to_string(rms));
+  std::printf("bias rms z over %d values (%d seeds): %.3f\n", count, seeds, rms);
+  EXPECT_GE(rms, 0.7);
+  EXPECT_LE(rms, 1.4);
+}
+
+// Must show: a single pose through a warm-up reports the terms it cannot
+// determine as undetermined, never as confident numbers.
+TEST(ThermalCalibration, SinglePoseRampReportsUndeterminedTerms) {
+  ThermalSimulatorOptions sim;
+  sim.profile = ThermalProfile::kWarmUp;
+  sim.ramp_seconds = 1200.0;
+  ThermalSimulatedSession truth;
+  Calibration c;
+  ASSERT_TRUE(Calibrate(sim, 21, nullptr, &truth, &c));
+  const ThermalPolynomial& bias = c.thermal.accel.bias;
+  ASSERT_GE(bias.order, 1) << c.message;
+  for (int k = 1; k <= bias.order; ++k) {
+    EXPECT_FALSE(bias.Determined(0, k)) << k;
+    EXPECT_FALSE(bias.Determined(1, k)) << k;
+  }
+  EXPECT_TRUE(bias.Determined(2, 1));
+  // Scale and misalignment: not determined at any power.
+  const ThermalPolynomial& scale = c.thermal.accel.scale;
+  for (int i = 0; i < scale.coefficients.rows(); ++i) {
+    for (int k = 1; k <= scale.order; ++k) EXPECT_FALSE(scale.Determined(i, k));
+  }
+  EXPECT_TRUE(std::isnan(c.accel.bias_std(0)));
+  EXPECT_TRUE(std::isnan(c.accel.matrix_std(0, 0)));
+  ASSERT_FALSE(c.thermal.notes.empty());
+  EXPECT_NE(c.thermal.notes[0].find("one static pose"), std::string::npos);
+  EXPECT_TRUE(bias.coefficients.allFinite());
+}
+
+// Must show: a span too small for the chosen order is named before the
+// solve, and the solve stays finite (dRonin#1854).
+TEST(ThermalCalibration, SmallSpanIsCaughtAndTheSolveStaysFinite) {
+  ThermalCalibrationOptions given;
+  given.accel_bias_order = 3;
+  const std::vector<std::string> messages = ThermalSpanMessages(6.0, given);
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0],
+            "your session spans 6.0 degC; the cubic accel bias term needs at least 25.0 degC, or "
+            "give order 1");
+  ThermalSimulatorOptions sim;
+  sim.soak_temperatures = {20.0, 23.0, 26.0};
+  ThermalSimulatedSession truth;
+  ASSERT_TRUE(SimulateThermal(sim, 31, &truth, nullptr));
+  given.accel_nominal_scale = 1.0 / truth.accel_units_per_si;
+  given.gyro_nominal_scale = 1.0 / truth.gyro_units_per_si;
+  Calibration c;
+  ASSERT_TRUE(Calibrate(sim, 31, &given, &truth, &c));
+  EXPECT_FALSE(c.warnings.empty());
+  const ThermalPolynomial& bias = c.thermal.accel.bias;
+  ASSERT_EQ(bias.order, 3);
+  EXPECT_TRUE(bias.coefficients.allFinite());
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(bias.Determined(i, 3)) << i;
+  // Over the session's range the fitted change stays near the truth's
+  // (no exploding coefficients): within 1 mg (10.9 counts) of it.
+  for (double temperature : {20.0, 26.0}) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const double estimate =
+          BiasAt(c.accel.model, c.gyro.model, c.thermal, ThermalSensor::kAccel, axis, temperature);
+      const double want =
+          BiasAt(truth.accel, truth.gyro, truth.thermal, ThermalSensor::kAccel, axis, temperature);
+      EXPECT_NEAR(estimate, want, 11.0) << axis << " at " << temperature;
+    }
+  }
+}
+
+// Hysteresis: a warm-up then cool-down through the poses with a 120 s lag
+// gets the lag term, near the truth; without a lag it is not chosen.
+TEST(ThermalCalibration, LagIsFoundWhereHeatingAndCoolingDisagree) {
+  ThermalSimulatorOptions sim;
+  sim.profile = ThermalProfile::kWarmCoolPoses;
+  sim.ramp_seconds = 1200.0;
+  sim.ramp_time_constant = 900.0;
+  sim.hold_seconds = 10.0;
+  sim.lag_time_constant = 60.0;
+  ThermalSimulatedSession truth;
+  Calibration c;
+  ASSERT_TRUE(Calibrate(sim, 41, nullptr, &truth, &c));
+  ASSERT_TRUE(c.thermal.lag_estimated) << c.message;
+  // The model's T - tau dT/dt is the lag's steady response to a ramp; on an
+  // exponential of time constant 900 s it responds as tau 900 / (900 - tau)
+  // = 64 s.
+  EXPECT_NEAR(c.thermal.lag_time_constant, 64.0,
+              std::max(10.0, 4.0 * c.thermal.lag_time_constant_std));
+  // Discovery (issue 35 part 7) names the hysteresis, and the higher order
+  // of the bias (the truth is cubic).
+  const ThermalDiscovery found = DiscoverThermal(truth.log, OptionsFor(truth));
+  ASSERT_TRUE(found.tried) << found.reason;
+  EXPECT_NE(std::find(found.named.begin(), found.named.end(), "thermal_hysteresis"),
+            found.named.end());
+  EXPECT_NE(std::find(found.named.begin(), found.named.end(), "temperature_higher_order"),
+            found.named.end());
+  sim.lag_time_constant = 0.0;
+  ASSERT_TRUE(Calibrate(sim, 42, nullptr, &truth, &c));
+  EXPECT_FALSE(c.thermal.lag_estimated) << c.message;
+}
+
+// The uncontrolled warm-up: turned through the poses while it heats. The
+// bias is right within its sigma at three temperatures of the range.
+TEST(ThermalCalibration, UncontrolledWarmUpWithPoses) {
+  ThermalSimulatorOptions sim;
+  sim.profile = ThermalProfile::kWarmUpPoses;
+  sim.ramp_seconds = 1500.0;
+  sim.ramp_time_constant = 500.0;
+  sim.hold_seconds = 10.0;
+  ThermalSimulatedSession truth;
+  Calibration c;
+  ASSERT_TRUE(Calibrate(sim, 51, nullptr, &truth, &c));
+  const ThermalModel& m = c.thermal;
+  EXPECT_GE(m.accel.bias.order, 1) << c.message;
+  EXPECT_GT(m.max_temperature - m.min_temperature, 30.0);
+  for (double temperature : {20.0, 35.0, 50.0}) {
+    const double x = temperature - m.reference_temperature;
+    for (ThermalSensor s : {ThermalSensor::kAccel, ThermalSensor::kGyro}) {
+      for (int axis = 0; axis < 3; ++axis) {
+        const double z = (BiasAt(c.accel.model, c.gyro.model, m, s, axis, temperature) -
+                          BiasAt(truth.accel, truth.gyro, truth.thermal, s, axis, temperature)) /
+                         m.Sensor(s).bias.Std(axis, x, true);
+        EXPECT_LT(std::abs(z), 4.0) << ToString(s) << axis << " at " << temperature;
+      }
+    }
+  }
+}
+
+TEST(ThermalCalibration, RefusesALogWithoutTemperature) {
+  ThermalSimulatorOptions sim;
+  ThermalSimulatedSession truth;
+  ASSERT_TRUE(SimulateThermal(sim, 1, &truth, nullptr));
+  Session session;
+  session.log = truth.log;
+  session.log.temperature.clear();
+  Calibration c;
+  EXPECT_FALSE(CalibrateThermal(session, OptionsFor(truth), &c));
+  EXPECT_NE(c.message.find("temperature column"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace gravcal
