@@ -12,6 +12,8 @@ import gravcal
 from conftest import config_path, read_json, run_cli, strip_times, without_log_file
 
 distributed = pytest.importorskip("distributed")
+# Debian's tornado 6.2 under distributed 2022.12 warns on every loop start.
+pytestmark = pytest.mark.filterwarnings("ignore:make_current is deprecated:DeprecationWarning")
 
 SHORT = {"sim_hold": 4, "sim_sample_rate": 25, "sim_rotation_time": 2}
 UNITS = 6
