@@ -1,5 +1,8 @@
 #include "estimation/solver_settings.h"
 
+#include <algorithm>
+#include <thread>
+
 #include "util/cancellation.h"
 
 namespace gravcal {
@@ -46,6 +49,12 @@ ceres::Solver::Options SolverOptions(const SolverTolerances& tolerances,
   static CancellationCallback cancellation;
   options.callbacks.push_back(&cancellation);
   return options;
+}
+
+int SingleCalibrationThreads() {
+  if (ThreadCancelFlag() != nullptr) return 1;
+  const unsigned cores = std::thread::hardware_concurrency();
+  return static_cast<int>(std::clamp(cores, 1u, 4u));
 }
 
 }  // namespace internal

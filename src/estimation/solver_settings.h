@@ -16,6 +16,12 @@ namespace internal {
 ceres::Solver::Options SolverOptions(const SolverTolerances& tolerances,
                                      ceres::LinearSolverType linear_solver);
 
+// Threads for the solver of a single calibration: the machine's (at most 4)
+// when called from a thread of its own, 1 inside a batch worker (a thread
+// with a cancellation flag, util/cancellation.h), which already runs one
+// unit per core.
+int SingleCalibrationThreads();
+
 }  // namespace internal
 }  // namespace gravcal
 

@@ -14,6 +14,7 @@
 #include "io/formats/file_format.h"
 #include "io/log_text.h"
 #include "util/error.h"
+#include "util/shortest_double.h"
 
 namespace gravcal {
 
@@ -189,9 +190,8 @@ bool ImuCsvStreamWriter::Flush(std::string* error) {
 bool ImuCsvStreamWriter::Write(const ImuSample& s, std::string* error) {
   char text[32 * 8];
   char* p = text;
-  char* const end = text + sizeof(text);
   auto put = [&](double v, char separator) {
-    p = std::to_chars(p, end, v).ptr;
+    p = internal::WriteShortestDouble(v, p);
     *p++ = separator;
   };
   put(s.t, ',');

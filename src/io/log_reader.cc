@@ -28,6 +28,7 @@
 #include "util/content_hash.h"
 #include "util/error.h"
 #include "util/numbers.h"
+#include "util/shortest_double.h"
 
 namespace gravcal {
 namespace {
@@ -387,9 +388,8 @@ bool ImuLogToCsv(const ImuLog& log, std::string* text, std::string* error) {
     char* p = contents.data();
     std::memcpy(p, header.data(), header.size());
     p += header.size();
-    char* const end = contents.data() + contents.size();
     auto put = [&](double x, char separator) {
-      p = std::to_chars(p, end, x).ptr;
+      p = internal::WriteShortestDouble(x, p);
       *p++ = separator;
     };
     for (size_t i = 0; i < log.size(); ++i) {

@@ -160,8 +160,10 @@ bool SolveHoldingUndetermined(const GyroPrepared& prep, const GyroLayout& layout
                               const std::vector<double>& magnitude_sigmas, double gravity,
                               GyroSolve* solve, std::vector<std::string>* undetermined,
                               std::string* error) {
-  const ceres::Solver::Options solver_options =
-      internal::SolverOptions(options.solver, ceres::DENSE_QR);
+  ceres::Solver::Options solver_options = internal::SolverOptions(options.solver, ceres::DENSE_QR);
+  // The rotations are evaluated in parallel for a single calibration; a
+  // batch runs units in parallel instead, one thread each.
+  solver_options.num_threads = internal::SingleCalibrationThreads();
   const AccelParameterization ap = accel.parameterization;
   solve->x = x0;
   solve->held.assign(layout.size, false);

@@ -90,7 +90,8 @@ struct AccelRotationResidual {
       return false;
     }
     T dq[4];
-    IntegrateGyroTurn(data_.turn, gyro_bias, gyro_matrix, static_cast<const T*>(nullptr), dq);
+    IntegrateGyroTurn(data_.turn, gyro_bias, gyro_matrix, static_cast<const T*>(nullptr), dq,
+                      &cache_);
     WhitenedTurnError<T>(dq, start, end, data_.tangent, data_.sqrt_information, residual);
     return true;
   }
@@ -102,6 +103,7 @@ struct AccelRotationResidual {
 
  private:
   const AccelRotationData data_;
+  mutable GyroTurnCache cache_;
 };
 
 }  // namespace gravcal

@@ -48,6 +48,8 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstring>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -190,6 +192,30 @@ void IntegrateGyroRotation(const GyroRotationData& data, const T* bias, const T*
 // forward for the steps, one backward for S_i and the H_k.
 //
 //   J_r(phi) = I - (1 - cos t) / t^2 [phi]x + (t - sin t) / t^3 [phi]x^2,  t = |phi|
+//
+// Each step costs one sincos(t / 2) (the step's quaternion; 1 - cos t is
+// 2 sin^2(t / 2) from the same value) and, only for steps above 0.01 rad,
+// one sin(t): sin t = 2 sin(t / 2) cos(t / 2) would round differently and
+// change the bits of the fit. The buffers are kept per thread, so a call
+// allocates nothing once a turn that long has been seen.
+inline void SinCos(double x, double* sine, double* cosine) {
+#if defined(__GLIBC__)
+  ::sincos(x, sine, cosine);
+#else
+  *sine = std::sin(x);
+  *cosine = std::cos(x);
+#endif
+}
+
+struct GyroTurnWorkspace {
+  std::vector<Eigen::Vector3d> w;
+  std::vector<Eigen::Vector3d> phi;
+  std::vector<Eigen::Vector4d> steps;
+  // sin(|phi_i| / 2) of each step, from the forward pass.
+  std::vector<double> half_sin;
+  std::vector<Eigen::Matrix3d> h_k;
+};
+
 inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const double* bias,
                                           const double* matrix, const double* g_sensitivity,
                                           double* dq, Eigen::Matrix<double, 4, 21>* jacobian) {
@@ -198,27 +224,57 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
   dq[1] = dq[2] = dq[3] = 0.0;
   const size_t n = data.t.size();
   if (n < 2) return;
+  thread_local GyroTurnWorkspace space;
+  if (space.w.size() < n) {
+    space.w.resize(n);
+    space.phi.resize(n);
+    space.steps.resize(n);
+    space.half_sin.resize(n);
+    space.h_k.resize(n);
+  }
+  std::vector<Eigen::Vector3d>& w = space.w;
+  std::vector<Eigen::Vector3d>& phi = space.phi;
+  std::vector<Eigen::Vector4d>& steps = space.steps;
+  std::vector<double>& half_sin = space.half_sin;
+  std::vector<Eigen::Matrix3d>& h_k = space.h_k;
   const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(matrix);
   // The rates w_k, as IntegrateGyroRotation<double> computes them.
-  std::vector<Eigen::Vector3d> w(n);
   for (size_t k = 0; k < n; ++k) {
     CalibratedGyroRate<double>(data, k, bias, matrix, g_sensitivity, w[k].data());
   }
-  // Forward: the steps phi_i and the turn.
-  std::vector<Eigen::Vector3d> phi(n - 1);
-  std::vector<Eigen::Vector4d> steps(n - 1);
+  // Forward: the steps phi_i and the turn. The step's quaternion is
+  // ceres::AngleAxisToQuaternion's, operation for operation.
   for (size_t i = 0; i + 1 < n; ++i) {
     // Samples i - 1 and i + 2 exist (and are read) only at inner steps.
     const double* before = w[i > 0 ? i - 1 : i].data();
     const double* after = w[i + 2 < n ? i + 2 : i + 1].data();
     GyroStepRotation<double>(data.t, i, before, w[i].data(), w[i + 1].data(), after, phi[i].data());
+    const double* a = phi[i].data();
+    const double theta_squared = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    double* q = steps[i].data();
+    if (theta_squared > 0.0) {
+      const double theta = std::sqrt(theta_squared);
+      double sine, cosine;
+      SinCos(theta * 0.5, &sine, &cosine);
+      const double k = sine / theta;
+      half_sin[i] = sine;
+      q[0] = cosine;
+      q[1] = a[0] * k;
+      q[2] = a[1] * k;
+      q[3] = a[2] * k;
+    } else {
+      half_sin[i] = 0.0;
+      q[0] = 1.0;
+      q[1] = a[0] * 0.5;
+      q[2] = a[1] * 0.5;
+      q[3] = a[2] * 0.5;
+    }
     double next[4];
-    ceres::AngleAxisToQuaternion(phi[i].data(), steps[i].data());
-    ceres::QuaternionProduct(dq, steps[i].data(), next);
+    ceres::QuaternionProduct(dq, q, next);
     for (int j = 0; j < 4; ++j) dq[j] = next[j];
   }
   // Backward: S_i and H_k.
-  std::vector<Eigen::Matrix3d> h_k(n, Eigen::Matrix3d::Zero());
+  for (size_t k = 0; k < n; ++k) h_k[k].setZero();
   double s[4] = {1.0, 0.0, 0.0, 0.0};
   for (size_t i = n - 1; i-- > 0;) {
     const double t2 = phi[i].squaredNorm();
@@ -228,7 +284,7 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
       beta = 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0;
     } else {
       const double t = std::sqrt(t2);
-      const double half = std::sin(0.5 * t);
+      const double half = half_sin[i];
       alpha = 2.0 * half * half / t2;
       beta = (t - std::sin(t)) / (t2 * t);
     }
@@ -274,26 +330,66 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
   }
 }
 
+// The last turn and Jacobian of one rotation, with the parameters they were
+// computed at. A residual is evaluated again at the same parameters (the
+// solver's last step, then the check of the free columns and the
+// covariance): the cache answers those with a comparison. Safe when one
+// rotation is evaluated from several threads.
+class GyroTurnCache {
+ public:
+  // True, with dq and *jacobian set, when key (21 values: b_g, M_g, G) is
+  // the key of the last Store.
+  bool Find(const double* key, double* dq, Eigen::Matrix<double, 4, 21>* jacobian) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!valid_ || std::memcmp(key, key_, sizeof(key_)) != 0) return false;
+    std::memcpy(dq, dq_, sizeof(dq_));
+    *jacobian = jacobian_;
+    return true;
+  }
+  void Store(const double* key, const double* dq, const Eigen::Matrix<double, 4, 21>& jacobian) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::memcpy(key_, key, sizeof(key_));
+    std::memcpy(dq_, dq, sizeof(dq_));
+    jacobian_ = jacobian;
+    valid_ = true;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  bool valid_ = false;
+  double key_[21] = {};
+  double dq_[4] = {};
+  Eigen::Matrix<double, 4, 21> jacobian_;
+};
+
 // IntegrateGyroRotation for Ceres: at plain values, or for automatic
 // differentiation with the derivatives of dq chained from
-// IntegrateGyroRotationJacobian into the N of the residual's parameters.
+// IntegrateGyroRotationJacobian into the N of the residual's parameters
+// (through `cache` when not null).
 inline void IntegrateGyroTurn(const GyroRotationData& data, const double* bias,
-                              const double* matrix, const double* g_sensitivity, double* dq) {
+                              const double* matrix, const double* g_sensitivity, double* dq,
+                              GyroTurnCache* /*cache*/ = nullptr) {
   IntegrateGyroRotation<double>(data, bias, matrix, g_sensitivity, dq);
 }
 template <int N>
 void IntegrateGyroTurn(const GyroRotationData& data, const ceres::Jet<double, N>* bias,
                        const ceres::Jet<double, N>* matrix,
-                       const ceres::Jet<double, N>* g_sensitivity, ceres::Jet<double, N>* dq) {
-  double b[3], m[9], g[9];
-  for (int i = 0; i < 3; ++i) b[i] = bias[i].a;
+                       const ceres::Jet<double, N>* g_sensitivity, ceres::Jet<double, N>* dq,
+                       GyroTurnCache* cache = nullptr) {
+  // key = (b_g, M_g, G), G = 0 when not estimated.
+  double key[21];
+  for (int i = 0; i < 3; ++i) key[i] = bias[i].a;
   for (int i = 0; i < 9; ++i) {
-    m[i] = matrix[i].a;
-    g[i] = g_sensitivity != nullptr ? g_sensitivity[i].a : 0.0;
+    key[3 + i] = matrix[i].a;
+    key[12 + i] = g_sensitivity != nullptr ? g_sensitivity[i].a : 0.0;
   }
   double q[4];
   Eigen::Matrix<double, 4, 21> jacobian;
-  IntegrateGyroRotationJacobian(data, b, m, g_sensitivity != nullptr ? g : nullptr, q, &jacobian);
+  if (cache == nullptr || !cache->Find(key, q, &jacobian)) {
+    IntegrateGyroRotationJacobian(data, key, key + 3, g_sensitivity != nullptr ? key + 12 : nullptr,
+                                  q, &jacobian);
+    if (cache != nullptr) cache->Store(key, q, jacobian);
+  }
   for (int k = 0; k < 4; ++k) {
     dq[k].a = q[k];
     dq[k].v.setZero();
@@ -385,12 +481,13 @@ struct GyroRotationResidual {
       }
     }
     T dq[4];
-    IntegrateGyroTurn(data_, bias, matrix, g_sensitivity, dq);
+    IntegrateGyroTurn(data_, bias, matrix, g_sensitivity, dq, &cache_);
     WhitenedTurnError<T>(dq, start, end, data_.tangent, data_.sqrt_information, residual);
     return true;
   }
 
   const GyroRotationData data_;
+  mutable GyroTurnCache cache_;
 };
 
 }  // namespace gravcal
