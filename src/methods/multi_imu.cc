@@ -441,12 +441,38 @@ void StartIntrinsics(const PlateImuData& imu, double gravity, PlateImuParameters
   }
 }
 
-void StartGyro(const PlateImuData& imu, PlateImuParameters* p) {
+// Starting gyroscope: b_g the mean of the still means, M_g = s I with s
+// the stated scale, or the data's when the two differ by more than 30 %:
+// the largest ratio over the turns of the tilt between the two poses
+// (from the accelerometer) to the integrated raw rate |sum (u - b_g) dt|
+// (a turn about a horizontal axis shows its whole angle as tilt).
+void StartGyro(const PlateImuData& imu, const std::vector<Eigen::Vector3d>& dirs,
+               PlateImuParameters* p, std::vector<std::string>* notes) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const PlatePoseData& pose : imu.poses) mean += pose.gyro_mean;
   mean /= static_cast<double>(std::max<size_t>(1, imu.poses.size()));
   for (int j = 0; j < 3; ++j) p->gyro_bias[j] = mean[j];
-  for (int j = 0; j < 9; ++j) p->gyro_matrix[j] = j % 4 == 0 ? imu.imu->gyro_scale : 0.0;
+  double data_scale = 0.0;
+  for (size_t k = 0; k < imu.turns.size(); ++k) {
+    const GyroRotationData& turn = imu.turns[k];
+    if (turn.t.size() < 2) continue;
+    const double tilt = std::acos(std::clamp(dirs[k].dot(dirs[k + 1]), -1.0, 1.0));
+    if (tilt < 20.0 * M_PI / 180.0) continue;
+    Eigen::Vector3d phi = Eigen::Vector3d::Zero();
+    for (size_t j = 1; j < turn.t.size(); ++j) {
+      phi += 0.5 * (turn.gyro[j] + turn.gyro[j - 1] - 2.0 * mean) * (turn.t[j] - turn.t[j - 1]);
+    }
+    if (phi.norm() > 0.0) data_scale = std::max(data_scale, tilt / phi.norm());
+  }
+  double scale = imu.imu->gyro_scale;
+  if (data_scale > 0.0 && std::abs(std::log(data_scale / scale)) > std::log(1.3)) {
+    std::ostringstream s;
+    s << imu.imu->name << ": the turns show a gyroscope scale of about " << data_scale
+      << " rad/s per raw unit, not the stated " << scale << ": started from the data's";
+    notes->push_back(s.str());
+    scale = data_scale;
+  }
+  for (int j = 0; j < 9; ++j) p->gyro_matrix[j] = j % 4 == 0 ? scale : 0.0;
 }
 
 // Intervals of `log` matched to the reference's by time: the shared pose is
@@ -778,8 +804,8 @@ bool CalibrateImpl(const std::vector<PlateImu>& imus, const MultiImuOptions& opt
   for (size_t i = 0; i < imus.size(); ++i) {
     PlateImuParameters& p = separate[i];
     StartIntrinsics(data[i], options.gravity, &p);
-    if (data[i].has_gyro) StartGyro(data[i], &p);
     for (const PlatePoseData& pose : data[i].poses) own_dirs[i].push_back(p.Direction(pose));
+    if (data[i].has_gyro) StartGyro(data[i], own_dirs[i], &p, &result->warnings);
     for (size_t k = 0; k < data[i].turns.size(); ++k) {
       data[i].turns[k].tangent = TangentBasis(own_dirs[i][k + 1]);
     }
