@@ -90,6 +90,7 @@ bool ReadNoise(const std::string& path, const std::string& text, ImuNoise* noise
 void BindCalibration(py::module_& m);
 void BindBatch(py::module_& m);
 void BindRecordings(py::module_& m);
+void BindMultiImu(py::module_& m);  // multi_imu_bindings.cc (issue 38)
 
 }  // namespace python
 }  // namespace gravcal

@@ -233,6 +233,7 @@ PYBIND11_MODULE(_gravcal, m) {
   BindCalibration(m);
   BindBatch(m);
   BindRecordings(m);
+  BindMultiImu(m);
   // The destination contract (io/files.h), checked before any work:
   // outputs and inputs as (path, name in messages) pairs.
   m.def("check_destinations", [](const std::vector<std::pair<std::string, std::string>>& outputs,

@@ -177,6 +177,22 @@ TEST(MultiImu, UnitThatMovedIsNamedAndItsRotationSplit) {
   EXPECT_FALSE(Named(result, "moved")) << ::testing::PrintToString(result.warnings);
 }
 
+TEST(MultiImu, FlippedAxisIsNamed) {
+  PlateSimulatorOptions o = PlateOptions(3);
+  o.flipped_imu = 1;
+  o.flipped_axis = 1;
+  SimulatedPlate plate;
+  std::string error;
+  ASSERT_TRUE(SimulatePlate(o, 9, &plate, &error)) << error;
+  MultiImuResult result;
+  ASSERT_TRUE(CalibrateMultiImu(PlateImus(plate), Options(plate), &result)) << result.message;
+  EXPECT_TRUE(Named(result, "imu1's y accelerometer axis reads with the wrong sign"))
+      << ::testing::PrintToString(result.warnings);
+  EXPECT_FALSE(Named(result, "imu2's"));
+  // The fit holds: its pose rows at the level of the others'.
+  EXPECT_LT(result.imus[1].accel_residual_rms, 3.0 * result.imus[2].accel_residual_rms);
+}
+
 TEST(MultiImu, DriftingClockIsNamed) {
   PlateSimulatorOptions o = PlateOptions(2);
   o.clock_drift_std = 5e-4;  // 500 ppm: 50 ms over the session

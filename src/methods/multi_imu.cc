@@ -638,6 +638,19 @@ void SinglePose(const std::vector<PlateImuData>& data, const MultiImuOptions& op
   result->message = "multi_imu: one shared pose; offsets along gravity only";
 }
 
+// sum |x_k - R S y_k|^2 at the best rotation R, S the sign change of axis
+// `flip` (-1: none).
+double DirectionMisfit(const std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d> y,
+                       int flip) {
+  if (flip >= 0) {
+    for (Eigen::Vector3d& v : y) v[flip] = -v[flip];
+  }
+  const Eigen::Matrix3d r = Wahba(x, y);
+  double c = 0.0;
+  for (size_t k = 0; k < x.size(); ++k) c += (x[k] - r * y[k]).squaredNorm();
+  return c;
+}
+
 }  // namespace
 
 Eigen::Matrix3d PlateImuParameters::Rotation() const {
@@ -823,6 +836,45 @@ bool CalibrateImpl(const std::vector<PlateImu>& imus, const MultiImuOptions& opt
   for (size_t i = 0; i < imus.size(); ++i) {
     PlateImuParameters& p = joint[i];
     for (int j = 0; j < 3; ++j) p.delta[j] = 0.0;
+    if (static_cast<int>(i) != ref) {
+      // Left-handed axes: one axis read with the wrong sign shows as a
+      // reflection between the two sets of directions; the axis whose sign
+      // change fits best is flipped in U (row j of U negated) and named.
+      // A sign change of one axis equals that of another times a half turn:
+      // the axis is the one that leaves the rotation nearest the stated.
+      int flip = -1;
+      const double none = DirectionMisfit(dirs, own_dirs[i], -1);
+      const Eigen::Matrix3d stated =
+          imus[ref].stated_mounting.transpose() * imus[i].stated_mounting;
+      double nearest = 1e300;
+      for (int j = 0; j < 3; ++j) {
+        std::vector<Eigen::Vector3d> y = own_dirs[i];
+        for (Eigen::Vector3d& v : y) v[j] = -v[j];
+        if (DirectionMisfit(dirs, y, -1) >= 0.25 * none) continue;
+        const Eigen::Matrix3d r = stated.transpose() * Wahba(dirs, y);
+        const double angle = std::acos(std::clamp((r.trace() - 1.0) / 2.0, -1.0, 1.0));
+        if (angle < nearest) {
+          nearest = angle;
+          flip = j;
+        }
+      }
+      if (flip >= 0) {
+        const int row[3][3] = {{0, 1, 2}, {-1, 3, 4}, {-1, -1, 5}};
+        for (int c = 0; c < 3; ++c) {
+          if (row[flip][c] >= 0) p.upper[row[flip][c]] = -p.upper[row[flip][c]];
+        }
+        for (Eigen::Vector3d& d : own_dirs[i]) d[flip] = -d[flip];
+        // The gyroscope's axis reads with the same wrong sign: M_g = s S.
+        const double scale =
+            (std::abs(p.gyro_matrix[0]) + std::abs(p.gyro_matrix[4]) + std::abs(p.gyro_matrix[8])) /
+            3.0;
+        for (int k = 0; k < 9; ++k) p.gyro_matrix[k] = k % 4 == 0 ? scale : 0.0;
+        p.gyro_matrix[4 * flip] = -scale;
+        result->warnings.push_back(imus[i].name + "'s " + std::string(1, "xyz"[flip]) +
+                                   " accelerometer axis reads with the wrong sign (its axes are "
+                                   "left-handed): flipped or miswired axis?");
+      }
+    }
     p.c0 = static_cast<int>(i) == ref ? Eigen::Matrix3d::Identity() : Wahba(dirs, own_dirs[i]);
     for (size_t k = 0; k < data[i].turns.size(); ++k) {
       data[i].turns[k].tangent = TangentBasis(p.c0.transpose() * dirs[k + 1]);
