@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "cli/commands.h"
-#include "gravcal/io/multi_imu_log.h"
 #include "cli/flags.h"
+#include "gravcal/io/multi_imu_log.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
