@@ -522,11 +522,26 @@ PlatePoseData PoseOf(const ImuLog& log, double begin, double end) {
   const StaticInterval s = MakeInterval(log, p.begin, p.end);
   const double n = static_cast<double>(std::max<size_t>(1, s.count()));
   p.accel_mean = s.accel_mean;
-  // Each axis at least its quantisation (a step of 1 raw unit: 1/12).
-  const double accel_var = std::max(s.accel_cov.trace() / 3.0, 1.0 / 12.0);
+  // Each axis at least its quantisation: step^2 / 12, the step the smallest
+  // nonzero change between samples (and a relative floor for data with
+  // none, such as a constant reading).
+  const double accel_step2 = s.accel_resolution.squaredNorm() / 3.0;
+  const double accel_var = std::max(
+      {s.accel_cov.trace() / 3.0, accel_step2 / 12.0, 1e-24 * s.accel_mean.squaredNorm() + 1e-300});
   p.accel_sigma = std::sqrt(accel_var / n);
   p.gyro_mean = s.gyro_mean;
-  p.gyro_sigma = std::sqrt(std::max(s.gyro_cov.trace() / 3.0, 1.0 / 12.0) / n);
+  double gyro_step2 = 0.0;
+  if (log.has_gyro()) {
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    for (size_t k = p.begin + 1; k < std::min(p.end, p.begin + 256); ++k) {
+      for (int j = 0; j < 3; ++j) {
+        const double d = std::abs(log.gyro[k][j] - log.gyro[k - 1][j]);
+        if (d > 0.0 && (step[j] == 0.0 || d < step[j])) step[j] = d;
+      }
+    }
+    gyro_step2 = step.squaredNorm() / 3.0;
+  }
+  p.gyro_sigma = std::sqrt(std::max({s.gyro_cov.trace() / 3.0, gyro_step2 / 12.0, 1e-30}) / n);
   return p;
 }
 
