@@ -95,6 +95,7 @@ void BindVerify(py::module_& m);
 void BindRecorder(py::module_& m);
 // thermal_bindings.cc (issue 35): thermal_model, thermal_evaluate.
 void BindThermal(py::module_& m);
+void BindMultiImu(py::module_& m);  // multi_imu_bindings.cc (issue 38)
 
 }  // namespace python
 }  // namespace gravcal

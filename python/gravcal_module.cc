@@ -236,6 +236,7 @@ PYBIND11_MODULE(_gravcal, m) {
   BindVerify(m);
   BindRecorder(m);
   BindThermal(m);
+  BindMultiImu(m);
   // The destination contract (io/files.h), checked before any work:
   // outputs and inputs as (path, name in messages) pairs.
   m.def("check_destinations", [](const std::vector<std::pair<std::string, std::string>>& outputs,

@@ -177,6 +177,22 @@ TEST(MultiImu, UnitThatMovedIsNamedAndItsRotationSplit) {
   EXPECT_FALSE(Named(result, "moved")) << ::testing::PrintToString(result.warnings);
 }
 
+TEST(MultiImu, FlippedAxisIsNamed) {
+  PlateSimulatorOptions o = PlateOptions(3);
+  o.flipped_imu = 1;
+  o.flipped_axis = 1;
+  SimulatedPlate plate;
+  std::string error;
+  ASSERT_TRUE(SimulatePlate(o, 9, &plate, &error)) << error;
+  MultiImuResult result;
+  ASSERT_TRUE(CalibrateMultiImu(PlateImus(plate), Options(plate), &result)) << result.message;
+  EXPECT_TRUE(Named(result, "imu1's y accelerometer axis reads with the wrong sign"))
+      << ::testing::PrintToString(result.warnings);
+  EXPECT_FALSE(Named(result, "imu2's"));
+  // The fit holds: its pose rows at the level of the others'.
+  EXPECT_LT(result.imus[1].accel_residual_rms, 3.0 * result.imus[2].accel_residual_rms);
+}
+
 TEST(MultiImu, DriftingClockIsNamed) {
   PlateSimulatorOptions o = PlateOptions(2);
   o.clock_drift_std = 5e-4;  // 500 ppm: 50 ms over the session
@@ -253,6 +269,42 @@ TEST(MultiImu, AxisRotationsAreDescribed) {
   EXPECT_EQ(
       DescribeAxisRotation(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix()),
       "rotated 180 degrees about x");
+}
+
+// Hand-like turns (irregular rate, wobbling axis) and a table in SI units
+// read with the shipped config's units (counts): the gyroscope starts from
+// the turns' scale, the accelerometer from the ellipsoid; still honest.
+TEST(MultiImu, HandTurnsAndSiUnitsStayHonest) {
+  for (int mode = 0; mode < 2; ++mode) {
+    std::vector<double> z, zt;
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+      PlateSimulatorOptions o = PlateOptions(3);
+      o.permuted_imu = 2;
+      if (mode == 0) o.imu.rotation_profile = "hand";
+      if (mode == 1) o.imu.raw_counts = false;
+      SimulatedPlate plate;
+      std::string error;
+      ASSERT_TRUE(SimulatePlate(o, seed, &plate, &error)) << error;
+      std::vector<PlateImu> imus = PlateImus(plate);
+      for (PlateImu& i : imus) {
+        i.accel_scale = 9.80665 / 16384.0;
+        i.gyro_scale = M_PI / 180.0 / 131.0;
+      }
+      MultiImuResult result;
+      ASSERT_TRUE(CalibrateMultiImu(imus, Options(plate), &result)) << result.message;
+      EXPECT_TRUE(Named(result, "imu2 looks rotated 90 degrees about z")) << seed;
+      for (int i = 0; i < 3; ++i) ZScores(plate, result, i, &z);
+      for (int i = 1; i < 3; ++i) {
+        zt.push_back((result.imus[i].time_offset - plate.truth[i].clock_offset) /
+                     result.imus[i].time_offset_std);
+      }
+    }
+    std::printf("mode %d: rms z %.3f (%zu), offsets %.3f (%zu)\n", mode, Rms(z), z.size(), Rms(zt),
+                zt.size());
+    EXPECT_GT(Rms(z), 0.7) << mode;
+    EXPECT_LT(Rms(z), 1.4) << mode;
+    EXPECT_LT(Rms(zt), 2.0) << mode;
+  }
 }
 
 }  // namespace

@@ -107,6 +107,11 @@ int RunDemo(const DemoArgs& args) {
 
 int RunCalibrate(const CalibrateArgs& args) {
   if (args.input.empty()) return Fail("calibrate needs --input <raw log>");
+  if (!args.output_dir.empty()) {
+    return Fail(
+        "--output-dir is for a multi-IMU config (one with 'imus:', configs/multi_imu.yaml); "
+        "one IMU writes --output <calib.json>");
+  }
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);

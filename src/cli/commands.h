@@ -50,6 +50,8 @@ struct CalibrateArgs : CommonArgs {
   std::string certificate;
   std::string unit;
   std::string store;
+  // Issue 38: the folder of a multi-IMU config's outputs.
+  std::string output_dir;
 };
 
 // apply and export: the calibration by file (--calibration) or, with
@@ -269,6 +271,11 @@ bool WriteOutput(const std::string& path, const std::string& text, std::string* 
 
 // Prints "gravcal: error: <message>" on stderr and returns `code`.
 int Fail(const std::string& message, int code = 1);
+
+// calibrate with a multi-IMU config (multi_imu_command.cc; issue 38).
+int RunMultiImuCalibrate(const std::string& config_path, const std::string& input,
+                         const std::string& output_dir, const std::string& report,
+                         bool has_overrides);
 
 }  // namespace cli
 }  // namespace gravcal

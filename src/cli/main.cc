@@ -17,6 +17,7 @@
 
 #include "cli/commands.h"
 #include "cli/flags.h"
+#include "gravcal/io/multi_imu_log.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
@@ -104,7 +105,8 @@ const std::vector<CommandInfo>& Commands() {
            FlagField<CalibrateArgs>("limits", &CalibrateArgs::limits),
            FlagField<CalibrateArgs>("certificate", &CalibrateArgs::certificate),
            FlagField<CalibrateArgs>("unit", &CalibrateArgs::unit),
-           FlagField<CalibrateArgs>("store", &CalibrateArgs::store)},
+           FlagField<CalibrateArgs>("store", &CalibrateArgs::store),
+           FlagField<CalibrateArgs>("output_dir", &CalibrateArgs::output_dir)},
           RunCalibrate),
       Command<ApplyArgs>(
           "apply",
@@ -531,6 +533,11 @@ int main(int argc, char** argv) {
   gflags::ParseCommandLineNonHelpFlags(&gflags_argc, &gflags_args, false);
 
   cli::CommonArgs common;
+  if (command == "calibrate" && gravcal::IsMultiImuConfigFile(cli::FlagText("config"))) {
+    return cli::RunMultiImuCalibrate(cli::FlagText("config"), cli::FlagText("input"),
+                                     cli::FlagText("output_dir"), cli::FlagText("report"),
+                                     !split.overrides.empty());
+  }
   if (!cli::LoadCommandConfig(split, &common.config, &error)) return cli::Fail(error);
   common.config_path = cli::FlagText("config");
   common.positional = split.positional;

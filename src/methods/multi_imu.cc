@@ -441,12 +441,38 @@ void StartIntrinsics(const PlateImuData& imu, double gravity, PlateImuParameters
   }
 }
 
-void StartGyro(const PlateImuData& imu, PlateImuParameters* p) {
+// Starting gyroscope: b_g the mean of the still means, M_g = s I with s
+// the stated scale, or the data's when the two differ by more than 30 %:
+// the largest ratio over the turns of the tilt between the two poses
+// (from the accelerometer) to the integrated raw rate |sum (u - b_g) dt|
+// (a turn about a horizontal axis shows its whole angle as tilt).
+void StartGyro(const PlateImuData& imu, const std::vector<Eigen::Vector3d>& dirs,
+               PlateImuParameters* p, std::vector<std::string>* notes) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const PlatePoseData& pose : imu.poses) mean += pose.gyro_mean;
   mean /= static_cast<double>(std::max<size_t>(1, imu.poses.size()));
   for (int j = 0; j < 3; ++j) p->gyro_bias[j] = mean[j];
-  for (int j = 0; j < 9; ++j) p->gyro_matrix[j] = j % 4 == 0 ? imu.imu->gyro_scale : 0.0;
+  double data_scale = 0.0;
+  for (size_t k = 0; k < imu.turns.size(); ++k) {
+    const GyroRotationData& turn = imu.turns[k];
+    if (turn.t.size() < 2) continue;
+    const double tilt = std::acos(std::clamp(dirs[k].dot(dirs[k + 1]), -1.0, 1.0));
+    if (tilt < 20.0 * M_PI / 180.0) continue;
+    Eigen::Vector3d phi = Eigen::Vector3d::Zero();
+    for (size_t j = 1; j < turn.t.size(); ++j) {
+      phi += 0.5 * (turn.gyro[j] + turn.gyro[j - 1] - 2.0 * mean) * (turn.t[j] - turn.t[j - 1]);
+    }
+    if (phi.norm() > 0.0) data_scale = std::max(data_scale, tilt / phi.norm());
+  }
+  double scale = imu.imu->gyro_scale;
+  if (data_scale > 0.0 && std::abs(std::log(data_scale / scale)) > std::log(1.3)) {
+    std::ostringstream s;
+    s << imu.imu->name << ": the turns show a gyroscope scale of about " << data_scale
+      << " rad/s per raw unit, not the stated " << scale << ": started from the data's";
+    notes->push_back(s.str());
+    scale = data_scale;
+  }
+  for (int j = 0; j < 9; ++j) p->gyro_matrix[j] = j % 4 == 0 ? scale : 0.0;
 }
 
 // Intervals of `log` matched to the reference's by time: the shared pose is
@@ -496,11 +522,26 @@ PlatePoseData PoseOf(const ImuLog& log, double begin, double end) {
   const StaticInterval s = MakeInterval(log, p.begin, p.end);
   const double n = static_cast<double>(std::max<size_t>(1, s.count()));
   p.accel_mean = s.accel_mean;
-  // Each axis at least its quantisation (a step of 1 raw unit: 1/12).
-  const double accel_var = std::max(s.accel_cov.trace() / 3.0, 1.0 / 12.0);
+  // Each axis at least its quantisation: step^2 / 12, the step the smallest
+  // nonzero change between samples (and a relative floor for data with
+  // none, such as a constant reading).
+  const double accel_step2 = s.accel_resolution.squaredNorm() / 3.0;
+  const double accel_var = std::max(
+      {s.accel_cov.trace() / 3.0, accel_step2 / 12.0, 1e-24 * s.accel_mean.squaredNorm() + 1e-300});
   p.accel_sigma = std::sqrt(accel_var / n);
   p.gyro_mean = s.gyro_mean;
-  p.gyro_sigma = std::sqrt(std::max(s.gyro_cov.trace() / 3.0, 1.0 / 12.0) / n);
+  double gyro_step2 = 0.0;
+  if (log.has_gyro()) {
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    for (size_t k = p.begin + 1; k < std::min(p.end, p.begin + 256); ++k) {
+      for (int j = 0; j < 3; ++j) {
+        const double d = std::abs(log.gyro[k][j] - log.gyro[k - 1][j]);
+        if (d > 0.0 && (step[j] == 0.0 || d < step[j])) step[j] = d;
+      }
+    }
+    gyro_step2 = step.squaredNorm() / 3.0;
+  }
+  p.gyro_sigma = std::sqrt(std::max({s.gyro_cov.trace() / 3.0, gyro_step2 / 12.0, 1e-30}) / n);
   return p;
 }
 
@@ -610,6 +651,19 @@ void SinglePose(const std::vector<PlateImuData>& data, const MultiImuOptions& op
   result->undetermined.push_back("one pose: no turns, so no time offsets");
   result->success = true;
   result->message = "multi_imu: one shared pose; offsets along gravity only";
+}
+
+// sum |x_k - R S y_k|^2 at the best rotation R, S the sign change of axis
+// `flip` (-1: none).
+double DirectionMisfit(const std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d> y,
+                       int flip) {
+  if (flip >= 0) {
+    for (Eigen::Vector3d& v : y) v[flip] = -v[flip];
+  }
+  const Eigen::Matrix3d r = Wahba(x, y);
+  double c = 0.0;
+  for (size_t k = 0; k < x.size(); ++k) c += (x[k] - r * y[k]).squaredNorm();
+  return c;
 }
 
 }  // namespace
@@ -778,8 +832,8 @@ bool CalibrateImpl(const std::vector<PlateImu>& imus, const MultiImuOptions& opt
   for (size_t i = 0; i < imus.size(); ++i) {
     PlateImuParameters& p = separate[i];
     StartIntrinsics(data[i], options.gravity, &p);
-    if (data[i].has_gyro) StartGyro(data[i], &p);
     for (const PlatePoseData& pose : data[i].poses) own_dirs[i].push_back(p.Direction(pose));
+    if (data[i].has_gyro) StartGyro(data[i], own_dirs[i], &p, &result->warnings);
     for (size_t k = 0; k < data[i].turns.size(); ++k) {
       data[i].turns[k].tangent = TangentBasis(own_dirs[i][k + 1]);
     }
@@ -797,6 +851,45 @@ bool CalibrateImpl(const std::vector<PlateImu>& imus, const MultiImuOptions& opt
   for (size_t i = 0; i < imus.size(); ++i) {
     PlateImuParameters& p = joint[i];
     for (int j = 0; j < 3; ++j) p.delta[j] = 0.0;
+    if (static_cast<int>(i) != ref) {
+      // Left-handed axes: one axis read with the wrong sign shows as a
+      // reflection between the two sets of directions; the axis whose sign
+      // change fits best is flipped in U (row j of U negated) and named.
+      // A sign change of one axis equals that of another times a half turn:
+      // the axis is the one that leaves the rotation nearest the stated.
+      int flip = -1;
+      const double none = DirectionMisfit(dirs, own_dirs[i], -1);
+      const Eigen::Matrix3d stated =
+          imus[ref].stated_mounting.transpose() * imus[i].stated_mounting;
+      double nearest = 1e300;
+      for (int j = 0; j < 3; ++j) {
+        std::vector<Eigen::Vector3d> y = own_dirs[i];
+        for (Eigen::Vector3d& v : y) v[j] = -v[j];
+        if (DirectionMisfit(dirs, y, -1) >= 0.25 * none) continue;
+        const Eigen::Matrix3d r = stated.transpose() * Wahba(dirs, y);
+        const double angle = std::acos(std::clamp((r.trace() - 1.0) / 2.0, -1.0, 1.0));
+        if (angle < nearest) {
+          nearest = angle;
+          flip = j;
+        }
+      }
+      if (flip >= 0) {
+        const int row[3][3] = {{0, 1, 2}, {-1, 3, 4}, {-1, -1, 5}};
+        for (int c = 0; c < 3; ++c) {
+          if (row[flip][c] >= 0) p.upper[row[flip][c]] = -p.upper[row[flip][c]];
+        }
+        for (Eigen::Vector3d& d : own_dirs[i]) d[flip] = -d[flip];
+        // The gyroscope's axis reads with the same wrong sign: M_g = s S.
+        const double scale =
+            (std::abs(p.gyro_matrix[0]) + std::abs(p.gyro_matrix[4]) + std::abs(p.gyro_matrix[8])) /
+            3.0;
+        for (int k = 0; k < 9; ++k) p.gyro_matrix[k] = k % 4 == 0 ? scale : 0.0;
+        p.gyro_matrix[4 * flip] = -scale;
+        result->warnings.push_back(imus[i].name + "'s " + std::string(1, "xyz"[flip]) +
+                                   " accelerometer axis reads with the wrong sign (its axes are "
+                                   "left-handed): flipped or miswired axis?");
+      }
+    }
     p.c0 = static_cast<int>(i) == ref ? Eigen::Matrix3d::Identity() : Wahba(dirs, own_dirs[i]);
     for (size_t k = 0; k < data[i].turns.size(); ++k) {
       data[i].turns[k].tangent = TangentBasis(p.c0.transpose() * dirs[k + 1]);

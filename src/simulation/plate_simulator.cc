@@ -149,6 +149,10 @@ bool SimulatePlateImpl(const PlateSimulatorOptions& options, uint64_t seed, Simu
           internal::DrawVector3([&] { return n01(noise); }) * options.imu.gyro_noise;
       Eigen::Vector3d v = accel_inverse * (f + na) + truth.accel.bias;
       Eigen::Vector3d u = gyro_inverse * (w + ng) + truth.gyro.bias;
+      if (i == options.flipped_imu) {
+        v[options.flipped_axis] = -v[options.flipped_axis];
+        u[options.flipped_axis] = -u[options.flipped_axis];
+      }
       if (options.imu.raw_counts) {
         v = v.array().round();
         u = u.array().round();
@@ -190,9 +194,10 @@ bool PlateSimulatorOptions::IsValid(std::string* error) const {
     return fail("mounting must be 'random' or 'aligned'");
   if (!(mounting_error_deg >= 0.0) || !(max_clock_offset >= 0.0) || !(clock_drift_std >= 0.0))
     return fail("mounting_error_deg, max_clock_offset and clock_drift_std must be >= 0");
-  if (permuted_imu >= imus || slip_imu >= imus)
+  if (permuted_imu >= imus || slip_imu >= imus || flipped_imu >= imus)
     return fail("permuted_imu and slip_imu must name an IMU (or be -1)");
-  if (permuted_axis < 0 || permuted_axis > 2) return fail("permuted_axis must be 0, 1 or 2");
+  if (permuted_axis < 0 || permuted_axis > 2 || flipped_axis < 0 || flipped_axis > 2)
+    return fail("permuted_axis and flipped_axis must be 0, 1 or 2");
   if (oversample < 1 || oversample > 64) return fail("oversample must be 1..64");
   if (slip_imu >= 0 && (slip_turn < 0 || !std::isfinite(slip_deg)))
     return fail("slip_turn must be >= 0 and slip_deg finite");

@@ -54,6 +54,11 @@ struct PlateSimulatorOptions {
   int permuted_imu = -1;
   int permuted_axis = 2;
   double permuted_angle_deg = 90.0;
+  // The unit whose axis flipped_axis (0..2) reads with the wrong sign, in
+  // both its accelerometer and gyroscope (left-handed axes: a wiring or
+  // driver mistake). -1 = none.
+  int flipped_imu = -1;
+  int flipped_axis = 0;
   // The unit that slips by slip_deg during turn slip_turn (the turn into
   // pose slip_turn + 1). -1 = none.
   int slip_imu = -1;
