@@ -69,8 +69,17 @@ TEST(CalibrationStore, HistoryFindsAPlantedDriftAndOnlyIt) {
     // 16 sigma over the 120 days from January 1 to May 1.
     const double truth_per_day = 16.0 * sigma / 120.0;
     EXPECT_NEAR(p.slope_per_day, truth_per_day, 4.0 * p.slope_std);
+    // The trend line through the middle of the values (day 60: 8 sigma).
+    EXPECT_NEAR(p.intercept + 60.0 * p.slope_per_day, 0.05 + 8.0 * sigma, 3.0 * sigma);
+    EXPECT_DOUBLE_EQ(p.days.back(), 120.0);
   }
   EXPECT_EQ(drifting, 1) << h.message;
+  // The report: one plot per parameter, five values with sigma bars in
+  // each, the drifting one titled so.
+  const std::string html = UnitHistoryToHtml(h);
+  EXPECT_EQ(testing_util::Count(html, "class='plot plot-history'"), h.parameters.size());
+  EXPECT_EQ(testing_util::Count(html, "accel.bias_z: drifts"), 1u);
+  EXPECT_EQ(testing_util::Count(html, "days since 2026-01-01T08:00:00Z"), h.parameters.size());
   ASSERT_TRUE(ReadUnitHistory(store, "steady", 0.01, &h, &error)) << error;
   for (const ParameterHistory& p : h.parameters) EXPECT_FALSE(p.drifts) << p.name;
   std::printf("steady: %s\n", h.message.c_str());

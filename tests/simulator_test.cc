@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/estimation/spectral_lines.h"
 #include "sigma_check.h"
 #include "test_util.h"
 
@@ -445,6 +446,49 @@ TEST(Simulator, TruthJsonHoldsTheTruth) {
     EXPECT_TRUE(j["options"].contains(field)) << field;
   }
   EXPECT_EQ(j["options"]["scheme"], "ten");
+}
+
+// The tone option: a line at the stated frequency and amplitude on the
+// stated raw axis of the gyroscope, found by the noise command's line
+// finder in the initial still period; none on another axis; and no other
+// number of the session changes (the tone draws nothing).
+TEST(Simulator, GyroToneIsALineOnOneAxisAndChangesNothingElse) {
+  SimulatorOptions options;
+  options.scheme = "six";
+  options.raw_counts = false;
+  options.initial_still_seconds = 60.0;
+  const SimulatedSession plain = MustSimulate(options, 5);
+  options.gyro_tone = 0.01;
+  options.tone_frequency = 17.0;
+  options.tone_axis = "y";
+  const SimulatedSession toned = MustSimulate(options, 5);
+  ASSERT_EQ(plain.log.size(), toned.log.size());
+  for (size_t i = 0; i < plain.log.size(); i += 97) {
+    EXPECT_EQ(plain.log.accel[i], toned.log.accel[i]) << i;
+    EXPECT_EQ(plain.log.gyro[i](0), toned.log.gyro[i](0)) << i;
+  }
+  const size_t still = static_cast<size_t>(50.0 * options.sample_rate);
+  for (int axis : {0, 1}) {
+    std::vector<double> x(still);
+    for (size_t i = 0; i < still; ++i) x[i] = toned.log.gyro[i](axis) / toned.gyro_units_per_si;
+    const std::vector<SpectralLine> lines = FindSpectralLines(x, 0, still, options.sample_rate);
+    bool found = false;
+    for (const SpectralLine& l : lines) {
+      if (std::fabs(l.frequency_hz - 17.0) > 0.3) continue;
+      found = true;
+      EXPECT_NEAR(l.amplitude, 0.01, 0.002) << axis;
+    }
+    EXPECT_EQ(found, axis == 1) << axis;
+  }
+  options.tone_axis = "w";
+  SimulatedSession session;
+  std::string error;
+  EXPECT_FALSE(Simulate(options, 5, &session, &error));
+  EXPECT_NE(error.find("tone_axis"), std::string::npos) << error;
+  options.tone_axis = "x";
+  options.tone_frequency = 60.0;
+  EXPECT_FALSE(Simulate(options, 5, &session, &error));
+  EXPECT_NE(error.find("tone_frequency"), std::string::npos) << error;
 }
 
 }  // namespace

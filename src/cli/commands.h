@@ -182,6 +182,8 @@ struct VerifyArgs : CommonArgs {
 struct HistoryArgs : CommonArgs {
   std::string store;
   std::string output;
+  // The HTML page: each parameter against the date with its sigma bars.
+  std::string report;
   double level = 0.01;
 };
 

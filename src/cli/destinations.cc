@@ -131,7 +131,7 @@ bool CheckCommandDestinations(const VerifyArgs& args, std::string* error) {
 }
 
 bool CheckCommandDestinations(const HistoryArgs& args, std::string* error) {
-  return Check(args, {{args.output, "--output", true}}, {}, error);
+  return Check(args, {{args.output, "--output", true}, {args.report, "--report"}}, {}, error);
 }
 
 bool WriteOutput(const std::string& path, const std::string& text, std::string* error) {

@@ -43,7 +43,7 @@
     "CSV of the constant-rate segments, t_begin, t_end, rates (methods that need a rate "        \
     "table)")                                                                                    \
   X(string, history, "", "calibrate: write the estimates' time history (CSV) here")              \
-  X(string, report, "", "HTML report to write (calibrate, batch, noise, discover)")              \
+  X(string, report, "", "HTML report to write (calibrate, batch, noise, discover, history)")     \
   X(string, kalibr, "", "noise: also write Kalibr's imu.yaml (continuous-time densities) here")  \
   X(string, handheld, "", "noise: also write the handheld filter's hk_* noise keys (YAML) here") \
   X(string, topics, "",                                                                          \

@@ -24,6 +24,10 @@ int RunHistory(const HistoryArgs& args) {
   if (!args.output.empty() && !WriteOutput(args.output, UnitHistoryToJson(history), &error)) {
     return Fail(error);
   }
+  if (!args.report.empty() &&
+      !WriteFileAtomically(args.report, UnitHistoryToHtml(history), &error)) {
+    return Fail(error);
+  }
   if (args.output == "-") return 0;
   std::printf("unit %s: %zu calibrations\n", history.unit.c_str(), history.calibrations.size());
   for (size_t k = 0; k < history.calibrations.size(); ++k) {

@@ -33,6 +33,12 @@ SensorNoise::SensorNoise(const SimulatorOptions& o, double accel_units_per_si,
       gyro_noise_(o.gyro_noise * gyro_units_per_si),
       accel_walk_(o.accel_bias_random_walk * std::sqrt(1.0 / o.sample_rate) * accel_units_per_si),
       gyro_walk_(o.gyro_bias_random_walk * std::sqrt(1.0 / o.sample_rate) * gyro_units_per_si),
+      accel_tone_(o.accel_tone * accel_units_per_si),
+      gyro_tone_(o.gyro_tone * gyro_units_per_si),
+      tone_step_(2.0 * M_PI * o.tone_frequency / o.sample_rate),
+      tone_axis_(o.tone_axis == "y"   ? 1
+                 : o.tone_axis == "z" ? 2
+                                      : 0),
       accel_instability_(o.accel_bias_instability, o.bias_instability_tau_low,
                          o.bias_instability_tau_high, o.sample_rate, seed, 1),
       gyro_instability_(o.gyro_bias_instability, o.bias_instability_tau_low,

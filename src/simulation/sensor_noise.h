@@ -7,6 +7,8 @@
 //                      noise_process.h) with only its bias instability
 //                      term, from a stream of its own, so that switching it
 //                      on changes no other number of a session;
+//   tones              amplitude sin(2 pi f k / rate) on one raw axis (no
+//                      random draw);
 // then quantisation to counts when the output is in counts. The white and
 // random-walk draws come from the caller's stream (`normal3`, three N(0, 1)),
 // in the order the simulators have always drawn them.
@@ -14,6 +16,7 @@
 #define GRAVCAL_SRC_SIMULATION_SENSOR_NOISE_H_
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -64,6 +67,12 @@ class SensorNoise {
     }
     if (accel_instability_.on()) *v += accel_units_per_si_ * accel_instability_.Next();
     if (gyro_instability_.on()) *u += gyro_units_per_si_ * gyro_instability_.Next();
+    if (accel_tone_ > 0.0 || gyro_tone_ > 0.0) {
+      const double wave = std::sin(tone_step_ * static_cast<double>(sample_));
+      (*v)(tone_axis_) += accel_tone_ * wave;
+      (*u)(tone_axis_) += gyro_tone_ * wave;
+    }
+    ++sample_;
     if (raw_counts_) {
       *v = v->array().round();
       *u = u->array().round();
@@ -78,6 +87,12 @@ class SensorNoise {
   double gyro_noise_;
   double accel_walk_;
   double gyro_walk_;
+  // Raw units, the phase step per sample (rad) and the axis.
+  double accel_tone_;
+  double gyro_tone_;
+  double tone_step_;
+  int tone_axis_;
+  uint64_t sample_ = 0;
   BiasInstability accel_instability_;
   BiasInstability gyro_instability_;
   Eigen::Vector3d accel_drift_ = Eigen::Vector3d::Zero();

@@ -127,6 +127,17 @@ bool CheckNoise(const SimulatorOptions& o, const FieldCheck& c) {
     return c.Fail("bias_instability_tau_high", o.bias_instability_tau_high,
                   "must be finite and above bias_instability_tau_low");
   }
+  if (!c.NonNegative("accel_tone", o.accel_tone) || !c.NonNegative("gyro_tone", o.gyro_tone)) {
+    return false;
+  }
+  if ((o.accel_tone > 0.0 || o.gyro_tone > 0.0) &&
+      !(o.tone_frequency > 0.0 && o.tone_frequency < 0.5 * o.sample_rate)) {
+    return c.Fail("tone_frequency", o.tone_frequency,
+                  "must be positive and below half the sample rate");
+  }
+  if (o.tone_axis != "x" && o.tone_axis != "y" && o.tone_axis != "z") {
+    return c.Fail("tone_axis", NAN, "must be x, y or z (not '" + o.tone_axis + "')");
+  }
   return true;
 }
 

@@ -268,6 +268,7 @@ bool ReadUnitHistory(const std::string& store, const std::string& unit, double l
       h.stds.push_back(params[k].determined[i] ? std::sqrt(params[k].covariance(i, i)) : NAN);
       t.push_back(days[k]);
     }
+    h.days = t;
     // Weighted mean, chi2 about it, and the weighted line.
     double sw = 0, swx = 0, swy = 0, swxx = 0, swxy = 0;
     int used = 0;
@@ -283,6 +284,7 @@ bool ReadUnitHistory(const std::string& store, const std::string& unit, double l
     }
     if (used >= 2) {
       const double mean = swy / sw;
+      h.mean = mean;
       h.chi2 = 0.0;
       for (size_t k = 0; k < h.values.size(); ++k) {
         if (h.stds[k] > 0.0) h.chi2 += std::pow((h.values[k] - mean) / h.stds[k], 2);
@@ -295,6 +297,7 @@ bool ReadUnitHistory(const std::string& store, const std::string& unit, double l
       if (det > 0.0) {
         h.slope_per_day = (sw * swxy - swx * swy) / det;
         h.slope_std = std::sqrt(sw / det);
+        h.intercept = (swy - h.slope_per_day * swx) / sw;
       }
     }
     history->parameters.push_back(h);
@@ -322,6 +325,7 @@ std::string UnitHistoryToJson(const UnitHistory& h) {
     params.push_back({{"name", p.name},
                       {"values", JsonArray<Json>(p.values)},
                       {"std", JsonArray<Json>(p.stds)},
+                      {"days", JsonArray<Json>(p.days)},
                       {"slope_per_day", JsonNumber<Json>(p.slope_per_day)},
                       {"slope_std", JsonNumber<Json>(p.slope_std)},
                       {"chi2", JsonNumber<Json>(p.chi2)},

@@ -96,6 +96,15 @@ struct SimulatorOptions {
   double gyro_bias_instability = 0.0;
   double bias_instability_tau_low = 1.0;
   double bias_instability_tau_high = 100.0;
+  // A tone (a sinusoid, as real still logs show: a 17 Hz line on one gyro
+  // axis from a fan, a motor or the sensor's own drive) on one raw axis
+  // ("x", "y" or "z") of each sensor: amplitude in m/s^2 (accelerometer) and
+  // rad/s (gyroscope) at tone_frequency Hz (below half the sample rate).
+  // Deterministic (no random draw), so it changes no other number. 0 = off.
+  double accel_tone = 0.0;
+  double gyro_tone = 0.0;
+  double tone_frequency = 17.0;
+  std::string tone_axis = "x";
 
   // Placement error of each pose, degrees (standard deviation per axis).
   double placement_error_deg = 2.0;

@@ -55,6 +55,12 @@ bool ClosestCalibration(const std::string& store, const std::string& unit, const
 struct ParameterHistory {
   std::string name;
   std::vector<double> values, stds;
+  // When each value was made: days since the unit's first calibration.
+  std::vector<double> days;
+  // The weighted mean, and the weighted line's value at day 0 (the line
+  // is intercept + slope_per_day * day).
+  double mean = NAN;
+  double intercept = NAN;
   // Weighted least-squares line value = a + slope * (t - t0), per day.
   double slope_per_day = NAN;
   double slope_std = NAN;
@@ -80,6 +86,12 @@ bool ReadUnitHistory(const std::string& store, const std::string& unit, double l
                      UnitHistory* history, std::string* error);
 
 std::string UnitHistoryToJson(const UnitHistory& history);
+
+// The history as a self-contained HTML page (gravcal history --report):
+// each parameter against the date, each value with its 1-sigma bar (and a
+// fainter 2-sigma one), the weighted mean and the weighted trend line, and
+// the drift test's verdict.
+std::string UnitHistoryToHtml(const UnitHistory& history);
 
 }  // namespace gravcal
 
