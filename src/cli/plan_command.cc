@@ -62,7 +62,7 @@ int RunCheck(const CommandArgs& args) {
 }
 
 JsonSections CalibrationCheckSections(const CommandArgs& args, const Session& session) {
-  if (!args.check || args.config.method != "twelve_position") return {};
+  if (!args.check || args.config.method != Method::kTwelvePosition) return {};
   // The session's noise model (read with the log), its poses (detected once).
   PlanRequest request = args.plan_request;
   request.noise_model = session.noise_model();

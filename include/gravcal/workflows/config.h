@@ -28,8 +28,8 @@
 namespace gravcal {
 
 struct Config {
-  // Calibration method, a name in the method registry (method_registry.h).
-  std::string method = "twelve_position";
+  // Calibration method (its registry entry: method_registry.h).
+  Method method = Method::kTwelvePosition;
   LogReaderOptions input;
   CalibrationOptions calibration;
   SimulatorOptions simulation;

@@ -9,11 +9,26 @@
 namespace gravcal {
 namespace internal {
 
+namespace {
+
+bool ReadMethod(const YAML::Node& n, Config* c, std::string* e) {
+  std::string name;
+  if (!ReadString(n, &name, e)) return false;
+  if (!FromString(name, &c->method)) {
+    *e = "unknown method '" + name + "' (available: " + CalibrationMethodNames() + ")";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 ConfigSection GeneralSection() {
   return {"general",
           ConfigSectionUse::kAllMethods,
           {
-              GRAVCAL_STRING("method", method, "calibration method: " + CalibrationMethodsHelp()),
+              GRAVCAL_KEY("method", "calibration method: " + CalibrationMethodsHelp(),
+                          ReadMethod(n, c, e), std::string(ToString(c.method))),
               GRAVCAL_BOOL("output_covariance", output_covariance,
                            "write accel.covariance into the calibration JSON"),
           }};
