@@ -64,7 +64,7 @@ int RunCheck(const PlanArgs& args) {
 }
 
 JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session) {
-  if (!args.check || args.config.method != "twelve_position") return {};
+  if (!args.check || args.config.method != Method::kTwelvePosition) return {};
   // The session's noise model (read with the log), its poses (detected once).
   PlanRequest request;
   request.noise_model = session.noise_model();
