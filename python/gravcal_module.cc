@@ -197,7 +197,8 @@ PYBIND11_MODULE(_gravcal, m) {
              Check(IsConfigKey(key), "unknown config key '" + key + "'");
              return ConfigValueText(c, key);
            })
-      .def_property_readonly("method", [](const Config& c) { return c.method; })
+      .def_property_readonly("method",
+                             [](const Config& c) { return std::string(ToString(c.method)); })
       .def("text", &ConfigText, "Every key with its value, one 'key: value' line each.");
   m.def("config_keys", []() {
     std::vector<std::pair<std::string, std::string>> keys;

@@ -35,7 +35,7 @@ TEST(CalibrationConfig, DragsInNoSimulatorAndNoDiscovery) {
 TEST(CalibrationConfig, DefaultsAreValidOptions) {
   const CalibrationConfig c;
   std::string error;
-  EXPECT_EQ(c.method, "twelve_position");
+  EXPECT_EQ(c.method, Method::kTwelvePosition);
   EXPECT_TRUE(c.input.IsValid(&error)) << error;
   EXPECT_TRUE(c.calibration.IsValid(&error)) << error;
   EXPECT_TRUE(c.gyro.IsValid(&error)) << error;

@@ -245,17 +245,16 @@ TEST(Config, ASwitchSetLaterOverridesThePathsKeys) {
 TEST(Config, InvalidValuesAreCaughtByValidation) {
   Config config;
   std::string error;
-  config.method = "thirteen_position";
-  EXPECT_FALSE(config.IsValid(&error));
+  EXPECT_FALSE(SetConfigValue("method", "thirteen_position", &config, &error));
   EXPECT_NE(error.find("method"), std::string::npos) << error;
+  EXPECT_EQ(config.method, Method::kTwelvePosition);
 }
 
 TEST(Config, UnknownMethodListsEveryRegistryMethod) {
   Config config;
   std::string error;
-  ASSERT_TRUE(SetConfigValue("method", "nine_position", &config, &error)) << error;
-  EXPECT_FALSE(config.IsValid(&error));
-  EXPECT_NE(error.find("unknown method 'nine_position'"), std::string::npos) << error;
+  EXPECT_FALSE(SetConfigValue("method", "nine_position", &config, &error));
+  EXPECT_NE(error.find("key 'method': unknown method 'nine_position'"), std::string::npos) << error;
   for (const CalibrationMethod& m : CalibrationMethods()) {
     EXPECT_NE(error.find(m.name), std::string::npos) << error;
   }
@@ -306,7 +305,7 @@ TEST(Config, DefaultsCommandKeysAndUsedKeysAreNotErrors) {
   for (const CalibrationMethod& m : CalibrationMethods()) {
     // Defaults of keys the method ignores never count: only keys set do.
     Config config;
-    config.method = m.name;
+    config.method = m.id;
     std::string error;
     EXPECT_TRUE(config.IsValid(&error)) << m.name << ": " << error;
     // Simulator and discovery keys belong to commands, not to methods.
@@ -332,7 +331,8 @@ TEST(Config, EveryRegistryMethodIsReachableByMethodKey) {
     Config config;
     std::string error;
     ASSERT_TRUE(LoadConfigText("method: " + m.name + "\n", "c.yaml", &config, &error)) << error;
-    EXPECT_EQ(config.method, m.name);
+    EXPECT_EQ(config.method, m.id);
+    EXPECT_EQ(m.name, ToString(m.id));
     EXPECT_EQ(FindCalibrationMethod(config.method), &m);
     EXPECT_TRUE(config.IsValid(&error)) << m.name << ": " << error;
     EXPECT_NE(help.find(m.name + " ("), std::string::npos) << help;

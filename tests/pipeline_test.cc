@@ -151,21 +151,20 @@ TEST(Pipeline, LogAndProvenanceFromOneRead) {
 
 TEST(Pipeline, InvalidConfigFailsWithTheKey) {
   Config config;
-  config.method = "nine_position";
+  config.calibration.nominal_scale = -1.0;
   PipelineInput input;
   Calibration c;
   EXPECT_FALSE(RunCalibration(config, input, &c));
-  EXPECT_NE(c.message.find("method"), std::string::npos) << c.message;
+  EXPECT_NE(c.message.find("nominal_scale"), std::string::npos) << c.message;
   EXPECT_FALSE(c.success);
 }
 
 TEST(Pipeline, UnknownMethodFailsNamingIt) {
   Config config;
-  config.method = "thirteen_position";
-  PipelineInput input;
-  Calibration c;
-  EXPECT_FALSE(RunCalibration(config, input, &c));
-  EXPECT_NE(c.message.find("unknown method 'thirteen_position'"), std::string::npos) << c.message;
+  std::string error;
+  EXPECT_FALSE(SetConfigValue("method", "thirteen_position", &config, &error));
+  EXPECT_NE(error.find("unknown method 'thirteen_position'"), std::string::npos) << error;
+  EXPECT_EQ(config.method, Method::kTwelvePosition);
 }
 
 TEST(Pipeline, KeyTheMethodDoesNotUseFailsBeforeRunning) {
@@ -187,7 +186,7 @@ TEST(Pipeline, KeyTheMethodDoesNotUseFailsBeforeRunning) {
 TEST(Pipeline, EveryRegistryMethodIsDispatched) {
   for (const CalibrationMethod& m : CalibrationMethods()) {
     Config config;
-    config.method = m.name;
+    config.method = m.id;
     PipelineInput input;
     Calibration c;
     EXPECT_FALSE(RunCalibration(config, input, &c)) << m.name;

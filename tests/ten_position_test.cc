@@ -120,7 +120,7 @@ TEST(TenPosition, RealMpu6050TenPoses) {
       << error;
   Calibration twelve;
   ASSERT_TRUE(RunCalibration(config, input, &twelve)) << twelve.message;
-  config.method = "ten_position";
+  config.method = Method::kTenPosition;
   config.ten_position.gyro_nominal_scale = M_PI / 180.0 / 131.0;
   // The twelve-position config's nominal_scale: ten_position does not read it
   // (it scales by the data), so it would be an unused-key error.
@@ -156,7 +156,7 @@ TEST(TenPosition, RejectsTooFewPositions) {
 
 TEST(TenPosition, InvalidOptionsNameTheKey) {
   Config config;
-  config.method = "ten_position";
+  config.method = Method::kTenPosition;
   config.ten_position.gyro_nominal_scale = -1.0;
   std::string error;
   EXPECT_FALSE(config.IsValid(&error));

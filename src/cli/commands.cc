@@ -119,7 +119,7 @@ int RunCalibrate(const CalibrateArgs& args) {
   // --history only for a method that keeps one, said before the work.
   const CalibrationMethod* method = FindCalibrationMethod(args.config.method);
   if (!args.history.empty() && method != nullptr && !method->keeps_history) {
-    return Fail("--history: method '" + args.config.method +
+    return Fail("--history: method '" + method->name +
                 "' keeps no estimate history (handheld_kalman does)");
   }
   // The log is read once: its provenance hash comes from the same bytes.

@@ -66,7 +66,8 @@ int RunCheck(const PlanArgs& args) {
 JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session) {
   // Issue 35: the thermal method's check adds what the temperature span
   // allows (CoverageReport::temperature).
-  if (!args.check || (args.config.method != "twelve_position" && args.config.method != "thermal")) {
+  if (!args.check ||
+      (args.config.method != Method::kTwelvePosition && args.config.method != Method::kThermal)) {
     return {};
   }
   // The session's noise model (read with the log), its poses (detected once).

@@ -70,6 +70,18 @@ const EnumName<LogFormat> kLogFormats[] = {
     {LogFormat::kWhitespace, "whitespace"},
 };
 
+const EnumName<Method> kMethods[] = {
+    {Method::kTwelvePosition, "twelve_position"}, {Method::kTenPosition, "ten_position"},
+    {Method::kKnownAttitude, "known_attitude"},   {Method::kHandheldKalman, "handheld_kalman"},
+    {Method::kRateTable, "rate_table"},           {Method::kThermal, "thermal"},
+};
+
+const EnumName<PoseSet> kPoseSets[] = {
+    {PoseSet::kFaces, "faces"},
+    {PoseSet::kFacesAnd45, "faces+45"},
+    {PoseSet::kFree, "free"},
+};
+
 const EnumName<MotionProfile> kMotionProfiles[] = {
     {MotionProfile::kHandheld, "handheld"},
     {MotionProfile::kTurntable, "turntable"},
@@ -146,6 +158,8 @@ GRAVCAL_ENUM_STRINGS(CoarseMethod, kCoarseMethods)
 GRAVCAL_ENUM_STRINGS(RefinementSolver, kRefinementSolvers)
 GRAVCAL_ENUM_STRINGS(NewtonResidual, kNewtonResiduals)
 GRAVCAL_ENUM_STRINGS(LogFormat, kLogFormats)
+GRAVCAL_ENUM_STRINGS(Method, kMethods)
+GRAVCAL_ENUM_STRINGS(PoseSet, kPoseSets)
 GRAVCAL_ENUM_STRINGS(MotionProfile, kMotionProfiles)
 GRAVCAL_ENUM_STRINGS(BatchStatus, kBatchStatuses)
 GRAVCAL_ENUM_STRINGS(Effect, kEffects)

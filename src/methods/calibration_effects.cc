@@ -180,22 +180,16 @@ bool FitCalibrationEffects(const ImuLog& log, const std::vector<StaticInterval>&
     }
   }
   if (!has_temperature) start.reference_temperature = 0.0;
+  // The model and solver sections hold for the fit with effects as for the
+  // one without: the refinement's shared settings (fit_settings.h: the
+  // parameterization, the robust loss, the covariance, the pose variance with
+  // its prior) pass whole, and the iteration limit. The tolerances stay the
+  // effect fit's own. (The Newton solver has no effect fit: the config
+  // refuses solver newton with effects.)
   EffectFitOptions fit_options;
-  fit_options.parameterization = options.refinement.parameterization;
+  static_cast<AccelFitSettings&>(fit_options) = options.refinement;
   fit_options.effects = effects;
-  // The solver section holds for the fit with effects as for the one
-  // without: the robust loss and its scale, the iteration limit, and whether
-  // a covariance is computed. (The Newton solver has no effect fit: the
-  // config refuses solver newton with effects.)
-  fit_options.loss = options.refinement.loss;
-  fit_options.loss_scale = options.refinement.loss_scale;
   fit_options.solver.max_iterations = options.refinement.solver.max_iterations;
-  fit_options.compute_covariance = options.refinement.compute_covariance;
-  // The refinement's pose variance (pose_variance: true) carries over: the
-  // magnitudes' extra variance by REML, with the same prior.
-  fit_options.magnitude_variance_component = options.refinement.estimate_pose_variance;
-  fit_options.magnitude_variance_prior = options.refinement.pose_disturbance_prior;
-  fit_options.magnitude_variance_prior_dof = options.refinement.pose_disturbance_prior_dof;
   fit_options.use_between_pose_rotations = turns > 0;
   fit_options.rotation_gyro_bias_variance =
       GyroBiasWanderVariance(options.pose_noise.model, observations);

@@ -144,11 +144,11 @@ double SensorFitSummary::Std(const std::string& name) const {
 }
 
 bool EffectFitOptions::IsValid(std::string* error) const {
-  if (!(magnitude_variance_prior >= 0.0) || !(magnitude_variance_prior_dof >= 0.0) ||
+  if (!(pose_disturbance_prior >= 0.0) || !(pose_disturbance_prior_dof >= 0.0) ||
       !(magnitude_extra_variance >= 0.0) || !std::isfinite(magnitude_extra_variance) ||
       !(rotation_gyro_bias_variance >= 0.0) || !std::isfinite(rotation_gyro_bias_variance)) {
     *error =
-        "effect fit: magnitude_extra_variance, magnitude_variance_prior and its dof and "
+        "effect fit: magnitude_extra_variance, pose_disturbance_prior and its dof and "
         "rotation_gyro_bias_variance must be >= 0";
     return false;
   }
@@ -214,7 +214,7 @@ bool FitEffects(const std::vector<StaticObservation>& observations, const AccelM
                             options.magnitude_extra_variance, &jacobian, &residuals, result)) {
       return false;
     }
-    if (options.magnitude_variance_component && options.compute_covariance &&
+    if (options.estimate_pose_variance && options.compute_covariance &&
         !internal::AbsorbMagnitudeVariance(observations, initial, initial_parameters, gravity,
                                            options, &jacobian, &residuals, result)) {
       return false;

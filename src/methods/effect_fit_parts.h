@@ -63,7 +63,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
               Eigen::MatrixXd* whitened_jacobian, Eigen::VectorXd* whitened_residuals,
               EffectFitResult* result);
 
-// magnitude_variance_component: the REML of one extra variance of the
+// estimate_pose_variance: the REML of one extra variance of the
 // magnitudes from the fit in *result (its whitened Jacobian and
 // residuals), and, when it is positive, the refit with it and the Student
 // inflation of the covariance. False (with result->message) when the refit

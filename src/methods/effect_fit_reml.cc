@@ -1,4 +1,4 @@
-// The REML of the effect fit (effect_fit.h, magnitude_variance_component):
+// The REML of the effect fit (effect_fit.h, estimate_pose_variance):
 // one extra variance common to the position magnitudes, what the pose means
 // share beyond their samples' noise, and the refit that absorbs it.
 #include <Eigen/Core>
@@ -15,7 +15,7 @@ namespace gravcal {
 namespace internal {
 namespace {
 
-// REML of one extra variance of the magnitudes (magnitude_variance_component)
+// REML of one extra variance of the magnitudes (estimate_pose_variance)
 // from a finished fit and its whitened Jacobian (magnitude rows first). The
 // magnitude rows enter unwhitened (m/s^2, sigma_k), the trend rows whitened
 // (sigma 1): s^2, of the order of sigma_k^2 (1e-7 (m/s^2)^2), is then
@@ -34,15 +34,15 @@ bool MagnitudeVariance(const EffectFitResult& fit, const Eigen::MatrixXd& whiten
                                         .rank
                                   : 0;
   const int magnitude_dof = n - (fit.accel_fit.rank - trend_rank);
-  if (magnitude_dof < 1 && !(options.magnitude_variance_prior_dof > 0.0)) {
+  if (magnitude_dof < 1 && !(options.pose_disturbance_prior_dof > 0.0)) {
     component->message =
         "the position magnitudes leave no residual degree of freedom: their extra variance is "
         "not estimated (give a prior)";
     return false;
   }
   VariancePrior prior;
-  prior.variance = options.magnitude_variance_prior * options.magnitude_variance_prior;
-  prior.dof = options.magnitude_variance_prior_dof;
+  prior.variance = options.pose_disturbance_prior * options.pose_disturbance_prior;
+  prior.dof = options.pose_disturbance_prior_dof;
   Eigen::VectorXd r = whitened_residuals;
   Eigen::VectorXd sigmas = Eigen::VectorXd::Ones(r.size());
   Eigen::MatrixXd jacobian = whitened_jacobian;

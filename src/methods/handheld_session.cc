@@ -68,7 +68,7 @@ bool CalibrateHandheld(const Session& session, const HandheldKalmanMethodOptions
     internal::AddWarning(WarningCode::kNoiseModel, note, &calibration->warnings,
                          &calibration->warning_codes);
   }
-  calibration->method = "handheld_kalman";
+  calibration->method = ToString(Method::kHandheldKalman);
   return ok;
 }
 

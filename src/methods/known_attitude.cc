@@ -428,7 +428,7 @@ bool CalibrateFromKnownAttitudes(const std::vector<Position>& positions,
                                  const CalibrationOptions& options, Calibration* calibration) {
   CHECK(calibration != nullptr);
   Calibration& c = *calibration;
-  c.method = "known_attitude";
+  c.method = ToString(Method::kKnownAttitude);
   if (!CheckInputs(positions, attitudes, options, &c)) return false;
   const int n = static_cast<int>(positions.size());
   const double g = c.gravity;
@@ -517,7 +517,7 @@ bool CalibrateKnownAttitude(const ImuLog& log, const std::string& attitudes_path
                             const CalibrationOptions& options, Calibration* calibration) {
   CHECK(calibration != nullptr);
   *calibration = Calibration();
-  calibration->method = "known_attitude";
+  calibration->method = ToString(Method::kKnownAttitude);
   if (attitudes_path.empty()) {
     calibration->message = "known_attitude needs the attitudes file (--attitudes fixture.csv)";
     return false;
@@ -542,7 +542,7 @@ bool CalibrateKnownAttitude(const Session& session, const KnownAttitudeMethodOpt
   CHECK(calibration != nullptr);
   *calibration = Calibration();
   Calibration& c = *calibration;
-  c.method = "known_attitude";
+  c.method = ToString(Method::kKnownAttitude);
   CalibrationOptions options = method.accel;
   if (session.noise) options.pose_noise.model = session.noise_model();
   std::vector<StaticInterval> intervals;

@@ -168,7 +168,7 @@ bool CalibrateRateTable(const ImuLog& log, const std::vector<RateTableSegment>& 
 bool CalibrateRateTable(const Session& session, const RateTableMethodOptions&,
                         Calibration* calibration) {
   *calibration = Calibration();
-  calibration->method = "rate_table";
+  calibration->method = ToString(Method::kRateTable);
   RateTableResult result;
   const bool ok = CalibrateRateTable(session.log, session.segments, &result);
   calibration->message = result.message;

@@ -211,7 +211,7 @@ bool CalibrateTenPosition(const Session& session, const TenPositionMethodOptions
   CalibrationOptions options = method.accel;
   if (session.noise) options.pose_noise.model = session.noise_model();
   Calibration& c = *calibration;
-  c.method = "ten_position";
+  c.method = ToString(Method::kTenPosition);
   std::string error;
   if (!ten.IsValid(&error)) {
     c.message = error;

@@ -685,7 +685,7 @@ int DistinctPoses(const std::vector<ThermalWindow>& windows) {
 bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& options,
                       Calibration* calibration, ThermalFitReport* report) {
   Calibration out;
-  out.method = "thermal";
+  out.method = ToString(Method::kThermal);
   out.gravity = options.gravity;
   out.gravity_source = "config";
   std::string error;

@@ -31,7 +31,7 @@ bool CalibrateTwelvePosition(const Session& session, const TwelvePositionMethodO
     if (session.noise) gyro.noise_model = session.noise_model();
     ok = AddGyroscopeCalibration(session.log, intervals, gyro, calibration);
   }
-  calibration->method = "twelve_position";
+  calibration->method = ToString(Method::kTwelvePosition);
   return ok;
 }
 

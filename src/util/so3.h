@@ -5,19 +5,14 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "gravcal/util/hat.h"
+
 namespace gravcal {
 namespace internal {
 
-// The cross-product matrix: Skew(v) * w = v x w.
-//
-//            [  0   -v_z   v_y ]
-//   [v]_x =  [ v_z   0    -v_x ]
-//            [-v_y   v_x   0   ]
-inline Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d s;
-  s << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return s;
-}
+// The cross-product matrix Skew(v) * w = v x w (gravcal/util/hat.h), for
+// any 3-vector expression.
+inline Eigen::Matrix3d Skew(const Eigen::Vector3d& v) { return Hat<double>(v); }
 
 // The rotation by `angle` (radians, right hand rule) about the unit `axis`.
 inline Eigen::Quaterniond AxisAngle(double angle, const Eigen::Vector3d& axis) {

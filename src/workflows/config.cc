@@ -229,15 +229,14 @@ bool CheckConsistency(const Config& c, const std::function<bool(const char*)>& r
 bool Config::IsValid(std::string* error) const {
   const CalibrationMethod* chosen = FindCalibrationMethod(method);
   if (chosen == nullptr) {
-    *error = "key 'method': unknown method '" + method +
-             "' (available: " + CalibrationMethodNames() + ")";
+    *error = "key 'method': unknown method (available: " + CalibrationMethodNames() + ")";
     return false;
   }
   for (const std::string& name : keys_set) {
     const ConfigKey* key = FindConfigKey(name);
     if (key != nullptr && key->use == ConfigSectionUse::kSomeMethods &&
         !MethodReadsKey(*chosen, *key)) {
-      *error = "key '" + name + "' is not used by method '" + method +
+      *error = "key '" + name + "' is not used by method '" + chosen->name +
                "' (remove it; 'gravcal help calibrate' lists the keys by section)";
       return false;
     }

@@ -85,7 +85,8 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
   // Never destroyed (Google style for static storage): a batch worker abandoned
   // with a hung unit may still read it while the process exits (found by TSan).
   static const std::vector<CalibrationMethod>& methods = *new std::vector<CalibrationMethod>{
-      {"twelve_position",
+      {Method::kTwelvePosition,
+       ToString(Method::kTwelvePosition),
        "multi-position magnitude fit",
        {"gravity", "detector", "pose_noise", "model", "solver", "gyro", "effects"},
        {},
@@ -93,7 +94,8 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
        nullptr,
        RunTwelvePosition,
        kPoseNoiseUse},
-      {"ten_position",
+      {Method::kTenPosition,
+       ToString(Method::kTenPosition),
        "patent, self-aligned",
        {"gravity", "detector", "pose_noise", "alignment"},
        {"parameterization", "allow_undetermined", "loss", "loss_scale", "covariance",
@@ -103,7 +105,8 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
        [](const Config& c, std::string* e) { return c.ten_position.IsValid(e); },
        RunTenPosition,
        kPoseNoiseUse},
-      {"known_attitude",
+      {Method::kKnownAttitude,
+       ToString(Method::kKnownAttitude),
        "fixture attitudes, --attitudes",
        {"gravity", "detector", "pose_noise"},
        {"loss", "loss_scale", "covariance", "max_iterations", "pose_variance",
@@ -112,7 +115,8 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
        nullptr,
        RunKnownAttitude,
        kPoseNoiseUse},
-      {"handheld_kalman",
+      {Method::kHandheldKalman,
+       ToString(Method::kHandheldKalman),
        "21-state Kalman filter on a handheld log",
        {"gravity", "handheld_kalman"},
        {"nominal_scale", "gyro_nominal_scale"},
@@ -121,14 +125,16 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
        RunHandheldKalman,
        "the filter's process noise Q (hk_*_noise_density, hk_*_bias_walk not set as keys)",
        /*keeps_history=*/true},
-      {"rate_table",
+      {Method::kRateTable,
+       ToString(Method::kRateTable),
        "gyroscope from constant-rate segments, --segments",
        {},
        {},
        MethodSideInput::kSegments,
        nullptr,
        RunRateTable},
-      {"thermal",
+      {Method::kThermal,
+       ToString(Method::kThermal),
        "bias, scale and misalignment against temperature (issue 35)",
        {"gravity", "detector", "thermal"},
        {"nominal_scale", "gyro_nominal_scale", "max_iterations"},
@@ -141,8 +147,13 @@ const std::vector<CalibrationMethod>& CalibrationMethods() {
 }
 
 const CalibrationMethod* FindCalibrationMethod(const std::string& name) {
+  Method method;
+  return FromString(name, &method) ? FindCalibrationMethod(method) : nullptr;
+}
+
+const CalibrationMethod* FindCalibrationMethod(Method method) {
   for (const CalibrationMethod& m : CalibrationMethods()) {
-    if (m.name == name) return &m;
+    if (m.id == method) return &m;
   }
   return nullptr;
 }

@@ -106,13 +106,19 @@ std::string Shortfalls(const std::vector<std::string>& names, const Eigen::Vecto
 // (the greedy search over thousands of directions can miss the balanced
 // 45-degree designs), keeping the better: meeting the targets in less time,
 // else the smaller worst ratio.
+// Whether the request's pose set is `free`.
+bool IsFree(const std::string& pose_set) {
+  PoseSet set;
+  return FromString(pose_set, &set) && set == PoseSet::kFree;
+}
+
 bool DesignOver(const std::string& pose_set, int free_candidates, const DesignModel& model,
                 const DesignNoise& noise, const DesignOptions& options, DesignResult* result) {
   std::vector<Eigen::Vector3d> candidates;
   CandidateDirections(pose_set, free_candidates, &candidates);
   if (!DesignPoses(candidates, model, noise, options, result)) return false;
-  if (pose_set != "free") return true;
-  CandidateDirections("faces+45", 0, &candidates);
+  if (!IsFree(pose_set)) return true;
+  CandidateDirections(ToString(PoseSet::kFacesAnd45), 0, &candidates);
   DesignResult subset;
   if (!DesignPoses(candidates, model, noise, options, &subset)) return true;
   const bool better = subset.meets_targets && result->meets_targets
@@ -179,7 +185,7 @@ bool PlanRotations(const Config& config, const PlanRequest& request,
   for (const PlannedPose& p : out->poses) poses.push_back({p.up, p.hold_seconds});
   RotationDesignOptions rotation;
   rotation.targets = start.gyro_targets;
-  rotation.free_axes = request.pose_set == "free" ? 12 : 0;
+  rotation.free_axes = IsFree(request.pose_set) ? 12 : 0;
   rotation.seconds_per_180 = request.turn_seconds;
   rotation.extra_hold_seconds = options.min_hold_seconds;
   rotation.max_extra_poses = std::max(0, options.max_poses - static_cast<int>(out->poses.size()));
@@ -230,7 +236,8 @@ bool PlanRotations(const Config& config, const PlanRequest& request,
 }  // namespace
 
 bool PlanRequest::IsValid(std::string* error) const {
-  if (pose_set != "faces" && pose_set != "faces+45" && pose_set != "free") {
+  PoseSet set;
+  if (!FromString(pose_set, &set)) {
     *error = "pose_set '" + pose_set + "': expected faces, faces+45 or free";
     return false;
   }
@@ -362,7 +369,7 @@ bool PlanDesignModel(const Config& config, DesignModel* model, std::string* erro
   // windows reach into it, and `settle` is trimmed from each end); the plan
   // counts the hold minus one `settle`.
   out.trimmed_seconds = config.calibration.detector.settle_seconds;
-  out.known_attitude = config.method == "known_attitude";
+  out.known_attitude = config.method == Method::kKnownAttitude;
   if (!out.IsValid(error)) return false;
   *model = out;
   return true;

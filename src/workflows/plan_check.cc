@@ -189,7 +189,7 @@ bool CheckRecording(const Session& session, const Config& config, const PlanRequ
   out.undetermined_with_proposed = Undetermined(names, current);
   // Issue 35: the temperature span the static poses cover, against the
   // orders the thermal method would fit.
-  if (log.has_temperature() && config.method == "thermal") {
+  if (log.has_temperature() && config.method == Method::kThermal) {
     double lo = INFINITY, hi = -INFINITY;
     for (const Position& p : positions) {
       lo = std::min(lo, p.temperature);

@@ -66,7 +66,7 @@ inline bool CalibrateAsCli(const Config& config, const SimulatedInput& input, ui
   pipeline.log = input.session.log;
   pipeline.source = "seed " + std::to_string(seed);
   std::string attitudes;
-  if (config.method == "known_attitude") {
+  if (config.method == Method::kKnownAttitude) {
     std::string path = testing_util::ScratchFileTemplate("gravcal_property_");
     const int fd = mkstemp(path.data());
     if (fd < 0) {

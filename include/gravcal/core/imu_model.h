@@ -41,20 +41,9 @@
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/gyro_model.h"
 #include "gravcal/core/model_effects.h"
+#include "gravcal/util/hat.h"
 
 namespace gravcal {
-
-// The cross-product matrix: Hat(v) w = v x w.
-//
-//            [  0   -v_z   v_y ]
-//   [v]_x =  [ v_z   0    -v_x ]
-//            [-v_y   v_x   0   ]
-template <typename T>
-Eigen::Matrix<T, 3, 3> Hat(const Eigen::Matrix<T, 3, 1>& v) {
-  Eigen::Matrix<T, 3, 3> s;
-  s << T(0.0), -v(2), v(1), v(2), T(0.0), -v(0), -v(1), v(0), T(0.0);
-  return s;
-}
 
 // The accelerometer's parameter blocks, by name. bias and upper are always
 // set; an effect block that is null is off.

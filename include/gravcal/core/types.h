@@ -79,6 +79,35 @@ enum class LogFormat {
 const char* ToString(LogFormat format);
 bool FromString(const std::string& name, LogFormat* format);
 
+// The calibration methods, the values of the config key `method`
+// (workflows/method_registry.h gives each its help, sections and entry
+// point).
+enum class Method {
+  kTwelvePosition,
+  kTenPosition,
+  kKnownAttitude,
+  kHandheldKalman,
+  kRateTable,
+  kThermal
+};
+// "twelve_position", "ten_position", "known_attitude", "handheld_kalman",
+// "rate_table".
+const char* ToString(Method method);
+bool FromString(const std::string& name, Method* method);
+
+// The candidate poses of a recording plan (`gravcal plan --pose_set`).
+enum class PoseSet {
+  // The six faces.
+  kFaces,
+  // The faces and the twelve 45-degree edges.
+  kFacesAnd45,
+  // Free directions on the sphere.
+  kFree,
+};
+// "faces", "faces+45", "free".
+const char* ToString(PoseSet set);
+bool FromString(const std::string& name, PoseSet* set);
+
 // The motion of a simulated handheld or rate-table recording.
 enum class MotionProfile { kHandheld, kTurntable, kVertical, kRateTable };
 // "handheld", "turntable", "vertical", "rate_table".

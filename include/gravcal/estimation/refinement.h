@@ -25,18 +25,16 @@
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/position.h"
 #include "gravcal/core/solver_result.h"
+#include "gravcal/estimation/fit_settings.h"
 #include "gravcal/estimation/observability.h"
 #include "gravcal/estimation/solver_tolerances.h"
 
 namespace gravcal {
 
-struct RefinementOptions {
-  AccelParameterization parameterization = AccelParameterization::kScaleMisalignment;
-  // Robust loss on the whitened residuals, and its scale in units of sigma.
-  LossType loss = LossType::kNone;
-  double loss_scale = 3.0;
-  // Compute the covariance of the estimate.
-  bool compute_covariance = true;
+// The shared settings (fit_settings.h: parameterization, the robust loss on
+// the whitened residuals, compute_covariance, the pose variance) and the
+// refinement's own.
+struct RefinementOptions : AccelFitSettings {
   // A parameter whose standard deviation exceeds these is reported as not
   // determined by the positions (no number): bias in m/s^2, entries of U
   // relative to the mean scale factor.
@@ -51,19 +49,15 @@ struct RefinementOptions {
   // Added to every sigma_k^2 (m/s^2)^2: the per-pose variance the samples
   // cannot show (methods/pose_variance.h sets it; 0 = white noise only).
   double extra_variance = 0.0;
-  // Estimate that variance by REML and absorb it (twelve_position, ceres).
-  // Off by default until it is validated on repeated real recordings (see
-  // docs/methods.md): on the real sessions it grows the sigmas 5-8 times;
-  // warn when its s exceeds max_pose_disturbance (m/s^2), or when a richer
-  // model explains the excess at structure_test_level (then not absorbed).
-  bool estimate_pose_variance = false;
+  // estimate_pose_variance (PoseVarianceOptions): estimate that variance by
+  // REML and absorb it (twelve_position, ceres), with the prior
+  // pose_disturbance_prior on pose_disturbance_prior_dof. Off by default
+  // until it is validated on repeated real recordings (see docs/methods.md):
+  // on the real sessions it grows the sigmas 5-8 times; warn when its s
+  // exceeds max_pose_disturbance (m/s^2), or when a richer model explains
+  // the excess at structure_test_level (then not absorbed).
   double max_pose_disturbance = 0.01;
   double structure_test_level = 1e-3;
-  // A prior on that variance (estimation/variance_component.h): the typical
-  // pose-to-pose scatter s0 of the placement, m/s^2, on pose_disturbance_dof
-  // degrees of freedom (0 = none, REML alone).
-  double pose_disturbance_prior = 0.0;
-  double pose_disturbance_prior_dof = 0.0;
   // The prior is set aside (REML alone, with a warning) when the residuals
   // scatter more than it allows beyond this level, or less beyond a
   // hundredth of it (methods/pose_variance.h): a prior this recording

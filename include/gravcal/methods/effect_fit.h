@@ -55,6 +55,7 @@
 #include "gravcal/core/position.h"
 #include "gravcal/core/solver_result.h"
 #include "gravcal/detection/static_detector.h"
+#include "gravcal/estimation/fit_settings.h"
 #include "gravcal/estimation/solver_tolerances.h"
 #include "gravcal/methods/twelve_position.h"
 
@@ -147,31 +148,38 @@ int AddBetweenPoseTurns(const ImuLog& log, const std::vector<StaticInterval>& in
                         std::vector<StaticObservation>* observations, double edge_seconds = 0.5,
                         double max_turn_seconds = 60.0);
 
-struct EffectFitOptions {
-  // The baseline accelerometer model: kScale holds the off-diagonal of U at
-  // zero (unless accel_misalignment is in `effects`); kAffine fits like
-  // kScaleMisalignment and keeps R.
-  AccelParameterization parameterization = AccelParameterization::kScaleMisalignment;
+// The shared settings (fit_settings.h) as the refinement reads them, so a
+// calibration hands its refinement's settings to this fit whole:
+// - parameterization, the baseline accelerometer model: kScale holds the
+//   off-diagonal of U at zero (unless accel_misalignment is in `effects`);
+//   kAffine fits like kScaleMisalignment and keeps R;
+// - loss at loss_scale, on each residual block (a position's magnitude, its
+//   within-pose trend, a turn between poses; a position's three gyroscope
+//   mean rates), as in the refinement (refinement.h): the solve is graduated
+//   from a scale holding every initial residual down to loss_scale, and the
+//   covariance weights each block's rows by sqrt(rho'(|r|^2)), the weights of
+//   iteratively reweighted least squares at the optimum. chi2 and the
+//   residuals stay unweighted;
+// - estimate_pose_variance: one extra variance s^2 common to the position
+//   magnitudes by REML (src/estimation/variance_component.h), refit with
+//   sigma_k^2 + s^2 and the covariance inflated by the Student factor of the
+//   estimate: what the pose means share beyond their samples' noise (bias
+//   instability and random walk wander from pose to pose, placement). For
+//   estimates with honest standard deviations (calibrate --effects); off for
+//   the likelihood-ratio tests, where every model must see the same noise.
+//   Skipped when the magnitudes leave no residual degree of freedom beyond
+//   what the trends determine and no prior (pose_disturbance_prior on
+//   pose_disturbance_prior_dof) is given.
+struct EffectFitOptions : AccelFitSettings {
   std::vector<Effect> effects;
   // Fit the gyroscope part (when the observations have it).
   bool fit_gyro = true;
   // Skip the accelerometer part (keep `initial` and its effects): for
   // refits of a gyroscope effect alone.
   bool fit_accel = true;
-  bool compute_covariance = true;
   // Add the AccelTrendResidual of every observation that has a trend; false
   // = the position magnitudes alone.
   bool use_within_pose_trends = true;
-  // Estimate one extra variance s^2 common to the position magnitudes by
-  // REML (src/estimation/variance_component.h), refit with sigma_k^2 + s^2
-  // and inflate the covariance by the Student factor of the estimate: what
-  // the pose means share beyond their samples' noise (bias instability and
-  // random walk wander from pose to pose, placement). For estimates with
-  // honest standard deviations (calibrate --effects); off for the
-  // likelihood-ratio tests, where every model must see the same noise.
-  // Skipped when the magnitudes leave no residual degree of freedom beyond
-  // what the trends determine and no prior is given.
-  bool magnitude_variance_component = false;
   // A fixed extra variance (m/s^2)^2 added to every magnitude's sigma_k^2
   // (>= 0; the REML above adds to it): for likelihood-ratio tests, where
   // every model must see the same noise, a value from outside the models
@@ -179,23 +187,9 @@ struct EffectFitOptions {
   // candidate absorbs it: on twelve poses with the drift and both tempcos
   // fitted, a hidden k2 is then found in 3 of 20 seeds instead of 20.
   double magnitude_extra_variance = 0.0;
-  // A prior on s (m/s^2, >= 0) on prior_dof (>= 0) degrees of freedom
-  // (variance_component.h; 0 = none, REML alone).
-  double magnitude_variance_prior = 0.0;
-  double magnitude_variance_prior_dof = 0.0;
 
   // Stopping rules of the Ceres solve.
   SolverTolerances solver = {50, 1e-12, 1e-12, 1e-10};
-  // Robust loss rho on each residual block (a position's magnitude, its
-  // within-pose trend, a turn between poses; a position's three gyroscope
-  // mean rates), loss_scale (> 0)
-  // in standard deviations, as in the refinement (refinement.h): the solve is
-  // graduated from a scale holding every initial residual down to loss_scale,
-  // and the covariance weights each block's rows by sqrt(rho'(|r|^2)), the
-  // weights of iteratively reweighted least squares at the optimum. chi2 and
-  // the residuals stay unweighted. kNone = least squares.
-  LossType loss = LossType::kNone;
-  double loss_scale = 3.0;
 
   // Issue 21: add the AccelRotationResidual
   // (residuals/accel_rotation_residual.h) of every turn between consecutive
@@ -269,7 +263,7 @@ struct EffectFitResult {
   EffectParameters parameters;
   std::vector<Effect> effects;
   SensorFitSummary accel_fit;
-  // The extra magnitude variance (magnitude_variance_component), (m/s^2)^2,
+  // The extra magnitude variance (estimate_pose_variance), (m/s^2)^2,
   // and the factor the accelerometer covariance was multiplied by.
   VarianceComponent magnitude_variance;
   double magnitude_variance_inflation = 1.0;

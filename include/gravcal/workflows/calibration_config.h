@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gravcal/core/model_effects.h"
+#include "gravcal/core/types.h"
 #include "gravcal/estimation/noise_characterisation.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/methods/gyro_calibration.h"
@@ -24,8 +25,8 @@
 namespace gravcal {
 
 struct CalibrationConfig {
-  // Calibration method, a name in the method registry (method_registry.h).
-  std::string method = "twelve_position";
+  // Calibration method (its registry entry: method_registry.h).
+  Method method = Method::kTwelvePosition;
   LogReaderOptions input;
   CalibrationOptions calibration;
   // Gyroscope from the rotations between the poses (gyro_model != none).

@@ -34,6 +34,8 @@ enum class MethodSideInput {
 };
 
 struct CalibrationMethod {
+  Method id = Method::kTwelvePosition;
+  // ToString(id): the value of `method:`.
   std::string name;
   std::string help;
   // Config sections (config.h, ConfigSectionUse::kSomeMethods) whose every
@@ -60,6 +62,8 @@ struct CalibrationMethod {
 const std::vector<CalibrationMethod>& CalibrationMethods();
 // nullptr when there is no method of that name.
 const CalibrationMethod* FindCalibrationMethod(const std::string& name);
+// The entry of `method`.
+const CalibrationMethod* FindCalibrationMethod(Method method);
 // "twelve_position, ten_position, ..." for messages.
 std::string CalibrationMethodNames();
 // "twelve_position (one-line help), ten_position (...), ..." for help text.

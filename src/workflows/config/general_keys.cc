@@ -9,11 +9,27 @@
 namespace gravcal {
 namespace internal {
 
+namespace {
+
+// The method by its name; an unknown name is refused with the available ones.
+bool ReadMethod(const YAML::Node& n, CalibrationConfig* c, std::string* e) {
+  std::string name;
+  if (!ReadString(n, &name, e)) return false;
+  if (!FromString(name, &c->method)) {
+    *e = "unknown method '" + name + "' (available: " + CalibrationMethodNames() + ")";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 SectionOf<CalibrationConfig> GeneralSection() {
   return {"general",
           ConfigSectionUse::kAllMethods,
           {
-              GRAVCAL_STRING("method", method, "calibration method: " + CalibrationMethodsHelp()),
+              GRAVCAL_KEY("method", "calibration method: " + CalibrationMethodsHelp(),
+                          ReadMethod(n, c, e), std::string(ToString(c.method))),
               GRAVCAL_BOOL("output_covariance", output_covariance,
                            "write accel.covariance into the calibration JSON"),
           }};

@@ -294,7 +294,7 @@ bool Contains(const std::vector<std::string>& v, const std::string& s) {
 // handheld one) has no state for it, so it never estimated it; a batch fit
 // estimated it and the data did not determine it.
 std::string NotDeterminedOrNotEstimated(const Calibration& c) {
-  if (c.method == "handheld_kalman") {
+  if (c.method == ToString(Method::kHandheldKalman)) {
     return "not estimated (held at its nominal value: the filter has no state for it; "
            "hk_cross_axis: true estimates the cross-axis terms)";
   }
@@ -312,7 +312,7 @@ std::string AccelSource(const Calibration& c, const std::string& fit_name, doubl
     return "fixed by the " + std::string(ToString(c.accel.model.parameterization)) + " model";
   if (!std::isfinite(std)) return NotDeterminedOrNotEstimated(c);
   if (from_housing) return "housing rotation (the poses' nominal axes)";
-  if (c.method == "twelve_position") return "magnitude fit";
+  if (c.method == ToString(Method::kTwelvePosition)) return "magnitude fit";
   return c.method + " fit";
 }
 
@@ -472,7 +472,7 @@ std::string CalibrationReport(const Calibration& c, const ImuLog& log, const std
   h << "<h1>Calibration report</h1><p>" << HtmlEscape(source) << " &mdash; method "
     << HtmlEscape(c.method) << ", " << log.size() << " samples, ";
   // A filter on a moving log has no static poses to count.
-  if (c.method != "handheld_kalman") h << c.positions.size() << " static poses, ";
+  if (c.method != ToString(Method::kHandheldKalman)) h << c.positions.size() << " static poses, ";
   h << "gravity " << FormatNumber(c.gravity, "%.6g") << " m/s^2 ("
     << HtmlEscape(c.gravity_source.empty() ? "not resolved" : c.gravity_source) << ")</p>\n";
 
