@@ -28,6 +28,8 @@
 #include "gravcal/core/position.h"
 #include "gravcal/core/rate_table_segment.h"
 #include "gravcal/core/solver_result.h"
+#include "gravcal/core/thermal_model.h"
+#include "gravcal/core/thermal_rate.h"
 #include "gravcal/core/types.h"
 
 // Static poses of a log, the input of the static methods.
@@ -41,6 +43,7 @@
 #include "gravcal/methods/rate_table.h"
 #include "gravcal/methods/session.h"
 #include "gravcal/methods/ten_position.h"
+#include "gravcal/methods/thermal_calibration.h"
 #include "gravcal/methods/twelve_position.h"
 #include "gravcal/methods/twelve_position_method.h"
 

@@ -36,6 +36,10 @@ std::vector<std::string> OutputComment(const std::string& calibration_path,
 
 }  // namespace
 
+// Samples further than this outside a thermal model's valid range are
+// counted in apply's warning, degrees C.
+constexpr double kClampWarningDegrees = 0.5;
+
 int RunApply(const ApplyArgs& args) {
   std::string calibration_path, error;
   if (!ResolveCalibrationPath(args.calibration, args.stored, &calibration_path, &error)) {
@@ -107,7 +111,10 @@ int RunApply(const ApplyArgs& args) {
     }
     if (!writer.Write(sample, &error)) return Fail(error);
     ++count;
-    if (clamped) {
+    // Clamped by more than the temperature sensor's noise: counted.
+    const ThermalModel& th = corrector.thermal;
+    if (clamped && (sample.temperature < th.min_temperature - kClampWarningDegrees ||
+                    sample.temperature > th.max_temperature + kClampWarningDegrees)) {
       ++clamped_count;
       lowest = std::min(lowest, sample.temperature);
       highest = std::max(highest, sample.temperature);
@@ -120,9 +127,9 @@ int RunApply(const ApplyArgs& args) {
   if (!writer.Commit(&error)) return Fail(error);
   if (clamped_count > 0) {
     std::fprintf(stderr,
-                 "gravcal: warning: %zu samples (temperatures %.1f to %.1f degC) lie outside the "
-                 "thermal model's range [%.1f, %.1f] degC; the correction there is clamped at the "
-                 "range's ends, as PX4 does\n",
+                 "gravcal: warning: %zu samples (temperatures %.1f to %.1f degC) lie more than "
+                 "0.5 degC outside the thermal model's range [%.1f, %.1f] degC; the correction "
+                 "there is clamped at the range's ends, as PX4 does\n",
                  clamped_count, lowest, highest, corrector.thermal.min_temperature,
                  corrector.thermal.max_temperature);
   }

@@ -75,6 +75,35 @@ std::string Calibration::FullReport() const {
                    refinement.iterations, refinement.termination.c_str(), refinement.chi2,
                    refinement.dof);
   }
+  // Issue 35: the thermal terms, each coefficient with its standard
+  // deviation or "not determined".
+  if (thermal.active() || !thermal.notes.empty()) {
+    text += Format("thermal: x = T - %.2f degC, valid %.2f to %.2f degC, lag %.3g s\n",
+                   thermal.reference_temperature, thermal.min_temperature, thermal.max_temperature,
+                   thermal.lag_time_constant);
+    for (ThermalSensor s : {ThermalSensor::kAccel, ThermalSensor::kGyro}) {
+      for (ThermalQuantity q :
+           {ThermalQuantity::kBias, ThermalQuantity::kScale, ThermalQuantity::kMisalignment}) {
+        const ThermalPolynomial& p = thermal.Sensor(s).Term(q);
+        if (!p.active()) continue;
+        const std::vector<std::string> names = ThermalComponentNames(s, q);
+        for (int i = 0; i < p.coefficients.rows(); ++i) {
+          text += Format("  %s %s %-3s", ToString(s), ToString(q), names[i].c_str());
+          for (int k = 1; k <= p.order; ++k) {
+            const bool known = p.Determined(i, k);
+            const double sd = known && i < static_cast<int>(p.covariance.size())
+                                  ? std::sqrt(p.covariance[i](k, k))
+                                  : NAN;
+            text += Format(" c%d ", k) +
+                    (known ? WithStd(p.coefficients(i, k - 1), sd) : std::string("not determined"));
+            text += k < p.order ? ";" : "";
+          }
+          text += " (" + ThermalUnit(q, 1) + "...)\n";
+        }
+      }
+    }
+    for (const std::string& n : thermal.notes) text += "  note: " + n + "\n";
+  }
   for (const std::string& w : warnings) text += "warning: " + w + "\n";
   return text;
 }

@@ -796,8 +796,16 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
   const ThermalLayout layout(orders, has_gyro);
   ThermalModel& model = out.thermal;
   model.reference_temperature = reference;
+  // The valid range: every sample of the windows (their means lie inside
+  // it, the temperature sensor's noise around them does not).
   model.min_temperature = lo;
   model.max_temperature = hi;
+  for (const ThermalWindow& w : windows) {
+    for (size_t i = w.begin; i < w.end; ++i) {
+      model.min_temperature = std::min(model.min_temperature, log.temperature[i]);
+      model.max_temperature = std::max(model.max_temperature, log.temperature[i]);
+    }
+  }
   const std::string selection = ToString(options.selection);
   auto how = [&](int fixed) { return fixed >= 0 ? std::string("given") : selection; };
   FillTerm(layout, best, ThermalSensor::kAccel, ThermalQuantity::kBias, layout.accel_bias,

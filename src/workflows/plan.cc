@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <sstream>
@@ -568,6 +569,27 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
     out.schemes.push_back(c);
   }
   out.message = design.message;
+  // Issue 35: the thermal method needs these poses repeated across a
+  // temperature span wide enough for the orders it may fit.
+  if (config.method == "thermal") {
+    const ThermalCalibrationOptions& t = config.thermal;
+    int order = 0;
+    for (const auto& [fixed, most] :
+         {std::pair<int, int>{t.accel_bias_order, t.accel_bias_max_order},
+          {t.accel_scale_order, t.accel_scale_max_order},
+          {t.accel_misalignment_order, t.accel_misalignment_max_order},
+          {t.gyro_bias_order, t.gyro_bias_max_order}}) {
+      order = std::max(order, fixed >= 0 ? fixed : most);
+    }
+    char line[400];
+    std::snprintf(line, sizeof(line),
+                  "; thermal: repeat these poses across at least %.0f degC (order %d terms need "
+                  "it; %.0f degC for linear ones): at several soak temperatures, or turned "
+                  "through them again and again while the unit warms up from cold and, to see a "
+                  "lag, while it cools; one pose on a ramp determines only the bias along gravity",
+                  ThermalMinimumSpan(order), order, ThermalMinimumSpan(1));
+    out.message += line;
+  }
   if (start.gyro_planned) {
     if (!PlanRotations(config, request, start, model, noise, options, &out, error)) return false;
   }

@@ -15,6 +15,11 @@ ThermalDiscovery DiscoverThermal(const ImuLog& log, const ThermalCalibrationOpti
   options.accel_bias_max_order = std::min(3, std::max(options.accel_bias_max_order, 3));
   options.gyro_bias_max_order = std::min(3, std::max(options.gyro_bias_max_order, 3));
   options.fit_lag = true;
+  // Discovery asks about the bias's order and the lag only: a linear scale
+  // term stays available (so that a scale change is not read as curvature),
+  // the misalignment search is left to calibrate (it keeps the search short).
+  options.accel_scale_max_order = std::min(options.accel_scale_max_order, 1);
+  options.accel_misalignment_max_order = 0;
   Session session;
   session.log = log;
   Calibration c;

@@ -3,8 +3,8 @@
 //
 // When the log has a temperature column spanning at least
 // ThermalMinimumSpan(1) over its static poses, the thermal calibration
-// (methods/thermal_calibration.h) searches each bias term's order (up to 3)
-// and the element's lag by BIC, exactly as `calibrate` with
+// (methods/thermal_calibration.h) searches each bias term's order (up to 3),
+// a linear scale term and the element's lag by BIC, as `calibrate` with
 // configs/thermal.yaml would. Two findings can be named:
 // - "temperature_higher_order": a bias term of order 2 or more is chosen,
 //   more than the catalogue's linear accel_temperature_bias /
