@@ -571,7 +571,7 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   out.message = design.message;
   // Issue 35: the thermal method needs these poses repeated across a
   // temperature span wide enough for the orders it may fit.
-  if (config.method == "thermal") {
+  if (config.method == Method::kThermal) {
     const ThermalCalibrationOptions& t = config.thermal;
     int order = 0;
     for (const auto& [fixed, most] :
