@@ -343,8 +343,8 @@ bool Recorder::Start(const Config& config, const RecorderOptions& options, std::
   s.options = options;
   if (!internal::StartPlan(config, options.request, &s.start, error)) return false;
   if (s.start.model.known_attitude) {
-    *error =
-        "record guides the magnitude model; method " + config.method + " needs fixture attitudes";
+    *error = std::string("record guides the magnitude model; method ") + ToString(config.method) +
+             " needs fixture attitudes";
     return false;
   }
   if (std::none_of(s.start.targeted.begin(), s.start.targeted.end(), [](bool t) { return t; })) {
