@@ -18,7 +18,7 @@ namespace gravcal {
 namespace {
 
 using internal::kInf;
-constexpr double kFaceSnapDeg = 10.0;
+using internal::kFaceSnapDeg;
 
 // The parameters DeterminedStd held (infinite standard deviation).
 std::vector<std::string> Undetermined(const std::vector<std::string>& names,

@@ -13,6 +13,10 @@
 namespace gravcal {
 namespace internal {
 
+// A pose whose up direction lies within this many degrees of a face counts
+// as that face (the placement error of a hand; check and record).
+constexpr double kFaceSnapDeg = 10.0;
+
 struct PlanStart {
   DesignModel model;
   // MagnitudeParameterNames of the config's parameterisation.

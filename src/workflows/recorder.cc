@@ -32,8 +32,7 @@ using internal::kInf;
 using internal::kRadToDeg;
 using Json = nlohmann::json;
 
-// A captured pose's up direction counts as a face within this (as check).
-constexpr double kFaceSnapDeg = 10.0;
+using internal::kFaceSnapDeg;
 // A suggestion is worded as a face within this.
 constexpr double kFaceWordDeg = 2.0;
 // Holds on the needed-hold grid.
