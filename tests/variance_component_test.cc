@@ -184,28 +184,6 @@ TEST(VarianceComponent, RejectsNoDegreesOfFreedom) {
   EXPECT_FALSE(vc.estimated);
 }
 
-// An exact fit (m = 0) with a prior: the residuals cannot show s^2, so the
-// estimate is the prior's s0^2 with var(s^2) = 2 s0^4 / nu0, whatever the
-// (zero) residuals; the inflation then counts the prior's dof.
-TEST(VarianceComponent, ExactFitTakesThePriorsScatter) {
-  const Draw d = MakeDraw(6, 6, 25.0, 1.0, 2.0, 3);
-  internal::VariancePrior prior;
-  prior.variance = 25.0;
-  prior.dof = 4.0;
-  VarianceComponent vc;
-  ASSERT_TRUE(internal::EstimateVarianceComponent(d.residuals, d.sigmas, d.jacobian, &vc, prior))
-      << vc.message;
-  EXPECT_TRUE(vc.estimated);
-  EXPECT_FALSE(vc.at_boundary);
-  EXPECT_EQ(vc.dof, 0);
-  EXPECT_DOUBLE_EQ(vc.variance, 25.0);
-  EXPECT_NEAR(vc.variance_std, 25.0 * std::sqrt(0.5), 1e-12);
-  EXPECT_NE(vc.message.find("prior alone"), std::string::npos) << vc.message;
-  double nu = 0.0;
-  internal::StudentInflation(vc, 2.25, &nu);
-  EXPECT_NEAR(nu, 4.0 * std::pow(27.25 / 25.0, 2), 1e-9);
-}
-
 }  // namespace
 }  // namespace gravcal
 

@@ -204,23 +204,6 @@ void Estimate(const RestrictedProblem& problem, const VariancePrior& prior,
   result->message = s.str();
 }
 
-// m = 0 (header): the prior's s0^2 with its information, when there is a
-// prior; false otherwise (result->message already says why).
-bool PriorOnly(const VariancePrior& prior, VarianceComponent* result) {
-  if (!(prior.dof > 0.0) || result->dof != 0) return false;
-  result->estimated = true;
-  result->variance = prior.variance;
-  result->variance_std = prior.variance * std::sqrt(2.0 / prior.dof);
-  result->at_boundary = false;
-  std::ostringstream s;
-  s.precision(3);
-  s << "s = " << std::sqrt(prior.variance) << " from the prior alone (s^2 = " << prior.variance
-    << " +- " << result->variance_std << " on its " << prior.dof
-    << " dof): the fit is exact and its residuals cannot show the pose scatter";
-  result->message = s.str();
-  return true;
-}
-
 }  // namespace
 
 bool EstimateVarianceComponent(const Eigen::VectorXd& residuals, const Eigen::VectorXd& sigmas,
@@ -230,7 +213,7 @@ bool EstimateVarianceComponent(const Eigen::VectorXd& residuals, const Eigen::Ve
   *result = VarianceComponent();
   if (!CheckInput(residuals, sigmas, jacobian, prior, result)) return false;
   RestrictedProblem problem;
-  if (!Restrict(residuals, sigmas, jacobian, &problem, result)) return PriorOnly(prior, result);
+  if (!Restrict(residuals, sigmas, jacobian, &problem, result)) return false;
   Estimate(problem, prior, result);
   return true;
 }

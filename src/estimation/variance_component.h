@@ -41,15 +41,6 @@
 // / (nu0 + m) when the white part is small), and its information grows by
 // nu0 / (2 s^4). nu0 = 0 (the default) is no prior: REML alone.
 //
-// With m = 0 (an exact fit: as many determined parameters as residuals)
-// the residuals say nothing about s^2, and the same objective is the
-// prior's alone: its minimum is s^2 = s0^2 with information nu0 / (2 s0^4),
-// var(s^2) = 2 s0^4 / nu0. The estimate is then the prior's (the message
-// says so, dof 0): a session that cannot show its own pose scatter is given
-// the scatter the setup is configured to have, rather than none. Without a
-// prior m = 0 is still no estimate. (EstimateVarianceComponent only: the
-// whitened form below, known_attitude's, still needs m >= 1.)
-//
 // An estimated s^2 makes every standard deviation itself an estimate, and
 // error / sigma then follows a Student t rather than N(0, 1): with few
 // residual degrees of freedom (three for twelve poses and nine parameters)
@@ -76,8 +67,7 @@ namespace internal {
 // `residuals` r_k and `sigmas` sigma_k (same unit), `jacobian` dr/dparameters
 // unwhitened (n x p; columns of any scale, rank decided after scaling each to
 // unit norm). Returns false (result->message says why) when n - rank(J) < 1
-// and there is no prior, or an input is not finite or a sigma is not
-// positive.
+// or an input is not finite or a sigma is not positive.
 struct VariancePrior {
   // s0^2 and nu0 (above); dof = 0 is no prior.
   double variance = 0.0;

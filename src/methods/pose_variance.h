@@ -59,12 +59,6 @@
 //    non-orthogonality's: nothing is absorbed, the fit's chi-square warning
 //    stays, and a warning names the term and points to `gravcal discover`.
 //
-// An exact fit (no residual degree of freedom: nine poses and nine
-// parameters) cannot show its scatter; with a prior, s^2 is the prior's
-// s0^2 on its nu0 dof (estimation/variance_component.h), absorbed as below,
-// so its sigmas carry the scatter the setup is configured to have instead of
-// none. Without a prior it is not estimated.
-//
 // 3. Otherwise s^2 is absorbed. When s exceeds max_pose_disturbance a
 //    warning says it is implausible for a sensor at rest; else no warning:
 //    the scatter is what hand-placed poses show.
