@@ -2,9 +2,9 @@
 // IMUs, calibrate one session of several IMUs (methods/multi_imu.h).
 #include "bindings.h"
 #include "gravcal/io/calibration_io.h"
-#include "gravcal/io/multi_imu_log.h"
 #include "gravcal/methods/multi_imu.h"
 #include "gravcal/simulation/plate_simulator.h"
+#include "gravcal/workflows/multi_imu_log.h"
 
 namespace gravcal {
 namespace python {

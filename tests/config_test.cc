@@ -13,9 +13,9 @@
 #include <utility>
 #include <vector>
 
-#include "gravcal/io/multi_imu_log.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/method_registry.h"
+#include "gravcal/workflows/multi_imu_log.h"
 #include "test_util.h"
 
 namespace gravcal {

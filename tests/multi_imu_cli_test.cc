@@ -7,8 +7,8 @@
 #include <string>
 
 #include "cli_runner.h"
-#include "gravcal/io/multi_imu_log.h"
 #include "gravcal/simulation/plate_simulator.h"
+#include "gravcal/workflows/multi_imu_log.h"
 
 namespace gravcal {
 namespace {

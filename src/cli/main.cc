@@ -17,11 +17,11 @@
 
 #include "cli/commands.h"
 #include "cli/flags.h"
-#include "gravcal/io/multi_imu_log.h"
 #include "gravcal/workflows/batch.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/method_registry.h"
+#include "gravcal/workflows/multi_imu_log.h"
 
 namespace gravcal {
 namespace cli {

@@ -8,8 +8,8 @@
 #include "cli/commands.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/files.h"
-#include "gravcal/io/multi_imu_log.h"
 #include "gravcal/methods/multi_imu.h"
+#include "gravcal/workflows/multi_imu_log.h"
 
 namespace gravcal {
 namespace cli {

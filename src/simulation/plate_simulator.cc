@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "simulation/smooth_step.h"
 #include "util/random_vector.h"
 #include "util/so3.h"
 #include "util/units.h"
@@ -19,8 +20,8 @@ namespace {
 using internal::AxisAngle;
 using internal::FromRotationVector;
 
-double SmoothStep(double x) { return x * x * x * (10.0 + x * (-15.0 + 6.0 * x)); }
-double SmoothStepRate(double x) { return 30.0 * x * x * (1.0 - x) * (1.0 - x); }
+using internal::SmoothStep;
+using internal::SmoothStepRate;
 
 // Catmull-Rom interpolation of a uniformly sampled signal (step h, first
 // sample at 0) at time t, clamped to the ends.

@@ -13,6 +13,7 @@
 #include "gravcal/core/gravity.h"
 #include "simulation/sensor_noise.h"
 #include "simulation/simulator_schemes.h"
+#include "simulation/smooth_step.h"
 #include "util/random_vector.h"
 #include "util/so3.h"
 #include "util/units.h"
@@ -26,11 +27,7 @@ using internal::FromRotationVector;
 // Corner frequency of the first-order low-pass that shapes hand tremor, Hz.
 constexpr double kTremorCornerHz = 5.0;
 
-// Minimum-jerk profile s(x) = 10 x^3 - 15 x^4 + 6 x^5 on [0, 1] and its
-// derivative ds/dx = 30 x^2 (1 - x)^2: rate and acceleration are zero at both
-// ends.
-double SmoothStep(double x) { return x * x * x * (10.0 + x * (-15.0 + 6.0 * x)); }
-double SmoothStepRate(double x) { return 30.0 * x * x * (1.0 - x) * (1.0 - x); }
+using internal::SmoothStepRate;
 
 long SampleCount(double seconds, double rate) { return std::lround(seconds * rate); }
 

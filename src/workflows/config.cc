@@ -39,12 +39,23 @@ const std::vector<ConfigSection>& ConfigSections() {
   // Never destroyed (Google style for static storage): a batch worker abandoned
   // with a hung unit may still read it while the process exits (found by TSan).
   static const std::vector<ConfigSection>& sections = *new std::vector<ConfigSection>{
-      Lift(GeneralSection()),        Lift(InputSection()),     Lift(GravitySection()),
-      Lift(DetectorSection()),       Lift(PoseNoiseSection()), Lift(ModelSection()),
-      Lift(SolverSection()),         Lift(GyroSection()),      Lift(AlignmentSection()),
-      Lift(HandheldKalmanSection()), Lift(EffectsSection()),   Lift(DiscoverySection()),
-      Lift(NoiseSection()),          Lift(SimulatorSection()), Lift(MotionSimulatorSection()),
-      Lift(ThermalSection()),        Lift(ThermalSimulatorSection()),
+      Lift(GeneralSection()),
+      Lift(InputSection()),
+      Lift(GravitySection()),
+      Lift(DetectorSection()),
+      Lift(PoseNoiseSection()),
+      Lift(ModelSection()),
+      Lift(SolverSection()),
+      Lift(GyroSection()),
+      Lift(AlignmentSection()),
+      Lift(HandheldKalmanSection()),
+      Lift(EffectsSection()),
+      Lift(DiscoverySection()),
+      Lift(NoiseSection()),
+      Lift(SimulatorSection()),
+      Lift(MotionSimulatorSection()),
+      Lift(ThermalSection()),
+      Lift(ThermalSimulatorSection()),
   };
   return sections;
 }

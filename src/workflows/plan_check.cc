@@ -17,8 +17,8 @@ namespace gravcal {
 
 namespace {
 
-using internal::kInf;
 using internal::kFaceSnapDeg;
+using internal::kInf;
 
 // The parameters DeterminedStd held (infinite standard deviation).
 std::vector<std::string> Undetermined(const std::vector<std::string>& names,

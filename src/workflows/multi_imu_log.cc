@@ -1,5 +1,5 @@
 // Reading a multi-IMU session and writing its assembly (io/multi_imu_log.h).
-#include "gravcal/io/multi_imu_log.h"
+#include "gravcal/workflows/multi_imu_log.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

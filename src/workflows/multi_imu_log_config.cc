@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "gravcal/core/gravity.h"
-#include "gravcal/io/multi_imu_log.h"
+#include "gravcal/workflows/multi_imu_log.h"
 
 namespace gravcal {
 namespace {

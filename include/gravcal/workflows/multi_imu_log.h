@@ -1,4 +1,4 @@
-// gravcal/io/multi_imu_log.h: the input of a multi-IMU session (issue 38):
+// gravcal/workflows/multi_imu_log.h: the input of a multi-IMU session (issue 38):
 // its config (configs/multi_imu.yaml; `imus: [...]`, each IMU with its own
 // columns, units, mounting and, optionally, its own log or bag topic) and
 // the reading of its logs into one PlateImu per IMU (methods/multi_imu.h).
@@ -13,8 +13,8 @@
 // each IMU's rotation to the reference, its sigma and the time offsets; the
 // Kalibr IMU chain; PX4's CAL_ACCn_ROT / CAL_GYROn_ROT where a rotation is
 // one of PX4's enumerated rotations.
-#ifndef GRAVCAL_IO_MULTI_IMU_LOG_H_
-#define GRAVCAL_IO_MULTI_IMU_LOG_H_
+#ifndef GRAVCAL_WORKFLOWS_MULTI_IMU_LOG_H_
+#define GRAVCAL_WORKFLOWS_MULTI_IMU_LOG_H_
 
 #include <Eigen/Core>
 #include <string>
@@ -100,4 +100,4 @@ int NearestPx4Rotation(const Eigen::Matrix3d& rotation, double* angle_deg);
 
 }  // namespace gravcal
 
-#endif  // GRAVCAL_IO_MULTI_IMU_LOG_H_
+#endif  // GRAVCAL_WORKFLOWS_MULTI_IMU_LOG_H_
