@@ -27,6 +27,7 @@ using internal::FromRotationVector;
 // Corner frequency of the first-order low-pass that shapes hand tremor, Hz.
 constexpr double kTremorCornerHz = 5.0;
 
+using internal::SmoothStep;
 using internal::SmoothStepRate;
 
 long SampleCount(double seconds, double rate) { return std::lround(seconds * rate); }
