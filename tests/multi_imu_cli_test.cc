@@ -15,7 +15,7 @@ namespace {
 
 using namespace testing_util;
 
-const std::string kConfig = std::string(GRAVCAL_SOURCE_DIR) + "/configs/multi_imu.yaml";
+const std::string kMultiImuConfig = std::string(GRAVCAL_SOURCE_DIR) + "/configs/multi_imu.yaml";
 
 std::string PlateCsv(int imus, int permuted) {
   PlateSimulatorOptions o;
@@ -36,8 +36,8 @@ TEST(MultiImuCli, CalibratesATableOfThreeImus) {
   ScratchDir scratch;
   const std::string input = scratch.Write("plate.csv", PlateCsv(3, 2));
   const std::string out = scratch / "out";
-  const CliResult r = RunCli({"calibrate", "--config", kConfig, "--input", input, "--output-dir",
-                              out, "--report", scratch / "report.html"},
+  const CliResult r = RunCli({"calibrate", "--config", kMultiImuConfig, "--input", input,
+                              "--output-dir", out, "--report", scratch / "report.html"},
                              scratch);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* name : {"imu0.json", "imu1.json", "imu2.json", "assembly.json",
@@ -65,8 +65,8 @@ TEST(MultiImuCli, BadConfigsAndTablesAreRefused) {
   ScratchDir scratch;
   const std::string out = scratch / "out";
   const std::string input = scratch.Write("plate.csv", "t,a.ax,a.ay\n0,1,2\n");
-  CliResult r =
-      RunCli({"calibrate", "--config", kConfig, "--input", input, "--output-dir", out}, scratch);
+  CliResult r = RunCli(
+      {"calibrate", "--config", kMultiImuConfig, "--input", input, "--output-dir", out}, scratch);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("found no IMU columns"), std::string::npos) << r.err;
   EXPECT_FALSE(FileExists(out + "/assembly.json"));
@@ -75,7 +75,7 @@ TEST(MultiImuCli, BadConfigsAndTablesAreRefused) {
   r = RunCli({"calibrate", "--config", bad, "--input", input, "--output-dir", out}, scratch);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("bad.yaml:4: imus[0]: unknown key 'colums'"), std::string::npos) << r.err;
-  r = RunCli({"calibrate", "--config", kConfig, "--input", input}, scratch);
+  r = RunCli({"calibrate", "--config", kMultiImuConfig, "--input", input}, scratch);
   EXPECT_NE(r.err.find("needs --output-dir"), std::string::npos) << r.err;
   const std::string missing =
       scratch.Write("missing.yaml", "imus:\n  - name: a\n  - name: b\n    accel_units: furlongs\n");
