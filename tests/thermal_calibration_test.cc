@@ -206,6 +206,29 @@ TEST(ThermalCalibration, UncontrolledWarmUpWithPoses) {
   }
 }
 
+// Raw counts calibrated with nominal_scale 1 (a config for SI data): the
+// fit starts from the data's own scale, says so, and still finds the
+// temperature terms; before, every order came out 0 with exit 0.
+TEST(ThermalCalibration, NominalScaleFarOffIsNamedAndTheFitStillWorks) {
+  const ThermalSimulatorOptions sim;
+  ThermalSimulatedSession truth;
+  ThermalCalibrationOptions given;  // nominal scales 1: wrong for counts
+  Calibration c;
+  ASSERT_TRUE(Calibrate(sim, 12, &given, &truth, &c));
+  bool named = false;
+  for (const std::string& w : c.warnings) named |= w.find("nominal_scale") != std::string::npos;
+  EXPECT_TRUE(named) << c.message;
+  EXPECT_GE(c.thermal.accel.bias.order, 1) << c.message;
+  EXPECT_GE(c.thermal.gyro.bias.order, 1) << c.message;
+  ThermalCalibrationOptions right = OptionsFor(truth);
+  Calibration reference;
+  ASSERT_TRUE(Calibrate(sim, 12, &right, &truth, &reference));
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(c.accel.model.bias(i), reference.accel.model.bias(i),
+                1e-3 * std::abs(reference.accel.model.bias(i)) + 1e-6);
+  }
+}
+
 TEST(ThermalCalibration, RefusesALogWithoutTemperature) {
   ThermalSimulatorOptions sim;
   ThermalSimulatedSession truth;

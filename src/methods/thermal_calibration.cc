@@ -283,6 +283,32 @@ std::vector<std::string> ThermalSpanMessages(double span, const ThermalCalibrati
 
 namespace {
 
+// The accelerometer scale the fit starts from: nominal_scale, unless the
+// window means read with it are not near gravity (median |a| outside
+// [0.5 g, 1.5 g]: raw counts with nominal_scale 1, or SI data given a
+// counts sensitivity). Then the data's own scale g / median |a_raw| is used
+// and `note` says so (an offset-free start; the fit estimates the rest).
+double StartAccelScale(const std::vector<ThermalWindow>& windows,
+                       const ThermalCalibrationOptions& o, std::string* note) {
+  std::vector<double> norms;
+  for (const ThermalWindow& w : windows) norms.push_back(w.accel_mean.norm());
+  if (norms.empty()) return o.accel_nominal_scale;
+  std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
+  const double median = norms[norms.size() / 2];
+  const double read = median * o.accel_nominal_scale;
+  if (!(median > 0.0) || (read > 0.5 * o.gravity && read < 1.5 * o.gravity)) {
+    return o.accel_nominal_scale;
+  }
+  const double scale = o.gravity / median;
+  std::ostringstream s;
+  s.precision(4);
+  s << "nominal_scale " << o.accel_nominal_scale << " reads the static poses as " << read
+    << " m/s^2, not gravity: the fit starts from the data's own scale " << scale
+    << " (set nominal_scale to m/s^2 per raw unit)";
+  *note = s.str();
+  return scale;
+}
+
 // One fit at fixed orders.
 struct Fit {
   bool ok = false;
@@ -304,6 +330,7 @@ class ThermalFitter {
         has_gyro_(has_gyro),
         reference_(reference_temperature),
         half_span_(std::max(1.0, 0.5 * span)) {
+    start_accel_scale_ = StartAccelScale(windows, o, &scale_note_);
     // The spread of the window means per axis, the data-based floor of the
     // bias terms' prior ranges: for the accelerometer within each static
     // interval (between poses gravity moves, not the temperature), for the
@@ -332,7 +359,7 @@ class ThermalFitter {
     const ThermalLayout layout(orders, has_gyro_);
     std::vector<double> initial(layout.size, 0.0);
     initial[layout.upper + 0] = initial[layout.upper + 3] = initial[layout.upper + 5] =
-        o_.accel_nominal_scale;
+        start_accel_scale_;
     if (has_gyro_) {
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       for (const ThermalWindow& w : windows_) mean += w.gyro_mean;
@@ -389,6 +416,9 @@ class ThermalFitter {
     }
     return f.chi2 + k * std::log(n);
   }
+
+  // Non-empty when nominal_scale did not read the poses near gravity.
+  const std::string& scale_note() const { return scale_note_; }
 
  private:
   std::vector<bool> Held(const ThermalLayout& layout, std::vector<bool> fixed) const {
@@ -599,6 +629,8 @@ class ThermalFitter {
   const double reference_;
   const double half_span_;
   double accel_range_ = 0.0;
+  double start_accel_scale_ = 1.0;
+  std::string scale_note_;
   double gyro_range_ = 0.0;
   int single_axis_ = -1;
   bool faces_only_ = false;
@@ -893,6 +925,10 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
   for (const std::string& m : ThermalSpanMessages(span, options)) {
     out.warnings.push_back(m);
     out.warning_codes.push_back(WarningCode::kUndetermined);
+  }
+  if (!fitter.scale_note().empty()) {
+    out.warnings.push_back(fitter.scale_note());
+    out.warning_codes.push_back(WarningCode::kUnclassified);
   }
   // Positions: one per static interval, with the residual after the model.
   ImuCorrector corrector;
