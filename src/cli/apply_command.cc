@@ -3,10 +3,21 @@
 // in constant memory), "-" for standard input and output. Exit 0 written; 1
 // bad input (no output file; on standard output nothing is written when the
 // problem shows before the first sample).
+//
+// A two-stage pipeline (issue 39 part 3): this thread reads and parses the
+// log into blocks of rows (and the temperature's rate, which runs in order);
+// worker threads (one per core) correct and format whole blocks into text;
+// this thread writes the blocks in their order. The output is the same
+// bytes as one thread's, and an error is the first one in row order.
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
+#include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli/commands.h"
@@ -34,11 +45,128 @@ std::vector<std::string> OutputComment(const std::string& calibration_path,
   return lines;
 }
 
-}  // namespace
-
 // Samples further than this outside a thermal model's valid range are
 // counted in apply's warning, degrees C.
 constexpr double kClampWarningDegrees = 0.5;
+
+// Rows per block handed to a worker.
+constexpr size_t kApplyBlockRows = 8192;
+
+// A block of rows: read here, corrected and formatted by a worker.
+struct ApplyBlock {
+  size_t rows = 0;
+  std::vector<ImuSample> samples = std::vector<ImuSample>(kApplyBlockRows);
+  std::vector<double> rates = std::vector<double>(kApplyBlockRows);
+  // The reader's position() of each row, for messages.
+  std::vector<size_t> positions = std::vector<size_t>(kApplyBlockRows);
+  std::unique_ptr<char[]> text =
+      std::make_unique<char[]>(kApplyBlockRows * ImuCsvStreamWriter::kMaxRowBytes);
+  size_t text_size = 0;
+  // The first row that failed (rows when none), and how.
+  size_t failed_row = 0;
+  bool no_root = false;
+  // Samples clamped by more than kClampWarningDegrees, and their range.
+  size_t clamped = 0;
+  double lowest = INFINITY, highest = -INFINITY;
+  bool done = true;  // Guarded by ApplyWorkers::mutex_.
+};
+
+// Corrects and formats a block's rows (stops at the first row that fails).
+void CorrectBlock(const ImuCorrector& corrector, bool gyro, bool temperature, ApplyBlock* b) {
+  b->failed_row = b->rows;
+  b->clamped = 0;
+  b->lowest = INFINITY;
+  b->highest = -INFINITY;
+  char* p = b->text.get();
+  const ThermalModel& th = corrector.thermal;
+  for (size_t i = 0; i < b->rows; ++i) {
+    ImuSample& sample = b->samples[i];
+    bool clamped = false;
+    if (!corrector.CorrectRow(sample.temperature, b->rates[i], sample.t, &sample.accel,
+                              gyro ? &sample.gyro : nullptr, &clamped)) {
+      b->failed_row = i;
+      b->no_root = true;
+      break;
+    }
+    // Finite readings and a checked calibration can still overflow (a
+    // reading of 1e300 counts): nothing that is not a number is written.
+    if (!sample.accel.allFinite() || !sample.gyro.allFinite()) {
+      b->failed_row = i;
+      b->no_root = false;
+      break;
+    }
+    p = ImuCsvStreamWriter::FormatRow(sample, gyro, temperature, p);
+    // Clamped by more than the temperature sensor's noise: counted.
+    if (clamped && (sample.temperature < th.min_temperature - kClampWarningDegrees ||
+                    sample.temperature > th.max_temperature + kClampWarningDegrees)) {
+      ++b->clamped;
+      b->lowest = std::min(b->lowest, sample.temperature);
+      b->highest = std::max(b->highest, sample.temperature);
+    }
+  }
+  b->text_size = static_cast<size_t>(p - b->text.get());
+}
+
+// Worker threads running CorrectBlock on the blocks submitted, in any
+// order; Wait(b) returns when b is done. Without threads, Submit runs it.
+class ApplyWorkers {
+ public:
+  ApplyWorkers(int threads, const ImuCorrector& corrector, bool gyro, bool temperature)
+      : corrector_(corrector), gyro_(gyro), temperature_(temperature) {
+    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { Run(); });
+  }
+  ~ApplyWorkers() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    work_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+  void Submit(ApplyBlock* b) {
+    if (threads_.empty()) return CorrectBlock(corrector_, gyro_, temperature_, b);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      b->done = false;
+      queue_.push_back(b);
+    }
+    work_.notify_one();
+  }
+  void Wait(ApplyBlock* b) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [b] { return b->done; });
+  }
+
+ private:
+  void Run() {
+    for (;;) {
+      ApplyBlock* b = nullptr;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        work_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+        if (queue_.empty()) return;
+        b = queue_.front();
+        queue_.pop_front();
+      }
+      CorrectBlock(corrector_, gyro_, temperature_, b);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        b->done = true;
+      }
+      done_.notify_all();
+    }
+  }
+
+  const ImuCorrector& corrector_;
+  const bool gyro_, temperature_;
+  std::mutex mutex_;
+  std::condition_variable work_, done_;
+  std::deque<ApplyBlock*> queue_;
+  bool stop_ = false;
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace
 
 int RunApply(const ApplyArgs& args) {
   std::string calibration_path, error;
@@ -79,50 +207,82 @@ int RunApply(const ApplyArgs& args) {
   }
   // The first sample is read before the output is opened, so that a bad
   // first row writes nothing (a log without one is an error).
-  ImuSample sample;
-  if (!reader.Next(&sample, &error)) return Fail(error);
+  const bool gyro = reader.has_gyro(), temperature = reader.has_temperature();
+  const int threads = static_cast<int>(std::min(8u, std::thread::hardware_concurrency()));
+  std::vector<ApplyBlock> ring(2 * static_cast<size_t>(std::max(threads, 1)) + 2);
+  ImuSample* first = &ring[0].samples[0];
+  if (!reader.Next(first, &error)) return Fail(error);
   ImuCsvStreamWriter writer;
-  if (!writer.Open(args.output, reader.has_gyro(), reader.has_temperature(),
-                   OutputComment(calibration_path, calibration, reader.has_gyro()), &error)) {
+  if (!writer.Open(args.output, gyro, temperature,
+                   OutputComment(calibration_path, calibration, gyro), &error)) {
     return Fail(error);
   }
-  size_t count = 0;
-  // Issue 35: the thermal model's lag needs the temperature's rate; its
-  // range is clamped (and counted for one warning).
-  ThermalRate rate;
+  ApplyWorkers workers(threads, corrector, gyro, temperature);
+  size_t count = 0, submitted = 0, written = 0;
   size_t clamped_count = 0;
   double lowest = INFINITY, highest = -INFINITY;
-  for (bool more = true; more; more = reader.Next(&sample, &error)) {
-    bool clamped = false;
-    const double temperature_rate = rate.Add(sample.t, sample.temperature);
-    if (!corrector.CorrectRow(sample.temperature, temperature_rate, sample.t, &sample.accel,
-                              reader.has_gyro() ? &sample.gyro : nullptr, &clamped)) {
-      writer.Abort();
-      return Fail(reader.where() +
-                  ": the quadratic term has no real root (reading outside the calibrated range)");
+  // Writes the oldest block submitted; false with `error` set when one of
+  // its rows failed (nothing after it is written).
+  auto write_oldest = [&]() {
+    ApplyBlock& b = ring[written++ % ring.size()];
+    workers.Wait(&b);
+    if (b.failed_row < b.rows) {
+      error = reader.where(b.positions[b.failed_row]) +
+              (b.no_root ? ": the quadratic term has no real root (reading outside the "
+                           "calibrated range)"
+                         : ": the corrected sample is not finite (the reading times the "
+                           "calibration overflows)");
+      return false;
     }
-    // Finite readings and a checked calibration can still overflow (a
-    // reading of 1e300 counts): nothing that is not a number is written.
-    if (!sample.accel.allFinite() || !sample.gyro.allFinite()) {
+    count += b.rows;
+    clamped_count += b.clamped;
+    lowest = std::min(lowest, b.lowest);
+    highest = std::max(highest, b.highest);
+    return writer.WriteRows(b.text.get(), b.text_size, &error);
+  };
+  // Issue 35: the thermal model's lag needs the temperature's rate, which
+  // runs through the rows in order (here); its range is clamped (and
+  // counted for one warning).
+  ThermalRate rate;
+  std::string read_error;
+  for (bool more = true; more;) {
+    if (submitted - written == ring.size() && !write_oldest()) {
       writer.Abort();
-      return Fail(reader.where() +
-                  ": the corrected sample is not finite (the reading times the "
-                  "calibration overflows)");
+      return Fail(error);
     }
-    if (!writer.Write(sample, &error)) return Fail(error);
-    ++count;
-    // Clamped by more than the temperature sensor's noise: counted.
-    const ThermalModel& th = corrector.thermal;
-    if (clamped && (sample.temperature < th.min_temperature - kClampWarningDegrees ||
-                    sample.temperature > th.max_temperature + kClampWarningDegrees)) {
-      ++clamped_count;
-      lowest = std::min(lowest, sample.temperature);
-      highest = std::max(highest, sample.temperature);
+    ApplyBlock& b = ring[submitted % ring.size()];
+    b.rows = 0;
+    if (submitted == 0) {  // The first sample, read above.
+      b.rates[0] = rate.Add(first->t, first->temperature);
+      b.positions[0] = reader.position();
+      b.rows = 1;
+    }
+    while (b.rows < kApplyBlockRows) {
+      ImuSample& sample = b.samples[b.rows];
+      if (!reader.Next(&sample, &read_error)) {
+        more = false;
+        break;
+      }
+      b.rates[b.rows] = rate.Add(sample.t, sample.temperature);
+      b.positions[b.rows] = reader.position();
+      ++b.rows;
+    }
+    if (b.rows > 0) {
+      workers.Submit(&b);
+      ++submitted;
     }
   }
-  if (!error.empty()) {
+  // Errors in row order: a row that failed to correct comes before a row
+  // that failed to read (which is after every row read).
+  while (written < submitted) {
+    if (!write_oldest()) {
+      writer.Abort();
+      return Fail(error);
+    }
+  }
+  if (!read_error.empty()) {
     writer.Abort();
-    return Fail(error);
+    return Fail(read_error);
   }
   if (!writer.Commit(&error)) return Fail(error);
   if (clamped_count > 0) {

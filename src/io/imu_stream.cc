@@ -144,12 +144,17 @@ bool ImuCsvStreamReader::Next(ImuSample* sample, std::string* error) {
   return true;
 }
 
-std::string ImuCsvStreamReader::where() const {
+std::string ImuCsvStreamReader::where() const { return where(position()); }
+
+size_t ImuCsvStreamReader::position() const {
+  if (state_ == nullptr) return 0;
+  if (state_->whole) return state_->next > 0 ? state_->next - 1 : 0;
+  return state_->lines != nullptr ? state_->lines->number() : 0;
+}
+
+std::string ImuCsvStreamReader::where(size_t position) const {
   if (state_ == nullptr) return name_;
-  if (state_->whole) {
-    return name_ + ": sample " + std::to_string(state_->next > 0 ? state_->next - 1 : 0);
-  }
-  return name_ + ":" + std::to_string(state_->lines != nullptr ? state_->lines->number() : 0);
+  return name_ + (state_->whole ? ": sample " : ":") + std::to_string(position);
 }
 
 ImuCsvStreamWriter::~ImuCsvStreamWriter() { Abort(); }
@@ -175,21 +180,23 @@ bool ImuCsvStreamWriter::Open(const std::string& path, bool gyro, bool temperatu
   return true;
 }
 
-bool ImuCsvStreamWriter::Flush(std::string* error) {
-  if (stdout_ == nullptr) {
-    if (!file_.Write(buffer_.data(), buffer_.size(), error)) return false;
-  } else if (!buffer_.empty() &&
-             std::fwrite(buffer_.data(), 1, buffer_.size(), stdout_) != buffer_.size()) {
+bool ImuCsvStreamWriter::WriteOut(const char* data, size_t size, std::string* error) {
+  if (stdout_ == nullptr) return file_.Write(data, size, error);
+  if (size > 0 && std::fwrite(data, 1, size, stdout_) != size) {
     *error = "standard output: cannot write: " + ErrnoText();
     return false;
   }
+  return true;
+}
+
+bool ImuCsvStreamWriter::Flush(std::string* error) {
+  if (!WriteOut(buffer_.data(), buffer_.size(), error)) return false;
   buffer_.clear();
   return true;
 }
 
-bool ImuCsvStreamWriter::Write(const ImuSample& s, std::string* error) {
-  char text[32 * 8];
-  char* p = text;
+char* ImuCsvStreamWriter::FormatRow(const ImuSample& s, bool gyro, bool temperature, char* p) {
+  static_assert(kMaxRowBytes >= 8 * (internal::kMaxShortestDouble + 1), "room for a row");
   auto put = [&](double v, char separator) {
     p = internal::WriteShortestDouble(v, p);
     *p++ = separator;
@@ -197,15 +204,28 @@ bool ImuCsvStreamWriter::Write(const ImuSample& s, std::string* error) {
   put(s.t, ',');
   put(s.accel(0), ',');
   put(s.accel(1), ',');
-  put(s.accel(2), gyro_ || temperature_ ? ',' : '\n');
-  if (gyro_) {
+  put(s.accel(2), gyro || temperature ? ',' : '\n');
+  if (gyro) {
     put(s.gyro(0), ',');
     put(s.gyro(1), ',');
-    put(s.gyro(2), temperature_ ? ',' : '\n');
+    put(s.gyro(2), temperature ? ',' : '\n');
   }
-  if (temperature_) put(s.temperature, '\n');
-  buffer_.append(text, p);
+  if (temperature) put(s.temperature, '\n');
+  return p;
+}
+
+bool ImuCsvStreamWriter::Write(const ImuSample& s, std::string* error) {
+  char text[kMaxRowBytes];
+  buffer_.append(text, FormatRow(s, gyro_, temperature_, text));
   return buffer_.size() < kBufferSize || Flush(error);
+}
+
+bool ImuCsvStreamWriter::WriteRows(const char* text, size_t size, std::string* error) {
+  if (buffer_.size() + size < kBufferSize) {
+    buffer_.append(text, size);
+    return true;
+  }
+  return Flush(error) && WriteOut(text, size, error);
 }
 
 bool ImuCsvStreamWriter::Commit(std::string* error) {

@@ -18,8 +18,38 @@ constexpr char kPairs[] =
     "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
     "8081828384858687888990919293949596979899";
 
-// Writes the `count` digits of x at p (x has exactly that many digits).
-void WriteDigits(uint64_t x, int count, char* p) { fmt::detail::format_decimal<char>(p, x, count); }
+// Writes the 8 digits of x < 10^8 (leading zeros included) at p: four
+// independent pairs, not a chain of divisions.
+inline void WriteEightDigits(uint32_t x, char* p) {
+  const uint32_t high = x / 10000, low = x % 10000;
+  std::memcpy(p, kPairs + 2 * (high / 100), 2);
+  std::memcpy(p + 2, kPairs + 2 * (high % 100), 2);
+  std::memcpy(p + 4, kPairs + 2 * (low / 100), 2);
+  std::memcpy(p + 6, kPairs + 2 * (low % 100), 2);
+}
+
+// Writes the `count` digits of x at p (x has exactly that many digits),
+// eight at a time from the right.
+inline void WriteDigits(uint64_t x, int count, char* p) {
+  char* end = p + count;
+  while (x >= 100000000) {
+    const uint64_t q = x / 100000000;
+    end -= 8;
+    WriteEightDigits(static_cast<uint32_t>(x - q * 100000000), end);
+    x = q;
+  }
+  uint32_t y = static_cast<uint32_t>(x);
+  while (y >= 100) {
+    end -= 2;
+    std::memcpy(end, kPairs + 2 * (y % 100), 2);
+    y /= 100;
+  }
+  if (y >= 10) {
+    std::memcpy(end - 2, kPairs + 2 * y, 2);
+  } else {
+    end[-1] = static_cast<char>('0' + y);
+  }
+}
 
 }  // namespace
 

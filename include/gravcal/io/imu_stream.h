@@ -60,6 +60,11 @@ class ImuCsvStreamReader {
   // Where the last sample was, for messages: "log.csv:17" for text,
   // "log.bag: sample 16" for a log read whole.
   std::string where() const;
+  // The same place as a number (the line for text, the sample for a log
+  // read whole), to name it later with where(position) (gravcal apply
+  // corrects rows on other threads).
+  size_t position() const;
+  std::string where(size_t position) const;
 
  private:
   struct State;
@@ -84,6 +89,12 @@ class ImuCsvStreamWriter {
             const std::vector<std::string>& comment, std::string* error);
   // Numbers are written in the shortest form that reads back exactly.
   bool Write(const ImuSample& sample, std::string* error);
+  // The row Write writes, formatted at p (room for kMaxRowBytes); returns
+  // its end. For callers that format rows on several threads.
+  static constexpr size_t kMaxRowBytes = 8 * 25;
+  static char* FormatRow(const ImuSample& sample, bool gyro, bool temperature, char* p);
+  // Rows formatted by FormatRow (with this writer's gyro and temperature).
+  bool WriteRows(const char* text, size_t size, std::string* error);
   // Flushes, closes and renames the temporary file onto the output.
   bool Commit(std::string* error);
   // Removes the temporary file (nothing for standard output).
@@ -91,6 +102,7 @@ class ImuCsvStreamWriter {
 
  private:
   bool Flush(std::string* error);
+  bool WriteOut(const char* data, size_t size, std::string* error);
 
   // Standard output, or nullptr when writing to `file_`.
   std::FILE* stdout_ = nullptr;

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <fstream>
 
+#include "io/formats/reader_module.h"
+
 namespace gravcal {
 namespace internal {
 namespace {
@@ -80,11 +82,10 @@ bool DetectFileFormatOf(const std::string& path, FileFormat* format, std::string
 std::unique_ptr<MessageRecording> NewMessageRecording(FileFormat format) {
   switch (format) {
     case FileFormat::kRos1Bag:
-      return NewRos1Bag();
     case FileFormat::kRosbag2Sqlite:
-      return NewRosbag2Sqlite();
     case FileFormat::kMcap:
-      return NewMcapFile();
+      // Read by the reader module, loaded when the file is opened.
+      return NewModuleRecording(static_cast<int>(format), FileFormatName(format));
     default:
       return nullptr;
   }

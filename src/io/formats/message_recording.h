@@ -80,6 +80,8 @@ inline std::string OneLine(const std::string& text) {
   return out;
 }
 
+// The readers themselves, compiled into the reader module only
+// (reader_module.h); the library reaches them through NewMessageRecording.
 std::unique_ptr<MessageRecording> NewRos1Bag();
 std::unique_ptr<MessageRecording> NewRosbag2Sqlite();
 std::unique_ptr<MessageRecording> NewMcapFile();
