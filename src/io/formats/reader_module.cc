@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <climits>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -29,8 +30,7 @@ std::string FolderOf(const std::string& path) {
 }
 
 // The folder of the binary this code is in: the tool, the Python
-// extension or a program linking the library (dladdr names the main
-// program "", hence /proc/self/exe).
+// extension or a program linking the library.
 std::string OwnFolder() {
   Dl_info info{};
   std::string file;
@@ -38,8 +38,10 @@ std::string OwnFolder() {
       info.dli_fname != nullptr) {
     file = info.dli_fname;
   }
-  if (file.empty() || file.find('/') == std::string::npos) {
-    char exe[4096];
+  // The main program is named as it was started (maybe relative, and the
+  // folder may have changed since): /proc/self/exe names its file.
+  if (file.empty() || file[0] != '/') {
+    char exe[PATH_MAX];
     const ssize_t n = readlink("/proc/self/exe", exe, sizeof(exe) - 1);
     if (n <= 0) return std::string();
     file.assign(exe, static_cast<size_t>(n));
