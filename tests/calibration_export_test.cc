@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +22,7 @@
 
 #include "cli_runner.h"
 #include "gravcal/core/calibration.h"
+#include "gravcal/core/thermal_rate.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/imu_stream.h"
 #include "gravcal/io/log_reader.h"
@@ -232,6 +234,65 @@ TEST(Apply, BadRowLeavesNoOutputFile) {
   EXPECT_NE(r.err.find("raw.csv:102: column 'az': 'abc' is not a number"), std::string::npos)
       << r.err;
   EXPECT_FALSE(testing_util::FileExists(out));
+}
+
+// apply corrects and formats blocks of 8192 rows on worker threads: a log
+// of several blocks comes out as the library's one-thread loop writes it,
+// byte for byte, and a row that fails in a later block is named by its line
+// with no file left.
+TEST(Apply, RowsCorrectedOnWorkerThreadsAreTheOneThreadBytes) {
+  const ScratchDir scratch;
+  const std::string calib = WriteCalibration(scratch, FullCalibration(true));
+  std::string text = RawLog(30000, true, 5);
+  const std::string raw = scratch.Write("raw.csv", text);
+  const std::string out = scratch / "out.csv";
+  const testing_util::CliResult r =
+      RunCli("apply --calibration " + calib + " --input " + raw + " --output " + out, scratch);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  LoadedCalibration loaded;
+  std::string error;
+  ASSERT_TRUE(ReadCalibrationJson(calib, &loaded, &error)) << error;
+  ImuCsvStreamReader reader;
+  ImuCsvStreamWriter writer;
+  ASSERT_TRUE(reader.Open(raw, &error)) << error;
+  ASSERT_TRUE(writer.Open(scratch / "one_thread.csv", true, true, {}, &error)) << error;
+  ThermalRate rate;
+  ImuSample s;
+  while (reader.Next(&s, &error)) {
+    bool clamped = false;
+    ASSERT_TRUE(loaded.corrector.CorrectRow(s.temperature, rate.Add(s.t, s.temperature), s.t,
+                                            &s.accel, &s.gyro, &clamped));
+    ASSERT_TRUE(writer.Write(s, &error)) << error;
+  }
+  ASSERT_EQ(error, "");
+  ASSERT_TRUE(writer.Commit(&error)) << error;
+  const std::string got = Slurp(out), want = Slurp(scratch / "one_thread.csv");
+  const size_t header = got.find("\nt,ax,ay,az,gx,gy,gz,temp\n");
+  ASSERT_NE(header, std::string::npos);
+  EXPECT_TRUE(got.substr(header + 1) == want) << "the rows differ from the one-thread loop's";
+  EXPECT_EQ(std::count(got.begin() + header + 1, got.end(), '\n'), 30001);
+
+  // A reading of 1e300 counts at row 25000 (line 25002, the fourth block)
+  // through a scale of 1e100 overflows.
+  size_t at = 0;
+  for (int line = 1; line < 25002; ++line) at = text.find('\n', at) + 1;
+  text.replace(at, text.find(',', text.find(',', at) + 1) - at,
+               text.substr(at, text.find(',', at) - at) + ",1e300");
+  Calibration huge = FullCalibration(false);
+  huge.accel.model.upper *= 1e100;
+  const std::string huge_calib = WriteCalibration(scratch, huge, "huge.json");
+  const std::string bad = scratch.Write("bad.csv", text);
+  const std::string bad_out = scratch / "bad_out.csv";
+  const testing_util::CliResult f = RunCli(
+      "apply --calibration " + huge_calib + " --input " + bad + " --output " + bad_out, scratch);
+  EXPECT_EQ(f.exit_code, 1);
+  EXPECT_NE(f.err.find("gravcal: error: " + bad +
+                       ":25002: the corrected sample is not finite (the reading times the "
+                       "calibration overflows)"),
+            std::string::npos)
+      << f.err;
+  EXPECT_FALSE(testing_util::FileExists(bad_out));
 }
 
 // A log larger than the address space the process may use goes through:
