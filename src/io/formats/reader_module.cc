@@ -17,13 +17,13 @@ namespace internal {
 
 namespace {
 
-struct LoadedModule {
+struct ReaderModuleState {
   ReaderModuleNewFunction create = nullptr;
   std::string where;  // The file loaded.
   std::string why;    // Why it was not, when create is null.
 };
 
-std::string FolderOf(const std::string& path) {
+std::string ModuleFolderOf(const std::string& path) {
   const size_t slash = path.rfind('/');
   if (slash == std::string::npos) return ".";
   return slash == 0 ? "/" : path.substr(0, slash);
@@ -31,7 +31,7 @@ std::string FolderOf(const std::string& path) {
 
 // The folder of the binary this code is in: the tool, the Python
 // extension or a program linking the library.
-std::string OwnFolder() {
+std::string ModuleOwnFolder() {
   Dl_info info{};
   std::string file;
   if (dladdr(reinterpret_cast<void*>(&NewModuleRecording), &info) != 0 &&
@@ -46,7 +46,7 @@ std::string OwnFolder() {
     if (n <= 0) return std::string();
     file.assign(exe, static_cast<size_t>(n));
   }
-  return FolderOf(file);
+  return ModuleFolderOf(file);
 }
 
 std::vector<std::string> ModuleFolders() {
@@ -56,7 +56,7 @@ std::vector<std::string> ModuleFolders() {
     folders.push_back(dir);
     return folders;
   }
-  const std::string own = OwnFolder();
+  const std::string own = ModuleOwnFolder();
   if (!own.empty()) {
     folders.push_back(own);
     folders.push_back(own + "/../" GRAVCAL_MODULE_INSTALL_LIBDIR "/gravcal");
@@ -67,8 +67,8 @@ std::vector<std::string> ModuleFolders() {
   return folders;
 }
 
-LoadedModule Load() {
-  LoadedModule m;
+ReaderModuleState LoadReaderModuleOnce() {
+  ReaderModuleState m;
   std::string looked;
   for (const std::string& folder : ModuleFolders()) {
     const std::string file = folder + "/" + kReaderModuleFile;
@@ -105,8 +105,8 @@ LoadedModule Load() {
   return m;
 }
 
-const LoadedModule& Module() {
-  static const LoadedModule module = Load();  // Thread-safe, once.
+const ReaderModuleState& TheReaderModule() {
+  static const ReaderModuleState module = LoadReaderModuleOnce();  // Thread-safe, once.
   return module;
 }
 
@@ -117,7 +117,7 @@ class ModuleRecording : public MessageRecording {
       : format_(format), format_name_(format_name) {}
   const char* FormatName() const override { return format_name_; }
   bool Open(const std::string& path, std::string* error) override {
-    const LoadedModule& m = Module();
+    const ReaderModuleState& m = TheReaderModule();
     if (m.create == nullptr) {
       *error = path + ": cannot read a " + format_name_ + ": " + m.why;
       return false;
@@ -155,7 +155,7 @@ std::unique_ptr<MessageRecording> NewModuleRecording(int format, const char* for
 }
 
 bool LoadReaderModule(std::string* where, std::string* why) {
-  const LoadedModule& m = Module();
+  const ReaderModuleState& m = TheReaderModule();
   *where = m.where;
   *why = m.why;
   return m.create != nullptr;
