@@ -17,6 +17,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -113,7 +114,12 @@ class ApplyWorkers {
  public:
   ApplyWorkers(int threads, const ImuCorrector& corrector, bool gyro, bool temperature)
       : corrector_(corrector), gyro_(gyro), temperature_(temperature) {
-    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { Run(); });
+    // A thread that cannot be started (a process limit) leaves fewer, or
+    // none: then Submit corrects on the calling thread.
+    try {
+      for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { Run(); });
+    } catch (const std::system_error&) {
+    }
   }
   ~ApplyWorkers() {
     {
