@@ -306,5 +306,71 @@ TEST(Acceptance, BadLimitsFileIsOneLineAndNothingWritten) {
   }
 }
 
+// merge-summaries keeps the shards' acceptance (issue 36): two shards of a
+// batch checked against one limits file merge into one acceptance section
+// (counts summed, the failed units in fleet order) and one limits.csv; a
+// shard checked against limits beside one that was not is refused by name,
+// nothing written.
+TEST(Acceptance, MergeSummariesKeepsTheShardsAcceptance) {
+  ScratchDir dir;
+  ASSERT_NO_FATAL_FAILURE(SimulateUnits(dir, 4));
+  auto shard = [&](int k, bool limits) {
+    std::vector<std::string> args = {"batch",
+                                     "--input-dir",
+                                     dir / "units",
+                                     "--config",
+                                     kConfig,
+                                     "--output-dir",
+                                     dir / ("out" + std::to_string(k)),
+                                     "--threads",
+                                     "1",
+                                     "--shard",
+                                     std::to_string(k) + "/2"};
+    if (limits) {
+      args.push_back("--limits");
+      args.push_back(dir / "limits.yaml");
+    }
+    return RunCli(args, dir);
+  };
+  ASSERT_EQ(shard(1, false).exit_code, 0);
+  ASSERT_EQ(shard(2, false).exit_code, 0);
+  std::vector<std::pair<double, std::string>> bias;
+  for (int k = 1; k <= 4; ++k) {
+    const std::string unit = "u" + std::to_string(k);
+    const std::string path = FileExists(dir / ("out1/" + unit + ".json"))
+                                 ? dir / ("out1/" + unit + ".json")
+                                 : dir / ("out2/" + unit + ".json");
+    bias.emplace_back(nlohmann::json::parse(Slurp(path))["accel"]["bias"][2].get<double>(), unit);
+  }
+  std::sort(bias.begin(), bias.end());
+  WriteText(dir / "limits.yaml", "parameters:\n  accel.bias_z: {max: " +
+                                     std::to_string(0.5 * (bias[1].first + bias[2].first)) + "}\n");
+  shard(1, true);
+  CliResult r =
+      RunCli({"merge-summaries", "--output-dir", dir / "merged", dir / "out1", dir / "out2"}, dir);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("was checked against limits"), std::string::npos) << r.err;
+  EXPECT_FALSE(FileExists(dir / "merged/summary.json"));
+  shard(2, true);
+  r = RunCli({"merge-summaries", "--output-dir", dir / "merged", dir / "out1", dir / "out2"}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json a = nlohmann::json::parse(Slurp(dir / "merged/summary.json"))["acceptance"];
+  EXPECT_EQ(a["checked"], 4);
+  EXPECT_EQ(a["pass"], 2);
+  EXPECT_EQ(a["fail"], 2);
+  ASSERT_EQ(a["failed"].size(), 2u);
+  // In fleet order (u1 .. u4), the two with the larger z bias.
+  const std::string first = std::min(bias[2].second, bias[3].second);
+  const std::string second = std::max(bias[2].second, bias[3].second);
+  EXPECT_EQ(a["failed"][0]["unit"], first);
+  EXPECT_EQ(a["failed"][1]["unit"], second);
+  const std::string csv = Slurp(dir / "merged/limits.csv");
+  EXPECT_EQ(csv.rfind("unit,verdict,failed\n", 0), 0u) << csv;
+  EXPECT_LT(csv.find("u1,"), csv.find("u2,"));
+  EXPECT_LT(csv.find("u3,"), csv.find("u4,"));
+  EXPECT_NE(csv.find(first + ",fail,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(bias[0].second + ",pass,"), std::string::npos) << csv;
+}
+
 }  // namespace
 }  // namespace gravcal

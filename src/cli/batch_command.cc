@@ -10,6 +10,7 @@
 
 #include "cli/commands.h"
 #include "gravcal/workflows/batch_folder.h"
+#include "gravcal/workflows/multi_imu_log.h"
 #include "util/error.h"
 #include "workflows/batch_scheduler_shard.h"
 
@@ -157,6 +158,7 @@ void PrintHiddenNote(const std::string& folder, const std::vector<std::string>& 
 }  // namespace
 
 int RunBatch(const BatchArgs& args) {
+  if (IsMultiImuConfigFile(args.config_path)) return RunPlateBatch(args);
   BatchSource source;
   BatchFolderOptions options;
   std::string shard_source;

@@ -15,6 +15,7 @@
 #include "gravcal/simulation/simulated_attitudes.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/method_registry.h"
+#include "gravcal/workflows/multi_imu_log.h"
 #include "gravcal/workflows/pipeline.h"
 #include "gravcal/workflows/report.h"
 #include "gravcal/workflows/simulation_workflow.h"
@@ -171,6 +172,7 @@ int RunCalibrate(const CalibrateArgs& args) {
 }
 
 int RunSimulate(const SimulateArgs& args) {
+  if (IsMultiImuConfigFile(args.config_path)) return RunPlateSimulate(args);
   if (!args.stream.empty()) return RunSimulateStream(args);
   if (args.rate != 0.0 || !args.follow_events.empty()) {
     return Fail("--rate and --follow-events go with simulate --stream");

@@ -279,6 +279,10 @@ int RunMultiImuCalibrate(const std::string& config_path, const std::string& inpu
                          const std::string& output_dir, const std::string& report,
                          bool has_overrides);
 
+// batch and simulate with a multi-IMU config (plate_commands.cc).
+int RunPlateBatch(const BatchArgs& args);
+int RunPlateSimulate(const SimulateArgs& args);
+
 }  // namespace cli
 }  // namespace gravcal
 

@@ -539,7 +539,15 @@ int main(int argc, char** argv) {
                                      cli::FlagText("output_dir"), cli::FlagText("report"),
                                      !split.overrides.empty());
   }
-  if (!cli::LoadCommandConfig(split, &common.config, &error)) return cli::Fail(error);
+  // batch and simulate with a multi-IMU config: it is read by their plate
+  // variants (plate_commands.cc), not as a single-IMU config.
+  const bool plates = (command == "batch" || command == "simulate") &&
+                      gravcal::IsMultiImuConfigFile(cli::FlagText("config"));
+  if (plates && !split.overrides.empty()) {
+    return cli::Fail("a multi-IMU config's keys are not taken as flags; set them in " +
+                     cli::FlagText("config"));
+  }
+  if (!plates && !cli::LoadCommandConfig(split, &common.config, &error)) return cli::Fail(error);
   common.config_path = cli::FlagText("config");
   common.positional = split.positional;
   return info->run(std::move(common));

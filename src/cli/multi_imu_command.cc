@@ -137,23 +137,8 @@ int RunMultiImuCalibrate(const std::string& config_path, const std::string& inpu
     std::fprintf(stderr, "gravcal: warning: %s\n", w.c_str());
   }
   if (!MakeFolders(output_dir, &error)) return Fail(error);
-  std::vector<FileContents> files;
-  std::vector<double> rates;
-  for (size_t i = 0; i < result.imus.size(); ++i) {
-    Calibration c = result.imus[i].calibration;
-    c.provenance = provenance;
-    files.push_back({output_dir + "/" + result.imus[i].name + ".json",
-                     CalibrationToJson(c, config.output_covariance)});
-    const ImuLog& log = imus[i].log;
-    double rate = config.imus[i].update_rate;
-    if (!(rate > 0.0) && log.size() > 1) rate = (log.size() - 1) / (log.t.back() - log.t.front());
-    rates.push_back(rate);
-  }
-  files.push_back({output_dir + "/assembly.json", MultiImuAssemblyToJson(result)});
-  files.push_back(
-      {output_dir + "/kalibr_imu_chain.yaml", MultiImuKalibrChain(result, config, rates)});
-  files.push_back({output_dir + "/px4_rotations.params",
-                   MultiImuPx4Rotations(result, config.options.permutation_tolerance_deg)});
+  std::vector<FileContents> files =
+      MultiImuSessionFiles(result, config, imus, provenance, output_dir);
   if (!report.empty()) files.push_back({report, ReportHtml(result)});
   if (!WriteFilesAtomically(files, &error)) return Fail(error);
   for (const PlateImuResult& r : result.imus) {

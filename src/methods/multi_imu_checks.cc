@@ -84,6 +84,11 @@ std::vector<Eigen::Vector3d> Smooth(const std::vector<Eigen::Vector3d>& w) {
   return out;
 }
 
+double MeanInterval(const ImuLog& log) {
+  return log.size() > 1 ? (log.t.back() - log.t.front()) / static_cast<double>(log.size() - 1)
+                        : 1.0;
+}
+
 size_t IndexAt(const ImuLog& log, double t) {
   return std::lower_bound(log.t.begin(), log.t.end(), t) - log.t.begin();
 }
@@ -164,6 +169,13 @@ void EstimateTimeOffsets(const std::vector<PlateImuData>& data,
       continue;
     }
     const ImuLog& log = data[i].imu->log;
+    // The offset is a sum over the reference's samples; IMU i's noise
+    // enters through its rate smoothed and interpolated at them, which for
+    // the slow rate of a turn carries its noise density: per reference
+    // sample s_i^2 h_i / h_0 (h the sample intervals; two logs at
+    // different rates).
+    const double scaled_noise =
+        data[i].gyro_noise * std::sqrt(MeanInterval(log) / MeanInterval(ref_log));
     const double step = std::max(
         1e-4, 0.25 * (log.t.back() - log.t.front()) / std::max<double>(1.0, log.size() - 1.0));
     std::vector<double> times, taus, vars;
@@ -182,8 +194,7 @@ void EstimateTimeOffsets(const std::vector<PlateImuData>& data,
       for (const Eigen::Vector3d& w : w0) peak = std::max(peak, w.norm());
       if (peak < 20.0 * ref.gyro_noise) continue;
       double tau = 0.0, var = 0.0;
-      const double noise_variance =
-          ref.gyro_noise * ref.gyro_noise + data[i].gyro_noise * data[i].gyro_noise;
+      const double noise_variance = ref.gyro_noise * ref.gyro_noise + scaled_noise * scaled_noise;
       if (!TurnOffset(t0, Smooth(w0), Spline(ti, Smooth(wi)), options.max_time_offset, step,
                       noise_variance, &tau, &var)) {
         continue;
@@ -243,7 +254,7 @@ void EstimateTimeOffsets(const std::vector<PlateImuData>& data,
       r.time_offset = mean;
       r.time_offset_std = std::sqrt(scale_const / sw);
     }
-    sigma_noise[i] = data[i].gyro_noise;
+    sigma_noise[i] = scaled_noise;
   }
   // The offsets share the reference's noise: correlated.
   const double s0 = ref.gyro_noise * ref.gyro_noise;

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <system_error>
 #include <utility>
 
@@ -140,6 +141,109 @@ bool WriteSummaryFiles(const std::string& folder, const std::vector<SummaryRow>&
 
 }  // namespace internal
 
+namespace {
+
+// The acceptance sections of the shards (AcceptBatchFolder: summary.json's
+// "acceptance" and limits.csv), merged: the counts summed, the failed
+// units and the limits.csv rows in fleet order.
+struct MergedAcceptance {
+  // Shards with a section, and the first folder with and without one.
+  size_t shards = 0;
+  std::string with, without;
+  std::string limits;
+  size_t checked = 0, pass = 0;
+  // (unit index in the fleet, entry) of each failed unit and limits row.
+  std::vector<std::pair<size_t, nlohmann::ordered_json>> failed;
+  std::vector<std::pair<size_t, std::string>> csv_rows;
+};
+
+// Takes shard `folder`'s section (its summary.json text parsed) into *m;
+// `index_of` maps unit names to fleet indices. False when the section is
+// malformed or its limits differ from the other shards'.
+bool TakeAcceptance(const std::string& folder, const std::string& summary_text,
+                    const std::map<std::string, size_t>& index_of, MergedAcceptance* m,
+                    std::string* error) {
+  using internal::SetError;
+  const std::string json_path = folder + "/summary.json";
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary_text, nullptr, false);
+  if (!j.is_object() || !j.contains("acceptance")) {
+    if (m->without.empty()) m->without = folder;
+    return true;
+  }
+  if (m->with.empty()) m->with = folder;
+  const nlohmann::ordered_json& a = j["acceptance"];
+  if (!a.is_object() || !a.value("limits", nlohmann::ordered_json()).is_string() ||
+      !a.value("checked", nlohmann::ordered_json()).is_number_unsigned() ||
+      !a.value("pass", nlohmann::ordered_json()).is_number_unsigned() ||
+      !a.value("failed", nlohmann::ordered_json()).is_array()) {
+    return SetError(error, json_path +
+                               ": its 'acceptance' section lacks limits, checked, pass or "
+                               "failed");
+  }
+  const std::string limits = a["limits"].get<std::string>();
+  if (m->shards > 0 && limits != m->limits) {
+    return SetError(error, json_path + ": checked against limits " + limits + ", " + m->with +
+                               " against " + m->limits);
+  }
+  ++m->shards;
+  m->limits = limits;
+  m->checked += a["checked"].get<size_t>();
+  m->pass += a["pass"].get<size_t>();
+  for (const nlohmann::ordered_json& f : a["failed"]) {
+    const std::string unit = f.is_object() ? f.value("unit", "") : "";
+    const auto at = index_of.find(unit);
+    if (at == index_of.end()) {
+      return SetError(error, json_path + ": failed unit '" + unit + "' is not in its summary.csv");
+    }
+    m->failed.emplace_back(at->second, f);
+  }
+  // limits.csv: "unit,verdict,failed" then one row per checked unit.
+  std::string csv;
+  const std::string csv_path = folder + "/limits.csv";
+  if (!ReadFileBytes(csv_path, &csv, error)) return false;
+  size_t begin = csv.find('\n');
+  if (csv.compare(0, 20, "unit,verdict,failed\n") != 0) {
+    return SetError(error, csv_path + ":1: not a limits.csv (unit,verdict,failed)");
+  }
+  for (begin = begin + 1; begin < csv.size();) {
+    size_t end = csv.find('\n', begin);
+    if (end == std::string::npos) end = csv.size();
+    const std::string line = csv.substr(begin, end - begin);
+    const auto at = index_of.find(line.substr(0, line.find(',')));
+    if (at == index_of.end()) {
+      return SetError(error, csv_path + ": unit '" + line.substr(0, line.find(',')) +
+                                 "' is not in its summary.csv");
+    }
+    m->csv_rows.emplace_back(at->second, line);
+    begin = end + 1;
+  }
+  return true;
+}
+
+// Writes the merged section into output_dir's summary.json and limits.csv.
+bool WriteMergedAcceptance(const std::string& output_dir, MergedAcceptance m, std::string* error) {
+  auto by_index = [](const auto& a, const auto& b) { return a.first < b.first; };
+  std::stable_sort(m.failed.begin(), m.failed.end(), by_index);
+  std::stable_sort(m.csv_rows.begin(), m.csv_rows.end(), by_index);
+  const std::string summary_path = output_dir + "/summary.json";
+  std::string text;
+  if (!ReadFileBytes(summary_path, &text, error)) return false;
+  nlohmann::ordered_json summary = nlohmann::ordered_json::parse(text, nullptr, false);
+  nlohmann::ordered_json failed = nlohmann::ordered_json::array();
+  for (const auto& f : m.failed) failed.push_back(f.second);
+  summary["acceptance"] = {{"limits", m.limits},
+                           {"checked", m.checked},
+                           {"pass", m.pass},
+                           {"fail", m.failed.size()},
+                           {"failed", failed}};
+  std::string csv = "unit,verdict,failed\n";
+  for (const auto& row : m.csv_rows) csv += row.second + "\n";
+  return WriteFilesAtomically(
+      {{summary_path, summary.dump(2) + "\n"}, {output_dir + "/limits.csv", csv}}, error);
+}
+
+}  // namespace
+
 bool MergeBatchSummaries(const std::vector<std::string>& shard_folders,
                          const std::string& output_dir, const FleetOptions& fleet,
                          FleetStatistics* statistics, std::string* error) {
@@ -148,6 +252,7 @@ bool MergeBatchSummaries(const std::vector<std::string>& shard_folders,
   FleetInfo merged;
   std::vector<std::string> shard_folder;
   std::vector<SummaryRow> rows;
+  MergedAcceptance acceptance;
   for (size_t d = 0; d < shard_folders.size(); ++d) {
     const std::string& folder = shard_folders[d];
     const std::string json_path = folder + "/summary.json";
@@ -157,6 +262,7 @@ bool MergeBatchSummaries(const std::vector<std::string>& shard_folders,
     if (!ReadFileBytes(json_path, &text, error) || !ParseFleetInfo(text, json_path, &info, error)) {
       return false;
     }
+    const std::string text_json = text;
     std::vector<SummaryRow> shard_rows;
     if (!ReadFileBytes(csv_path, &text, error) ||
         !ParseSummaryCsv(text, csv_path, &shard_rows, error)) {
@@ -180,7 +286,15 @@ bool MergeBatchSummaries(const std::vector<std::string>& shard_folders,
                                  std::to_string(info.shard_count) + " is also in " + seen);
     }
     seen = folder;
+    std::map<std::string, size_t> index_of;
+    for (const SummaryRow& row : shard_rows) index_of[row.unit] = row.index;
+    if (!TakeAcceptance(folder, text_json, index_of, &acceptance, error)) return false;
     rows.insert(rows.end(), shard_rows.begin(), shard_rows.end());
+  }
+  if (acceptance.shards > 0 && !acceptance.without.empty()) {
+    return SetError(error, acceptance.with + " was checked against limits (" + acceptance.limits +
+                               ") and " + acceptance.without +
+                               " was not: run every shard with the same --limits");
   }
   std::string missing;
   for (size_t k = 0; k < shard_folder.size(); ++k) {
@@ -202,8 +316,11 @@ bool MergeBatchSummaries(const std::vector<std::string>& shard_folders,
   }
   merged.shard_index = 1;
   merged.shard_count = 1;
-  return internal::MakeFolders(output_dir, error) &&
-         internal::WriteSummaryFiles(output_dir, rows, merged, fleet, statistics, error);
+  if (!internal::MakeFolders(output_dir, error) ||
+      !internal::WriteSummaryFiles(output_dir, rows, merged, fleet, statistics, error)) {
+    return false;
+  }
+  return acceptance.shards == 0 || WriteMergedAcceptance(output_dir, acceptance, error);
 }
 
 }  // namespace gravcal

@@ -151,6 +151,31 @@ nlohmann::json Value(double x) { return std::isfinite(x) ? nlohmann::json(x) : n
 
 }  // namespace
 
+std::vector<FileContents> MultiImuSessionFiles(const MultiImuResult& result,
+                                               const MultiImuConfig& config,
+                                               const std::vector<PlateImu>& imus,
+                                               const CalibrationProvenance& provenance,
+                                               const std::string& output_dir) {
+  std::vector<FileContents> files;
+  std::vector<double> rates;
+  for (size_t i = 0; i < result.imus.size(); ++i) {
+    Calibration c = result.imus[i].calibration;
+    c.provenance = provenance;
+    files.push_back({output_dir + "/" + result.imus[i].name + ".json",
+                     CalibrationToJson(c, config.output_covariance)});
+    const ImuLog& log = imus[i].log;
+    double rate = i < config.imus.size() ? config.imus[i].update_rate : 0.0;
+    if (!(rate > 0.0) && log.size() > 1) rate = (log.size() - 1) / (log.t.back() - log.t.front());
+    rates.push_back(rate);
+  }
+  files.push_back({output_dir + "/assembly.json", MultiImuAssemblyToJson(result)});
+  files.push_back(
+      {output_dir + "/kalibr_imu_chain.yaml", MultiImuKalibrChain(result, config, rates)});
+  files.push_back({output_dir + "/px4_rotations.params",
+                   MultiImuPx4Rotations(result, config.options.permutation_tolerance_deg)});
+  return files;
+}
+
 std::string MultiImuAssemblyToJson(const MultiImuResult& result) {
   nlohmann::json j;
   j["format"] = "gravcal multi-IMU assembly";
@@ -186,6 +211,8 @@ std::string MultiImuAssemblyToJson(const MultiImuResult& result) {
     imu["timed_turns"] = r.timed_turns;
     imu["accel_residual_rms"] = Value(r.accel_residual_rms);
     imu["turn_residual_rms_deg"] = Value(r.turn_residual_deg);
+    imu["variance_factors"] = {
+        {"accel_poses", r.accel_factor}, {"gyro_poses", r.gyro_factor}, {"turns", r.turn_factor}};
     if (std::isfinite(r.up_offset)) {
       imu["up_offset"] = r.up_offset;
       imu["up_offset_sigma"] = r.up_offset_std;

@@ -2,6 +2,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/LU>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -148,9 +149,10 @@ bool ParseImu(const std::string& name, const YAML::Node& node, size_t index, con
         for (int c = 0; c < 3 && ok; ++c)
           ok = Number(name, key, v[r][c], &imu->rotation(r, c), error);
       }
-      if (ok && !(imu->rotation.transpose() * imu->rotation)
-                     .isApprox(Eigen::Matrix3d::Identity(), 1e-3) ||
-          (ok && imu->rotation.determinant() < 0.0)) {
+      if (!ok) return false;
+      if (!(imu->rotation.transpose() * imu->rotation)
+               .isApprox(Eigen::Matrix3d::Identity(), 1e-3) ||
+          imu->rotation.determinant() < 0.0) {
         *error = At(name, v) + where + "'rotation' is not a rotation (orthonormal, det +1)";
         return false;
       }
@@ -178,6 +180,53 @@ bool ParseImu(const std::string& name, const YAML::Node& node, size_t index, con
     return false;
   }
   return true;
+}
+
+// A sim_* key into the plate simulator's options; false with the line.
+bool SimKey(const std::string& name, const std::string& key, const YAML::Node& v,
+            PlateSimulatorOptions* sim, std::string* error) {
+  double x = 0.0;
+  if (key == "sim_mounting") {
+    if (!Text(name, key, v, &sim->mounting, error)) return false;
+    if (sim->mounting != "aligned" && sim->mounting != "random") {
+      *error = At(name, v) + "sim_mounting is aligned or random";
+      return false;
+    }
+    return true;
+  }
+  if (!Number(name, key, v, &x, error)) return false;
+  const bool whole = x == std::floor(x);
+  auto index = [&](int* out, int low) {
+    if (!whole || x < low || x > 64) {
+      *error = At(name, v) + "key '" + key + "' must be a whole number from " +
+               std::to_string(low) + " to 64";
+      return false;
+    }
+    *out = static_cast<int>(x);
+    return true;
+  };
+  auto positive = [&](double* out, bool zero_ok) {
+    if (zero_ok ? !(x >= 0.0) : !(x > 0.0)) {
+      *error = At(name, v) + "key '" + key + "' must be " + (zero_ok ? ">= 0" : "> 0");
+      return false;
+    }
+    *out = x;
+    return true;
+  };
+  if (key == "sim_imus") return index(&sim->imus, 1);
+  if (key == "sim_permuted_imu") return index(&sim->permuted_imu, -1);
+  if (key == "sim_flipped_imu") return index(&sim->flipped_imu, -1);
+  if (key == "sim_slip_imu") return index(&sim->slip_imu, -1);
+  if (key == "sim_max_clock_offset") return positive(&sim->max_clock_offset, true);
+  if (key == "sim_clock_drift_std") return positive(&sim->clock_drift_std, true);
+  if (key == "sim_hold") return positive(&sim->imu.hold_seconds, false);
+  if (key == "sim_turn") return positive(&sim->imu.rotation_seconds, false);
+  if (key == "sim_rate") return positive(&sim->imu.sample_rate, false);
+  *error = At(name, v) + "unknown key '" + key +
+           "' (the simulator's keys: sim_imus, sim_mounting, sim_permuted_imu, "
+           "sim_flipped_imu, sim_slip_imu, sim_max_clock_offset, sim_clock_drift_std, "
+           "sim_hold, sim_turn, sim_rate)";
+  return false;
 }
 
 }  // namespace
@@ -210,6 +259,13 @@ bool ParseMultiImuConfig(const std::string& text, const std::string& name, Multi
     return false;
   }
   MultiImuConfig c;
+  // The simulated plate: aligned units (the shipped config states no
+  // mountings), holds and turns of a bench session.
+  c.simulation.mounting = "aligned";
+  c.simulation.imu.hold_seconds = 4.0;
+  c.simulation.imu.initial_still_seconds = 4.0;
+  c.simulation.imu.rotation_seconds = 2.0;
+  c.simulation.oversample = 2;
   // The unit defaults first: the IMUs start from them.
   Units defaults;
   for (const auto& kv : root) {
@@ -295,6 +351,8 @@ bool ParseMultiImuConfig(const std::string& text, const std::string& name, Multi
       ok = Number(name, key, v, &c.options.max_time_offset, error);
     } else if (key == "permutation_tolerance") {
       ok = Number(name, key, v, &c.options.permutation_tolerance_deg, error);
+    } else if (key.compare(0, 4, "sim_") == 0) {
+      if (!SimKey(name, key, v, &c.simulation, error)) return false;
     } else if (key == "separate") {
       try {
         c.options.separate = v.as<bool>();
@@ -306,8 +364,11 @@ bool ParseMultiImuConfig(const std::string& text, const std::string& name, Multi
       *error = At(name, kv.first) + "unknown key '" + key +
                "' (method, format, imus, reference, time_column, time_scale, gravity, window, "
                "threshold_factor, min_duration, settle, max_time_offset, "
-               "permutation_tolerance, separate, and the unit keys accel_units, gyro_units, "
-               "accel_counts_per_g, gyro_counts_per_dps, accel_scale, gyro_scale)";
+               "permutation_tolerance, separate, the unit keys accel_units, gyro_units, "
+               "accel_counts_per_g, gyro_counts_per_dps, accel_scale, gyro_scale, and the "
+               "simulator's sim_imus, sim_mounting, sim_permuted_imu, sim_flipped_imu, "
+               "sim_slip_imu, sim_max_clock_offset, sim_clock_drift_std, sim_hold, sim_turn, "
+               "sim_rate)";
       return false;
     }
     if (!ok) return false;
@@ -329,6 +390,19 @@ bool ParseMultiImuConfig(const std::string& text, const std::string& name, Multi
   }
   c.options.reference = reference;
   if (!c.options.IsValid(error)) {
+    *error = name + ": " + *error;
+    return false;
+  }
+  // The simulated table is written in the top-level units: raw counts or
+  // SI.
+  if (defaults.accel_units == "counts" && defaults.gyro_units == "counts") {
+    c.simulation.imu.raw_counts = true;
+    c.simulation.imu.accel_counts_per_g = defaults.counts_per_g;
+    c.simulation.imu.gyro_counts_per_dps = defaults.counts_per_dps;
+  } else {
+    c.simulation.imu.raw_counts = false;
+  }
+  if (!c.simulation.IsValid(error)) {
     *error = name + ": " + *error;
     return false;
   }

@@ -17,12 +17,14 @@
 // orthogonalised accelerometer frame); C_i = C_i0 Exp(delta_i) with delta_i
 // the estimated rotation vector (3; its covariance is the rotation's sigma).
 // The separate calibration of one IMU is the same problem with the poses
-// d_k its own: the gain of the joint fit is the shared poses.
+// d_k its own and its own variance factors: what a calibration of that IMU
+// alone reports. The gain of the joint fit is the shared poses.
 //
 // Weights: each group of rows (accelerometer poses, gyroscope poses, turns)
-// starts from the white noise the still samples show and is rescaled by
-// its own chi2/dof after a first solve (a variance factor per group), so
-// the sigmas stay honest where the poses scatter beyond their samples.
+// of each IMU starts from the white noise the still samples show and is
+// rescaled by its own chi2/dof after a first solve (a variance factor per
+// IMU and group), so the sigmas stay honest where the poses scatter beyond
+// their samples, and one unit's misfit does not inflate the others'.
 //
 // Time. The turns give the relative timing of the gyroscopes: IMU i's
 // calibrated rate turned into the plate frame, C_i M_gi (u_i - b_gi), is
@@ -118,6 +120,11 @@ struct PlateImuResult {
   double clock_drift = NAN;
   double clock_drift_std = NAN;
   int timed_turns = 0;
+  // Its variance factors (accel poses, gyro poses, turns): chi2 / dof of
+  // its rows in the joint fit, at least 1; its sigmas are scaled by them.
+  double accel_factor = 1.0;
+  double gyro_factor = 1.0;
+  double turn_factor = 1.0;
   // rms of its pose rows (m/s^2) and turn rows (deg).
   double accel_residual_rms = NAN;
   double turn_residual_deg = NAN;
@@ -142,7 +149,8 @@ struct MultiImuResult {
   // Named mistakes (permuted axes, moved units, drifting clocks) and other
   // warnings.
   std::vector<std::string> warnings;
-  // Variance factors of the row groups (accel poses, gyro poses, turns).
+  // The largest variance factor of each row group (accel poses, gyro
+  // poses, turns) over the IMUs (PlateImuResult has each IMU's).
   double accel_factor = 1.0;
   double gyro_factor = 1.0;
   double turn_factor = 1.0;

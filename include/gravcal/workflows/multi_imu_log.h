@@ -21,8 +21,10 @@
 #include <vector>
 
 #include "gravcal/core/calibration.h"
+#include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/methods/multi_imu.h"
+#include "gravcal/simulation/plate_simulator.h"
 
 namespace gravcal {
 
@@ -58,6 +60,12 @@ struct MultiImuConfig {
   MultiImuOptions options;
   // Write the separate calibrations' sigmas next to the joint ones.
   bool output_covariance = true;
+  // `gravcal simulate --config <this>`: the plate simulator's options, from
+  // the sim_* keys (sim_imus, sim_mounting, sim_permuted_imu,
+  // sim_flipped_imu, sim_slip_imu, sim_max_clock_offset,
+  // sim_clock_drift_std, sim_hold, sim_turn, sim_rate) and the top-level
+  // units (the table is written in them).
+  PlateSimulatorOptions simulation;
 };
 
 // True when `path` is a YAML file whose top level has the key `imus`.
@@ -78,6 +86,15 @@ bool ReadMultiImuLogs(MultiImuConfig* config, const std::string& input, std::vec
 // The IMUs of a table header (imus: auto): names with .ax .ay .az columns.
 std::vector<MultiImuLogSpec> ImusOfHeader(const std::string& text, double accel_scale,
                                           double gyro_scale);
+
+// The files of one calibrated session in output_dir: <name>.json per IMU
+// (the calibration schema, with `provenance`), assembly.json,
+// kalibr_imu_chain.yaml and px4_rotations.params.
+std::vector<FileContents> MultiImuSessionFiles(const MultiImuResult& result,
+                                               const MultiImuConfig& config,
+                                               const std::vector<PlateImu>& imus,
+                                               const CalibrationProvenance& provenance,
+                                               const std::string& output_dir);
 
 // assembly.json (docs/data_contract.md).
 std::string MultiImuAssemblyToJson(const MultiImuResult& result);
