@@ -9,6 +9,7 @@
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/io/long_log.h"
 #include "gravcal/io/plan_io.h"
 #include "gravcal/methods/twelve_position.h"
 #include "gravcal/simulation/handheld_simulator.h"
@@ -124,9 +125,12 @@ int RunCalibrate(const CalibrateArgs& args) {
                 "' keeps no estimate history (handheld_kalman does)");
   }
   // The log is read once: its provenance hash comes from the same bytes.
+  // In bounded memory: a long log is read as block means (io/long_log.h).
   Session session;
   CalibrationProvenance provenance;
-  if (!ReadImuLog(args.input, args.config.input, &session.log, &provenance, &error)) {
+  LongLogReading reading;
+  if (!ReadImuLogBounded(args.input, args.config.input, &reading, &session.log, &provenance,
+                         &error)) {
     return Fail(error);
   }
   SessionFiles files;
@@ -136,6 +140,7 @@ int RunCalibrate(const CalibrateArgs& args) {
   Calibration c;
   const bool ok = RunCalibration(args.config, files, &session, &c);
   c.provenance = provenance;
+  AddLongLogWarning(reading, &c);
   PrintWarnings(c);
   // The report also for a failed calibration: it says why. For a session of
   // static poses it shows what the detector rejected too (the detection the

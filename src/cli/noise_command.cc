@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "cli/commands.h"
-#include "gravcal/io/log_reader.h"
+#include "gravcal/io/long_log.h"
 #include "gravcal/workflows/noise_workflow.h"
 
 namespace gravcal {
@@ -36,10 +36,14 @@ int RunNoise(const LogReportArgs& args) {
   std::string error;
   NoiseOptions options;
   if (!NoiseOptionsFromConfig(args.config, &options, &error)) return Fail(error);
+  // In bounded memory: a long log is read as block means (io/long_log.h).
   ImuLog log;
-  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  LongLogReading reading;
+  if (!ReadImuLogBounded(args.input, args.config.input, &reading, &log, nullptr, &error)) {
+    return Fail(error);
+  }
   ImuNoise noise;
-  if (!CharacteriseLogNoise(log, options, &noise, &error)) return Fail(error);
+  if (!CharacteriseLongLogNoise(log, reading, options, &noise, &error)) return Fail(error);
   std::vector<std::string> written;
   if (!WriteNoiseFiles(noise, args.input, {args.output, args.kalibr, args.handheld, args.report},
                        &written, &error)) {

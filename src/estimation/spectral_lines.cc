@@ -14,9 +14,13 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// In-place iterative radix-2 FFT; data.size() a power of two.
-void Fft(std::vector<std::complex<double>>* data) {
+// In-place iterative radix-2 FFT; data.size() a power of two. The twiddle
+// factors of each stage are made once, by the same recurrence w *= step as
+// each block would repeat (so the result is bit for bit the same), into
+// `twiddle`.
+void Fft(std::vector<std::complex<double>>* data, std::vector<std::complex<double>>* twiddle) {
   std::vector<std::complex<double>>& a = *data;
+  std::vector<std::complex<double>>& tw = *twiddle;
   const size_t n = a.size();
   for (size_t i = 1, j = 0; i < n; ++i) {
     size_t bit = n >> 1;
@@ -27,14 +31,26 @@ void Fft(std::vector<std::complex<double>>* data) {
   for (size_t len = 2; len <= n; len <<= 1) {
     const double angle = -2.0 * kPi / static_cast<double>(len);
     const std::complex<double> step(std::cos(angle), std::sin(angle));
+    const size_t half = len / 2;
+    tw.resize(half);
+    std::complex<double> w(1.0, 0.0);
+    for (size_t k = 0; k < half; ++k) {
+      tw[k] = w;
+      w *= step;
+    }
     for (size_t i = 0; i < n; i += len) {
-      std::complex<double> w(1.0, 0.0);
-      for (size_t k = 0; k < len / 2; ++k) {
-        const std::complex<double> u = a[i + k];
-        const std::complex<double> v = a[i + k + len / 2] * w;
-        a[i + k] = u + v;
-        a[i + k + len / 2] = u - v;
-        w *= step;
+      std::complex<double>* lo = a.data() + i;
+      std::complex<double>* hi = lo + half;
+      for (size_t k = 0; k < half; ++k) {
+        // v = hi[k] * tw[k] written out (the product std::complex takes for
+        // finite values, without its check for infinities: the data are
+        // finite).
+        const double hr = hi[k].real(), hm = hi[k].imag();
+        const double wr = tw[k].real(), wm = tw[k].imag();
+        const std::complex<double> v(hr * wr - hm * wm, hr * wm + hm * wr);
+        const std::complex<double> u = lo[k];
+        lo[k] = u + v;
+        hi[k] = u - v;
       }
     }
   }
@@ -51,14 +67,14 @@ std::vector<double> WelchPsd(const std::vector<double>& x, size_t begin, size_t 
     w2 += window[i] * window[i];
   }
   std::vector<double> psd(length / 2 + 1, 0.0);
-  std::vector<std::complex<double>> buffer(length);
+  std::vector<std::complex<double>> buffer(length), twiddle;
   *segments = 0;
   for (size_t start = begin; start + length <= end; start += length / 2) {
     double mean = 0.0;
     for (size_t i = 0; i < length; ++i) mean += x[start + i];
     mean /= static_cast<double>(length);
     for (size_t i = 0; i < length; ++i) buffer[i] = window[i] * (x[start + i] - mean);
-    Fft(&buffer);
+    Fft(&buffer, &twiddle);
     for (size_t k = 0; k < psd.size(); ++k) psd[k] += std::norm(buffer[k]);
     ++*segments;
   }

@@ -19,6 +19,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/warnings.h"
+#include "gravcal/io/long_log.h"
 #include "io/csv_table.h"
 #include "io/file_text.h"
 #include "io/formats/file_format.h"
@@ -88,10 +90,83 @@ size_t EstimateRows(std::string_view rest, uint64_t total) {
 // it). Fills out->t, accel, gyro, temperature (only out->gyro for the
 // gyroscope file); does not check for an empty result. *lines is the number
 // of lines.
+// Rows into a log in bounded memory (LogReaderOptions::max_samples): pushed
+// as they are until the log holds `max` entries, then each two neighbours
+// merged into their mean and from then on every `block` rows pushed as one
+// mean.
+class BlockAverager {
+ public:
+  BlockAverager(size_t max, ImuLog* out) : max_(max - max % 2), out_(out) {}
+
+  void Add(double t, const Eigen::Vector3d& accel, const Eigen::Vector3d* gyro,
+           const double* temperature) {
+    ImuLog& o = *out_;
+    // Full when a new block begins: halve first, so that a log of max_
+    // rows is kept as it is.
+    if (count_ == 0 && max_ > 0 && o.t.size() >= max_) Halve();
+    if (block_ == 1) {
+      o.t.push_back(t);
+      o.accel.push_back(accel);
+      if (gyro != nullptr) o.gyro.push_back(*gyro);
+      if (temperature != nullptr) o.temperature.push_back(*temperature);
+    } else {
+      t_ += t;
+      accel_ += accel;
+      if (gyro != nullptr) gyro_ += *gyro;
+      if (temperature != nullptr) temperature_ += *temperature;
+      if (++count_ < block_) return;
+      const double inv = 1.0 / static_cast<double>(block_);
+      o.t.push_back(t_ * inv);
+      o.accel.push_back(accel_ * inv);
+      if (gyro != nullptr) o.gyro.push_back(gyro_ * inv);
+      if (temperature != nullptr) o.temperature.push_back(temperature_ * inv);
+      t_ = 0.0;
+      temperature_ = 0.0;
+      accel_.setZero();
+      gyro_.setZero();
+      count_ = 0;
+    }
+  }
+
+  size_t block() const { return block_; }
+
+ private:
+  // Each two neighbouring entries become their mean.
+  void Halve() {
+    ImuLog& o = *out_;
+    const size_t half = o.t.size() / 2;
+    for (size_t i = 0; i < half; ++i) {
+      o.t[i] = 0.5 * (o.t[2 * i] + o.t[2 * i + 1]);
+      o.accel[i] = 0.5 * (o.accel[2 * i] + o.accel[2 * i + 1]);
+      if (!o.gyro.empty()) o.gyro[i] = 0.5 * (o.gyro[2 * i] + o.gyro[2 * i + 1]);
+      if (!o.temperature.empty()) {
+        o.temperature[i] = 0.5 * (o.temperature[2 * i] + o.temperature[2 * i + 1]);
+      }
+    }
+    o.t.resize(half);
+    o.accel.resize(half);
+    if (!o.gyro.empty()) o.gyro.resize(half);
+    if (!o.temperature.empty()) o.temperature.resize(half);
+    block_ *= 2;
+  }
+
+  const size_t max_;
+  ImuLog* out_;
+  size_t block_ = 1;
+  size_t count_ = 0;
+  double t_ = 0.0, temperature_ = 0.0;
+  Eigen::Vector3d accel_ = Eigen::Vector3d::Zero(), gyro_ = Eigen::Vector3d::Zero();
+};
+
 bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std::string& name,
                const LogReaderOptions& options, const ImuLog* reference,
-               const std::string& reference_name, ImuLog* out, size_t* lines, std::string* error) {
+               const std::string& reference_name, ImuLog* out, size_t* lines,
+               LongLogReading* bounded, std::string* error) {
   internal::LogRowParser parser(name, options, reference != nullptr);
+  // A second gyroscope file is matched row for row: never averaged.
+  const size_t max_samples =
+      bounded != nullptr && options.gyro_path.empty() ? bounded->max_samples : 0;
+  BlockAverager averager(max_samples, out);
   std::string_view line;
   std::string why;
   bool reserved = false;
@@ -125,22 +200,29 @@ bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std
     if (!reserved) {
       const std::string_view rest = source->rest();
       const uint64_t left = bytes == 0 ? rest.size() : bytes - (source->bytes_read() - rest.size());
-      const size_t rows = EstimateRows(rest, left) + 1;
+      size_t rows = EstimateRows(rest, left) + 1;
+      if (max_samples > 0) rows = std::min(rows, max_samples);
       out->t.reserve(rows);
       out->accel.reserve(rows);
       if (parser.has(kGx)) out->gyro.reserve(rows);
       if (parser.has(kTemp)) out->temperature.reserve(rows);
       reserved = true;
     }
-    out->t.push_back(parser.value(kT));
-    out->accel.emplace_back(parser.value(internal::kAx), parser.value(internal::kAy),
-                            parser.value(internal::kAz));
-    if (parser.has(kGx))
-      out->gyro.emplace_back(parser.value(kGx), parser.value(kGy), parser.value(kGz));
-    if (parser.has(kTemp)) out->temperature.push_back(parser.value(kTemp));
+    const Eigen::Vector3d accel(parser.value(internal::kAx), parser.value(internal::kAy),
+                                parser.value(internal::kAz));
+    const Eigen::Vector3d gyro =
+        parser.has(kGx) ? Eigen::Vector3d(parser.value(kGx), parser.value(kGy), parser.value(kGz))
+                        : Eigen::Vector3d::Zero();
+    const double temperature = parser.has(kTemp) ? parser.value(kTemp) : 0.0;
+    averager.Add(parser.value(kT), accel, parser.has(kGx) ? &gyro : nullptr,
+                 parser.has(kTemp) ? &temperature : nullptr);
   }
   if (!why.empty()) return SetError(error, why);
   *lines = source->number();
+  if (bounded != nullptr) {
+    bounded->samples_averaged = averager.block();
+    bounded->rows_read = parser.rows();
+  }
   return true;
 }
 
@@ -163,12 +245,13 @@ bool OpenForReading(const std::string& path, OpenFile* file, std::string* error)
 // block.
 bool ParseLog(internal::LogLines* source, uint64_t bytes, internal::FileFormat format,
               const std::string& name, const LogReaderOptions& options, ImuLog* log,
-              std::string* error) {
+              LongLogReading* bounded, std::string* error) {
   const bool euroc = format == internal::FileFormat::kEuroc && internal::LayoutFromFile(options);
   const LogReaderOptions& layout = euroc ? internal::EurocOptions(options) : options;
   ImuLog parsed;
   size_t lines = 0;
-  if (!ParseText(source, bytes, euroc, name, layout, nullptr, name, &parsed, &lines, error)) {
+  if (!ParseText(source, bytes, euroc, name, layout, nullptr, name, &parsed, &lines, bounded,
+                 error)) {
     return false;
   }
   if (parsed.t.empty()) return SetError(error, name + ": no samples");
@@ -180,7 +263,7 @@ bool ParseLog(internal::LogLines* source, uint64_t bytes, internal::FileFormat f
     ImuLog gyro;
     size_t gyro_lines_read = 0;
     if (!ParseText(&gyro_lines, 0, false, options.gyro_path, options, &parsed, name, &gyro,
-                   &gyro_lines_read, error)) {
+                   &gyro_lines_read, nullptr, error)) {
       return false;
     }
     if (gyro.gyro.size() != parsed.t.size()) {
@@ -208,7 +291,7 @@ bool ParseImpl(std::string_view text, const std::string& name, const LogReaderOp
                                " is read from its file, not from memory");
   }
   internal::LogLines source(text, name);
-  return ParseLog(&source, 0, format, name, options, log, error);
+  return ParseLog(&source, 0, format, name, options, log, nullptr, error);
 }
 
 // Checks what the writer needs without ImuLog::Validate's per-sample cost.
@@ -286,7 +369,7 @@ namespace {
 // bytes: from the text parsed for a text log, from a second read for a
 // message recording (read message by message).
 bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
-             internal::ContentHash* hash, std::string* error) {
+             internal::ContentHash* hash, LongLogReading* bounded, std::string* error) {
   if (log == nullptr) return SetError(error, path + ": no log to read into");
   try {
     internal::FileFormat format = internal::FileFormat::kText;
@@ -322,7 +405,12 @@ bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* l
       return true;
     }
     const uint64_t bytes = static_cast<uint64_t>(st.st_size);
-    if (!internal::CheckLogFitsInMemory(path, bytes, internal::AvailableMemoryBytes(), error)) {
+    // Read in bounded memory (max_samples) unless a second file is matched
+    // row for row.
+    const bool in_bounds =
+        bounded != nullptr && bounded->max_samples > 0 && options.gyro_path.empty();
+    if (!in_bounds &&
+        !internal::CheckLogFitsInMemory(path, bytes, internal::AvailableMemoryBytes(), error)) {
       return false;
     }
     // Block by block (io/log_text.h LogLines): no copy of the whole text.
@@ -331,7 +419,7 @@ bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* l
       hash->Begin(bytes);
       source.HashInto(hash);
     }
-    if (!ParseLog(&source, bytes, format, path, options, log, error)) return false;
+    if (!ParseLog(&source, bytes, format, path, options, log, bounded, error)) return false;
     if (source.bytes_read() != bytes) {
       return SetError(error, path + ": changed while it was read (" + std::to_string(bytes) +
                                  " bytes, then " + std::to_string(source.bytes_read()) + ")");
@@ -347,13 +435,13 @@ bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* l
 
 bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
                 std::string* error) {
-  return ReadLog(path, options, log, nullptr, error);
+  return ReadLog(path, options, log, nullptr, nullptr, error);
 }
 
 bool ReadImuLog(const std::string& path, const LogReaderOptions& options, ImuLog* log,
                 CalibrationProvenance* provenance, std::string* error) {
   internal::ContentHash hash;
-  if (!ReadLog(path, options, log, &hash, error)) return false;
+  if (!ReadLog(path, options, log, &hash, nullptr, error)) return false;
   *provenance = {path, hash.Hex(), GRAVCAL_VERSION};
   return true;
 }
@@ -416,6 +504,46 @@ bool WriteImuLogCsv(const ImuLog& log, const std::string& path, std::string* err
   std::string contents;
   if (!ImuLogToCsv(log, &contents, error)) return SetError(error, path + ": " + *error);
   return WriteFileAtomically(path, contents, error);
+}
+
+}  // namespace gravcal
+
+namespace gravcal {
+
+std::string LongLogReading::Describe() const {
+  if (samples_averaged <= 1) return "";
+  const size_t entries = rows_read / samples_averaged;
+  return "the log's " + std::to_string(rows_read) + " rows were read in bounded memory as " +
+         std::to_string(entries) + " means of " + std::to_string(samples_averaged) +
+         " rows (at most " + std::to_string(max_samples) + " held)";
+}
+
+bool ReadImuLogBounded(const std::string& path, const LogReaderOptions& options,
+                       LongLogReading* reading, ImuLog* log, CalibrationProvenance* provenance,
+                       std::string* error) {
+  if (reading->max_samples != 0 && reading->max_samples < 16) {
+    return SetError(error, path + ": max_samples is " + std::to_string(reading->max_samples) +
+                               ", must be 0 (no limit) or at least 16");
+  }
+  reading->samples_averaged = 1;
+  reading->rows_read = 0;
+  LongLogReading result = *reading;
+  internal::ContentHash hash;
+  if (!ReadLog(path, options, log, provenance != nullptr ? &hash : nullptr, &result, error)) {
+    return false;
+  }
+  *reading = result;
+  if (provenance != nullptr) *provenance = {path, hash.Hex(), GRAVCAL_VERSION};
+  return true;
+}
+
+void AddLongLogWarning(const LongLogReading& reading, Calibration* calibration) {
+  if (reading.samples_averaged <= 1) return;
+  internal::AddWarning(WarningCode::kParameterSource,
+                       reading.Describe() +
+                           ": poses and turns come from those means (the turns integrated at "
+                           "their rate), and a pose's spread per sample is that of a mean",
+                       &calibration->warnings, &calibration->warning_codes);
 }
 
 }  // namespace gravcal

@@ -1,5 +1,6 @@
 #include "gravcal/workflows/noise_workflow.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -68,6 +69,41 @@ bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoi
                 g, options.accel_scale);
   noise->unit_check = text;
   noise->message += std::string("; unit ") + text;
+  return true;
+}
+
+bool CharacteriseLongLogNoise(const ImuLog& log, const LongLogReading& reading,
+                              const NoiseOptions& options, ImuNoise* noise, std::string* error) {
+  const size_t block = std::max<size_t>(reading.samples_averaged, 1);
+  if (block == 1) return CharacteriseLogNoise(log, options, noise, error);
+  const double b = static_cast<double>(block);
+  NoiseOptions on_means = options;
+  on_means.rate_hz /= b;
+  if (!CharacteriseLogNoise(log, on_means, noise, error)) return false;
+  ImuNoiseModel& model = noise->model;
+  model.rate_hz *= b;
+  model.still_begin *= block;
+  model.still_end *= block;
+  noise->timing.rate_hz *= b;
+  noise->timing.median_step /= b;
+  auto per_row = [&](AllanDeviation* curve) {
+    curve->rate_hz *= b;
+    curve->samples *= block;
+    for (AllanPoint& p : curve->points) p.m *= block;
+  };
+  for (int a = 0; a < 3; ++a) {
+    per_row(&noise->accel_curves[a]);
+    per_row(&noise->gyro_curves[a]);
+  }
+  per_row(&noise->temperature_curve);
+  char text[200];
+  std::snprintf(text, sizeof(text),
+                ": the Allan deviation is the overlapping estimate on those means (stride %zu "
+                "rows), taus from %.4g s; rates are per row",
+                block, block / model.rate_hz);
+  const std::string said = reading.Describe() + text;
+  noise->message += "; " + said;
+  noise->timing.message += noise->timing.message.empty() ? said : "; " + said;
   return true;
 }
 

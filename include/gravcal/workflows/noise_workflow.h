@@ -15,6 +15,7 @@
 
 #include "gravcal/core/imu_log.h"
 #include "gravcal/estimation/noise_characterisation.h"
+#include "gravcal/io/long_log.h"
 #include "gravcal/workflows/config.h"
 
 namespace gravcal {
@@ -34,6 +35,16 @@ bool NoiseOptionsFromConfig(const Config& config, NoiseOptions* options, std::st
 // failure.
 bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise* noise,
                           std::string* error);
+
+// CharacteriseLogNoise on a log ReadImuLogBounded read (io/long_log.h).
+// On block means (reading.samples_averaged > 1) the Allan deviation is the
+// overlapping estimate on the means (taus from one block on), a nominal
+// rate is divided by the block, and the results are restated per row of the
+// recording (the rate, the still interval's rows, the curves' rates, sample
+// counts and averaging factors; taus unchanged); noise->message and the
+// timing's text (noise.json choices.timing.text) say what was done.
+bool CharacteriseLongLogNoise(const ImuLog& log, const LongLogReading& reading,
+                              const NoiseOptions& options, ImuNoise* noise, std::string* error);
 
 // The files of `gravcal noise`; an empty path is not written.
 struct NoiseFiles {
