@@ -56,10 +56,14 @@ constexpr size_t kApplyBlockRows = 8192;
 // A block of rows: read here, corrected and formatted by a worker.
 struct ApplyBlock {
   size_t rows = 0;
-  std::vector<ImuSample> samples = std::vector<ImuSample>(kApplyBlockRows);
+  std::vector<double> t = std::vector<double>(kApplyBlockRows);
+  std::vector<Eigen::Vector3d> accel = std::vector<Eigen::Vector3d>(kApplyBlockRows);
+  std::vector<Eigen::Vector3d> gyro = std::vector<Eigen::Vector3d>(kApplyBlockRows);
+  std::vector<double> temperature = std::vector<double>(kApplyBlockRows);
   std::vector<double> rates = std::vector<double>(kApplyBlockRows);
   // The reader's position() of each row, for messages.
   std::vector<size_t> positions = std::vector<size_t>(kApplyBlockRows);
+  std::unique_ptr<bool[]> clamped = std::make_unique<bool[]>(kApplyBlockRows);
   std::unique_ptr<char[]> text =
       std::make_unique<char[]>(kApplyBlockRows * ImuCsvStreamWriter::kMaxRowBytes);
   size_t text_size = 0;
@@ -67,40 +71,55 @@ struct ApplyBlock {
   size_t failed_row = 0;
   bool no_root = false;
   // Samples clamped by more than kClampWarningDegrees, and their range.
-  size_t clamped = 0;
+  size_t clamped_count = 0;
   double lowest = INFINITY, highest = -INFINITY;
   bool done = true;  // Guarded by ApplyWorkers::mutex_.
+
+  void Put(size_t i, const ImuSample& s) {
+    t[i] = s.t;
+    accel[i] = s.accel;
+    gyro[i] = s.gyro;
+    temperature[i] = s.temperature;
+  }
 };
 
-// Corrects and formats a block's rows (stops at the first row that fails).
+// Corrects and formats a block's rows, up to the first row that fails
+// (ImuCorrector::CorrectRows, then the finite check, row by row as one
+// thread would).
 void CorrectBlock(const ImuCorrector& corrector, bool gyro, bool temperature, ApplyBlock* b) {
+  const size_t corrected =
+      corrector.CorrectRows(b->rows, b->temperature.data(), b->rates.data(), b->t.data(),
+                            b->accel.data(), gyro ? b->gyro.data() : nullptr, b->clamped.get());
   b->failed_row = b->rows;
-  b->clamped = 0;
+  b->no_root = false;
+  // Finite readings and a checked calibration can still overflow (a
+  // reading of 1e300 counts): nothing that is not a number is written.
+  for (size_t i = 0; i < corrected; ++i) {
+    if (!b->accel[i].allFinite() || !b->gyro[i].allFinite()) {
+      b->failed_row = i;
+      break;
+    }
+  }
+  if (corrected < b->failed_row) {
+    b->failed_row = corrected;
+    b->no_root = true;
+  }
+  b->clamped_count = 0;
   b->lowest = INFINITY;
   b->highest = -INFINITY;
   char* p = b->text.get();
   const ThermalModel& th = corrector.thermal;
-  for (size_t i = 0; i < b->rows; ++i) {
-    ImuSample& sample = b->samples[i];
-    bool clamped = false;
-    if (!corrector.CorrectRow(sample.temperature, b->rates[i], sample.t, &sample.accel,
-                              gyro ? &sample.gyro : nullptr, &clamped)) {
-      b->failed_row = i;
-      b->no_root = true;
-      break;
-    }
-    // Finite readings and a checked calibration can still overflow (a
-    // reading of 1e300 counts): nothing that is not a number is written.
-    if (!sample.accel.allFinite() || !sample.gyro.allFinite()) {
-      b->failed_row = i;
-      b->no_root = false;
-      break;
-    }
+  ImuSample sample;
+  for (size_t i = 0; i < b->failed_row; ++i) {
+    sample.t = b->t[i];
+    sample.accel = b->accel[i];
+    sample.gyro = b->gyro[i];
+    sample.temperature = b->temperature[i];
     p = ImuCsvStreamWriter::FormatRow(sample, gyro, temperature, p);
     // Clamped by more than the temperature sensor's noise: counted.
-    if (clamped && (sample.temperature < th.min_temperature - kClampWarningDegrees ||
-                    sample.temperature > th.max_temperature + kClampWarningDegrees)) {
-      ++b->clamped;
+    if (b->clamped[i] && (sample.temperature < th.min_temperature - kClampWarningDegrees ||
+                          sample.temperature > th.max_temperature + kClampWarningDegrees)) {
+      ++b->clamped_count;
       b->lowest = std::min(b->lowest, sample.temperature);
       b->highest = std::max(b->highest, sample.temperature);
     }
@@ -216,8 +235,8 @@ int RunApply(const ApplyArgs& args) {
   const bool gyro = reader.has_gyro(), temperature = reader.has_temperature();
   const int threads = static_cast<int>(std::min(8u, std::thread::hardware_concurrency()));
   std::vector<ApplyBlock> ring(2 * static_cast<size_t>(std::max(threads, 1)) + 2);
-  ImuSample* first = &ring[0].samples[0];
-  if (!reader.Next(first, &error)) return Fail(error);
+  ImuSample sample;
+  if (!reader.Next(&sample, &error)) return Fail(error);
   ImuCsvStreamWriter writer;
   if (!writer.Open(args.output, gyro, temperature,
                    OutputComment(calibration_path, calibration, gyro), &error)) {
@@ -241,7 +260,7 @@ int RunApply(const ApplyArgs& args) {
       return false;
     }
     count += b.rows;
-    clamped_count += b.clamped;
+    clamped_count += b.clamped_count;
     lowest = std::min(lowest, b.lowest);
     highest = std::max(highest, b.highest);
     return writer.WriteRows(b.text.get(), b.text_size, &error);
@@ -258,17 +277,13 @@ int RunApply(const ApplyArgs& args) {
     }
     ApplyBlock& b = ring[submitted % ring.size()];
     b.rows = 0;
-    if (submitted == 0) {  // The first sample, read above.
-      b.rates[0] = rate.Add(first->t, first->temperature);
-      b.positions[0] = reader.position();
-      b.rows = 1;
-    }
-    while (b.rows < kApplyBlockRows) {
-      ImuSample& sample = b.samples[b.rows];
-      if (!reader.Next(&sample, &read_error)) {
+    // The first sample was read above.
+    for (bool have = submitted == 0; b.rows < kApplyBlockRows; have = false) {
+      if (!have && !reader.Next(&sample, &read_error)) {
         more = false;
         break;
       }
+      b.Put(b.rows, sample);
       b.rates[b.rows] = rate.Add(sample.t, sample.temperature);
       b.positions[b.rows] = reader.position();
       ++b.rows;

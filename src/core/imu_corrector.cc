@@ -118,6 +118,27 @@ bool ImuCorrector::CorrectRow(double temperature, double temperature_rate, doubl
   return true;
 }
 
+size_t ImuCorrector::CorrectRows(size_t n, const double* temperature,
+                                 const double* temperature_rate, const double* time,
+                                 Eigen::Vector3d* accel_rows, Eigen::Vector3d* gyro_rows,
+                                 bool* clamped) const {
+  // CorrectRow's steps, the parameters and thermal blocks made once.
+  const ImuParameters p(accel, has_gyro ? &gyro : nullptr, effects, active_effects);
+  const ThermalBlocks<double> accel_thermal = thermal.Blocks(ThermalSensor::kAccel);
+  const ThermalBlocks<double> gyro_thermal = thermal.Blocks(ThermalSensor::kGyro);
+  for (size_t i = 0; i < n; ++i) {
+    const double x = thermal.Offset(temperature[i], temperature_rate[i], &clamped[i]);
+    Eigen::Vector3d a;
+    if (!AccelOf(p, accel_thermal, x, accel_rows[i], temperature[i], time[i], &a)) return i;
+    if (gyro_rows != nullptr && has_gyro) {
+      gyro_rows[i] =
+          GyroOf(p, gyro_thermal, x, accel.rotation, gyro_rows[i], a, temperature[i], time[i]);
+    }
+    accel_rows[i] = a;
+  }
+  return n;
+}
+
 ImuCorrector ImuCorrector::WithEffects(const std::vector<Effect>& keep) const {
   ImuCorrector out = *this;
   out.active_effects.clear();

@@ -31,6 +31,7 @@
 #define GRAVCAL_CORE_IMU_CORRECTOR_H_
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,13 @@ struct ImuCorrector {
   // model's valid range and was clamped.
   bool CorrectRow(double temperature, double temperature_rate, double time, Eigen::Vector3d* accel,
                   Eigen::Vector3d* gyro, bool* clamped) const;
+  // CorrectRow over the rows [0, n) of a block, the same numbers row by row,
+  // with the model set up once (gravcal apply): accel[i] and gyro[i] (gyro
+  // may be null) corrected in place, clamped[i] set. Returns the first row
+  // that fails (left unchanged, the rows after it untouched), n when none.
+  size_t CorrectRows(size_t n, const double* temperature, const double* temperature_rate,
+                     const double* time, Eigen::Vector3d* accel, Eigen::Vector3d* gyro,
+                     bool* clamped) const;
 
   // The same model with only the terms a target can hold: the effects in
   // `keep` (others dropped). Used to measure what an export truncates.
