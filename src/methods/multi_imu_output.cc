@@ -10,7 +10,7 @@ namespace gravcal {
 namespace internal {
 namespace {
 
-constexpr const char* kIntrinsicNames[21] = {
+constexpr const char* kPlateIntrinsicNames[21] = {
     "bias_x", "bias_y", "bias_z",      "u_xx",        "u_xy",        "u_xz", "u_yy",
     "u_yz",   "u_zz",   "gyro_bias_x", "gyro_bias_y", "gyro_bias_z", "m_xx", "m_xy",
     "m_xz",   "m_yx",   "m_yy",        "m_yz",        "m_zx",        "m_zy", "m_zz"};
@@ -36,7 +36,7 @@ void FillCalibration(const PlateImuData& imu, const PlateImuParameters& p,
   const int rc[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
   for (int k = 0; k < 6; ++k) c->accel.matrix_std(rc[k][0], rc[k][1]) = sd(3 + k);
   c->accel.covariance = cov.topLeftCorner(accel_n, accel_n);
-  c->accel.covariance_names.assign(kIntrinsicNames, kIntrinsicNames + accel_n);
+  c->accel.covariance_names.assign(kPlateIntrinsicNames, kPlateIntrinsicNames + accel_n);
   if (imu.has_gyro) {
     GyroCalibration& g = c->gyro;
     g.estimated = true;
