@@ -134,7 +134,8 @@ TEST(MultiImuCli, IndependentPlatesMeetTheMustShow) {
 // multi-IMU config writes plate.csv and truth.json; calibrate finds the
 // simulated clock offsets; a batch of two plates and an unreadable one is
 // one row per IMU (the fleet statistics count units), each plate's files
-// in its folder, the bad plate one failed row, exit 1.
+// in its folder, the bad plate one failed row, exit 1; each IMU a unit of
+// the acceptance limits with its certificate.
 TEST(MultiImuCli, SimulatedPlatesCalibrateAndBatchAsUnits) {
   ScratchDir scratch;
   const std::string config = scratch.Write(
@@ -161,18 +162,26 @@ TEST(MultiImuCli, SimulatedPlatesCalibrateAndBatchAsUnits) {
   ASSERT_EQ(std::rename((scratch / "sim4/plate.csv").c_str(), (scratch / "plates/b.csv").c_str()),
             0);
   scratch.Write("plates/c.csv", "t,x\n0,1\n");
-  r = RunCli({"batch", "--config", config, "--input-dir", scratch / "plates", "--output-dir",
-              scratch / "out", "--threads", "1"},
-             scratch);
+  // The noise density is measured in each IMU's holds (the simulator's
+  // 0.02 m/s^2 per sample at 100 Hz: 0.002 m/s^2/sqrt(Hz)).
+  const std::string limits =
+      scratch.Write("limits.yaml", "residual_rms: 0.05\naccel_noise_density: 0.004\n");
+  r = RunCli(
+      {"batch", "--config", config, "--input-dir", scratch / "plates", "--output-dir",
+       scratch / "out", "--threads", "1", "--limits", limits, "--certificate", scratch / "certs"},
+      scratch);
   EXPECT_EQ(r.exit_code, 1) << r.err;
+  // Each IMU is a unit of the acceptance limits and has its certificate.
+  EXPECT_NE(r.err.find("4 of 4 calibrated units pass"), std::string::npos) << r.err;
+  EXPECT_TRUE(FileExists(scratch / "certs/b.imu1.html"));
   EXPECT_NE(r.err.find("batch of 3 plates (1 failed): 5 units, 4 ok, 1 failed"), std::string::npos)
       << r.err;
-  for (const char* file : {"a/imu0.json", "a/imu1.json", "a/assembly.json", "b/imu1.json"}) {
+  for (const char* file : {"a.imu0.json", "a.imu1.json", "a/assembly.json", "b.imu1.json"}) {
     EXPECT_TRUE(FileExists(scratch / (std::string("out/") + file))) << file;
   }
   const std::string csv = Slurp(scratch / "out/summary.csv");
   for (const char* unit :
-       {",a/imu0,ok,", ",a/imu1,ok,", ",b/imu0,ok,", ",b/imu1,ok,", ",c,failed,"}) {
+       {",a.imu0,ok,", ",a.imu1,ok,", ",b.imu0,ok,", ",b.imu1,ok,", ",c,failed,"}) {
     EXPECT_NE(csv.find(unit), std::string::npos) << unit << "\n" << csv;
   }
   EXPECT_NE(csv.find("time_offset"), std::string::npos);

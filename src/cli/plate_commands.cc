@@ -60,7 +60,7 @@ int RunPlateBatch(const BatchArgs& args) {
   const FleetStatistics& s = summary.statistics;
   std::fprintf(stderr,
                "gravcal: batch of %zu plates (%zu failed): %zu units, %zu ok, %zu failed; wrote "
-               "%s/<plate>/ and summary.csv, summary.json\n",
+               "%s/<plate>.<imu>.json, <plate>/assembly.json, summary.csv and summary.json\n",
                summary.plates, summary.failed_plates, s.units, s.ok, s.failed + s.not_converged,
                args.output_dir.c_str());
   const int code = s.failed + s.not_converged > 0

@@ -20,11 +20,12 @@ namespace internal {
 
 // One IMU's view of one shared pose.
 struct PlatePoseData {
-  size_t begin = 0, end = 0;                             // samples of its log
-  Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();  // raw
-  double accel_sigma = 0.0;                              // of the mean, m/s^2
-  Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();   // raw
-  double gyro_sigma = 0.0;                               // of the mean, raw
+  size_t begin = 0, end = 0;                                // samples of its log
+  Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();     // raw
+  double accel_sigma = 0.0;                                 // of the mean, m/s^2
+  Eigen::Vector3d accel_raw_std = Eigen::Vector3d::Zero();  // per sample, raw
+  Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();      // raw
+  double gyro_sigma = 0.0;                                  // of the mean, raw
 };
 
 // One IMU's data: its poses (one per shared pose), its turns (turn k joins

@@ -1,6 +1,7 @@
 // The multi-IMU calibration's results (methods/multi_imu.h): each IMU's
 // calibration in the existing schema, the sigmas compared between the
 // joint and separate fits, and the single-pose case.
+#include <algorithm>
 #include <cmath>
 
 #include "methods/multi_imu_internal.h"
@@ -9,7 +10,7 @@ namespace gravcal {
 namespace internal {
 namespace {
 
-constexpr const char* kIntrinsicNames[21] = {
+constexpr const char* kPlateIntrinsicNames[21] = {
     "bias_x", "bias_y", "bias_z",      "u_xx",        "u_xy",        "u_xz", "u_yy",
     "u_yz",   "u_zz",   "gyro_bias_x", "gyro_bias_y", "gyro_bias_z", "m_xx", "m_xy",
     "m_xz",   "m_yx",   "m_yy",        "m_yz",        "m_zx",        "m_zy", "m_zz"};
@@ -35,7 +36,7 @@ void FillCalibration(const PlateImuData& imu, const PlateImuParameters& p,
   const int rc[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
   for (int k = 0; k < 6; ++k) c->accel.matrix_std(rc[k][0], rc[k][1]) = sd(3 + k);
   c->accel.covariance = cov.topLeftCorner(accel_n, accel_n);
-  c->accel.covariance_names.assign(kIntrinsicNames, kIntrinsicNames + accel_n);
+  c->accel.covariance_names.assign(kPlateIntrinsicNames, kPlateIntrinsicNames + accel_n);
   if (imu.has_gyro) {
     GyroCalibration& g = c->gyro;
     g.estimated = true;
@@ -47,10 +48,26 @@ void FillCalibration(const PlateImuData& imu, const PlateImuParameters& p,
     g.covariance_names = {"bias_x", "bias_y", "bias_z", "m_xx", "m_xy", "m_xz",
                           "m_yx",   "m_yy",   "m_yz",   "m_zx", "m_zy", "m_zz"};
   }
+  // Each shared pose as a position of this IMU (its hold's samples, mean
+  // and noise: what the acceptance limits' noise density reads).
   std::vector<double> residuals;
+  c->positions.clear();
+  const ImuLog& log = imu.imu->log;
   for (const PlatePoseData& pose : imu.poses) {
     Eigen::Vector3d m = a.upper * (pose.accel_mean - a.bias);
     residuals.push_back(m.norm() - gravity);
+    PositionReport r;
+    r.position.raw_mean = pose.accel_mean;
+    r.position.sample_count = pose.end - pose.begin;
+    r.position.raw_mean_cov = pose.accel_raw_std.array().square().matrix().asDiagonal();
+    r.position.raw_mean_cov /= static_cast<double>(std::max<size_t>(1, r.position.sample_count));
+    r.position.t_begin = pose.begin < log.size() ? log.t[pose.begin] : NAN;
+    r.position.t_end = pose.end >= 1 && pose.end <= log.size() ? log.t[pose.end - 1] : NAN;
+    r.position.temperature = NAN;
+    r.raw_std = pose.accel_raw_std;
+    r.residual_after = residuals.back();
+    r.sigma = pose.accel_sigma;
+    c->positions.push_back(r);
   }
   c->residual_refined = SummarizeResiduals(residuals);
   c->message = "multi_imu: calibrated on the plate's shared poses";

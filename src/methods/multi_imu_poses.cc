@@ -145,6 +145,7 @@ PlatePoseData PoseOf(const ImuLog& log, double begin, double end) {
   const StaticInterval s = MakeInterval(log, p.begin, p.end);
   const double n = static_cast<double>(std::max<size_t>(1, s.count()));
   p.accel_mean = s.accel_mean;
+  p.accel_raw_std = s.accel_cov.diagonal().cwiseMax(0.0).cwiseSqrt();
   // Each axis at least its quantisation: step^2 / 12, the step the smallest
   // nonzero change between samples (and a relative floor for data with
   // none, such as a constant reading).

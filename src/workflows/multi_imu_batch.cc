@@ -30,7 +30,7 @@ void FailPlate(const BatchUnit& plate, const MultiImuConfig& config, const std::
   out->failed = true;
   std::vector<std::string> names;
   if (!config.auto_imus) {
-    for (const MultiImuLogSpec& s : config.imus) names.push_back(plate.id + "/" + s.name);
+    for (const MultiImuLogSpec& s : config.imus) names.push_back(plate.id + "." + s.name);
   }
   if (names.empty()) names.push_back(plate.id);
   for (const std::string& name : names) {
@@ -60,7 +60,8 @@ void RunPlate(const BatchUnit& plate, const MultiImuConfig& base, const std::str
   }
   const std::string folder = output_dir + "/" + plate.id;
   if (!MakeFolders(folder, &error) ||
-      !WriteFilesAtomically(MultiImuSessionFiles(result, config, imus, provenance, folder),
+      !WriteFilesAtomically(MultiImuSessionFiles(result, config, imus, provenance, folder,
+                                                 output_dir + "/" + plate.id + "."),
                             &error)) {
     FailPlate(plate, config, error, out);
     return;
@@ -70,7 +71,7 @@ void RunPlate(const BatchUnit& plate, const MultiImuConfig& base, const std::str
   for (const std::string& w : result.warnings) out->warnings.push_back(plate.id + ": " + w);
   for (const PlateImuResult& r : result.imus) {
     BatchResult b;
-    b.unit = plate.id + "/" + r.name;
+    b.unit = plate.id + "." + r.name;
     b.status = BatchStatus::kOk;
     b.message = r.calibration.message;
     b.calibration = r.calibration;

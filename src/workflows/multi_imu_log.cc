@@ -155,14 +155,16 @@ std::vector<FileContents> MultiImuSessionFiles(const MultiImuResult& result,
                                                const MultiImuConfig& config,
                                                const std::vector<PlateImu>& imus,
                                                const CalibrationProvenance& provenance,
-                                               const std::string& output_dir) {
+                                               const std::string& output_dir,
+                                               const std::string& calibration_prefix) {
+  const std::string prefix = calibration_prefix.empty() ? output_dir + "/" : calibration_prefix;
   std::vector<FileContents> files;
   std::vector<double> rates;
   for (size_t i = 0; i < result.imus.size(); ++i) {
     Calibration c = result.imus[i].calibration;
     c.provenance = provenance;
-    files.push_back({output_dir + "/" + result.imus[i].name + ".json",
-                     CalibrationToJson(c, config.output_covariance)});
+    files.push_back(
+        {prefix + result.imus[i].name + ".json", CalibrationToJson(c, config.output_covariance)});
     const ImuLog& log = imus[i].log;
     double rate = i < config.imus.size() ? config.imus[i].update_rate : 0.0;
     if (!(rate > 0.0) && log.size() > 1) rate = (log.size() - 1) / (log.t.back() - log.t.front());

@@ -1,12 +1,13 @@
 // gravcal/workflows/multi_imu_batch.h: a batch of plates (issue 38). Each
 // unit of the batch (a file of --input-dir or a manifest row) is one
 // multi-IMU session, calibrated as `calibrate --config <multi-IMU config>
-// --output-dir` does, into <output_dir>/<plate>/ (<imu>.json per IMU,
-// assembly.json, the Kalibr chain, the PX4 rotations). The summary has one
-// row per IMU, unit "<plate>/<imu>" (its calibration is
-// <output_dir>/<plate>/<imu>.json, the batch folder's <unit>.json), so the
-// fleet statistics count units, not plates. Each row also has the IMU's
-// time offset to its plate's reference and the rotation's sigma.
+// --output-dir` does. Each IMU is a unit "<plate>.<imu>" with its
+// calibration in <output_dir>/<plate>.<imu>.json (the batch folder's
+// <unit>.json, so limits, certificates and the store take it as any unit);
+// the plate's assembly.json, Kalibr chain and PX4 rotations are in
+// <output_dir>/<plate>/. The summary has one row per IMU, so the fleet
+// statistics count units, not plates. Each row also has the IMU's time
+// offset to its plate's reference and the rotation's sigma.
 //
 // A plate that cannot be calibrated fails every IMU the config lists (one
 // row each), or one row named after the plate when the IMUs come from the
@@ -39,7 +40,7 @@ struct PlateBatchSummary {
   // One per IMU (or per unreadable plate), in plate order then IMU order.
   std::vector<SummaryRow> rows;
   FleetStatistics statistics;
-  // Each calibrated IMU: its unit id "<plate>/<imu>" and its plate's path.
+  // Each calibrated IMU: its unit id "<plate>.<imu>" and its plate's path.
   std::vector<std::pair<std::string, std::string>> units;
   // "<plate>: <warning>" for every named mistake of every plate.
   std::vector<std::string> warnings;

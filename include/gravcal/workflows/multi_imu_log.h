@@ -87,14 +87,16 @@ bool ReadMultiImuLogs(MultiImuConfig* config, const std::string& input, std::vec
 std::vector<MultiImuLogSpec> ImusOfHeader(const std::string& text, double accel_scale,
                                           double gyro_scale);
 
-// The files of one calibrated session in output_dir: <name>.json per IMU
-// (the calibration schema, with `provenance`), assembly.json,
-// kalibr_imu_chain.yaml and px4_rotations.params.
+// The files of one calibrated session: <calibration_prefix><name>.json per
+// IMU (the calibration schema, with `provenance`; the prefix "" means
+// "<output_dir>/"), and in output_dir assembly.json, kalibr_imu_chain.yaml
+// and px4_rotations.params.
 std::vector<FileContents> MultiImuSessionFiles(const MultiImuResult& result,
                                                const MultiImuConfig& config,
                                                const std::vector<PlateImu>& imus,
                                                const CalibrationProvenance& provenance,
-                                               const std::string& output_dir);
+                                               const std::string& output_dir,
+                                               const std::string& calibration_prefix = "");
 
 // assembly.json (docs/data_contract.md).
 std::string MultiImuAssemblyToJson(const MultiImuResult& result);
