@@ -54,15 +54,20 @@ bool SameFileState(const struct stat& a, const struct stat& b) {
 // ReadFileBytes, refusing a regular file that changed while it was read
 // (truncated, rewritten, or of another size than the bytes read): the
 // bytes would be a mix, and their hash would mark a wrong result as current.
+// The message for a unit file whose size changed while it was read.
+std::string ChangedWhileRead(const std::string& path) {
+  return path +
+         ": the file changed while it was read (truncated or rewritten?); the unit is tried "
+         "again on the next run";
+}
+
 bool ReadUnitFile(const std::string& path, std::string* bytes, std::string* error) {
   struct stat before, after;
   const bool regular = stat(path.c_str(), &before) == 0 && S_ISREG(before.st_mode);
   if (!ReadFileBytes(path, bytes, error)) return false;
   if (regular && (stat(path.c_str(), &after) != 0 || !SameFileState(before, after) ||
                   static_cast<off_t>(bytes->size()) != before.st_size)) {
-    *error = path +
-             ": the file changed while it was read (truncated or rewritten?); the unit "
-             "is tried again on the next run";
+    *error = ChangedWhileRead(path);
     return false;
   }
   return true;
@@ -112,9 +117,7 @@ bool StreamedUnitHash(const std::string& path, const std::string& attitudes_byte
   }
   std::fclose(file);
   if (read != size) {
-    *error = path +
-             ": the file changed while it was read (truncated or rewritten?); the unit "
-             "is tried again on the next run";
+    *error = ChangedWhileRead(path);
     return false;
   }
   hash.End();
