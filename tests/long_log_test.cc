@@ -6,11 +6,13 @@
 #include "gravcal/io/long_log.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <thread>
 
 #include "gravcal/estimation/noise_characterisation.h"
 #include "gravcal/io/log_reader.h"
@@ -100,6 +102,41 @@ TEST(LongLog, LongerLogHoldsAtMostMaxSamplesBlockMeans) {
     ASSERT_NEAR((bounded.gyro[k] - gyro * inv).norm(), 0.0, 1e-16) << k;
     ASSERT_NEAR(bounded.temperature[k], temperature * inv, 1e-12) << k;
   }
+}
+
+// A log made on the fly into a pipe (a FIFO a thread writes) streams in
+// bounded memory too: the same entries as from a regular file with the same
+// text, its capacity at most max_samples.
+TEST(LongLog, PipeStreamsInBoundedMemory) {
+  std::string text = "t,ax,ay,az,gx,gy,gz\n";
+  for (int i = 0; i < 5000; ++i) {
+    text += std::to_string(i * 0.01) + "," + std::to_string(0.001 * (i % 7)) + ",0.2,9.8," +
+            std::to_string(1e-3 * (i % 5)) + ",0,0\n";
+  }
+  const std::string file = ::testing::TempDir() + "/long_log_pipe.csv";
+  const std::string fifo = ::testing::TempDir() + "/long_log_pipe.fifo";
+  std::ofstream(file) << text;
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&]() { std::ofstream(fifo) << text; });
+  ImuLog from_pipe, from_file;
+  LongLogReading pipe_reading, file_reading;
+  std::string error;
+  const bool ok = ReadBounded(fifo, 256, &from_pipe, &pipe_reading, &error);
+  writer.join();
+  std::remove(fifo.c_str());
+  ASSERT_TRUE(ok) << error;
+  ASSERT_TRUE(ReadBounded(file, 256, &from_file, &file_reading, &error)) << error;
+  std::remove(file.c_str());
+  // 256 entries of 16 rows hold 4096 rows: 5000 need means of 32.
+  EXPECT_EQ(pipe_reading.samples_averaged, 32u);
+  EXPECT_EQ(pipe_reading.rows_read, 5000u);
+  EXPECT_EQ(from_pipe.size(), 156u);
+  EXPECT_LE(from_pipe.t.capacity(), 256u);
+  EXPECT_LE(from_pipe.accel.capacity(), 256u);
+  EXPECT_EQ(from_pipe.t, from_file.t);
+  EXPECT_EQ(from_pipe.accel, from_file.accel);
+  EXPECT_EQ(from_pipe.gyro, from_file.gyro);
 }
 
 // A bad row deep in a long log is still one line naming the file and line.

@@ -201,7 +201,9 @@ bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std
       const std::string_view rest = source->rest();
       const uint64_t left = bytes == 0 ? rest.size() : bytes - (source->bytes_read() - rest.size());
       size_t rows = EstimateRows(rest, left) + 1;
-      if (max_samples > 0) rows = std::min(rows, max_samples);
+      // Bounded: never more than max_samples; a pipe (no length) reserves
+      // them at once rather than grow to twice as many.
+      if (max_samples > 0) rows = bytes == 0 ? max_samples : std::min(rows, max_samples);
       out->t.reserve(rows);
       out->accel.reserve(rows);
       if (parser.has(kGx)) out->gyro.reserve(rows);
@@ -365,6 +367,35 @@ bool LogReaderOptions::IsValid(std::string* error) const {
 
 namespace {
 
+// A pipe or device (not a regular file), read once from its start: the
+// format from its first bytes. In bounded memory (`bounded`, no `hash`) it is
+// streamed; else read whole, since the content hash needs the length first.
+bool ReadPipe(const std::string& path, const LogReaderOptions& options, ImuLog* log,
+              internal::ContentHash* hash, LongLogReading* bounded, std::string* error) {
+  std::string why;
+  if (!options.IsValid(&why)) return SetError(error, path + ": invalid options: " + why);
+  if (bounded != nullptr && bounded->max_samples > 0 && options.gyro_path.empty() &&
+      hash == nullptr) {
+    OpenFile file;
+    if (!OpenForReading(path, &file, error)) return false;
+    internal::LogLines source(file.get(), path);
+    const std::string_view head = source.Head(4096, &why);
+    if (!why.empty()) return SetError(error, why);
+    internal::FileFormat format = internal::FileFormat::kText;
+    if (!internal::DetectFileFormat(head, &format, &why)) return SetError(error, path + ": " + why);
+    if (internal::NewMessageRecording(format) != nullptr) {
+      return SetError(error, path + ": a " + internal::FileFormatName(format) +
+                                 " is read from its file, not from a pipe");
+    }
+    return ParseLog(&source, 0, format, path, options, log, bounded, error);
+  }
+  FileText text;
+  if (!text.Read(path, error)) return false;
+  if (!ParseImpl(text.view(), path, options, log, error)) return false;
+  if (hash != nullptr) hash->Add(text.view());
+  return true;
+}
+
 // ReadImuLog; `hash`, when not null, gets the content hash of the file's
 // bytes: from the text parsed for a text log, from a second read for a
 // message recording (read message by message).
@@ -372,6 +403,11 @@ bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* l
              internal::ContentHash* hash, LongLogReading* bounded, std::string* error) {
   if (log == nullptr) return SetError(error, path + ": no log to read into");
   try {
+    struct stat path_stat;
+    if (stat(path.c_str(), &path_stat) == 0 && !S_ISREG(path_stat.st_mode) &&
+        !S_ISDIR(path_stat.st_mode)) {
+      return ReadPipe(path, options, log, hash, bounded, error);
+    }
     internal::FileFormat format = internal::FileFormat::kText;
     if (!internal::DetectFileFormatOf(path, &format, error)) return false;
     if (std::unique_ptr<internal::MessageRecording> recording =
@@ -395,14 +431,8 @@ bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* l
     if (!OpenForReading(path, &file, error)) return false;
     struct stat st;
     if (fstat(fileno(file.get()), &st) != 0 || !S_ISREG(st.st_mode)) {
-      // A pipe or device: its length is known only at its end, which the
-      // content hash needs first; read whole.
       file.reset();
-      FileText text;
-      if (!text.Read(path, error)) return false;
-      if (!ParseImpl(text.view(), path, options, log, error)) return false;
-      if (hash != nullptr) hash->Add(text.view());
-      return true;
+      return ReadPipe(path, options, log, hash, bounded, error);
     }
     const uint64_t bytes = static_cast<uint64_t>(st.st_size);
     // Read in bounded memory (max_samples) unless a second file is matched

@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <functional>
+#include <string>
 #include <thread>
 
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/log_reader.h"
+#include "gravcal/io/long_log.h"
 #include "gravcal/io/recording.h"
 #include "gravcal/workflows/pipeline.h"
 #include "util/content_hash.h"
@@ -51,17 +54,76 @@ bool SameFileState(const struct stat& a, const struct stat& b) {
 // ReadFileBytes, refusing a regular file that changed while it was read
 // (truncated, rewritten, or of another size than the bytes read): the
 // bytes would be a mix, and their hash would mark a wrong result as current.
+// The message for a unit file whose size changed while it was read.
+std::string ChangedWhileRead(const std::string& path) {
+  return path +
+         ": the file changed while it was read (truncated or rewritten?); the unit is tried "
+         "again on the next run";
+}
+
 bool ReadUnitFile(const std::string& path, std::string* bytes, std::string* error) {
   struct stat before, after;
   const bool regular = stat(path.c_str(), &before) == 0 && S_ISREG(before.st_mode);
   if (!ReadFileBytes(path, bytes, error)) return false;
   if (regular && (stat(path.c_str(), &after) != 0 || !SameFileState(before, after) ||
                   static_cast<off_t>(bytes->size()) != before.st_size)) {
-    *error = path +
-             ": the file changed while it was read (truncated or rewritten?); the unit "
-             "is tried again on the next run";
+    *error = ChangedWhileRead(path);
     return false;
   }
+  return true;
+}
+
+// Units larger than this are hashed block by block and read in bounded
+// memory (io/long_log.h), as `calibrate` reads a log, never held whole.
+// Smaller ones (at most about 1.5 M rows: read exactly either way) are read
+// whole once, for the hash and the samples.
+constexpr uint64_t kStreamedUnitBytes = uint64_t{64} << 20;
+
+// Whether `path` is a text log of more than kStreamedUnitBytes.
+bool IsLongTextUnit(const std::string& path) {
+  struct stat st;
+  if (stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) ||
+      static_cast<uint64_t>(st.st_size) <= kStreamedUnitBytes) {
+    return false;
+  }
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) return false;
+  std::string head(4096, '\0');
+  head.resize(std::fread(head.data(), 1, head.size(), file));
+  std::fclose(file);
+  return !IsMessageRecording(head);
+}
+
+// UnitContentHash of the log file at `path` (no gyroscope file), its bytes
+// read block by block.
+bool StreamedUnitHash(const std::string& path, const std::string& attitudes_bytes,
+                      const Config& config, std::string* hex, std::string* error) {
+  struct stat st;
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr || fstat(fileno(file), &st) != 0) {
+    if (file != nullptr) std::fclose(file);
+    *error = path + ": cannot open";
+    return false;
+  }
+  const uint64_t size = static_cast<uint64_t>(st.st_size);
+  ContentHash hash;
+  hash.Add(GravcalVersion());
+  hash.Add(ConfigText(config));
+  hash.Begin(size);
+  std::string block(size_t{1} << 20, '\0');
+  uint64_t read = 0;
+  for (size_t n; (n = std::fread(block.data(), 1, block.size(), file)) > 0; read += n) {
+    hash.Append(std::string_view(block.data(), n));
+  }
+  std::fclose(file);
+  if (read != size) {
+    *error = ChangedWhileRead(path);
+    return false;
+  }
+  hash.End();
+  hash.Add("");  // no gyroscope file
+  hash.Add(attitudes_bytes);
+  *hex = hash.Hex();
   return true;
 }
 
@@ -83,9 +145,11 @@ void RunUnit(const BatchUnit& unit, const Config& base, const SkipFunction& skip
   std::string log_bytes;
   std::string gyro_bytes;
   std::string attitudes_bytes;
+  const bool streamed =
+      !unit.path.empty() && config.input.gyro_path.empty() && IsLongTextUnit(unit.path);
   if (unit.path.empty()) {
     log_bytes = LogBytes(unit.log);
-  } else if (!ReadUnitFile(unit.path, &log_bytes, &error)) {
+  } else if (!streamed && !ReadUnitFile(unit.path, &log_bytes, &error)) {
     return stop(error);
   }
   if ((!config.input.gyro_path.empty() &&
@@ -94,7 +158,11 @@ void RunUnit(const BatchUnit& unit, const Config& base, const SkipFunction& skip
        !ReadUnitFile(unit.attitudes_path, &attitudes_bytes, &error))) {
     return stop(error);
   }
-  r->content_hash = UnitContentHash(log_bytes, gyro_bytes, attitudes_bytes, config);
+  if (!streamed) {
+    r->content_hash = UnitContentHash(log_bytes, gyro_bytes, attitudes_bytes, config);
+  } else if (!StreamedUnitHash(unit.path, attitudes_bytes, config, &r->content_hash, &error)) {
+    return stop(error);
+  }
   if (skip && skip(unit, r->content_hash)) {
     r->skipped = true;
     return stop("skipped: the stored result has this content hash");
@@ -102,8 +170,14 @@ void RunUnit(const BatchUnit& unit, const Config& base, const SkipFunction& skip
   SessionFiles files;
   files.attitudes_path = unit.attitudes_path;
   Session session;
+  LongLogReading reading;
+  CalibrationProvenance provenance;
   if (unit.path.empty()) {
     session.log = unit.log;
+  } else if (streamed) {
+    if (!ReadImuLogBounded(unit.path, config.input, &reading, &session.log, &provenance, &error)) {
+      return stop(error);
+    }
   } else {
     // Exactly what ReadImuLog does after reading the file.
     // Bags and MCAP files are read from the file, message by message.
@@ -115,7 +189,12 @@ void RunUnit(const BatchUnit& unit, const Config& base, const SkipFunction& skip
   const Clock::time_point read_end = Clock::now();
   const bool ok = RunCalibration(config, files, &session, &r->calibration);
   // Issue 16: the same provenance as calibrate records.
-  if (!unit.path.empty()) r->calibration.provenance = LogProvenanceOfBytes(unit.path, log_bytes);
+  if (streamed) {
+    r->calibration.provenance = provenance;
+    AddLongLogWarning(reading, &r->calibration);
+  } else if (!unit.path.empty()) {
+    r->calibration.provenance = LogProvenanceOfBytes(unit.path, log_bytes);
+  }
   const Clock::time_point end = Clock::now();
   r->message = r->calibration.message;
   r->status = ok                             ? BatchStatus::kOk

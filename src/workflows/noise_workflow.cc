@@ -96,11 +96,12 @@ bool CharacteriseLongLogNoise(const ImuLog& log, const LongLogReading& reading,
     per_row(&noise->gyro_curves[a]);
   }
   per_row(&noise->temperature_curve);
-  char text[200];
+  char text[300];
   std::snprintf(text, sizeof(text),
-                ": the Allan deviation is the overlapping estimate on those means (stride %zu "
-                "rows), taus from %.4g s; rates are per row",
-                block, block / model.rate_hz);
+                ": the rate above is the means' (the rows' is %.6g Hz, noise.json's rate_hz), "
+                "and the Allan deviation is the overlapping estimate on the means (stride %zu "
+                "rows), taus from %.4g s",
+                model.rate_hz, block, block / model.rate_hz);
   const std::string said = reading.Describe() + text;
   noise->message += "; " + said;
   noise->timing.message += noise->timing.message.empty() ? said : "; " + said;
