@@ -22,12 +22,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "gravcal/detection/static_detector.h"
 #include "gravcal/estimation/pose_mean_covariance.h"
+#include "gravcal/io/calibration_io.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/report.h"
@@ -157,12 +159,14 @@ TEST(RealHonesty, PosesAndRepeatsWithinTheirSigmas) {
     lopo[i] = LopoRms(fits[i]);
     Describe(kSessions[i].file, fits[i], RmsOf(split), split.size(), lopo[i]);
   }
-  // The three AHRS repeats pairwise. good2 and good3 (14 and 15 poses)
-  // determine every parameter and must agree within their sigmas, neither
-  // too far apart nor too close. good1 has nine poses for the nine
-  // parameters (an exact fit; u_xy and u_xz undetermined, left out of z):
-  // its other sigmas rest on the white noise and the near-singular
-  // directions, so its pairs can only fail one way, by disagreeing.
+  // The three AHRS repeats pairwise, each within its sigmas, neither too
+  // far apart nor too close. good2 and good3 (14 and 15 poses) determine
+  // every parameter. good1's nine poses determine u_xy and u_xz only to
+  // second order: they are held at the coarse fit's value (reported without
+  // a number, left out of z) and good1's other sigmas are conditional on
+  // them, labelled so. Before they were held, the free fit's linearised
+  // sigmas were inflated by those near-flat directions: good1's pairs gave
+  // rms z 0.45 and 0.52, all three 0.62 over 23 (too small).
   std::vector<double> all;
   for (int i = 0; i < 3; ++i) {
     for (int j = i + 1; j < 3; ++j) {
@@ -177,14 +181,24 @@ TEST(RealHonesty, PosesAndRepeatsWithinTheirSigmas) {
       std::printf("\n");
       for (double v : z) EXPECT_LT(std::fabs(v), 3.5) << "good" << i + 1 << "-good" << j + 1;
       EXPECT_LT(RmsOf(z), 1.4) << "good" << i + 1 << "-good" << j + 1;
-      if (i == 1) {
-        EXPECT_EQ(z.size(), 9u);
-        EXPECT_GT(RmsOf(z), 0.7) << "good2-good3";
-      }
+      EXPECT_GT(RmsOf(z), 0.7) << "good" << i + 1 << "-good" << j + 1;
+      EXPECT_EQ(z.size(), i == 0 ? 7u : 9u);
       all.insert(all.end(), z.begin(), z.end());
     }
   }
   std::printf("AHRS repeats: rms z %.2f over %zu differences\n", RmsOf(all), all.size());
+  EXPECT_GT(RmsOf(all), 0.7);
+  EXPECT_LT(RmsOf(all), 1.4);
+  // good1's held terms are named wherever its sigmas are shown.
+  const std::vector<std::string> held = {"u_xy", "u_xz"};
+  EXPECT_EQ(fits[0].calibration.refinement.observability.undetermined, held);
+  const std::string json = CalibrationToJson(fits[0].calibration, false);
+  EXPECT_NE(json.find("\"conditional_on\""), std::string::npos);
+  Config good1;
+  ImuLog good1_log;
+  ASSERT_TRUE(LoadSession(kSessions[0].config, kSessions[0].file, &good1, &good1_log));
+  const std::string html = CalibrationToHtml(fits[0].calibration, good1_log, "good1");
+  EXPECT_NE(html.find("sigma conditional on holding u_xy, u_xz"), std::string::npos);
   // The recordings with residual degrees of freedom: leave-one-pose-out
   // predictions within their sigmas (the MPU-6050's one residual and
   // good1's none cannot show it: real_sessions.h).
@@ -334,6 +348,67 @@ TEST(RealHonesty, VerdictSeparatesScatterDisturbedPoseAndFailure) {
   EXPECT_FALSE(RunCalibration(config, input, &f));
   html = CalibrationToHtml(f, input.log, "failed");
   EXPECT_NE(html.find("Record the session again"), std::string::npos);
+}
+
+// A simulated session shaped like good1: its nine pose directions (x up and
+// down, the rest in the y-z plane), nine poses for the nine parameters.
+// u_xy and u_xz enter the magnitude only to second order there: the
+// weakest is held (and the other too when still weak), named, and the other
+// parameters' sigmas (conditional on them) agree with the truth, rms z over
+// 60 sessions in [0.7, 1.4] (measured 0.90; 0.72 with a 0.2 % truth
+// non-orthogonality instead of 1 %). They include the held terms' spread
+// up to max_matrix_std (refinement.cc, AddHeldSpread): without it, the
+// sigmas conditional on u_xy = u_xz = 0 gave rms z 1.84, and held at the
+// coarse fit's value (which these poses leave far off) 20.
+TEST(RealHonesty, WeakTermsHeldAndTheOtherSigmasConditionalOnThem) {
+  std::vector<Eigen::Vector3d> directions = {
+      {0.010, -0.005, -1.000}, {-1.000, -0.001, 0.031}, {0.000, -0.760, 0.650},
+      {-0.020, 0.770, 0.637},  {0.999, 0.007, 0.036},   {0.003, -0.073, 0.997},
+      {-0.007, 0.773, 0.635},  {0.007, 0.976, -0.218},  {0.004, -0.978, -0.208}};
+  for (Eigen::Vector3d& d : directions) d.normalize();
+  CalibrationOptions options;
+  options.gravity.gravity = 9.80665;
+  options.allow_undetermined = true;
+  std::vector<double> z;
+  int both = 0, sessions_held = 0, stalled = 0;
+  std::mt19937_64 rng(33);
+  for (int session = 0; session < 60; ++session) {
+    const AccelModel truth = AccelModel::Random(AccelParameterization::kScaleMisalignment,
+                                                9.80665 / 16384, 0.02, 0.01, 400, &rng);
+    const std::vector<Position> positions =
+        testing_util::MakePositions(truth, directions, 9.80665, 0.005, 0.02, 600, false, &rng);
+    Calibration fit;
+    // An exact fit on near-singular poses can stall; it says so (false).
+    if (!CalibrateFromPositions(positions, options, &fit)) {
+      EXPECT_NE(fit.message.find("did not converge"), std::string::npos) << fit.message;
+      ++stalled;
+      continue;
+    }
+    testing_util::ParameterEstimate e, t;
+    ASSERT_TRUE(testing_util::EstimateOf(fit, options.refinement.parameterization, &e));
+    t.value = testing_util::FreeParameters(truth, options.refinement.parameterization);
+    t.sigma = Eigen::VectorXd::Zero(t.value.size());
+    testing_util::AppendZ(e, t, &z);
+    // One or both of the flat terms held (or none, when this session's
+    // noise happens to determine them), nothing else; named in a warning.
+    const std::vector<std::string>& undetermined = fit.refinement.observability.undetermined;
+    if (undetermined.empty()) continue;
+    ++sessions_held;
+    for (const std::string& name : undetermined) {
+      EXPECT_TRUE(name == "u_xy" || name == "u_xz") << session << ": " << name;
+    }
+    bool named = false;
+    for (const std::string& w : fit.warnings) named |= w.find("conditional on holding") != w.npos;
+    EXPECT_TRUE(named) << session;
+    both += undetermined.size() == 2;
+  }
+  std::printf(
+      "good1-shaped simulations: rms z %.2f over %zu (held in %d of 60, both in %d, stalled %d)\n",
+      RmsOf(z), z.size(), sessions_held, both, stalled);
+  EXPECT_LE(stalled, 3);
+  EXPECT_GT(sessions_held, 30);
+  EXPECT_GT(RmsOf(z), 0.7);
+  EXPECT_LT(RmsOf(z), 1.4);
 }
 
 }  // namespace

@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "gravcal/io/log_reader.h"
 #include "gravcal/methods/handheld_kalman.h"
 #include "gravcal/methods/twelve_position.h"
 #include "gravcal/simulation/handheld_simulator.h"
@@ -205,6 +207,83 @@ TEST(SensorChecks, NewtonReportsTheChiSquareCheck) {
     const int i = FindWarning(c, {"times the noise level", "chi2"});
     ASSERT_GE(i, 0) << AllWarnings(c);
     EXPECT_EQ(c.warning_codes[i], WarningCode::kResidualsAboveNoise);
+  }
+}
+
+// The gyroscope's axis convention checked against the accelerometer's from
+// the turns alone (no gyroscope model fitted: gyro_model none, as for a
+// hand-held log): a flipped x or swapped x and y is named for every method;
+// the session as simulated gets no such warning.
+TEST(SensorChecks, GyroAxisConventionNamedWithoutAGyroscopeFit) {
+  GyroSession g = MakeGyroSession();
+  std::string error;
+  ASSERT_TRUE(SetConfigValue("gyro_model", "none", &g.config, &error)) << error;
+  const std::string kCheck = "the gyroscope's axes disagree with the accelerometer's";
+  PipelineInput input;
+  input.log = g.session.log;
+  Calibration c;
+  ASSERT_TRUE(RunCalibration(g.config, input, &c)) << c.message;
+  EXPECT_EQ(FindWarning(c, {kCheck}), -1) << AllWarnings(c);
+  EXPECT_EQ(internal::GyroAxisConventionWarning(g.session.log), "");
+
+  for (int change = 0; change < 3; ++change) {
+    input.log = g.session.log;
+    for (Eigen::Vector3d& w : input.log.gyro) {
+      if (change == 0) w.x() = -w.x();
+      if (change == 1) std::swap(w.x(), w.y());
+      if (change == 2) w.z() = -w.z();
+    }
+    ASSERT_TRUE(RunCalibration(g.config, input, &c)) << c.message;
+    const char* cause[3] = {"raw x axis looks flipped", "raw x and y axes look swapped",
+                            "raw z axis looks flipped"};
+    const int i = FindWarning(c, {kCheck, cause[change]});
+    ASSERT_GE(i, 0) << change << AllWarnings(c);
+    EXPECT_EQ(c.warning_codes[i], WarningCode::kSensorData);
+  }
+}
+
+// The real logs (skipped without ../shared/data/real). The sunsided
+// MPU-6050 hand-held logs' README says their gyroscope x axis has the
+// opposite sign convention to the accelerometer's. Measured: in
+// full_sphere.csv and roll_and_tilt_45_90.csv the columns as given explain
+// none of the turning and x and y both negated explain 68 % and 75 % (one
+// flipped x alone 24 %), so the mismatch is named there, as the data show
+// it; tilt_sphere.csv fits as given (51 %) and is only printed. The real
+// logs with a gyroscope recorded the right way round get no warning.
+TEST(SensorChecks, GyroAxisConventionOnTheRealLogs) {
+  if (testing_util::RealDataDir().empty()) GTEST_SKIP() << "../shared/data/real is not there";
+  struct Log {
+    const char* config;
+    const char* file;
+    const char* expected;  // nullptr: no warning; "": printed only
+  };
+  const Log logs[] = {
+      {nullptr, "sunsided_mpu6050/full_sphere.csv", "raw x and y axes both look flipped"},
+      {nullptr, "sunsided_mpu6050/roll_and_tilt_45_90.csv", "raw x and y axes both look flipped"},
+      {nullptr, "sunsided_mpu6050/tilt_sphere.csv", ""},
+      {nullptr, "sunsided_mpu6050/still_10min.csv", nullptr},
+      {"ahrs_static_poses.yaml", "ahrs_static_poses/imu_good2.txt", nullptr},
+      {"mpu6050_ten_pose.yaml", "mpu6050_ten_pose/session.csv", nullptr},
+      {"ferraris_nilspod.yaml", "ferraris_nilspod/session.csv", nullptr},
+  };
+  for (const Log& l : logs) {
+    Config config;
+    ImuLog log;
+    std::string error;
+    if (l.config != nullptr) {
+      ASSERT_TRUE(testing_util::LoadRealSession(l.config, l.file, &config, &log, &error)) << error;
+    } else {
+      ASSERT_TRUE(
+          ReadImuLog(testing_util::RealDataDir() + "/" + l.file, config.input, &log, &error))
+          << error;
+    }
+    const std::string w = internal::GyroAxisConventionWarning(log);
+    std::printf("%s: %s\n", l.file, w.empty() ? "(no warning)" : w.c_str());
+    if (l.expected == nullptr) {
+      EXPECT_EQ(w, "") << l.file;
+    } else if (*l.expected != '\0') {
+      EXPECT_NE(w.find(l.expected), std::string::npos) << l.file << ": " << w;
+    }
   }
 }
 

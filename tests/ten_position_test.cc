@@ -130,8 +130,12 @@ TEST(TenPosition, RealMpu6050TenPoses) {
   Calibration ten;
   ASSERT_TRUE(RunCalibration(config, input, &ten)) << ten.message;
   ASSERT_EQ(ten.positions.size(), 10u);
+  // The ten poses do not determine u_xy: it is held at zero, which leaves
+  // two residual degrees of freedom instead of one, and the residuals are
+  // the poses' own scatter (measured up to 2.2e-3 m/s^2; before the hold,
+  // the near-exact fit left them below 1e-3).
   for (const PositionReport& r : ten.positions) {
-    EXPECT_LT(std::fabs(r.residual_after), 1e-3);
+    EXPECT_LT(std::fabs(r.residual_after), 3e-3);
     EXPECT_TRUE(std::isfinite(r.roll_deg));
   }
   for (int i = 0; i < 3; ++i) {

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <Eigen/QR>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -156,6 +157,179 @@ std::string GyroLooksLikeAccelerometer(const std::vector<StaticInterval>& interv
          ") and turn with the accelerometer's (a linear map explains " +
          Num(100.0 * (1.0 - residual / spread)) +
          " % of their spread), as gravity does; check which columns are gx, gy, gz";
+}
+
+namespace {
+
+// The centre of the sphere the samples x lie on (least squares on
+// |x|^2 = 2 c.x + (r^2 - |c|^2), linear in c), or zero when the samples do
+// not span enough directions to tell (a poorly conditioned system).
+Eigen::Vector3d SphereCentre(const std::vector<Eigen::Vector3d>& x) {
+  if (x.size() < 10) return Eigen::Vector3d::Zero();
+  Eigen::MatrixXd a(x.size(), 4);
+  Eigen::VectorXd b(x.size());
+  for (size_t i = 0; i < x.size(); ++i) {
+    a.row(i) << 2.0 * x[i].transpose(), 1.0;
+    b(i) = x[i].squaredNorm();
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  if (!(sv(3) > 1e-3 * sv(0))) return Eigen::Vector3d::Zero();
+  const Eigen::VectorXd c = svd.solve(b);
+  return c.head<3>();
+}
+
+// The signed permutation number `code` (0..47): row i of M has sign
+// sign_i at column perm[i].
+Eigen::Matrix3d SignedPermutation(int code) {
+  static const int kPerms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                   {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  const int* perm = kPerms[code / 8];
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 3; ++i) m(i, perm[i]) = (code >> i) & 1 ? -1.0 : 1.0;
+  return m;
+}
+
+// What M says about the raw gyroscope axes, in words.
+std::string DescribeMapping(const Eigen::Matrix3d& m) {
+  int flipped = 0, flipped_axis = -1, moved = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (m(i, i) == 0.0) ++moved;
+    for (int j = 0; j < 3; ++j) {
+      if (m(i, j) < 0.0) {
+        ++flipped;
+        flipped_axis = j;
+      }
+    }
+  }
+  if (moved == 0 && flipped == 1) {
+    return std::string("its raw ") + kAxis[flipped_axis] +
+           " axis looks flipped (the opposite sign convention to the other axes and the "
+           "accelerometer)";
+  }
+  if (moved == 0 && flipped == 2) {
+    const int kept = m(0, 0) > 0.0 ? 0 : m(1, 1) > 0.0 ? 1 : 2;
+    return std::string("its raw ") + kAxis[(kept + 1) % 3] + " and " + kAxis[(kept + 2) % 3] +
+           " axes both look flipped (a half turn about " + kAxis[kept] +
+           " against the accelerometer's axes)";
+  }
+  if (moved == 2 && flipped == 0) {
+    int i = 0;
+    while (m(i, i) != 0.0) ++i;
+    int j = i + 1;
+    while (m(j, j) != 0.0) ++j;
+    return std::string("its raw ") + kAxis[i] + " and " + kAxis[j] + " axes look swapped";
+  }
+  std::string text = "its axes fit the accelerometer's as";
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (m(i, j) != 0.0) {
+        text += std::string(i ? "," : "") + " " + kAxis[i] + " = " + (m(i, j) < 0 ? "-" : "+") +
+                "raw " + kAxis[j];
+      }
+    }
+  }
+  return text;
+}
+
+}  // namespace
+
+std::string GyroAxisConventionWarning(const ImuLog& log) {
+  const size_t n = std::min(log.accel.size(), log.gyro.size());
+  if (n < 50 || log.t.size() < n) return "";
+  // Means over bins of kBin seconds of time (host time stamps come in
+  // bursts: a count of samples is no measure of time), and their times.
+  constexpr double kBin = 0.05;
+  std::vector<Eigen::Vector3d> f, w;
+  std::vector<double> t;
+  for (size_t i = 0; i < n;) {
+    const double start = log.t[i];
+    if (!std::isfinite(start)) return "";
+    Eigen::Vector3d a = Eigen::Vector3d::Zero(), g = Eigen::Vector3d::Zero();
+    double s = 0.0;
+    size_t k = i;
+    for (; k < n && log.t[k] >= start && log.t[k] < start + kBin; ++k) {
+      a += log.accel[k];
+      g += log.gyro[k];
+      s += log.t[k];
+    }
+    if (k == i) return "";  // time going backwards: not this check's to judge
+    const double count = static_cast<double>(k - i);
+    f.push_back(a / count);
+    w.push_back(g / count);
+    t.push_back(s / count);
+    i = k;
+  }
+  if (f.size() < 40) return "";
+  const Eigen::Vector3d centre = SphereCentre(f);
+  for (Eigen::Vector3d& v : f) v -= centre;
+  // The gyroscope's offset: its median per axis (the unit is still part of
+  // the time in most logs; a turn's rate is far above it anyway).
+  Eigen::Vector3d bias;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double> v;
+    for (const Eigen::Vector3d& x : w) v.push_back(x(a));
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    bias(a) = v[v.size() / 2];
+  }
+  std::vector<double> norms, rates;
+  for (size_t i = 0; i < f.size(); ++i) {
+    norms.push_back(f[i].norm());
+    rates.push_back((w[i] - bias).norm());
+  }
+  std::vector<double> sorted = norms;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double g = sorted[sorted.size() / 2];
+  sorted = rates;
+  std::nth_element(sorted.begin(), sorted.begin() + 9 * sorted.size() / 10, sorted.end());
+  const double fast = sorted[9 * sorted.size() / 10];
+  if (!(g > 0.0) || !(fast > 0.0)) return "";
+  // Central differences at the moving samples with |f| near g.
+  std::vector<Eigen::Vector3d> d, fm, wm;
+  double turning = 0.0;
+  for (size_t i = 1; i + 1 < f.size(); ++i) {
+    const double span = t[i + 1] - t[i - 1];
+    if (!(span > 0.0) || span > 4.0 * kBin) continue;
+    if (std::abs(norms[i] - g) > 0.1 * g || rates[i] < 0.2 * fast) continue;
+    d.push_back((f[i + 1] - f[i - 1]) / span);
+    fm.push_back(f[i]);
+    wm.push_back(w[i] - bias);
+    turning += 0.5 * span;
+  }
+  if (turning < 2.0 || d.size() < 20) return "";
+  double total = 0.0;
+  for (const Eigen::Vector3d& v : d) total += v.squaredNorm();
+  double best = INFINITY, identity = INFINITY;
+  int best_code = 0;
+  for (int code = 0; code < 48; ++code) {
+    const Eigen::Matrix3d m = SignedPermutation(code);
+    double cd = 0.0, cc = 0.0;
+    for (size_t i = 0; i < d.size(); ++i) {
+      const Eigen::Vector3d c = fm[i].cross(m * wm[i]);
+      cd += c.dot(d[i]);
+      cc += c.squaredNorm();
+    }
+    if (!(cc > 0.0)) continue;
+    const double k = std::max(cd / cc, 0.0);
+    const double residual = total - 2.0 * k * cd + k * k * cc;
+    if (code == 0) identity = residual;
+    if (residual < best) {
+      best = residual;
+      best_code = code;
+    }
+  }
+  // The best mapping must explain a fair part of the turning (hand turns
+  // carry linear accelerations too), and the columns as given less than
+  // half of what it explains.
+  const double explained = 1.0 - best / total;
+  const double as_given = std::max(0.0, 1.0 - identity / total);
+  if (best_code == 0 || !(explained > 0.3) || !(as_given < 0.5 * explained)) return "";
+  return "the gyroscope's axes disagree with the accelerometer's: while the unit turns, the "
+         "specific force turns as the gyroscope says only with another axis convention (" +
+         DescribeMapping(SignedPermutation(best_code)) + "; it explains " + Num(100.0 * explained) +
+         " % of the turning, the columns as given " + Num(100.0 * as_given) +
+         " %): fix the axis in the logger or the reader (or negate or swap those columns), or "
+         "a gyroscope calibration carries the mirror image";
 }
 
 }  // namespace internal

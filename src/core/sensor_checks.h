@@ -37,6 +37,21 @@ std::string HandednessWarning(const std::string& sensor, const Eigen::Matrix3d& 
 // linear in a). Then a one-line message naming the columns.
 std::string GyroLooksLikeAccelerometer(const std::vector<StaticInterval>& intervals);
 
+// Empty unless the gyroscope's raw axes disagree with the accelerometer's
+// convention: while the unit turns slowly the specific force f turns
+// against the rate, df/dt = f x w (body frame), so the accelerometer alone
+// says how the gyroscope must read. Over the moving samples whose |f| is
+// near its median (no large linear acceleration), d = df/dt is fitted as
+// k f x (M w_raw), k > 0 (any gyroscope unit), for each of the 48 signed
+// axis permutations M, on means over 0.05 s of time. When the best M is not
+// the identity, explains more than 30 % of |d|^2 and the columns as given
+// less than half as much, a one-line message names the gyroscope axis that
+// looks flipped, the pair that looks swapped or flipped, or the mapping that
+// fits. The accelerometer's offset (unsigned counts) is removed by a sphere
+// fit when the log covers enough directions. Needs time stamps and at least
+// 2 s of turning.
+std::string GyroAxisConventionWarning(const ImuLog& log);
+
 }  // namespace internal
 }  // namespace gravcal
 

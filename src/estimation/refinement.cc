@@ -299,8 +299,92 @@ std::vector<std::string> WeakParameters(const RefinementOptions& options,
 
 }  // namespace
 
+namespace {
+
+// The weak parameter whose standard deviation is the largest multiple of
+// its limit (normalised units, as WeakParameters).
+std::string Weakest(const RefinementOptions& options, const Eigen::MatrixXd& cov,
+                    const std::vector<std::string>& weak, const RefinementResult& result) {
+  std::string weakest;
+  double worst = -1.0;
+  for (size_t i = 0; i < result.parameter_names.size(); ++i) {
+    if (std::find(weak.begin(), weak.end(), result.parameter_names[i]) == weak.end()) continue;
+    const double limit = i < 3 ? options.max_bias_std : options.max_matrix_std;
+    const double ratio = std::sqrt(std::max(cov(i, i), 0.0)) / limit;
+    if (ratio > worst) {
+      worst = ratio;
+      weakest = result.parameter_names[i];
+    }
+  }
+  return weakest;
+}
+
+// The spread a held term may have about its held value: what makes it
+// undetermined, max_bias_std or max_matrix_std (normalised units). The
+// estimated terms move with it through the fit,
+//
+//   dx_o = G dx_h,   G = -(J_o^T J_o)^-1 J_o^T J_h
+//
+// (J whitened, o the estimated columns, h the held ones), so their
+// covariance conditional on the held values gains G diag(spread^2) G^T: the
+// standard deviations stay honest when the held value is off by up to that
+// spread. The held rows and columns stay zero (they are reported without a
+// number).
+void AddHeldSpread(const MagnitudeFitStart& fit, const AccelModel& refined_n,
+                   const std::vector<bool>& held_column, const RefinementOptions& options,
+                   const std::vector<double>& sigmas, Eigen::MatrixXd* cov) {
+  std::vector<int> o, h;
+  for (int i = 0; i < static_cast<int>(held_column.size()); ++i) {
+    (held_column[i] ? h : o).push_back(i);
+  }
+  if (h.empty() || o.empty()) return;
+  const Eigen::MatrixXd j = MagnitudeJacobian(fit.normalized, refined_n, sigmas);
+  Eigen::MatrixXd jo(j.rows(), o.size()), jh(j.rows(), h.size());
+  for (size_t k = 0; k < o.size(); ++k) jo.col(k) = j.col(o[k]);
+  Eigen::VectorXd spread2(h.size());
+  for (size_t k = 0; k < h.size(); ++k) {
+    jh.col(k) = j.col(h[k]);
+    const double limit = h[k] < 3 ? options.max_bias_std : options.max_matrix_std;
+    spread2(k) = limit * limit;
+  }
+  const Eigen::MatrixXd g = -(jo.transpose() * jo).ldlt().solve(jo.transpose() * jh);
+  if (!g.allFinite()) return;
+  const Eigen::MatrixXd add = g * spread2.asDiagonal() * g.transpose();
+  for (size_t a = 0; a < o.size(); ++a) {
+    for (size_t b = 0; b < o.size(); ++b) (*cov)(o[a], o[b]) += add(a, b);
+  }
+}
+
+// Sets the off-diagonal entries of model->upper named in `held` (u_xy,
+// u_xz, u_yz) to zero.
+void ZeroHeldCrossTerms(const std::vector<std::string>& held, AccelModel* model) {
+  const char* names[3] = {"u_xy", "u_xz", "u_yz"};
+  const int rows[3] = {0, 0, 1}, cols[3] = {1, 2, 2};
+  for (int k = 0; k < 3; ++k) {
+    if (std::find(held.begin(), held.end(), names[k]) != held.end()) {
+      model->upper(rows[k], cols[k]) = 0.0;
+    }
+  }
+}
+
+// Refine; `outermost` is false in the refits that hold weak terms (the
+// outermost call names every term they held, in one warning).
+bool RefineHoldingWeak(const std::vector<Position>& positions, const AccelModel& initial,
+                       double gravity, const RefinementOptions& options, bool outermost,
+                       RefinementResult* result);
+
+}  // namespace
+
 bool Refine(const std::vector<Position>& positions, const AccelModel& initial, double gravity,
             const RefinementOptions& options, RefinementResult* result) {
+  return RefineHoldingWeak(positions, initial, gravity, options, true, result);
+}
+
+namespace {
+
+bool RefineHoldingWeak(const std::vector<Position>& positions, const AccelModel& initial,
+                       double gravity, const RefinementOptions& options, bool outermost,
+                       RefinementResult* result) {
   CHECK(result != nullptr);
   // Solve in well-conditioned units (normalization.h); |a| is unchanged.
   MagnitudeFitStart fit;
@@ -350,39 +434,63 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
                          "no standard deviations are reported",
                          &result->warnings, &result->warning_codes);
   } else if (options.compute_covariance) {
+    AddHeldSpread(fit, refined_n, m.held_column, options, result->sigmas, &cov);
     result->covariance = fit.norm.Undo(cov);
     result->covariance_available = true;
     const std::vector<std::string> weak = WeakParameters(options, cov, m.held_column, result);
     std::string listed;
     for (const std::string& name : weak) listed += (listed.empty() ? "" : ", ") + name;
     // Only when something is left to fit.
-    if (!weak.empty() && !result->converged && static_cast<int>(weak.size()) < num_active) {
-      // The flat directions stalled the solver: hold them at their initial
-      // (coarse) value and fit the rest again. (When the solve converged,
-      // the free fit is kept: holding would make the other parameters'
-      // standard deviations conditional on the held value.)
+    if (!weak.empty() && static_cast<int>(weak.size()) < num_active) {
+      // Hold the flat directions at their initial (coarse) value and fit
+      // the rest again. The free fit's other sigmas are inflated by the
+      // near-singular directions through a linearisation that is poor
+      // there (a term determined only to second order); the refit's are
+      // conditional on the held values, and are reported as such, with the
+      // held terms named (core/conditional_sigmas.h).
+      // One term at a time, the weakest first: holding it can make the
+      // others determined (an exact fit on near-singular poses shows every
+      // term weak while one or two flat directions cause it).
+      // When that refit stalls (the free fit may have stalled on the flat
+      // directions too), every weak term is held at once.
+      // A non-orthogonality term is held at zero (the nominal: a term the
+      // poses cannot see is not taken from the coarse fit, whose value for
+      // it can be far off); any other at the coarse fit's value.
       RefinementOptions again = options;
-      again.held_parameters.insert(again.held_parameters.end(), weak.begin(), weak.end());
+      again.held_parameters.push_back(Weakest(options, cov, weak, *result));
+      AccelModel start = initial;
+      ZeroHeldCrossTerms(again.held_parameters, &start);
       const double first_seconds = result->solve_seconds;
       const int first_iterations = result->iterations;
-      const Eigen::MatrixXd free_covariance = result->covariance;
-      if (!Refine(positions, initial, gravity, again, result)) return false;
+      if (!RefineHoldingWeak(positions, start, gravity, again, false, result)) return false;
+      if (!result->converged && weak.size() > 1) {
+        again = options;
+        again.held_parameters.insert(again.held_parameters.end(), weak.begin(), weak.end());
+        start = initial;
+        ZeroHeldCrossTerms(again.held_parameters, &start);
+        if (!RefineHoldingWeak(positions, start, gravity, again, false, result)) return false;
+      }
       result->solve_seconds += first_seconds;
       result->iterations += first_iterations;
-      // The other parameters' covariance from the free fit: the refit's is
-      // conditional on the held values being right, which the data do not
-      // say.
-      if (result->covariance_available && free_covariance.rows() == result->covariance.rows()) {
-        result->covariance = free_covariance;
+      if (outermost) {
+        // Every term the refits held (not the caller's own held_parameters).
+        std::vector<std::string> held;
+        for (const std::string& name : result->observability.undetermined) {
+          const auto& own = options.held_parameters;
+          if (std::find(own.begin(), own.end(), name) == own.end()) held.push_back(name);
+        }
+        std::string names;
+        for (const std::string& name : held) names += (names.empty() ? "" : ", ") + name;
+        internal::AddWarning(WarningCode::kUndetermined,
+                             "the positions do not determine " + names +
+                                 " (standard deviation beyond max_bias_std / max_matrix_std); "
+                                 "they are held (a non-orthogonality term at zero, any other at "
+                                 "the coarse fit's value) and reported without a number, and "
+                                 "every other standard deviation is conditional on holding them "
+                                 "(with their spread up to that limit): add positions with other "
+                                 "axes up or down",
+                             &result->warnings, &result->warning_codes);
       }
-      internal::AddWarning(WarningCode::kUndetermined,
-                           "the positions do not determine " + listed +
-                               " (standard deviation beyond max_bias_std / max_matrix_std); "
-                               "they are held at the coarse fit's value and reported without "
-                               "a number, and the other parameters' standard deviations are "
-                               "those of the free fit (not conditional on the held values): add "
-                               "positions with other axes up or down",
-                           &result->warnings, &result->warning_codes);
       return true;
     }
     if (!weak.empty()) {
@@ -402,5 +510,7 @@ bool Refine(const std::vector<Position>& positions, const AccelModel& initial, d
   result->message = s.str();
   return true;
 }
+
+}  // namespace
 
 }  // namespace gravcal

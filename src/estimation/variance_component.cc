@@ -65,8 +65,11 @@ bool Complement(const Eigen::MatrixXd& jacobian, Eigen::MatrixXd* basis,
     const double norm = scaled.col(j).norm();
     if (norm > 0.0) scaled.col(j) /= norm;
   }
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(scaled);
-  qr.setThreshold(1e-10);
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr;
+  if (scaled.cols() > 0) {
+    qr.setThreshold(1e-10);
+    qr.compute(scaled);
+  }
   const int rank = scaled.cols() > 0 ? static_cast<int>(qr.rank()) : 0;
   const int m = n - rank;
   result->dof = m;

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "core/conditional_sigmas.h"
 #include "gravcal/core/imu_model.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/files.h"
@@ -168,6 +169,10 @@ std::string CalibrationToJson(const Calibration& c, bool include_covariance) {
   json out;
   out["method"] = c.method;
   out["accel"] = AccelJson(c.accel, include_covariance);
+  // The undetermined terms the fit held: every accelerometer standard
+  // deviation is conditional on holding them (issue 33).
+  const std::vector<std::string> held = internal::ConditionalOn(c.refinement);
+  if (!held.empty()) out["accel"]["std"]["conditional_on"] = held;
   if (c.gyro.estimated) out["gyro"] = GyroJson(c.gyro, include_covariance);
   if (!c.effects.estimates.empty()) out["effects"] = EffectsJson(c.effects);
   if (c.thermal.active() || !c.thermal.notes.empty()) {

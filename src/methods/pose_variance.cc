@@ -33,16 +33,24 @@ double MeanInverseVariance(const std::vector<double>& sigmas) {
   return h / std::max<size_t>(sigmas.size(), 1);
 }
 
-// REML s^2 from the residuals of `fit`, over its estimated (not held) columns.
+// REML s^2 from the residuals of `fit`, over its estimated columns (not
+// those held by the options, nor the undetermined ones the fit held).
 bool EstimateFromFit(const std::vector<Position>& placed, const RefinementOptions& options,
                      const RefinementResult& fit, const VariancePrior& prior,
                      VarianceComponent* vc) {
   const int n = static_cast<int>(placed.size());
   const Eigen::MatrixXd all = MagnitudeJacobian(placed, fit.model, std::vector<double>(n, 1.0));
   std::vector<int> columns;
+  auto listed = [](const std::vector<std::string>& list, const std::string& name) {
+    return std::find(list.begin(), list.end(), name) != list.end();
+  };
   for (int i = 0; i < static_cast<int>(fit.parameter_names.size()); ++i) {
-    const auto& held = options.held_parameters;
-    if (std::find(held.begin(), held.end(), fit.parameter_names[i]) == held.end()) {
+    const std::string& name = fit.parameter_names[i];
+    // The terms the fit held as undetermined (held at a value: no variance).
+    const bool held_weak = listed(fit.observability.undetermined, name) &&
+                           fit.covariance_available && i < fit.covariance.rows() &&
+                           fit.covariance(i, i) == 0.0;
+    if (!listed(options.held_parameters, name) && !held_weak) {
       columns.push_back(i);
     }
   }

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 
+#include "core/sensor_checks.h"
+#include "core/warnings.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/rate_table_segments.h"
+#include "util/source_prefix.h"
 
 namespace gravcal {
 namespace {
@@ -80,6 +83,14 @@ bool RunCalibration(const Config& config, const SessionFiles& files, Session* se
   }
   const bool ok = method.run(config, *session, calibration);
   calibration->method = method.name;
+  // Issue 33: a gyroscope whose axes disagree with the accelerometer's
+  // convention (a flipped or swapped axis), named for every method.
+  const std::string convention = internal::GyroAxisConventionWarning(session->log);
+  if (!convention.empty()) {
+    internal::AddWarning(WarningCode::kSensorData,
+                         internal::PrefixSource(session->log.source, convention),
+                         &calibration->warnings, &calibration->warning_codes);
+  }
   return ok;
 }
 

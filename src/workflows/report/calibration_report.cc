@@ -3,7 +3,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/conditional_sigmas.h"
 #include "gravcal/workflows/report.h"
+#include "util/join.h"
 #include "util/statistics.h"
 #include "workflows/report/svg_plot.h"
 #include "workflows/report/thermal_report.h"
@@ -110,9 +112,14 @@ Verdict Judge(const Calibration& c) {
     std::string names;
     for (const std::string& n : r.observability.undetermined)
       names += (names.empty() ? "" : ", ") + n;
-    v.Raise(Level::kLook, "this session cannot determine " + names +
-                              ": they are reported without a number; the other parameters "
-                              "can be used, or add poses (`gravcal check` names them)");
+    const std::string held = internal::Join(internal::ConditionalOn(r));
+    v.Raise(Level::kLook,
+            "this session cannot determine " + names +
+                ": they are reported without a number; the other parameters can be used" +
+                (held.empty() ? std::string()
+                              : " (their standard deviations are conditional on holding " + held +
+                                    " at the coarse fit's value)") +
+                ", or add poses (`gravcal check` names them)");
   }
   // Warnings that only say what the method cannot do or where a number
   // comes from do not call for a look.
@@ -312,8 +319,11 @@ std::string AccelSource(const Calibration& c, const std::string& fit_name, doubl
     return "fixed by the " + std::string(ToString(c.accel.model.parameterization)) + " model";
   if (!std::isfinite(std)) return NotDeterminedOrNotEstimated(c);
   if (from_housing) return "housing rotation (the poses' nominal axes)";
-  if (c.method == ToString(Method::kTwelvePosition)) return "magnitude fit";
-  return c.method + " fit";
+  // Issue 33: a sigma that rests on holding undetermined terms says so.
+  const std::string held = internal::Join(internal::ConditionalOn(c.refinement));
+  const std::string given = held.empty() ? "" : " (sigma conditional on holding " + held + ")";
+  if (c.method == ToString(Method::kTwelvePosition)) return "magnitude fit" + given;
+  return c.method + " fit" + given;
 }
 
 std::vector<ParameterRow> Parameters(const Calibration& c) {
