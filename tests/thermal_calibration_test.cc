@@ -161,11 +161,12 @@ TEST(ThermalCalibration, LagIsFoundWhereHeatingAndCoolingDisagree) {
   Calibration c;
   ASSERT_TRUE(Calibrate(sim, 41, nullptr, &truth, &c));
   ASSERT_TRUE(c.thermal.lag_estimated) << c.message;
-  // The model's T - tau dT/dt is the lag's steady response to a ramp; on an
-  // exponential of time constant 900 s it responds as tau 900 / (900 - tau)
-  // = 64 s.
-  EXPECT_NEAR(c.thermal.lag_time_constant, 64.0,
-              std::max(10.0, 4.0 * c.thermal.lag_time_constant_std));
+  // The fit filters the recorded temperature through the lag itself, so it
+  // finds the truth (the small-lag form T - tau dT/dt it used before found
+  // the steady response to the exponential ramp, tau 900 / (900 - tau) = 64
+  // s).
+  EXPECT_NEAR(c.thermal.lag_time_constant, 60.0,
+              std::max(3.0, 4.0 * c.thermal.lag_time_constant_std));
   // Discovery (issue 35 part 7) names the hysteresis, and the higher order
   // of the bias (the truth is cubic).
   const ThermalDiscovery found = DiscoverThermal(truth.log, OptionsFor(truth));

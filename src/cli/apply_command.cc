@@ -87,9 +87,9 @@ int RunApply(const ApplyArgs& args) {
     return Fail(error);
   }
   size_t count = 0;
-  // Issue 35: the thermal model's lag needs the temperature's rate; its
+  // Issue 35: the thermal model's lag needs the element temperature's rate; its
   // range is clamped (and counted for one warning).
-  ThermalRate rate;
+  ThermalElementRate rate(corrector.thermal.lag_time_constant);
   size_t clamped_count = 0;
   double lowest = INFINITY, highest = -INFINITY;
   for (bool more = true; more; more = reader.Next(&sample, &error)) {
