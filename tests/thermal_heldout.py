@@ -211,7 +211,7 @@ def make_session(seed, kind, truth, rate=50.0, hold=16.0, turn=2.0, soaks=None, 
         f[i] = r.T @ gvec
         w[i] = rate_b if angle > 1e-9 else 0.0
     if kind == 'soak':
-        rec = np.full(n, soaks[0])
+        rec = np.full(n, float(soaks[0]))
         start_temp = soaks[0]
         for k, (t0, target) in enumerate(soak_starts):
             t1 = soak_starts[k + 1][0] if k + 1 < len(soak_starts) else total + 1
@@ -508,7 +508,7 @@ def main():
     # 1. Representable truth (cubic bias, diagonal scale, no scale(T), no
     # misalignment): what remains after PX4's and ArduPilot's corrections.
     for layout in (['contract'] if smoke else ['contract', 'counts'] if quick else
-                   ['contract', 'counts', 'renamed', 'raw_temp']):
+                   ['contract', 'counts', 'renamed']):
         rng = np.random.default_rng(11)
         truth = Truth(rng, scale_t=False, misalign=False)
         s = make_session(11, 'soak', truth, rate=rate, soaks=soaks)
