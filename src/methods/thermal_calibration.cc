@@ -550,16 +550,25 @@ class ThermalFitter {
     Eigen::MatrixXd j = Jacobian(layout, sigmas, theta, nullptr);
     const std::vector<double> prior = PriorScale(layout, theta);
     for (int c = 0; c < layout.size; ++c) j.col(c) *= prior[c];
-    // A column of whose squared norm the columns kept before it explain all
-    // but kCollinear (its own part under 10 % of its size) is undetermined
-    // however much information it carries: that part comes from small
-    // perturbations of the design (the thermal drift and the pose noise
-    // tilting one tilted pose's direction lend each of U's three
-    // off-diagonals "information" on what is one combination of them;
-    // measured: 0.2-0.4 % of their squared norm), which the nonlinear
-    // problem does not honour. Genuinely separate terms keep far more (x^3
-    // beside x over four soak temperatures: 8 %, over five: 11 %).
+    // U's off-diagonal and the accelerometer misalignment terms enter |U d|
+    // on the faces only to second order: the first-order "information" the
+    // columns carry there comes from small perturbations of the design (the
+    // thermal drift and the pose noise tilting a tilted pose's direction
+    // lend each of the three off-diagonals information on what is one
+    // combination of them; measured 0.2-0.4 % of their squared norm beyond
+    // the columns kept before them), which the nonlinear problem does not
+    // honour: a solve slides along the valley. Such a column is undetermined
+    // when the columns kept before it explain all but kCollinear of it.
+    // (Other terms are not held to this: x beside the constant on a
+    // single warm-up keeps under 1 % and is rightly determined.)
     constexpr double kCollinear = 1e-2;
+    std::vector<bool> valley(layout.size, false);
+    for (int k : {1, 2, 4}) valley[layout.upper + k] = true;
+    for (int c = 0; c < layout.size; ++c) {
+      const ThermalLayout::Slot& s = layout.slots[c];
+      valley[c] = valley[c] || (s.thermal && s.sensor == ThermalSensor::kAccel &&
+                                s.quantity == ThermalQuantity::kMisalignment);
+    }
     const Eigen::VectorXd original = j.colwise().squaredNorm().transpose();
     std::vector<bool> undetermined(layout.size, false), done(layout.size, false);
     std::vector<int> groups = layout.group;
@@ -579,7 +588,8 @@ class ThermalFitter {
         }
         if (best < 0) break;
         done[best] = true;
-        if (!(best_norm >= o_.min_information) || !(best_norm >= kCollinear * original(best))) {
+        if (!(best_norm >= o_.min_information) ||
+            (valley[best] && !(best_norm >= kCollinear * original(best)))) {
           undetermined[best] = true;
           continue;
         }
