@@ -375,6 +375,9 @@ class ThermalFitter {
       const auto it = start.find(layout.names[j]);
       if (it != start.end()) initial[j] = it->second;
     }
+    // U's off-diagonal starts (and, when undetermined, stays) at 0, not at
+    // a previous step's value.
+    for (int k : {1, 2, 4}) initial[layout.upper + k] = 0.0;
     // What is determined depends on where the Jacobian is taken (a bias far
     // from its value tilts the poses' directions and lends the
     // non-orthogonality information it does not have), so the test is
