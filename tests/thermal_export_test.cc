@@ -260,9 +260,11 @@ LoadedCalibration ThermalCalibration(bool scale) {
   return c;
 }
 
-ExportResult ExportOrDie(const LoadedCalibration& c, ExportTarget target, std::string* text) {
+ExportResult ExportOrDie(const LoadedCalibration& c, ExportTarget target, std::string* text,
+                         int ardupilot_imu = 1) {
   ExportOptions options;
   options.target = target;
+  options.ardupilot_imu = ardupilot_imu;
   options.calibration_name = "thermal.json";
   options.accel_device_id = 2818058;
   options.gyro_device_id = 2818314;
@@ -331,6 +333,41 @@ TEST(ThermalExport, Px4AndArduPilotFilesReproduceTheModelTheyCanHold) {
   EXPECT_LT(a4.gyro, 1e-6);
   EXPECT_LT(aa.accel, 2e-5);
   EXPECT_LT(aa.gyro, 2e-6);
+}
+
+// ArduPilot's second and third IMU: their own parameter names (INS_ACC2OFFS_X,
+// INS_TCAL2_*, INS_ACC2_CALTEMP), which the target's equations for that
+// instance read back to gravcal's correction; instance 1's names are absent,
+// so the file cannot touch the first IMU.
+TEST(ThermalExport, ArduPilotInstanceNWritesThatImusParameters) {
+  const LoadedCalibration c = ThermalCalibration(false);
+  for (int imu : {2, 3}) {
+    std::string text;
+    ExportOrDie(c, ExportTarget::kArduPilot, &text, imu);
+    const targets::Params p = targets::ReadParm(text);
+    const std::string n = std::to_string(imu);
+    EXPECT_EQ(p.count("INS_ACC" + n + "OFFS_X"), 1u);
+    EXPECT_EQ(p.count("INS_GYR" + n + "OFFS_Z"), 1u);
+    EXPECT_EQ(p.at("INS_TCAL" + n + "_ENABLE"), 1.0);
+    EXPECT_EQ(p.at("INS_GYR" + n + "_CALTEMP"), 25.0);
+    EXPECT_EQ(p.count("INS_ACCOFFS_X") + p.count("INS_TCAL1_ENABLE") + p.count("INS_ACC1_CALTEMP"),
+              0u);
+    const Agreement a = Compare(
+        c,
+        [&](const Eigen::Vector3d& v, double t) { return targets::ArduPilotAccel(p, v, t, imu); },
+        [&](const Eigen::Vector3d& u, double t) { return targets::ArduPilotGyro(p, u, t, imu); });
+    EXPECT_LT(a.accel, 2e-5) << imu;
+    EXPECT_LT(a.gyro, 2e-6) << imu;
+    // Read as the first IMU's, the file corrects nothing.
+    const Eigen::Vector3d raw(0.3, -0.2, 9.9);
+    EXPECT_EQ(targets::ArduPilotAccel(p, raw, 40.0, 1), raw.cast<float>().cast<double>());
+  }
+  ExportOptions bad;
+  bad.target = ExportTarget::kArduPilot;
+  bad.ardupilot_imu = 4;
+  std::string error;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_NE(error.find("ardupilot_imu"), std::string::npos) << error;
 }
 
 // scale(T) is not held: the file says so with its size, and the stated

@@ -13,7 +13,9 @@
 // ArduPilot (libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp,
 // TCal::correct_sensor, polynomial_eval; AP_InertialSensor_Backend.cpp,
 // _rotate_and_correct_accel):
-//   only when INS_TCAL1_ENABLE == 1; T and CALTEMP each clipped to
+//   only when INS_TCALn_ENABLE == 1 (n the IMU instance, 1..3; the first
+//   IMU's offsets are INS_ACCOFFS_*, the second's INS_ACC2OFFS_*, with
+//   INS_ACCn_CALTEMP, INS_GYRn_CALTEMP); T and CALTEMP each clipped to
 //   [TMIN, TMAX]; P(x) = (c1 + (c2 + c3 x) x) x * 1e-6 with x = T - 35;
 //   v = raw - P(T) + P(CALTEMP), then accel = (v - INS_ACCOFFS) .* INS_ACCSCAL,
 //   gyro = v - INS_GYROFFS.
@@ -122,19 +124,20 @@ inline Eigen::Vector3d Px4Gyro(const Params& p, uint32_t device_id, const Eigen:
   return w.cast<double>();
 }
 
-// ArduPilot's raw reading after TCAL (before offsets and scale).
-inline Eigen::Vector3f ArduPilotTcal(const Params& p, const char* sensor, const char* caltemp,
-                                     const Eigen::Vector3d& raw, double temperature) {
+// ArduPilot's raw reading after TCAL (before offsets and scale), IMU
+// instance `imu` (1..3): INS_TCALn_*, and the CALTEMP `caltemp`.
+inline Eigen::Vector3f ArduPilotTcal(const Params& p, const char* sensor,
+                                     const std::string& caltemp, const Eigen::Vector3d& raw,
+                                     double temperature, int imu = 1) {
   Eigen::Vector3f v = raw.cast<float>();
-  if (Get(p, "INS_TCAL1_ENABLE", 0.0f) != 1.0f) return v;
-  const float tmin = Get(p, "INS_TCAL1_TMIN", 0.0f), tmax = Get(p, "INS_TCAL1_TMAX", 70.0f);
+  const std::string tcal = "INS_TCAL" + std::to_string(imu) + "_";
+  if (Get(p, tcal + "ENABLE", 0.0f) != 1.0f) return v;
+  const float tmin = Get(p, tcal + "TMIN", 0.0f), tmax = Get(p, tcal + "TMAX", 70.0f);
   const float t = std::min(std::max(static_cast<float>(temperature), tmin), tmax);
   const float tc = std::min(std::max(Get(p, caltemp, -300.0f), tmin), tmax);
   const char* axes = "XYZ";
   for (int i = 0; i < 3; ++i) {
-    auto c = [&](int k) {
-      return Get(p, std::string("INS_TCAL1_") + sensor + std::to_string(k) + "_" + axes[i], 0.0f);
-    };
+    auto c = [&](int k) { return Get(p, tcal + sensor + std::to_string(k) + "_" + axes[i], 0.0f); };
     auto poly = [&](float x) { return (c(1) + (c(2) + c(3) * x) * x) * x * 1.0e-6f; };
     v[i] -= poly(t - 35.0f);
     v[i] += poly(tc - 35.0f);
@@ -142,24 +145,31 @@ inline Eigen::Vector3f ArduPilotTcal(const Params& p, const char* sensor, const 
   return v;
 }
 
+// IMU `imu`'s offsets: INS_ACCOFFS_X for the first, INS_ACC2OFFS_X, ...
+inline std::string ArduPilotInstance(int imu) { return imu > 1 ? std::to_string(imu) : ""; }
+
 inline Eigen::Vector3d ArduPilotAccel(const Params& p, const Eigen::Vector3d& raw,
-                                      double temperature) {
-  const Eigen::Vector3f v = ArduPilotTcal(p, "ACC", "INS_ACC1_CALTEMP", raw, temperature);
+                                      double temperature, int imu = 1) {
+  const Eigen::Vector3f v =
+      ArduPilotTcal(p, "ACC", "INS_ACC" + std::to_string(imu) + "_CALTEMP", raw, temperature, imu);
+  const std::string n = ArduPilotInstance(imu);
   const char* axes = "XYZ";
   Eigen::Vector3f a;
   for (int i = 0; i < 3; ++i) {
-    a[i] = (v[i] - Get(p, std::string("INS_ACCOFFS_") + axes[i], 0.0f)) *
-           Get(p, std::string("INS_ACCSCAL_") + axes[i], 1.0f);
+    a[i] = (v[i] - Get(p, "INS_ACC" + n + "OFFS_" + axes[i], 0.0f)) *
+           Get(p, "INS_ACC" + n + "SCAL_" + axes[i], 1.0f);
   }
   return a.cast<double>();
 }
 
 inline Eigen::Vector3d ArduPilotGyro(const Params& p, const Eigen::Vector3d& raw,
-                                     double temperature) {
-  const Eigen::Vector3f v = ArduPilotTcal(p, "GYR", "INS_GYR1_CALTEMP", raw, temperature);
+                                     double temperature, int imu = 1) {
+  const Eigen::Vector3f v =
+      ArduPilotTcal(p, "GYR", "INS_GYR" + std::to_string(imu) + "_CALTEMP", raw, temperature, imu);
+  const std::string n = ArduPilotInstance(imu);
   const char* axes = "XYZ";
   Eigen::Vector3f w;
-  for (int i = 0; i < 3; ++i) w[i] = v[i] - Get(p, std::string("INS_GYROFFS_") + axes[i], 0.0f);
+  for (int i = 0; i < 3; ++i) w[i] = v[i] - Get(p, "INS_GYR" + n + "OFFS_" + axes[i], 0.0f);
   return w.cast<double>();
 }
 

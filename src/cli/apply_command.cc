@@ -265,10 +265,10 @@ int RunApply(const ApplyArgs& args) {
     highest = std::max(highest, b.highest);
     return writer.WriteRows(b.text.get(), b.text_size, &error);
   };
-  // Issue 35: the thermal model's lag needs the temperature's rate, which
-  // runs through the rows in order (here); its range is clamped (and
+  // Issue 35: the thermal model's lag needs the element temperature's rate,
+  // which runs through the rows in order (here); its range is clamped (and
   // counted for one warning).
-  ThermalRate rate;
+  ThermalElementRate rate(corrector.thermal.lag_time_constant);
   std::string read_error;
   for (bool more = true; more;) {
     if (submitted - written == ring.size() && !write_oldest()) {

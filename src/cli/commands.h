@@ -157,6 +157,7 @@ struct ExportArgs : CommonArgs {
   uint64_t accel_device_id = 0;
   uint64_t gyro_device_id = 0;
   bool drop_thermal = false;
+  int ardupilot_imu = 1;
 };
 
 // compare a.json b.json (the two calibrations are the positional

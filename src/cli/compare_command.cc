@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "gravcal/estimation/calibration_comparison.h"
 #include "gravcal/estimation/check_session.h"
+#include "gravcal/io/calibration_io.h"
 #include "gravcal/io/calibration_uncertainty_io.h"
 #include "gravcal/io/comparison_io.h"
 #include "gravcal/io/files.h"
@@ -116,11 +117,18 @@ int RunVerify(const VerifyArgs& args) {
   if (!ComparisonOptionsFromLevel(args.level, &options, &error)) return Fail(error);
   Calibration stored;
   if (!ReadCalibrationUncertainty(args.calibration, &stored, nullptr, &error)) return Fail(error);
+  // The thermal model (issue 35): verify takes the poses to T_ref with it.
+  LoadedCalibration loaded;
+  if (!ReadCalibrationJson(args.calibration, &loaded, &error)) return Fail(error);
+  stored.thermal = loaded.corrector.thermal;
   ImuLog log;
   if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
   CheckSessionResult result;
   if (!VerifyCheckLog(log, stored, args.config.calibration, options, &result, &error)) {
     return Fail(error);
+  }
+  for (const std::string& w : result.warnings) {
+    std::fprintf(stderr, "gravcal: warning: %s\n", w.c_str());
   }
   if (!result.comparison.tested) return Fail(args.input + ": cannot be tested: nothing to test");
   if (!args.output.empty() &&

@@ -45,6 +45,7 @@ int RunExport(const ExportArgs& args) {
   options.accel_device_id = static_cast<int64_t>(args.accel_device_id);
   options.gyro_device_id = static_cast<int64_t>(args.gyro_device_id);
   options.drop_thermal = args.drop_thermal;
+  options.ardupilot_imu = args.ardupilot_imu;
   ExportResult result;
   if (!ExportCalibration(calibration, options, &result, &error)) return Fail(error);
   for (const std::string& line : result.dropped) {

@@ -121,7 +121,10 @@
   X(uint64, gyro_device_id, 0,                                                                   \
     "export --to px4: the gyroscope's device id (CAL_GYRO0_ID), which TC_G0_ID must match")      \
   X(bool, drop_thermal, false,                                                                   \
-    "export: leave the thermal model out of a px4 or ardupilot file (said in the file)")
+    "export: leave the thermal model out of a px4 or ardupilot file (said in the file)")         \
+  X(int32, ardupilot_imu, 1,                                                                     \
+    "export --to ardupilot: the IMU instance n (1-3) the file is for: INS_ACCnOFFS_*, "          \
+    "INS_TCALn_*, INS_ACCn_CALTEMP (n = 1 writes INS_ACCOFFS_*)")
 
 namespace gravcal {
 namespace cli {

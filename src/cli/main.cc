@@ -253,7 +253,8 @@ const std::vector<CommandInfo>& Commands() {
            StoredFlag<ExportArgs>("max_age_days", &StoredCalibrationArgs::max_age_days),
            FlagField<ExportArgs>("accel_device_id", &ExportArgs::accel_device_id),
            FlagField<ExportArgs>("gyro_device_id", &ExportArgs::gyro_device_id),
-           FlagField<ExportArgs>("drop_thermal", &ExportArgs::drop_thermal)},
+           FlagField<ExportArgs>("drop_thermal", &ExportArgs::drop_thermal),
+           FlagField<ExportArgs>("ardupilot_imu", &ExportArgs::ardupilot_imu)},
           RunExport),
       Command<CompareArgs>(
           "compare",

@@ -304,11 +304,11 @@ struct AutopilotFormat {
   std::vector<std::string> header;
   // Name prefixes of the accelerometer offset and scale and the gyroscope
   // offset, and the suffix after the axis letter.
-  const char* accel_offset;
-  const char* accel_scale;
-  const char* gyro_offset;
-  const char* offset_suffix;
-  const char* scale_suffix;
+  std::string accel_offset;
+  std::string accel_scale;
+  std::string gyro_offset;
+  std::string offset_suffix;
+  std::string scale_suffix;
   // One parameter line from the name and the value.
   std::string (*line)(const std::string& name, const std::string& value);
 };
@@ -320,16 +320,13 @@ std::string AutopilotParameters(const LoadedCalibration& c, const ExportOptions&
   s << Comment(Provenance(c, o), "#") << Comment(DroppedComment(r), "#") << Comment(f.header, "#");
   const char* axes[3] = {"X", "Y", "Z"};
   for (int i = 0; i < 3; ++i) {
-    s << f.line(std::string(f.accel_offset) + axes[i] + f.offset_suffix,
-                ExactNumber(t.accel.bias(i)));
+    s << f.line(f.accel_offset + axes[i] + f.offset_suffix, ExactNumber(t.accel.bias(i)));
   }
   for (int i = 0; i < 3; ++i) {
-    s << f.line(std::string(f.accel_scale) + axes[i] + f.scale_suffix,
-                ExactNumber(t.accel.upper(i, i)));
+    s << f.line(f.accel_scale + axes[i] + f.scale_suffix, ExactNumber(t.accel.upper(i, i)));
   }
   for (int i = 0; t.has_gyro && i < 3; ++i) {
-    s << f.line(std::string(f.gyro_offset) + axes[i] + f.offset_suffix,
-                ExactNumber(t.gyro.bias(i)));
+    s << f.line(f.gyro_offset + axes[i] + f.offset_suffix, ExactNumber(t.gyro.bias(i)));
   }
   return s.str();
 }
@@ -352,18 +349,20 @@ const AutopilotFormat& Px4Format() {
   return format;
 }
 
-const AutopilotFormat& ArduPilotFormat() {
-  static const AutopilotFormat format = {
+// IMU instance `imu` (1..3): INS_ACCOFFS_X for the first, INS_ACC2OFFS_X
+// for the second (AP_InertialSensor.cpp's parameter table).
+AutopilotFormat ArduPilotFormat(int imu) {
+  const std::string n = imu > 1 ? std::to_string(imu) : "";
+  return {
       {"ArduPilot (AP_InertialSensor_Backend): a = rot (diag(ACCSCAL) (a_m - ACCOFFS)) in",
        "m/s^2, w = rot (w_m - GYROFFS) in rad/s, sensor frame before the board rotation.",
-       "Parameter file: NAME VALUE per line."},
-      "INS_ACCOFFS_",
-      "INS_ACCSCAL_",
-      "INS_GYROFFS_",
+       "IMU instance " + std::to_string(imu) + ". Parameter file: NAME VALUE per line."},
+      "INS_ACC" + n + "OFFS_",
+      "INS_ACC" + n + "SCAL_",
+      "INS_GYR" + n + "OFFS_",
       "",
       "",
       [](const std::string& name, const std::string& value) { return name + " " + value + "\n"; }};
-  return format;
 }
 
 }  // namespace
@@ -397,6 +396,11 @@ bool NeedsNoise(ExportTarget target) {
 }
 
 bool ExportOptions::IsValid(std::string* error) const {
+  if (ardupilot_imu < 1 || ardupilot_imu > 3) {
+    *error = "ardupilot_imu must be 1, 2 or 3 (ArduPilot's IMU instances), not " +
+             std::to_string(ardupilot_imu);
+    return false;
+  }
   if (NeedsNoise(target) && noise == nullptr) {
     *error = std::string("export --to ") + ToString(target) +
              " needs the noise model (--noise noise.json from gravcal noise)";
@@ -488,11 +492,12 @@ bool ExportCalibration(const LoadedCalibration& calibration, const ExportOptions
       break;
     case ExportTarget::kArduPilot:
       if (!AutopilotScales(truncated, "ardupilot", error)) return false;
-      if (!internal::ArduPilotThermalLines(thermal, ArduPilotFormat().line, &thermal_lines,
-                                           error)) {
+      if (!internal::ArduPilotThermalLines(thermal, ArduPilotFormat(options.ardupilot_imu).line,
+                                           &thermal_lines, error)) {
         return false;
       }
-      text = AutopilotParameters(calibration, options, *result, truncated, ArduPilotFormat()) +
+      text = AutopilotParameters(calibration, options, *result, truncated,
+                                 ArduPilotFormat(options.ardupilot_imu)) +
              thermal_lines;
       break;
     case ExportTarget::kC: {

@@ -202,22 +202,26 @@ bool ArduPilotThermalLines(
   }
   if (gyro && thermal.accel.Varies() &&
       (thermal.gyro.t_min != range.t_min || thermal.gyro.t_max != range.t_max)) {
-    *error =
-        "ardupilot: INS_TCAL1 holds one temperature range for both sensors; the "
-        "accelerometer's [" +
-        ExactNumber(range.t_min) + ", " + ExactNumber(range.t_max) + "] and the gyroscope's [" +
-        ExactNumber(thermal.gyro.t_min) + ", " + ExactNumber(thermal.gyro.t_max) + "] degC differ";
+    *error = "ardupilot: INS_TCAL" + std::to_string(thermal.ardupilot_imu) +
+             " holds one temperature range for both sensors; the "
+             "accelerometer's [" +
+             ExactNumber(range.t_min) + ", " + ExactNumber(range.t_max) +
+             "] and the gyroscope's [" + ExactNumber(thermal.gyro.t_min) + ", " +
+             ExactNumber(thermal.gyro.t_max) + "] degC differ";
     return false;
   }
+  const std::string n = std::to_string(thermal.ardupilot_imu);
+  const std::string tcal = "INS_TCAL" + n + "_";
   std::string s =
-      "# Thermal compensation (ArduPilot AP_InertialSensor_tempcal.cpp), first IMU:\n"
+      "# Thermal compensation (ArduPilot AP_InertialSensor_tempcal.cpp), IMU " + n +
+      ":\n"
       "#   v = raw - P(T) + P(CALTEMP),  P(T) = 1e-6 (c1 e + c2 e^2 + c3 e^3),  e = T - 35 degC\n"
       "# with T and CALTEMP clamped to [TMIN, TMAX], before INS_ACCOFFS / INS_GYROFFS. The\n"
       "# CALTEMPs say where the offsets of this file hold. Needs a firmware built with\n"
       "# temperature calibration (HAL_INS_TEMPERATURE_CAL_ENABLE) and a reboot.\n";
-  s += line("INS_TCAL1_ENABLE", "1");
-  s += line("INS_TCAL1_TMIN", ExactNumber(range.t_min));
-  s += line("INS_TCAL1_TMAX", ExactNumber(range.t_max));
+  s += line(tcal + "ENABLE", "1");
+  s += line(tcal + "TMIN", ExactNumber(range.t_min));
+  s += line(tcal + "TMAX", ExactNumber(range.t_max));
   auto coefficients = [&](const ThermalCurve& c, bool on, const char* name) {
     // ArduPilot's polynomial is in (T - 35 degC) without a constant: the
     // constant of the shifted curve cancels between P(T) and P(Tcal).
@@ -225,7 +229,7 @@ bool ArduPilotThermalLines(
     if (on) q = ShiftPolynomial(Cubic(c), kArduPilotReference - c.t_ref);
     for (int k = 1; k <= kTargetOrder; ++k) {
       for (int axis = 0; axis < 3; ++axis) {
-        s += line(std::string("INS_TCAL1_") + name + std::to_string(k) + "_" + "XYZ"[axis],
+        s += line(tcal + name + std::to_string(k) + "_" + "XYZ"[axis],
                   ExactNumber(kArduPilotScale * q(axis, k)));
       }
     }
@@ -234,9 +238,11 @@ bool ArduPilotThermalLines(
   coefficients(thermal.gyro, gyro, "GYR");
   // The offsets in the file hold at t_ref (c_0 = 0): Tcal = t_ref, inside
   // the range so ArduPilot's clamp leaves it.
-  s += line("INS_ACC1_CALTEMP", ExactNumber(Clamp(thermal.accel.t_ref, range.t_min, range.t_max)));
+  s += line("INS_ACC" + n + "_CALTEMP",
+            ExactNumber(Clamp(thermal.accel.t_ref, range.t_min, range.t_max)));
   if (thermal.has_gyro) {
-    s += line("INS_GYR1_CALTEMP", ExactNumber(Clamp(thermal.gyro.t_ref, range.t_min, range.t_max)));
+    s += line("INS_GYR" + n + "_CALTEMP",
+              ExactNumber(Clamp(thermal.gyro.t_ref, range.t_min, range.t_max)));
   }
   *text = s;
   return true;
@@ -400,6 +406,7 @@ AutopilotThermal ToAutopilotThermal(const ThermalModel& held, bool has_gyro,
   t.has_gyro = has_gyro;
   t.accel_device_id = options.accel_device_id;
   t.gyro_device_id = options.gyro_device_id;
+  t.ardupilot_imu = options.ardupilot_imu;
   return t;
 }
 

@@ -67,6 +67,8 @@ struct AutopilotThermal {
   // PX4 device ids (CAL_ACC0_ID / CAL_GYRO0_ID on the vehicle); 0 = none.
   int64_t accel_device_id = 0;
   int64_t gyro_device_id = 0;
+  // ArduPilot's IMU instance (1..3): INS_TCALn_*, INS_ACCn_CALTEMP.
+  int ardupilot_imu = 1;
 };
 
 // PX4: the lines after the CAL_* lines of the QGroundControl parameter file
@@ -78,9 +80,9 @@ bool Px4ThermalLines(
     const std::function<std::string(const std::string&, const std::string&, bool integer)>& line,
     std::string* text, std::string* error);
 
-// ArduPilot: INS_TCAL1_ENABLE, TMIN, TMAX, ACC1..3_X..Z, GYR1..3_X..Z and
-// INS_ACC1_CALTEMP / INS_GYR1_CALTEMP (= t_ref, where the file's INS_ACCOFFS
-// and INS_GYROFFS hold).
+// ArduPilot, IMU instance n = thermal.ardupilot_imu: INS_TCALn_ENABLE,
+// TMIN, TMAX, ACC1..3_X..Z, GYR1..3_X..Z and INS_ACCn_CALTEMP /
+// INS_GYRn_CALTEMP (= t_ref, where the file's offsets hold).
 bool ArduPilotThermalLines(
     const AutopilotThermal& thermal,
     const std::function<std::string(const std::string&, const std::string&)>& line,

@@ -143,6 +143,7 @@ ThermalLayout::ThermalLayout(const ThermalOrders& o, bool gyro) : orders(o), has
 
 namespace {
 
+using internal::ThermalElementSeries;
 using internal::ThermalLayout;
 using internal::ThermalOrders;
 using internal::ThermalWindowResidual;
@@ -225,6 +226,8 @@ std::vector<ThermalWindow> ThermalWindows(const ImuLog& log,
       }
       const double n = static_cast<double>(w.end - w.begin);
       w.time = sum_t / n;
+      w.t_begin = log.t[w.begin];
+      w.t_end = log.t[w.end - 1];
       w.temperature = sum_temperature / n;
       // The rate over rate_seconds around the window, all samples.
       const double half = 0.5 * options.rate_seconds;
@@ -323,9 +326,11 @@ struct Fit {
 
 class ThermalFitter {
  public:
-  ThermalFitter(const std::vector<ThermalWindow>& windows, const ThermalCalibrationOptions& o,
-                bool has_gyro, double reference_temperature, double span)
+  ThermalFitter(const std::vector<ThermalWindow>& windows, const ThermalElementSeries& element,
+                const ThermalCalibrationOptions& o, bool has_gyro, double reference_temperature,
+                double span)
       : windows_(windows),
+        element_(element),
         o_(o),
         has_gyro_(has_gyro),
         reference_(reference_temperature),
@@ -370,30 +375,33 @@ class ThermalFitter {
       const auto it = start.find(layout.names[j]);
       if (it != start.end()) initial[j] = it->second;
     }
+    // U's off-diagonal starts (and, when undetermined, stays) at 0, not at
+    // a previous step's value.
+    for (int k : {1, 2, 4}) initial[layout.upper + k] = 0.0;
     // What is determined depends on where the Jacobian is taken (a bias far
     // from its value tilts the poses' directions and lends the
-    // non-orthogonality information it does not have at the solution), so
-    // the test is repeated at each solution, every solve starting again
-    // from `initial`. From the third solve on a parameter once found
-    // undetermined stays so, which ends the passes.
-    // The first solve holds U's off-diagonal too: on axis-aligned poses
-    // |U d| depends on it only to second order, and a free start lets the
-    // solver slide along that valley (u02, u12 against u22).
+    // non-orthogonality information it does not have), so the test is
+    // taken twice: at the start, for a first solve that also holds U's
+    // off-diagonal (on the faces |U d| depends on it only to second order,
+    // and a free start slides along that valley), then once more at that
+    // first solution, whose bias and scale are the data's, for the final
+    // solve from `initial`. It is not repeated at the final solution: one
+    // that slid along a valley the poses leave open (six faces and one or
+    // two tilted poses: U's columns turned by tens of degrees, the bias at
+    // metres per second squared) would find itself determined there.
     Fit fit;
     fit.theta = initial;
     std::vector<double> sigmas = AccelSigmas(layout, initial);
     fit.fixed = Held(layout, Undetermined(layout, fit.theta, sigmas));
     for (int j : {layout.upper + 1, layout.upper + 2, layout.upper + 4}) fit.fixed[j] = true;
-    for (int pass = 0;; ++pass) {
+    if (!Solve(layout, sigmas, &fit)) return fit;
+    sigmas = AccelSigmas(layout, fit.theta);
+    const std::vector<bool> again = Held(layout, Undetermined(layout, fit.theta, sigmas));
+    if (again != fit.fixed) {
+      fit.fixed = again;
       fit.theta = initial;
       if (!Solve(layout, sigmas, &fit)) return fit;
       sigmas = AccelSigmas(layout, fit.theta);
-      std::vector<bool> again = Held(layout, Undetermined(layout, fit.theta, sigmas));
-      if (pass >= 2) {
-        for (int j = 0; j < layout.size; ++j) again[j] = again[j] || fit.fixed[j];
-      }
-      if (again == fit.fixed || pass >= 5) break;
-      fit.fixed = again;
     }
     Covariance(layout, sigmas, &fit);
     return fit;
@@ -466,9 +474,9 @@ class ThermalFitter {
   void Build(const ThermalLayout& layout, const std::vector<double>& sigmas, double* theta,
              ceres::Problem* problem) const {
     for (size_t k = 0; k < windows_.size(); ++k) {
-      problem->AddResidualBlock(
-          ThermalWindowResidual::Create(layout, windows_[k], reference_, o_.gravity, sigmas[k]),
-          nullptr, theta);
+      problem->AddResidualBlock(ThermalWindowResidual::Create(layout, windows_[k], &element_,
+                                                              reference_, o_.gravity, sigmas[k]),
+                                nullptr, theta);
     }
   }
 
@@ -533,11 +541,38 @@ class ThermalFitter {
 
   // Modified Gram-Schmidt over the prior-scaled columns in priority order
   // (the header): true = undetermined.
-  std::vector<bool> Undetermined(const ThermalLayout& layout, const std::vector<double>& theta,
+  // The test is taken with U's off-diagonal at 0 (the axis-aligned U a
+  // MEMS part is near): on the six faces |U d| depends on the
+  // off-diagonal only to second order, so away from 0 the linearisation
+  // lends it information the poses do not have, and a solve that slid
+  // along that valley would confirm itself (seen on six faces plus one
+  // tilted pose: U's columns turned by 70 degrees, the bias at 2000 m/s^2).
+  std::vector<bool> Undetermined(const ThermalLayout& layout, std::vector<double> theta,
                                  const std::vector<double>& sigmas) const {
+    for (int k : {1, 2, 4}) theta[layout.upper + k] = 0.0;
     Eigen::MatrixXd j = Jacobian(layout, sigmas, theta, nullptr);
     const std::vector<double> prior = PriorScale(layout, theta);
     for (int c = 0; c < layout.size; ++c) j.col(c) *= prior[c];
+    // U's off-diagonal and the accelerometer misalignment terms enter |U d|
+    // on the faces only to second order: the first-order "information" the
+    // columns carry there comes from small perturbations of the design (the
+    // thermal drift and the pose noise tilting a tilted pose's direction
+    // lend each of the three off-diagonals information on what is one
+    // combination of them; measured 0.2-0.4 % of their squared norm beyond
+    // the columns kept before them), which the nonlinear problem does not
+    // honour: a solve slides along the valley. Such a column is undetermined
+    // when the columns kept before it explain all but kCollinear of it.
+    // (Other terms are not held to this: x beside the constant on a
+    // single warm-up keeps under 1 % and is rightly determined.)
+    constexpr double kCollinear = 1e-2;
+    std::vector<bool> valley(layout.size, false);
+    for (int k : {1, 2, 4}) valley[layout.upper + k] = true;
+    for (int c = 0; c < layout.size; ++c) {
+      const ThermalLayout::Slot& s = layout.slots[c];
+      valley[c] = valley[c] || (s.thermal && s.sensor == ThermalSensor::kAccel &&
+                                s.quantity == ThermalQuantity::kMisalignment);
+    }
+    const Eigen::VectorXd original = j.colwise().squaredNorm().transpose();
     std::vector<bool> undetermined(layout.size, false), done(layout.size, false);
     std::vector<int> groups = layout.group;
     std::sort(groups.begin(), groups.end());
@@ -556,7 +591,8 @@ class ThermalFitter {
         }
         if (best < 0) break;
         done[best] = true;
-        if (!(best_norm >= o_.min_information)) {
+        if (!(best_norm >= o_.min_information) ||
+            (valley[best] && !(best_norm >= kCollinear * original(best)))) {
           undetermined[best] = true;
           continue;
         }
@@ -580,6 +616,12 @@ class ThermalFitter {
       problem.SetParameterBlockConstant(fit->theta.data());
     } else if (!held.empty()) {
       problem.SetManifold(fit->theta.data(), new ceres::SubsetManifold(layout.size, held));
+    }
+    // The lag filter is stable for tau >= 0 only (a negative tau, an
+    // element leading its own sensor, is not physical).
+    if (layout.lag >= 0 && !fit->fixed[layout.lag]) {
+      fit->theta[layout.lag] = std::max(0.0, fit->theta[layout.lag]);
+      problem.SetParameterLowerBound(fit->theta.data(), layout.lag, 0.0);
     }
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::DENSE_QR;
@@ -624,6 +666,7 @@ class ThermalFitter {
   }
 
   const std::vector<ThermalWindow>& windows_;
+  const ThermalElementSeries& element_;
   const ThermalCalibrationOptions& o_;
   const bool has_gyro_;
   const double reference_;
@@ -752,7 +795,10 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
                                ? options.reference_temperature
                                : std::round(5.0 * (lo + hi)) / 10.0;
   const bool has_gyro = log.has_gyro();
-  ThermalFitter fitter(windows, options, has_gyro, reference, span);
+  // The element temperature's grid: 1 s, or the sample period when longer.
+  const internal::ThermalElementSeries element(
+      log, std::max(1.0, (log.t.back() - log.t.front()) / std::max<size_t>(1, log.size() - 1)));
+  ThermalFitter fitter(windows, element, options, has_gyro, reference, span);
   const int poses = DistinctPoses(windows);
   // A pose within 10 degrees of a face counts as that face (as check does).
   bool faces_only = true;
@@ -875,6 +921,24 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
     const int j = layout.upper + i;
     out.accel.matrix_std(upper_row[i], upper_col[i]) =
         best.fixed[j] ? NAN : std::sqrt(best.covariance(j, j));
+  }
+  // The base model's covariance at T_ref (the determined b and U entries,
+  // marginal over the thermal terms), for compare and verify.
+  {
+    const char* names[9] = {"bias_x", "bias_y", "bias_z", "u_xx", "u_xy",
+                            "u_xz",   "u_yy",   "u_yz",   "u_zz"};
+    std::vector<int> kept;
+    for (int j = 0; j < 9; ++j) {
+      if (best.fixed[j]) continue;
+      kept.push_back(j);
+      out.accel.covariance_names.push_back(names[j]);
+    }
+    out.accel.covariance.resize(kept.size(), kept.size());
+    for (size_t r = 0; r < kept.size(); ++r) {
+      for (size_t c = 0; c < kept.size(); ++c) {
+        out.accel.covariance(r, c) = best.covariance(kept[r], kept[c]);
+      }
+    }
   }
   for (int j = 0; j < layout.size; ++j) {
     if (!best.fixed[j]) continue;

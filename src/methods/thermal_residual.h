@@ -6,10 +6,12 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "gravcal/core/imu_log.h"
 #include "gravcal/core/thermal_model.h"
 #include "gravcal/methods/thermal_calibration.h"
 
@@ -54,15 +56,51 @@ struct ThermalLayout {
   std::vector<Slot> slots;
 };
 
+// The sensing element's temperature T_e, a first-order lag of the recorded
+// temperature T_s (tau dT_e/dt = T_s - T_e, T_e = T_s at the log's start),
+// on a grid of step h: s_i the mean of T_s over bin i, T_s linear between
+// grid points, for which
+//
+//   e_i = s_i - tau m_i + (e_{i-1} - s_{i-1} + tau m_i) a,
+//   a = exp(-h / tau),  m_i = (s_i - s_{i-1}) / h
+//
+// is exact (tau = 0: e_i = s_i), with d e_i / d tau carried alongside.
+class ThermalElementSeries {
+ public:
+  ThermalElementSeries(const ImuLog& log, double step);
+  // The change tau makes to the mean element temperature over [t_begin,
+  // t_end]: mean(e(tau)) - mean(e(0)), and its derivative in tau (tau >= 0).
+  void WindowShift(double tau, double t_begin, double t_end, double* shift,
+                   double* derivative) const;
+
+ private:
+  void Update(double tau) const;
+  double t0_ = 0.0;
+  double h_ = 1.0;
+  std::vector<double> s_;
+  // The last tau's series (the fit is single-threaded).
+  mutable double tau_ = NAN;
+  mutable std::vector<double> e_, de_;
+};
+
+// The value of a Ceres Jet (or of a double).
+inline double ThermalScalar(double v) { return v; }
+template <typename T, int N>
+double ThermalScalar(const ceres::Jet<T, N>& v) {
+  return v.a;
+}
+
 // The residual of one window (the equations in thermal_calibration.h):
 // 1 accelerometer residual, then 3 gyroscope residuals when the layout has
 // a gyroscope.
 class ThermalWindowResidual {
  public:
   ThermalWindowResidual(const ThermalLayout& layout, const ThermalWindow& window,
-                        double reference_temperature, double gravity, double accel_sigma)
+                        const ThermalElementSeries* element, double reference_temperature,
+                        double gravity, double accel_sigma)
       : layout_(layout),
         window_(window),
+        element_(element),
         reference_temperature_(reference_temperature),
         gravity_(gravity),
         accel_sigma_(accel_sigma) {}
@@ -73,8 +111,15 @@ class ThermalWindowResidual {
   bool operator()(T const* const* parameters, T* residuals) const {
     const T* theta = parameters[0];
     const ThermalOrders& o = layout_.orders;
+    // x = T_e - T_ref: the window's mean temperature moved by the lag
+    // (exact value and first derivative in tau at tau's current value).
     T x = T(window_.temperature - reference_temperature_);
-    if (layout_.lag >= 0) x -= theta[layout_.lag] * T(window_.rate);
+    if (layout_.lag >= 0 && element_ != nullptr) {
+      const double tau = std::max(0.0, ThermalScalar(theta[layout_.lag]));
+      double shift = 0.0, derivative = 0.0;
+      element_->WindowShift(tau, window_.t_begin, window_.t_end, &shift, &derivative);
+      x += T(shift) + T(derivative) * (theta[layout_.lag] - T(tau));
+    }
     ThermalBlocks<T> accel;
     accel.sensor = ThermalSensor::kAccel;
     if (o.accel_bias > 0) accel.bias = theta + layout_.accel_bias;
@@ -110,10 +155,12 @@ class ThermalWindowResidual {
 
   // The cost function over theta (one block of layout.size).
   static ceres::CostFunction* Create(const ThermalLayout& layout, const ThermalWindow& window,
+                                     const ThermalElementSeries* element,
                                      double reference_temperature, double gravity,
                                      double accel_sigma) {
-    auto* f = new ceres::DynamicAutoDiffCostFunction<ThermalWindowResidual, 8>(
-        new ThermalWindowResidual(layout, window, reference_temperature, gravity, accel_sigma));
+    auto* f =
+        new ceres::DynamicAutoDiffCostFunction<ThermalWindowResidual, 8>(new ThermalWindowResidual(
+            layout, window, element, reference_temperature, gravity, accel_sigma));
     f->AddParameterBlock(layout.size);
     f->SetNumResiduals(layout.has_gyro ? 4 : 1);
     return f;
@@ -122,6 +169,7 @@ class ThermalWindowResidual {
  private:
   const ThermalLayout layout_;
   const ThermalWindow window_;
+  const ThermalElementSeries* element_;
   const double reference_temperature_;
   const double gravity_;
   const double accel_sigma_;

@@ -112,8 +112,9 @@ bool SimulateThermal(const ThermalSimulatorOptions& o, uint64_t seed,
   std::normal_distribution<double> normal(0.0, 1.0);
   ThermalSimulatedSession out;
   out.seed = seed;
-  const double accel_units = o.accel_counts_per_g / o.gravity;
-  const double gyro_units = o.gyro_counts_per_dps * 180.0 / M_PI;
+  // Raw units per SI unit: counts, or 1 when the session is written in SI.
+  const double accel_units = o.raw_counts ? o.accel_counts_per_g / o.gravity : 1.0;
+  const double gyro_units = o.raw_counts ? o.gyro_counts_per_dps * 180.0 / M_PI : 1.0;
   out.accel_units_per_si = accel_units;
   out.gyro_units_per_si = gyro_units;
 

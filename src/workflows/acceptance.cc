@@ -149,6 +149,22 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
       if (out.min_temperature > out.max_temperature) {
         return KeyError(name, key, "min is above max", error);
       }
+    } else if (key == "temperature_sensitivity") {
+      if (!entry.second.IsMap() || entry.second.size() == 0) {
+        return KeyError(name, key,
+                        "must be a map with accel_bias (mg/K) and/or gyro_bias (deg/s/K)", error);
+      }
+      for (const auto& field : entry.second) {
+        const std::string f = field.first.as<std::string>();
+        double* target = f == "accel_bias"  ? &out.max_accel_bias_tempco
+                         : f == "gyro_bias" ? &out.max_gyro_bias_tempco
+                                            : nullptr;
+        if (target == nullptr) {
+          return KeyError(name, key + "." + f, "unknown (accel_bias, gyro_bias)", error);
+        }
+        if (!ReadNumber(field.second, name, key + "." + f, target, error)) return false;
+        if (!(*target > 0.0)) return KeyError(name, key + "." + f, "must be positive", error);
+      }
     } else if (key == "parameters") {
       if (!entry.second.IsMap()) return KeyError(name, key, "must be a map of parameters", error);
       for (const auto& p : entry.second) {
@@ -177,7 +193,7 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
     } else {
       return KeyError(name, key,
                       "unknown (parameters, residual_rms, gravity_std, accel_noise_density, "
-                      "temperature)",
+                      "temperature, temperature_sensitivity)",
                       error);
     }
   }
@@ -281,6 +297,25 @@ void CheckAcceptance(const Calibration& calibration, const AcceptanceLimits& lim
                                      limits.min_temperature, limits.max_temperature));
     }
   }
+  const std::pair<ThermalSensor, double> tempcos[] = {
+      {ThermalSensor::kAccel, limits.max_accel_bias_tempco},
+      {ThermalSensor::kGyro, limits.max_gyro_bias_tempco}};
+  for (const auto& [sensor, limit] : tempcos) {
+    if (!std::isfinite(limit)) continue;
+    const std::string what = std::string("temperature_sensitivity.") + ToString(sensor) + "_bias";
+    const double s = ThermalSensitivity(calibration, sensor);
+    if (std::isfinite(s)) {
+      result->checks.push_back(Range(what, s, 0.0, limit));
+      continue;
+    }
+    LimitCheck c;
+    c.name = what;
+    c.max = limit;
+    c.pass = true;
+    c.checked = false;
+    c.why = "not checked: the calibration has no thermal model (method thermal)";
+    result->checks.push_back(c);
+  }
   std::string failed;
   for (const LimitCheck& c : result->checks) {
     if (c.pass) continue;
@@ -294,6 +329,31 @@ void CheckAcceptance(const Calibration& calibration, const AcceptanceLimits& lim
           ? "pass (" + std::to_string(result->checks.size() - unchecked) + " limits" +
                 (unchecked > 0 ? ", " + std::to_string(unchecked) + " not checked" : "") + ")"
           : "fail: " + failed;
+}
+
+double ThermalSensitivity(const Calibration& calibration, ThermalSensor sensor) {
+  const ThermalModel& th = calibration.thermal;
+  const bool gyro = sensor == ThermalSensor::kGyro;
+  if (!th.active() || (gyro && !calibration.gyro.estimated)) return NAN;
+  const ThermalPolynomial& p = th.Sensor(sensor).bias;
+  if (!p.active()) return 0.0;
+  const Eigen::Matrix3d m = gyro ? calibration.gyro.model.matrix : calibration.accel.model.matrix();
+  const double lo =
+      std::isfinite(th.min_temperature) ? th.min_temperature : th.reference_temperature;
+  const double hi =
+      std::isfinite(th.max_temperature) ? th.max_temperature : th.reference_temperature;
+  constexpr int kGrid = 64;
+  double worst = 0.0;
+  for (int g = 0; g <= kGrid; ++g) {
+    const double x = lo + (hi - lo) * g / kGrid - th.reference_temperature;
+    // d p_i / dx = sum_k k c_ik x^(k-1), raw units per K.
+    Eigen::Vector3d slope = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      for (int k = p.order; k >= 1; --k) slope(i) = slope(i) * x + k * p.coefficients(i, k - 1);
+    }
+    worst = std::max(worst, (m * slope).cwiseAbs().maxCoeff());
+  }
+  return gyro ? worst * 180.0 / M_PI : worst / (9.80665e-3);
 }
 
 bool MakeCertificate(const Calibration& c, const CertificateInfo& info,

@@ -1,6 +1,9 @@
 #include "gravcal/workflows/compare.h"
 
+#include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -61,6 +64,58 @@ std::string OutputDifferenceToJson(const OutputDifference& d) {
   return j.dump();
 }
 
+namespace {
+
+std::string VerifyDegrees(double v) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f", v);
+  return text;
+}
+
+// Issue 35: with a thermal model, each pose mean is taken to T_ref, where
+// the stored base model (b, U) holds: v' = b + U^-1 s, s the thermal
+// correction (I + D(x))^-1 U (v - b - db(x)) at the pose's temperature
+// (clamped to the valid range, rate 0: the poses are static). Poses more
+// than 0.5 degC outside the range are named in a warning, as apply does;
+// a log without temperature is tested at T_ref, with a warning.
+void ThermalCheckPoses(const ImuLog& log, const Calibration& stored,
+                       std::vector<Position>* positions, std::vector<std::string>* warnings) {
+  const ThermalModel& th = stored.thermal;
+  if (!th.active()) return;
+  if (!log.has_temperature()) {
+    warnings->push_back(log.source +
+                        ": the calibration has a thermal model but the check session has no "
+                        "'temp' column: tested at its reference temperature " +
+                        VerifyDegrees(th.reference_temperature) + " degC");
+    return;
+  }
+  const AccelModel& a = stored.accel.model;
+  size_t outside = 0;
+  double lowest = INFINITY, highest = -INFINITY;
+  for (Position& p : *positions) {
+    if (!std::isfinite(p.temperature)) continue;
+    if (p.temperature < th.min_temperature - 0.5 || p.temperature > th.max_temperature + 0.5) {
+      ++outside;
+      lowest = std::min(lowest, p.temperature);
+      highest = std::max(highest, p.temperature);
+    }
+    const Eigen::Vector3d s = CorrectAccelThermal(th, a.bias, a.upper, p.raw_mean,
+                                                  th.Offset(p.temperature, 0.0, nullptr));
+    p.raw_mean = a.bias + a.upper.triangularView<Eigen::Upper>().solve(s);
+  }
+  if (outside > 0) {
+    warnings->push_back(
+        log.source + ": " + std::to_string(outside) + " check poses (temperatures " +
+        VerifyDegrees(lowest) + " to " + VerifyDegrees(highest) +
+        " degC) lie more than 0.5 degC outside the thermal model's range [" +
+        VerifyDegrees(th.min_temperature) + ", " + VerifyDegrees(th.max_temperature) +
+        "] degC; the correction is clamped there and the check may see a change that is only "
+        "temperature");
+  }
+}
+
+}  // namespace
+
 bool VerifyCheckLog(const ImuLog& log, const Calibration& stored, const CalibrationOptions& options,
                     const ComparisonOptions& comparison, CheckSessionResult* result,
                     std::string* error) {
@@ -75,10 +130,13 @@ bool VerifyCheckLog(const ImuLog& log, const Calibration& stored, const Calibrat
     *error = internal::PrefixSource(log.source, "no static pose found in the check session");
     return false;
   }
+  std::vector<std::string> warnings;
+  ThermalCheckPoses(log, stored, &positions, &warnings);
   if (!VerifyCheckSession(positions, stored, comparison, result)) {
     *error = internal::PrefixSource(log.source, result->comparison.message);
     return false;
   }
+  result->warnings = warnings;
   return true;
 }
 

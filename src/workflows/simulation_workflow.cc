@@ -40,6 +40,7 @@ bool SimulateFromConfig(const Config& config, const SimulationRequest& request,
     ThermalSimulatorOptions thermal = config.thermal_simulation;
     FromString(config.sim_thermal, &thermal.profile);
     thermal.gravity = sim.gravity;
+    thermal.raw_counts = sim.raw_counts;
     ThermalSimulatedSession session;
     if (!SimulateThermal(thermal, request.seed, &session, error)) return false;
     SimulatedSession& out = files->session;

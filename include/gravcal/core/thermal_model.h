@@ -4,13 +4,14 @@
 //
 // Temperature. T_s is the temperature the log records (degrees C). The
 // sensing element may lag it; with the optional first-order lag time
-// constant tau (s) the model uses the element's temperature in its
-// small-lag form
+// constant tau (s, >= 0) the model uses the element's temperature T_e,
+// tau dT_e/dt = T_s - T_e (T_e = T_s at the log's start), written
 //
-//   T_e = T_s - tau dT_s/dt
+//   T_e = T_s - tau r,   r = dT_e/dt
 //
-// (exact for a steady ramp once the transient has died away; tau = 0: no
-// lag; a negative tau is an element that leads the sensor). T_e is then
+// so the `rate` below is the element's rate, which a filter along the log
+// gives (ThermalElementRate, thermal_rate.h; for a steady ramp, once the
+// transient has died away, it equals dT_s/dt). tau = 0: no lag. T_e is then
 // clamped to the valid range [T_min, T_max] the calibration covered, as
 // PX4's temperature compensation clamps, and enters every polynomial as
 //
@@ -271,7 +272,7 @@ struct ThermalModel {
   }
   // True when T lies in [T_min, T_max] (a NaN range holds every T).
   bool InRange(double temperature) const;
-  // T_e = T - tau dT/dt (rate in degrees C per s; a NaN rate is 0).
+  // T_e = T - tau r (r = dT_e/dt, the element's rate, degrees C per s; NaN = 0).
   double ElementTemperature(double temperature, double rate) const;
   // x = clamp(T_e, T_min, T_max) - T_ref; `clamped` (may be null) says
   // whether the clamp acted. A NaN temperature gives x = 0 (the base model).

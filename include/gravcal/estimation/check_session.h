@@ -47,6 +47,9 @@ struct CheckPose {
 struct CheckSessionResult {
   ComparisonResult comparison;
   std::vector<CheckPose> poses;
+  // What the caller should hear (a check session outside the stored thermal
+  // model's range, or without the temperature it needs).
+  std::vector<std::string> warnings;
 };
 
 // `stored` needs accel.model and accel.covariance (with names, std as read

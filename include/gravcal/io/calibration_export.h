@@ -52,6 +52,10 @@ struct ExportOptions {
   int64_t gyro_device_id = 0;
   // px4, ardupilot: leave the thermal model out (said in the file).
   bool drop_thermal = false;
+  // ardupilot: the IMU instance n (1..3): INS_ACCnOFFS_*, INS_ACCnSCAL_*,
+  // INS_GYRnOFFS_* (no n for the first IMU), INS_TCALn_*, INS_ACCn_CALTEMP,
+  // INS_GYRn_CALTEMP.
+  int ardupilot_imu = 1;
   bool IsValid(std::string* error) const;
 };
 

@@ -115,9 +115,12 @@ struct ThermalWindow {
   size_t end = 0;
   // The static interval it belongs to.
   int interval = 0;
+  // Mean time, first and last sample's times (s).
   double time = 0.0;
+  double t_begin = 0.0;
+  double t_end = 0.0;
   double temperature = 0.0;
-  // degrees C per s.
+  // The recorded temperature's rate, degrees C per s.
   double rate = 0.0;
   Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();
   Eigen::Matrix3d accel_mean_cov = Eigen::Matrix3d::Identity();

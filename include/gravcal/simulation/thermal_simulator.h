@@ -84,7 +84,9 @@ struct ThermalSimulatorOptions {
   double rotation_seconds = 2.0;
   double sample_rate = 100.0;
   double gravity = 9.80665;
-  // Raw units.
+  // Raw units: counts (true; the sensitivities below) or SI (false: m/s^2,
+  // rad/s, the units configs/thermal.yaml's nominal scales of 1 expect).
+  bool raw_counts = true;
   double accel_counts_per_g = 10920.0;
   double gyro_counts_per_dps = 16.384;
   // White noise densities (SI per sqrt(Hz)) and the temperature sensor's

@@ -11,6 +11,7 @@
 //   gravity_std: 0.0001     # standard uncertainty of the gravity used, m/s^2
 //   accel_noise_density: 0.002   # m/s^2/sqrt(Hz), the largest axis, measured in the holds
 //   temperature: {min: 15, max: 35}   # degC, every hold, where the log has temperature
+//   temperature_sensitivity: {accel_bias: 0.5, gyro_bias: 0.05}   # mg/K, deg/s/K
 //
 // Parameter names are compare's (estimation/calibration_comparison.h):
 // model names (accel.bias_x, accel.u_xy, accel.rot_z, gyro.m_xy) and the
@@ -32,6 +33,13 @@
 // Temperature: every hold's mean temperature must lie in [min, max]. A log
 // without temperature leaves the limit not checked (listed as such, not
 // failed): the limit applies where the data carry temperature.
+//
+// Temperature sensitivity (issue 35's thermal model): the largest slope of
+// the bias against temperature over the calibration's valid range and the
+// three axes, taken through the calibrated matrix to SI,
+// max_T,i |(M d db(x)/dx)_i|, in mg/K (accelerometer, g = 9.80665 m/s^2)
+// and deg/s/K (gyroscope). A calibration without a thermal model leaves it
+// not checked (said); one whose bias term was fitted as constant has 0.
 //
 // Certificate: each parameter with its standard uncertainty u_c and the
 // expanded uncertainty U = k u_c (k = 2), and the budget whose squares sum to
@@ -79,7 +87,16 @@ struct AcceptanceLimits {
   // degC, every hold's mean temperature.
   double min_temperature = -std::numeric_limits<double>::infinity();
   double max_temperature = std::numeric_limits<double>::infinity();
+  // mg/K and deg/s/K, ThermalSensitivity.
+  double max_accel_bias_tempco = std::numeric_limits<double>::infinity();
+  double max_gyro_bias_tempco = std::numeric_limits<double>::infinity();
 };
+
+// The largest |d bias / dT| of a sensor's thermal model over its valid
+// range and axes (above): mg/K for the accelerometer, deg/s/K for the
+// gyroscope; NaN when the calibration has no thermal model (or no such
+// sensor).
+double ThermalSensitivity(const Calibration& calibration, ThermalSensor sensor);
 
 // The accelerometer's white-noise density per axis measured in the holds
 // (above), m/s^2/sqrt(Hz); NaN where no hold has a sample count, a duration
