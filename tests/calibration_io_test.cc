@@ -468,9 +468,11 @@ TEST(CalibrationModel, IsTheModelItsJsonHolds) {
   EXPECT_EQ(undetermined[0], "effects.accel_temperature_bias." + temperature.names[1]);
   EXPECT_EQ(model.accel.bias, read.corrector.accel.bias);
   EXPECT_EQ(model.gyro.matrix, read.corrector.gyro.matrix);
-  EXPECT_EQ(model.effects.accel_temperature_bias, Eigen::Vector3d(1e-3, 0.0, -2e-3));
-  EXPECT_EQ(model.effects.accel_temperature_bias, read.corrector.effects.accel_temperature_bias);
-  EXPECT_EQ(model.effects.gyro_bias_drift, read.corrector.effects.gyro_bias_drift);
+  EXPECT_EQ(model.effects.Vector(Effect::kAccelTemperatureBias), Eigen::Vector3d(1e-3, 0.0, -2e-3));
+  EXPECT_EQ(model.effects.Vector(Effect::kAccelTemperatureBias),
+            read.corrector.effects.Vector(Effect::kAccelTemperatureBias));
+  EXPECT_EQ(model.effects.Vector(Effect::kGyroBiasDrift),
+            read.corrector.effects.Vector(Effect::kGyroBiasDrift));
   EXPECT_EQ(model.effects.reference_temperature, 25.0);
   // Applied, the two give the same bits.
   Eigen::Vector3d a = Eigen::Vector3d(1200.0, -300.0, 16000.0), b = a;

@@ -323,9 +323,9 @@ TEST(EffectRotations, HiddenGyroscopeEffectsAreNotTakenForAccelerometerOnes) {
   for (int which = 0; which < 3; ++which) {
     SimulatorOptions sim = TwelvePoseWarmUp();
     // 0.01 deg/s/K, 0.03 deg/s/min, 0.05 deg/s/g (discovery_test.cc).
-    if (which == 0) sim.gyro_temperature_bias_std = 1.7e-4;
-    if (which == 1) sim.gyro_bias_drift_std = 1e-5;
-    if (which == 2) sim.gyro_g_sensitivity_std = 9e-5;
+    if (which == 0) sim.effect_std[Effect::kGyroTemperatureBias] = 1.7e-4;
+    if (which == 1) sim.effect_std[Effect::kGyroBiasDrift] = 1e-5;
+    if (which == 2) sim.effect_std[Effect::kGyroGSensitivity] = 9e-5;
     int significant = 0, warned = 0;
     for (int seed = 1; seed <= 10; ++seed) {
       SimulatedSession session;

@@ -30,7 +30,7 @@ bool Calibration::Model(ImuCorrector* model, std::vector<std::string>* undetermi
   }
   for (const EffectEstimate& estimate : effects.estimates) {
     // accel_misalignment is the off-diagonal of accel.upper.
-    if (estimate.effect == Effect::kAccelMisalignment) continue;
+    if (Info(estimate.effect).form == EffectForm::kInUpper) continue;
     const EffectInfo& info = Info(estimate.effect);
     const std::string key = std::string("effects.") + info.name;
     std::vector<double> values = estimate.values;
@@ -41,7 +41,7 @@ bool Calibration::Model(ImuCorrector* model, std::vector<std::string>* undetermi
       }
       values[i] = 0.0;
     }
-    if (!SetEffectValues(estimate.effect, values, &corrector.effects)) {
+    if (!corrector.effects.SetValues(estimate.effect, values)) {
       return internal::SetError(error, "key '" + key + ".value': must have " +
                                            std::to_string(info.num_parameters) + " numbers");
     }
