@@ -24,6 +24,7 @@
 #include "gravcal/core/effects/accel_misalignment.h"
 #include "gravcal/core/effects/accel_quadratic.h"
 #include "gravcal/core/effects/accel_temperature_bias.h"
+#include "gravcal/core/effects/accel_temperature_bias_quadratic.h"
 #include "gravcal/core/effects/accel_temperature_scale.h"
 #include "gravcal/core/effects/gyro_bias_drift.h"
 #include "gravcal/core/effects/gyro_g_sensitivity.h"
@@ -42,6 +43,7 @@
   X(GyroGSensitivity)                                                 \
   X(GyroTemperatureBias)                                              \
   X(GyroBiasDrift)                                                    \
+  X(AccelTemperatureBiasQuadratic)                                    \
   /* a new effect: one line above */
 // clang-format on
 
