@@ -49,13 +49,13 @@ ImuCorrector FullCorrector() {
   c.has_gyro = true;
   c.gyro.bias << 0.01, -0.02, 0.003;
   c.gyro.matrix << 1.002, 0.001, 0.0, -0.002, 0.998, 0.001, 0.0, 0.001, 1.001;
-  c.effects.accel_temperature_bias << 1e-3, -2e-3, 5e-4;
-  c.effects.accel_temperature_scale << 1e-4, -1e-4, 2e-4;
-  c.effects.accel_bias_drift << 1e-6, 2e-6, -1e-6;
-  c.effects.accel_quadratic << 1e-4, 2e-4, -1e-4;
-  c.effects.gyro_g_sensitivity.setConstant(1e-4);
-  c.effects.gyro_temperature_bias << 1e-4, 2e-4, 3e-4;
-  c.effects.gyro_bias_drift << 1e-7, 1e-7, 1e-7;
+  c.effects.Vector(Effect::kAccelTemperatureBias) << 1e-3, -2e-3, 5e-4;
+  c.effects.Vector(Effect::kAccelTemperatureScale) << 1e-4, -1e-4, 2e-4;
+  c.effects.Vector(Effect::kAccelBiasDrift) << 1e-6, 2e-6, -1e-6;
+  c.effects.Vector(Effect::kAccelQuadratic) << 1e-4, 2e-4, -1e-4;
+  c.effects.Matrix(Effect::kGyroGSensitivity).setConstant(1e-4);
+  c.effects.Vector(Effect::kGyroTemperatureBias) << 1e-4, 2e-4, 3e-4;
+  c.effects.Vector(Effect::kGyroBiasDrift) << 1e-7, 1e-7, 1e-7;
   c.effects.reference_temperature = 25.0;
   c.effects.reference_time = 1700000000.0;
   c.active_effects = {Effect::kAccelTemperatureBias, Effect::kAccelTemperatureScale,

@@ -103,7 +103,7 @@ BENCHMARK(BM_DiscoveryTwelveScaleMisalignmentBaseline)->Unit(benchmark::kMillise
 
 void BM_DiscoveryRandom24HiddenTemperatureBias(benchmark::State& state) {
   SimulatorOptions sim = WarmUp("random:24");
-  sim.accel_temperature_bias_std = 0.005;
+  sim.effect_std[Effect::kAccelTemperatureBias] = 0.005;
   static const std::vector<Session> sessions =
       MakeSessions(sim, AccelParameterization::kScaleMisalignment);
   Run(state, sessions);

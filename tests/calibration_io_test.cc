@@ -427,5 +427,71 @@ TEST(CalibrationChecksOnLoad, ApplyAndExportRefuseAnEditedCalibration) {
   EXPECT_FALSE(testing_util::FileExists(out));
 }
 
+// Issue 34: a Calibration carries its model. Calibration::Model gives the
+// corrector that reading the calibration's JSON gives (the effects switched
+// on, their values, an undetermined parameter as 0 and named), and refuses
+// parts that disagree with the key named, as reading the file does.
+TEST(CalibrationModel, IsTheModelItsJsonHolds) {
+  Calibration c;
+  c.success = true;
+  c.message = "ok";
+  c.accel.model.bias = Eigen::Vector3d(10.0, -20.0, 5.0);
+  c.accel.model.upper << 0.0006, 1e-6, -2e-6, 0.0, 0.00061, 3e-6, 0.0, 0.0, 0.00059;
+  c.gyro.estimated = true;
+  c.gyro.model.bias = Eigen::Vector3d(1.0, 2.0, 3.0);
+  c.gyro.model.matrix = 1.3e-4 * Eigen::Matrix3d::Identity();
+  EffectEstimate temperature;
+  temperature.effect = Effect::kAccelTemperatureBias;
+  temperature.names = Info(Effect::kAccelTemperatureBias).parameter_names;
+  temperature.values = {1e-3, NAN, -2e-3};
+  temperature.std = {1e-4, NAN, 1e-4};
+  temperature.unit = Info(Effect::kAccelTemperatureBias).unit;
+  EffectEstimate drift;
+  drift.effect = Effect::kGyroBiasDrift;
+  drift.names = Info(Effect::kGyroBiasDrift).parameter_names;
+  drift.values = {1e-5, 2e-5, 3e-5};
+  drift.std = {1e-6, 1e-6, 1e-6};
+  drift.unit = Info(Effect::kGyroBiasDrift).unit;
+  c.effects.estimates = {temperature, drift};
+  c.effects.reference_temperature = 25.0;
+  c.effects.reference_time = 100.0;
+
+  ImuCorrector model;
+  std::vector<std::string> undetermined;
+  std::string error;
+  ASSERT_TRUE(c.Model(&model, &undetermined, &error)) << error;
+  LoadedCalibration read;
+  ASSERT_TRUE(CalibrationFromJson(CalibrationToJson(c, true), "c.json", &read, &error)) << error;
+  EXPECT_EQ(model.active_effects, read.corrector.active_effects);
+  EXPECT_EQ(undetermined, read.undetermined);
+  ASSERT_EQ(undetermined.size(), 1u);
+  EXPECT_EQ(undetermined[0], "effects.accel_temperature_bias." + temperature.names[1]);
+  EXPECT_EQ(model.accel.bias, read.corrector.accel.bias);
+  EXPECT_EQ(model.gyro.matrix, read.corrector.gyro.matrix);
+  EXPECT_EQ(model.effects.Vector(Effect::kAccelTemperatureBias), Eigen::Vector3d(1e-3, 0.0, -2e-3));
+  EXPECT_EQ(model.effects.Vector(Effect::kAccelTemperatureBias),
+            read.corrector.effects.Vector(Effect::kAccelTemperatureBias));
+  EXPECT_EQ(model.effects.Vector(Effect::kGyroBiasDrift),
+            read.corrector.effects.Vector(Effect::kGyroBiasDrift));
+  EXPECT_EQ(model.effects.reference_temperature, 25.0);
+  // Applied, the two give the same bits.
+  Eigen::Vector3d a = Eigen::Vector3d(1200.0, -300.0, 16000.0), b = a;
+  Eigen::Vector3d w = Eigen::Vector3d(5.0, 6.0, 7.0), u = w;
+  ASSERT_TRUE(model.CorrectRow(31.0, 140.0, &a, &w));
+  ASSERT_TRUE(read.corrector.CorrectRow(31.0, 140.0, &b, &u));
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(w, u);
+
+  // A gyroscope effect without a gyroscope model is refused by its key.
+  c.gyro.estimated = false;
+  EXPECT_FALSE(c.Model(&model, nullptr, &error));
+  EXPECT_NE(error.find("key 'effects.gyro_bias_drift'"), std::string::npos) << error;
+  // A temperature effect needs its reference temperature.
+  c.gyro.estimated = true;
+  c.effects.reference_temperature = NAN;
+  EXPECT_FALSE(c.Model(&model, nullptr, &error));
+  EXPECT_NE(error.find("effects.reference_temperature"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace gravcal

@@ -105,28 +105,28 @@ constexpr int kSeeds = 20;
 
 TEST(Discovery, FindsAccelQuadraticNonlinearity) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.accel_quadratic_std = kQuadratic;
+  sim.effect_std[Effect::kAccelQuadratic] = kQuadratic;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelQuadratic),
               /*197 of 200*/ 0.92, /*188 of 200*/ 0.86);
 }
 
 TEST(Discovery, FindsAccelTemperatureBias) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.accel_temperature_bias_std = kTemperatureBias;
+  sim.effect_std[Effect::kAccelTemperatureBias] = kTemperatureBias;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelTemperatureBias),
               /*199 of 200*/ 0.94, /*198 of 200*/ 0.93);
 }
 
 TEST(Discovery, FindsAccelTemperatureScale) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.accel_temperature_scale_std = kTemperatureScale;
+  sim.effect_std[Effect::kAccelTemperatureScale] = kTemperatureScale;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelTemperatureScale),
               /*190 of 200*/ 0.87, /*174 of 200*/ 0.77);
 }
 
 TEST(Discovery, FindsAccelBiasDrift) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.accel_bias_drift_std = kBiasDrift;
+  sim.effect_std[Effect::kAccelBiasDrift] = kBiasDrift;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelBiasDrift),
               /*194 of 200*/ 0.90, /*193 of 200*/ 0.89);
 }
@@ -139,21 +139,21 @@ TEST(Discovery, FindsAccelMisalignmentMissingFromScaleBaseline) {
 
 TEST(Discovery, FindsGyroGSensitivity) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.gyro_g_sensitivity_std = kGSensitivity;
+  sim.effect_std[Effect::kGyroGSensitivity] = kGSensitivity;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroGSensitivity),
               /*200 of 200*/ 0.95, /*199 of 200*/ 0.94);
 }
 
 TEST(Discovery, FindsGyroTemperatureBias) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.gyro_temperature_bias_std = kGyroTemperatureBias;
+  sim.effect_std[Effect::kGyroTemperatureBias] = kGyroTemperatureBias;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroTemperatureBias),
               /*200 of 200*/ 0.95, /*199 of 200*/ 0.94);
 }
 
 TEST(Discovery, FindsGyroBiasDrift) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.gyro_bias_drift_std = kGyroDrift;
+  sim.effect_std[Effect::kGyroBiasDrift] = kGyroDrift;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroBiasDrift),
               /*200 of 200*/ 0.95, /*198 of 200*/ 0.93);
 }
@@ -182,7 +182,7 @@ TEST(Discovery, NamesNothingWithoutHiddenEffect) {
 // are not tried, with a warning naming why, and the rest still work.
 TEST(Discovery, SaysWhatALogWithoutGyroscopeOrTemperatureCannotTest) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.accel_quadratic_std = kQuadratic;
+  sim.effect_std[Effect::kAccelQuadratic] = kQuadratic;
   SimulatedSession session;
   std::string error;
   ASSERT_TRUE(Simulate(sim, 1, &session, &error)) << error;
@@ -236,11 +236,11 @@ TEST(Discovery, InvalidOptionsAndTooFewPositionsFailWithAMessage) {
 TEST(Discovery, FindsTwoHiddenEffectsLargerFirst) {
   SimulatorOptions a = testing_util::WarmUpSession();
   a.temperature_tau = 60.0;
-  a.accel_temperature_bias_std = 3.0 * kTemperatureBias;
+  a.effect_std[Effect::kAccelTemperatureBias] = 3.0 * kTemperatureBias;
   SimulatorOptions b = testing_util::WarmUpSession();
-  b.accel_quadratic_std = 1.5 * kQuadratic;
+  b.effect_std[Effect::kAccelQuadratic] = 1.5 * kQuadratic;
   SimulatorOptions both = a;
-  both.accel_quadratic_std = b.accel_quadratic_std;
+  both.effect_std[Effect::kAccelQuadratic] = b.effect_std[Effect::kAccelQuadratic];
   int found = 0, in_order = 0;
   for (int seed = 1; seed <= kSeeds; ++seed) {
     const Outcome run = Discover(both, seed);
@@ -271,7 +271,7 @@ TEST(Discovery, FindsTwoHiddenEffectsLargerFirst) {
 TEST(Discovery, ReportsTemperatureVersusTimeAmbiguityInMonotonicWarmUp) {
   SimulatorOptions sim = testing_util::WarmUpSession();
   sim.temperature_tau = 3000.0;
-  sim.accel_temperature_bias_std = 5.0 * kTemperatureBias;
+  sim.effect_std[Effect::kAccelTemperatureBias] = 5.0 * kTemperatureBias;
   int reported = 0;
   const int seeds = 10;
   for (int seed = 1; seed <= seeds; ++seed) {

@@ -29,10 +29,10 @@ EffectParameters RandomParameters(std::mt19937_64* rng) {
     return Eigen::Vector3d(n(*rng), n(*rng), n(*rng)) * s;
   };
   EffectParameters p;
-  p.accel_quadratic = v(2e-4);
-  p.accel_temperature_bias = v(0.01);
-  p.accel_temperature_scale = v(3e-4);
-  p.accel_bias_drift = v(1e-4);
+  p.Vector(Effect::kAccelQuadratic) = v(2e-4);
+  p.Vector(Effect::kAccelTemperatureBias) = v(0.01);
+  p.Vector(Effect::kAccelTemperatureScale) = v(3e-4);
+  p.Vector(Effect::kAccelBiasDrift) = v(1e-4);
   p.reference_temperature = 25.0;
   p.reference_time = 100.0;
   return p;
@@ -64,8 +64,8 @@ TEST(ModelEffects, ZeroParametersAndUnknownTemperatureAreTheIdentity) {
   EXPECT_EQ(ApplyAccelEffects(zero, s, 40.0, 50.0), s);
   std::mt19937_64 rng(4);
   EffectParameters p = RandomParameters(&rng);
-  p.accel_quadratic.setZero();
-  p.accel_bias_drift.setZero();
+  p.Vector(Effect::kAccelQuadratic).setZero();
+  p.Vector(Effect::kAccelBiasDrift).setZero();
   // No temperature column: the temperature terms are off.
   EXPECT_EQ(ApplyAccelEffects(p, s, NAN, p.reference_time), s);
 }
@@ -95,25 +95,26 @@ TEST(EffectResidual, JacobianMatchesNumericDifferences) {
       GravityMagnitudeResidual::CreateWithEffects(raw, 6.0, -40.0, 9.81, 0.001));
   double bias[3] = {20.0, -30.0, 45.0};
   double upper[6] = {6.0e-4, 2e-6, -3e-6, 6.1e-4, 1e-6, 5.9e-4};
-  double blocks[4][3];
-  const Eigen::Vector3d* values[4] = {&p.accel_quadratic, &p.accel_temperature_bias,
-                                      &p.accel_temperature_scale, &p.accel_bias_drift};
-  for (int b = 0; b < 4; ++b) {
-    for (int i = 0; i < 3; ++i) blocks[b][i] = (*values[b])(i);
+  // The effects' block in the registry's layout (core/effect_registry.h).
+  double effects[kAccelEffectParameters];
+  std::copy(p.accel.begin(), p.accel.end(), effects);
+  double* params[3] = {bias, upper, effects};
+  const int sizes[3] = {3, 6, kAccelEffectParameters};
+  std::vector<double> steps[3] = {std::vector<double>(3, 1e-3), std::vector<double>(6, 1e-10),
+                                  std::vector<double>(kAccelEffectParameters, 1e-6)};
+  for (int i = 0; i < 3; ++i) {
+    steps[2][effects::kLayout.offset[static_cast<int>(Effect::kAccelQuadratic)] + i] = 1e-5;
   }
-  double* params[6] = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
-  const int sizes[6] = {3, 6, 3, 3, 3, 3};
-  const double kStep[6] = {1e-3, 1e-10, 1e-5, 1e-6, 1e-6, 1e-6};
   double r;
-  double jac[6][6];
-  double* jacobians[6] = {jac[0], jac[1], jac[2], jac[3], jac[4], jac[5]};
+  double jac[3][kAccelEffectParameters > 6 ? kAccelEffectParameters : 6];
+  double* jacobians[3] = {jac[0], jac[1], jac[2]};
   ASSERT_TRUE(cost->Evaluate(params, &r, jacobians));
-  for (int b = 0; b < 6; ++b) {
+  for (int b = 0; b < 3; ++b) {
     for (int i = 0; i < sizes[b]; ++i) {
       const double x = params[b][i];
       // Steps that move |a| by 1e-7 m/s^2 or more: large enough for the
       // rounding of |a| (about 1e-15 m/s^2), small enough for the curvature.
-      const double h = kStep[b];
+      const double h = steps[b][i];
       double rp, rm;
       params[b][i] = x + h;
       cost->Evaluate(params, &rp, nullptr);
@@ -166,10 +167,11 @@ testing_util::SigmaCheck ErrorOverSigma(const SimulatorOptions& sim,
           for (int c = 0; c < 3; ++c) truth.push_back(g_truth(r, c));
         }
       } else if (e.effect == Effect::kGyroTemperatureBias) {
-        const Eigen::Vector3d t = gyro_inverse * session.effects.gyro_temperature_bias;
+        const Eigen::Vector3d t =
+            gyro_inverse * session.effects.Vector(Effect::kGyroTemperatureBias);
         truth = {t(0), t(1), t(2)};
       } else if (e.effect == Effect::kGyroBiasDrift) {
-        const Eigen::Vector3d t = gyro_inverse * session.effects.gyro_bias_drift;
+        const Eigen::Vector3d t = gyro_inverse * session.effects.Vector(Effect::kGyroBiasDrift);
         truth = {t(0), t(1), t(2)};
       }
       for (size_t i = 0; i < e.values.size(); ++i) {
@@ -187,8 +189,8 @@ testing_util::SigmaCheck ErrorOverSigma(const SimulatorOptions& sim,
 // over 30 seeds).
 TEST(EffectFit, CalibrateEstimatesEffectsWithHonestSigmas) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.accel_temperature_bias_std = 0.005;
-  sim.gyro_g_sensitivity_std = 1.8e-4;
+  sim.effect_std[Effect::kAccelTemperatureBias] = 0.005;
+  sim.effect_std[Effect::kGyroGSensitivity] = 1.8e-4;
   const testing_util::SigmaCheck check =
       ErrorOverSigma(sim, {Effect::kAccelTemperatureBias, Effect::kGyroGSensitivity}, 30);
   EXPECT_EQ(check.Names().size(), 3u + 9u);
@@ -197,11 +199,11 @@ TEST(EffectFit, CalibrateEstimatesEffectsWithHonestSigmas) {
 
 TEST(EffectFit, CalibrateEstimatesThreeAccelAndTwoGyroEffectsWithHonestSigmas) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.accel_quadratic_std = 1.5e-4;
-  sim.accel_temperature_scale_std = 1e-4;
-  sim.accel_bias_drift_std = 8e-5;
-  sim.gyro_temperature_bias_std = 1.7e-4;
-  sim.gyro_bias_drift_std = 1e-5;
+  sim.effect_std[Effect::kAccelQuadratic] = 1.5e-4;
+  sim.effect_std[Effect::kAccelTemperatureScale] = 1e-4;
+  sim.effect_std[Effect::kAccelBiasDrift] = 8e-5;
+  sim.effect_std[Effect::kGyroTemperatureBias] = 1.7e-4;
+  sim.effect_std[Effect::kGyroBiasDrift] = 1e-5;
   const testing_util::SigmaCheck check = ErrorOverSigma(
       sim,
       {Effect::kAccelQuadratic, Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift,
@@ -320,7 +322,7 @@ TEST(EffectFit, GyroPartHonoursTheRobustLoss) {
 // standard deviations or covariance (they were computed and written).
 TEST(EffectFit, CovarianceFalseHoldsForTheFitWithEffects) {
   SimulatorOptions sim = testing_util::WarmUpSession();
-  sim.accel_temperature_bias_std = 0.005;
+  sim.effect_std[Effect::kAccelTemperatureBias] = 0.005;
   SimulatedSession session;
   std::string error;
   ASSERT_TRUE(Simulate(sim, 2, &session, &error)) << error;

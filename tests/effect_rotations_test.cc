@@ -107,16 +107,20 @@ TEST(AccelRotationResidual, JacobianMatchesNumericDifferences) {
   std::unique_ptr<ceres::CostFunction> cost(AccelRotationResidual::Create(d));
   double bias[3] = {0.02, -0.03, 0.05};
   double upper[6] = {1.01, 0.002, -0.003, 0.99, 0.001, 1.02};
-  double k2[3] = {1e-4, -2e-4, 5e-5};
-  double beta[3] = {0.002, -0.001, 0.003};
-  double c[3] = {1e-4, -2e-4, 3e-4};
-  double delta[3] = {8e-5, -5e-5, 2e-5};
+  // The effects' block (core/effect_registry.h), every term switched on.
+  EffectParameters p;
+  p.Vector(Effect::kAccelQuadratic) << 1e-4, -2e-4, 5e-5;
+  p.Vector(Effect::kAccelTemperatureBias) << 0.002, -0.001, 0.003;
+  p.Vector(Effect::kAccelTemperatureScale) << 1e-4, -2e-4, 3e-4;
+  p.Vector(Effect::kAccelBiasDrift) << 8e-5, -5e-5, 2e-5;
+  p.Vector(Effect::kAccelTemperatureBiasQuadratic) << 2e-4, -1e-4, 3e-4;
+  std::vector<double> effects(p.accel.begin(), p.accel.end());
   double gyro_bias[3] = {0.01, -0.02, 0.005};
   double gyro_matrix[9] = {1.0, 0.01, -0.02, 0.005, 0.98, 0.01, -0.01, 0.02, 1.03};
   std::vector<std::vector<double>> jacobians;
   testing_util::ExpectJacobianMatchesCentralDifferences(
-      *cost, {bias, upper, k2, beta, c, delta, gyro_bias, gyro_matrix}, {3, 6, 3, 3, 3, 3, 3, 9},
-      {1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8, 1e-6, 1e-6}, 1e-4, &jacobians);
+      *cost, {bias, upper, effects.data(), gyro_bias, gyro_matrix},
+      {3, 6, kAccelEffectParameters, 3, 9}, {1e-6, 1e-6, 1e-8, 1e-6, 1e-6}, 1e-4, &jacobians);
 }
 
 // The rows are counted and named; the gyroscope estimated with them is the
@@ -323,9 +327,9 @@ TEST(EffectRotations, HiddenGyroscopeEffectsAreNotTakenForAccelerometerOnes) {
   for (int which = 0; which < 3; ++which) {
     SimulatorOptions sim = TwelvePoseWarmUp();
     // 0.01 deg/s/K, 0.03 deg/s/min, 0.05 deg/s/g (discovery_test.cc).
-    if (which == 0) sim.gyro_temperature_bias_std = 1.7e-4;
-    if (which == 1) sim.gyro_bias_drift_std = 1e-5;
-    if (which == 2) sim.gyro_g_sensitivity_std = 9e-5;
+    if (which == 0) sim.effect_std[Effect::kGyroTemperatureBias] = 1.7e-4;
+    if (which == 1) sim.effect_std[Effect::kGyroBiasDrift] = 1e-5;
+    if (which == 2) sim.effect_std[Effect::kGyroGSensitivity] = 9e-5;
     int significant = 0, warned = 0;
     for (int seed = 1; seed <= 10; ++seed) {
       SimulatedSession session;

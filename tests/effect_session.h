@@ -26,8 +26,8 @@ constexpr double kTemperatureScale = 1e-4;
 constexpr double kBiasDrift = 8e-5;
 
 // The family-wise level of discovery (discovery_significance 0.01) divided
-// over the eight candidates of the catalogue.
-constexpr double kCandidateLevel = 0.01 / 8.0;
+// over the candidates of the catalogue.
+constexpr double kCandidateLevel = 0.01 / kNumEffects;
 
 // The seed's twelve poses held 30 s during a warm-up 20 -> 35 degC (time
 // constant 200 s, so the poses see different temperature rates), with the
@@ -46,24 +46,9 @@ inline SimulatorOptions TwelvePoseWarmUp() {
 }
 
 // The simulated hidden effect `e` drawn per axis with standard deviation
-// `std` (accelerometer block effects; others unchanged).
+// `std` (others unchanged).
 inline SimulatorOptions WithHidden(SimulatorOptions o, Effect e, double std) {
-  switch (e) {
-    case Effect::kAccelQuadratic:
-      o.accel_quadratic_std = std;
-      break;
-    case Effect::kAccelTemperatureBias:
-      o.accel_temperature_bias_std = std;
-      break;
-    case Effect::kAccelTemperatureScale:
-      o.accel_temperature_scale_std = std;
-      break;
-    case Effect::kAccelBiasDrift:
-      o.accel_bias_drift_std = std;
-      break;
-    default:
-      break;
-  }
+  o.effect_std[e] = std;
   return o;
 }
 

@@ -92,16 +92,23 @@ TEST(AccelTrendResidual, JacobianMatchesNumericDifferences) {
       AccelTrendResidual::Create(raw, slope, whitening, 0.03, 4.0, -50.0));
   double bias[3] = {20.0, -30.0, 45.0};
   double upper[6] = {6.0e-4, 2e-6, -3e-6, 6.1e-4, 1e-6, 5.9e-4};
-  double k2[3] = {1e-4, -2e-4, 5e-5};
-  double beta[3] = {0.002, -0.001, 0.003};
-  double c[3] = {1e-4, -2e-4, 3e-4};
-  double delta[3] = {8e-5, -5e-5, 2e-5};
+  // The effects' block (core/effect_registry.h), every term switched on.
+  EffectParameters p;
+  p.Vector(Effect::kAccelQuadratic) << 1e-4, -2e-4, 5e-5;
+  p.Vector(Effect::kAccelTemperatureBias) << 0.002, -0.001, 0.003;
+  p.Vector(Effect::kAccelTemperatureScale) << 1e-4, -2e-4, 3e-4;
+  p.Vector(Effect::kAccelBiasDrift) << 8e-5, -5e-5, 2e-5;
+  p.Vector(Effect::kAccelTemperatureBiasQuadratic) << 2e-4, -1e-4, 3e-4;
+  std::vector<double> effects(p.accel.begin(), p.accel.end());
   std::vector<std::vector<double>> jac;
-  testing_util::ExpectJacobianMatchesCentralDifferences(
-      *cost, {bias, upper, k2, beta, c, delta}, {3, 6, 3, 3, 3, 3},
-      {1e-2, 1e-9, 1e-6, 1e-6, 1e-7, 1e-8}, 1e-5, &jac);
+  testing_util::ExpectJacobianMatchesCentralDifferences(*cost, {bias, upper, effects.data()},
+                                                        {3, 6, kAccelEffectParameters},
+                                                        {1e-2, 1e-9, 1e-8}, 1e-5, &jac);
   // The quadratic term predicts no trend.
-  for (double d : jac[2]) EXPECT_EQ(d, 0.0);
+  const int k2 = effects::kLayout.offset[static_cast<int>(Effect::kAccelQuadratic)];
+  for (size_t row = 0; row < jac[2].size() / kAccelEffectParameters; ++row) {
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(jac[2][row * kAccelEffectParameters + k2 + i], 0.0);
+  }
   // The one row along gravity (discover's trends): same parameters, one
   // residual.
   AccelTrendResidual::Whitening along(1, 3);
@@ -109,9 +116,9 @@ TEST(AccelTrendResidual, JacobianMatchesNumericDifferences) {
   std::unique_ptr<ceres::CostFunction> one(
       AccelTrendResidual::Create(raw, slope, along * 30.0, 0.03, 4.0, -50.0));
   EXPECT_EQ(one->num_residuals(), 1);
-  testing_util::ExpectJacobianMatchesCentralDifferences(
-      *one, {bias, upper, k2, beta, c, delta}, {3, 6, 3, 3, 3, 3},
-      {1e-2, 1e-9, 1e-6, 1e-6, 1e-7, 1e-8}, 1e-5, &jac);
+  testing_util::ExpectJacobianMatchesCentralDifferences(*one, {bias, upper, effects.data()},
+                                                        {3, 6, kAccelEffectParameters},
+                                                        {1e-2, 1e-9, 1e-8}, 1e-5, &jac);
 }
 
 // A still log with a known linear trend and white noise: the slope is

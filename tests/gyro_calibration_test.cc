@@ -156,7 +156,7 @@ TEST(GyroCalibration, FullModelSigmaMatchesSpreadAndResidualsAtNoiseLevel) {
 
 TEST(GyroCalibration, GSensitivitySigmaMatchesSpread) {
   SimulatorOptions sim = HandSession();
-  sim.gyro_g_sensitivity_std = 2e-4;  // about 0.1 deg/s per g
+  sim.effect_std[Effect::kGyroGSensitivity] = 2e-4;  // about 0.1 deg/s per g
   // 60 seeds, each parameter checked in the band of tests/sigma_check.h;
   // the 400-seed run of the property harness (tests/property) checks the
   // same model with G.
@@ -177,7 +177,7 @@ TEST(GyroCalibration, GSensitivitySigmaMatchesSpread) {
 
 TEST(GyroCalibration, UnmodelledGSensitivityIsFlagged) {
   SimulatorOptions sim = HandSession();
-  sim.gyro_g_sensitivity_std = 2e-3;
+  sim.effect_std[Effect::kGyroGSensitivity] = 2e-3;
   GyroCalibrationOptions options;
   options.parameterization = GyroParameterization::kFull;
   const GyroRun run = CalibrateSimulated(sim, 1, options);

@@ -36,9 +36,8 @@ bool AccelOf(const ImuParameters& p, const ThermalBlocks<double>& thermal, doubl
   double s[3];
   model.SensorFrame(shifted, s);
   thermal.RemoveScale(x, s);
-  const AccelBlocks<double>& b = model.accel();
-  if (!CorrectAccelEffects(b.quadratic, b.temperature_bias, b.temperature_scale, b.drift,
-                           p.TemperatureOffset(temperature), p.TimeOffset(time), s)) {
+  if (!RemoveAccelEffects<double>(model.accel().effect, p.TemperatureOffset(temperature),
+                                  p.TimeOffset(time), s)) {
     return false;
   }
   double out[3];

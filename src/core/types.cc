@@ -2,6 +2,8 @@
 
 #include <cstddef>
 
+#include "gravcal/core/effect_registry.h"
+
 namespace gravcal {
 namespace {
 
@@ -95,16 +97,10 @@ const EnumName<BatchStatus> kBatchStatuses[] = {
     {BatchStatus::kNotConverged, "not_converged"},
 };
 
-const EnumName<Effect> kEffects[] = {
-    {Effect::kAccelMisalignment, "accel_misalignment"},
-    {Effect::kAccelQuadratic, "accel_quadratic_nonlinearity"},
-    {Effect::kAccelTemperatureBias, "accel_temperature_bias"},
-    {Effect::kAccelTemperatureScale, "accel_temperature_scale"},
-    {Effect::kAccelBiasDrift, "accel_bias_drift"},
-    {Effect::kGyroGSensitivity, "gyro_g_sensitivity"},
-    {Effect::kGyroTemperatureBias, "gyro_temperature_bias"},
-    {Effect::kGyroBiasDrift, "gyro_bias_drift"},
-};
+// The names come from the effects' definitions (core/effect_registry.h).
+#define GRAVCAL_EFFECT_NAME(Name) {Effect::k##Name, effects::Name::kName},
+const EnumName<Effect> kEffects[] = {GRAVCAL_EFFECTS(GRAVCAL_EFFECT_NAME)};
+#undef GRAVCAL_EFFECT_NAME
 
 const EnumName<EffectSensor> kEffectSensors[] = {
     {EffectSensor::kAccelerometer, "accelerometer"},

@@ -34,7 +34,10 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
   const std::string sqrt = f ? "sqrtf" : "sqrt";
   const EffectParameters& e = c.effects;
   const bool quadratic = Contains(c.active_effects, Effect::kAccelQuadratic);
-  auto on = [&](Effect effect, const Eigen::MatrixXd& value) -> Eigen::MatrixXd {
+  auto on = [&](Effect effect) -> Eigen::MatrixXd {
+    const Eigen::MatrixXd value = Info(effect).num_parameters == 9
+                                      ? Eigen::MatrixXd(e.Matrix(effect))
+                                      : Eigen::MatrixXd(e.Vector(effect));
     return Contains(c.active_effects, effect) ? value
                                               : Eigen::MatrixXd::Zero(value.rows(), value.cols());
   };
@@ -46,15 +49,15 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
   array("ACCEL_UPPER", c.accel.upper);
   array("ACCEL_ROTATION", c.accel.rotation);
   // Only a term the functions below use (-Wunused-const-variable).
-  if (quadratic) array("ACCEL_QUADRATIC", e.accel_quadratic);
-  array("ACCEL_TEMP_BIAS", on(Effect::kAccelTemperatureBias, e.accel_temperature_bias));
-  array("ACCEL_TEMP_SCALE", on(Effect::kAccelTemperatureScale, e.accel_temperature_scale));
-  array("ACCEL_DRIFT", on(Effect::kAccelBiasDrift, e.accel_bias_drift));
+  if (quadratic) array("ACCEL_QUADRATIC", e.Vector(Effect::kAccelQuadratic));
+  array("ACCEL_TEMP_BIAS", on(Effect::kAccelTemperatureBias));
+  array("ACCEL_TEMP_SCALE", on(Effect::kAccelTemperatureScale));
+  array("ACCEL_DRIFT", on(Effect::kAccelBiasDrift));
   array("GYRO_BIAS", c.has_gyro ? c.gyro.bias : Eigen::Vector3d::Zero());
   array("GYRO_MATRIX", c.has_gyro ? c.gyro.matrix : Eigen::Matrix3d::Identity());
-  array("GYRO_G_SENSITIVITY", on(Effect::kGyroGSensitivity, e.gyro_g_sensitivity));
-  array("GYRO_TEMP_BIAS", on(Effect::kGyroTemperatureBias, e.gyro_temperature_bias));
-  array("GYRO_DRIFT", on(Effect::kGyroBiasDrift, e.gyro_bias_drift));
+  array("GYRO_G_SENSITIVITY", on(Effect::kGyroGSensitivity));
+  array("GYRO_TEMP_BIAS", on(Effect::kGyroTemperatureBias));
+  array("GYRO_DRIFT", on(Effect::kGyroBiasDrift));
   // A reference the model has no term for is unused, and may be NaN (no
   // temperature column), which is no C literal: 0 then.
   s << "static const " << real << " " << p << "REFERENCE_TEMPERATURE = "
@@ -125,6 +128,12 @@ void WriteFunctions(const ImuCorrector& c, bool f, std::ostringstream* out) {
 }
 
 }  // namespace
+
+std::vector<Effect> CCorrectorEffects() {
+  return {Effect::kAccelQuadratic, Effect::kAccelTemperatureBias, Effect::kAccelTemperatureScale,
+          Effect::kAccelBiasDrift, Effect::kGyroGSensitivity,     Effect::kGyroTemperatureBias,
+          Effect::kGyroBiasDrift};
+}
 
 std::vector<ExportedFile> CCorrectorFiles(const ImuCorrector& corrector,
                                           const std::vector<std::string>& comment) {

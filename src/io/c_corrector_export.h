@@ -37,6 +37,10 @@ std::string CThermalBias(const ImuCorrector& c, const CPrecision& p, ThermalSens
 std::string CThermalRemoveScale(const ImuCorrector& c, const CPrecision& p, ThermalSensor sensor,
                                 const std::string& y);
 
+// The effects the generated functions hold (the C target drops others and
+// its export notes name them).
+std::vector<Effect> CCorrectorEffects();
+
 // gravcal_correct.h and gravcal_correct.c; `comment` lines head both.
 std::vector<ExportedFile> CCorrectorFiles(const ImuCorrector& corrector,
                                           const std::vector<std::string>& comment);

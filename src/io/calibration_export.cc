@@ -166,8 +166,8 @@ bool KalibrYaml(const LoadedCalibration& c, const ExportOptions& o, const Export
     return false;
   }
   if (Contains(k.active_effects, Effect::kGyroGSensitivity)) {
-    a_g = k.effects.gyro_g_sensitivity * k.accel.rotation.transpose() * c_i_b.transpose() *
-          c_gyro_i.transpose();
+    a_g = k.effects.Matrix(Effect::kGyroGSensitivity) * k.accel.rotation.transpose() *
+          c_i_b.transpose() * c_gyro_i.transpose();
   }
   std::string noise;
   if (!NoiseBlock(*o.noise, &noise, error)) return false;
@@ -207,7 +207,7 @@ bool OpenVinsYaml(const LoadedCalibration& c, const ExportOptions& o, const Expo
   }
   Eigen::Matrix3d tg = Eigen::Matrix3d::Zero();
   if (Contains(k.active_effects, Effect::kGyroGSensitivity)) {
-    tg = k.effects.gyro_g_sensitivity * k.accel.rotation.transpose();
+    tg = k.effects.Matrix(Effect::kGyroGSensitivity) * k.accel.rotation.transpose();
   }
   std::string noise;
   if (!NoiseBlock(*o.noise, &noise, error)) return false;
@@ -427,8 +427,9 @@ ImuCorrector TruncatedCorrector(const ImuCorrector& full, ExportTarget target) {
     case ExportTarget::kRos:
       return full;
     case ExportTarget::kC: {
-      // The C functions take no temperature rate: no thermal lag.
-      ImuCorrector t = full;
+      // The C functions take no temperature rate: no thermal lag; the
+      // effects they hold.
+      ImuCorrector t = full.WithEffects(internal::CCorrectorEffects());
       t.thermal.lag_time_constant = 0.0;
       return t;
     }

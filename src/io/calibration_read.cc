@@ -1,6 +1,7 @@
 // Reading a calibration JSON: every key checked and named, and the checks of
 // the models it holds. Writing is in calibration_write.cc.
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <utility>
@@ -246,7 +247,7 @@ bool ReadEffect(const json& entry, Effect effect, const std::string& key, JsonRe
   }
   const json& values = entry["value"];
   const int n = Info(effect).num_parameters;
-  if (effect == Effect::kAccelMisalignment) {  // lives in accel.upper
+  if (Info(effect).form == EffectForm::kInUpper) {  // lives in accel.upper
     return CheckMisalignment(values, key, r, out->corrector.accel);
   }
   if (static_cast<int>(values.size()) != n) {
@@ -260,7 +261,7 @@ bool ReadEffect(const json& entry, Effect effect, const std::string& key, JsonRe
       v[i] = 0.0;
     }
   }
-  SetEffectValues(effect, v, &out->corrector.effects);
+  out->corrector.effects.SetValues(effect, v);
   if (Info(effect).sensor == EffectSensor::kGyroscope && !out->corrector.has_gyro) {
     return r->Fail(key, "is a gyroscope effect but the file has no 'gyro' section");
   }
@@ -440,18 +441,15 @@ bool CheckCalibrationModels(const LoadedCalibration& c, const std::string& name,
     if (!CheckSensorMatrix(c.corrector.gyro.matrix, &why)) return fail("gyro.matrix", why);
   }
   const EffectParameters& e = c.corrector.effects;
-  const std::pair<const char*, bool> effects[] = {
-      {"effects.accel_quadratic_nonlinearity", e.accel_quadratic.allFinite()},
-      {"effects.accel_temperature_bias", e.accel_temperature_bias.allFinite()},
-      {"effects.accel_temperature_scale", e.accel_temperature_scale.allFinite()},
-      {"effects.accel_bias_drift", e.accel_bias_drift.allFinite()},
-      {"effects.gyro_temperature_bias", e.gyro_temperature_bias.allFinite()},
-      {"effects.gyro_bias_drift", e.gyro_bias_drift.allFinite()},
-      {"effects.gyro_g_sensitivity", e.gyro_g_sensitivity.allFinite()},
-      {"effects.reference_time", std::isfinite(e.reference_time)},
-      {"effects.reference_temperature", std::isfinite(e.reference_temperature)}};
-  for (const auto& [key, finite] : effects) {
-    if (!finite) return fail(key, "is not finite");
+  for (const EffectInfo& info : EffectCatalogue()) {
+    const std::vector<double> v = e.Values(info.effect);
+    if (!std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); })) {
+      return fail(std::string("effects.") + info.name, "is not finite");
+    }
+  }
+  if (!std::isfinite(e.reference_time)) return fail("effects.reference_time", "is not finite");
+  if (!std::isfinite(e.reference_temperature)) {
+    return fail("effects.reference_temperature", "is not finite");
   }
   if (!(c.gravity > 0.0) || !std::isfinite(c.gravity)) {
     return fail("gravity.value", "must be positive and finite");

@@ -72,8 +72,8 @@ bool CorrectedForce(const AccelBlocks& accel, const Eigen::Vector3d& v, double t
                     double time_offset, Eigen::Vector3d* a) {
   const double* b = accel.blocks[0];
   Eigen::Vector3d m = UpperMatrix(accel.blocks[1]) * (v - Eigen::Vector3d(b[0], b[1], b[2]));
-  if (!CorrectAccelEffects<double>(accel.blocks[2], accel.blocks[3], accel.blocks[4],
-                                   accel.blocks[5], temperature_offset, time_offset, m.data())) {
+  const gravcal::AccelBlocks<double> effects(nullptr, nullptr, accel.blocks[2]);
+  if (!RemoveAccelEffects<double>(effects.effect, temperature_offset, time_offset, m.data())) {
     return false;
   }
   *a = m;
@@ -202,15 +202,15 @@ bool WeighRows(const std::vector<StaticObservation>& observations, const Normali
 
 // Fits b_g' and M_g' to the rows with the accelerometer held.
 void FitGyroAlone(const AccelBlocks& accel, const SolverTolerances& solver, RotationRows* rows) {
-  double held[6][9];
-  const int sizes[6] = {3, 6, 3, 3, 3, 3};
-  for (int b = 0; b < 6; ++b) std::copy(accel.blocks[b], accel.blocks[b] + sizes[b], held[b]);
+  double held[3][kAccelEffectParameters > 6 ? kAccelEffectParameters : 6];
+  const int sizes[3] = {3, 6, kAccelEffectParameters};
+  for (int b = 0; b < 3; ++b) std::copy(accel.blocks[b], accel.blocks[b] + sizes[b], held[b]);
   ceres::Problem problem;
   for (const AccelRotationData& d : rows->data) {
     problem.AddResidualBlock(AccelRotationResidual::Create(d), nullptr, held[0], held[1], held[2],
-                             held[3], held[4], held[5], rows->gyro_bias, rows->gyro_matrix);
+                             rows->gyro_bias, rows->gyro_matrix);
   }
-  for (int b = 0; b < 6; ++b) problem.SetParameterBlockConstant(held[b]);
+  for (int b = 0; b < 3; ++b) problem.SetParameterBlockConstant(held[b]);
   ceres::Solver::Summary summary;
   ceres::Solve(SolverOptions(solver, ceres::DENSE_QR), &problem, &summary);
 }

@@ -63,9 +63,10 @@ constexpr int kMinRotations = 7;
 std::vector<std::pair<int, int>> TurnPairs(const std::vector<StaticObservation>& observations);
 
 // The accelerometer's parameter blocks in the fit's normalised units
-// (normalization.h): b', U', k2, beta, c, delta.
+// (normalization.h): b', U' and the effects' block (kAccelEffectParameters,
+// in SI units).
 struct AccelBlocks {
-  const double* blocks[6];
+  const double* blocks[3];
 };
 
 struct RotationRows {

@@ -122,7 +122,7 @@ void FillEstimates(EffectFitResult* result) {
     est.unit = info.unit;
     const SensorFitSummary& fit =
         info.sensor == EffectSensor::kAccelerometer ? result->accel_fit : result->gyro_fit;
-    if (e == Effect::kAccelMisalignment) {
+    if (Info(e).form == EffectForm::kInUpper) {
       const Eigen::Matrix3d& u = result->accel.upper;
       est.values = {u(0, 1), u(0, 2), u(1, 2)};
     } else {

@@ -59,14 +59,22 @@ bool SetAccelSigmas(const std::vector<Position>& positions, const AccelModel& st
   return true;
 }
 
-// The accelerometer effects with a parameter block each, in block order.
-constexpr Effect kAccelBlockEffect[4] = {Effect::kAccelQuadratic, Effect::kAccelTemperatureBias,
-                                         Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift};
+// The accelerometer effects stored in the effects' block, in block order
+// (the registry's, core/effect_registry.h).
+std::vector<Effect> AccelBlockEffects() {
+  std::vector<Effect> out;
+  for (const EffectInfo& info : EffectCatalogue()) {
+    if (info.form == EffectForm::kAccelOffset || info.form == EffectForm::kAccelShape) {
+      out.push_back(info.effect);
+    }
+  }
+  return out;
+}
 
 // fit->parameter_names (the columns of the dense Jacobian); returns the
 // indices of the free entries of U.
-std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const bool on[4], bool rotations,
-                                        SensorFitSummary* fit) {
+std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const std::vector<int>& effect_free,
+                                        bool rotations, SensorFitSummary* fit) {
   static const char* kUpperNames[6] = {"u_xx", "u_xy", "u_xz", "u_yy", "u_yz", "u_zz"};
   fit->parameter_names = {"bias_x", "bias_y", "bias_z"};
   std::vector<int> upper_free;
@@ -76,11 +84,10 @@ std::vector<int> SetAccelParameterNames(bool free_off_diagonal, const bool on[4]
     upper_free.push_back(i);
     fit->parameter_names.push_back(kUpperNames[i]);
   }
-  for (int b = 0; b < 4; ++b) {
-    if (!on[b]) continue;
-    for (const std::string& n : Info(kAccelBlockEffect[b]).parameter_names) {
-      fit->parameter_names.push_back(n);
-    }
+  for (Effect e : AccelBlockEffects()) {
+    const int offset = effects::kLayout.offset[static_cast<int>(e)];
+    if (std::find(effect_free.begin(), effect_free.end(), offset) == effect_free.end()) continue;
+    for (const std::string& n : Info(e).parameter_names) fit->parameter_names.push_back(n);
   }
   if (rotations) {
     for (const char* n : {"rotation_gyro_bias_x", "rotation_gyro_bias_y", "rotation_gyro_bias_z",
@@ -114,12 +121,14 @@ struct AccelBlock {
 // trend residuals per position) and, with
 // `covariance`, the dense Jacobian of the free parameters at `params`, rows
 // in block order; false when the model has no value at a position.
-// params holds the six accelerometer blocks and, with rotations, b_g' and
-// M_g' (their columns last).
-bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const params[8],
-                      const std::vector<int>& upper_free, const bool on[4], bool rotations,
-                      bool covariance, Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals,
-                      SensorFitSummary* fit, std::vector<Eigen::Vector3d>* trend_residuals,
+// params holds the three accelerometer blocks (b', U', the effects) and,
+// with rotations, b_g' and M_g' (their columns last); upper_free and
+// effect_free are the free entries of U' and of the effects' block.
+bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const params[5],
+                      const std::vector<int>& upper_free, const std::vector<int>& effect_free,
+                      bool rotations, bool covariance, Eigen::MatrixXd* jacobian,
+                      Eigen::VectorXd* residuals, SensorFitSummary* fit,
+                      std::vector<Eigen::Vector3d>* trend_residuals,
                       std::vector<Eigen::Vector2d>* rotation_residuals) {
   fit->chi2 = 0.0;
   fit->trend_chi2 = 0.0;
@@ -128,8 +137,8 @@ bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const
   int row0 = 0;
   for (const AccelBlock& block : blocks) {
     double r[3];
-    double jb[9], ju[18], je[4][9], jgb[9], jgm[27];
-    double* jacobians[8] = {jb, ju, je[0], je[1], je[2], je[3], jgb, jgm};
+    double jb[9], ju[18], je[3 * kAccelEffectParameters], jgb[9], jgm[27];
+    double* jacobians[5] = {jb, ju, je, jgb, jgm};
     if (!block.cost->Evaluate(params, r, covariance ? jacobians : nullptr)) return false;
     for (int row = 0; row < block.rows; ++row) {
       (*residuals)(row0 + row) = r[row];
@@ -140,9 +149,8 @@ bool EvaluateAccelFit(const std::vector<AccelBlock>& blocks, const double* const
       int col = 0;
       for (int i = 0; i < 3; ++i) (*jacobian)(row0 + row, col++) = jb[3 * row + i];
       for (int i : upper_free) (*jacobian)(row0 + row, col++) = ju[6 * row + i];
-      for (int b = 0; b < 4; ++b) {
-        if (!on[b]) continue;
-        for (int i = 0; i < 3; ++i) (*jacobian)(row0 + row, col++) = je[b][3 * row + i];
+      for (int i : effect_free) {
+        (*jacobian)(row0 + row, col++) = je[kAccelEffectParameters * row + i];
       }
       if (!rotations) continue;
       for (int i = 0; i < 3; ++i) {
@@ -235,7 +243,7 @@ std::vector<AccelBlock> AccelResidualBlocks(const std::vector<StaticObservation>
 
 // The largest whitened norm |r| of the blocks at `params` (the widest scale
 // of a graduated robust solve).
-double LargestBlockNorm(const std::vector<AccelBlock>& blocks, const double* const params[8]) {
+double LargestBlockNorm(const std::vector<AccelBlock>& blocks, const double* const params[5]) {
   double largest = 0.0;
   for (const AccelBlock& b : blocks) {
     double r[3];
@@ -254,7 +262,9 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
               EffectFitResult* result) {
   const std::vector<Effect>& effects = options.effects;
   const bool free_off_diagonal = options.parameterization != AccelParameterization::kScale ||
-                                 Contains(effects, Effect::kAccelMisalignment);
+                                 std::any_of(effects.begin(), effects.end(), [](Effect e) {
+                                   return Info(e).form == EffectForm::kInUpper;
+                                 });
   std::vector<Position> positions;
   for (const StaticObservation& o : observations) positions.push_back(o.accel);
   AccelModel start = initial;
@@ -274,25 +284,29 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   double bias[3] = {start_n.bias(0), start_n.bias(1), start_n.bias(2)};
   double upper[6];
   start_n.GetUpper(upper);
-  double blocks[4][3];
-  const Eigen::Vector3d* kInitial[4] = {
-      &initial_parameters.accel_quadratic, &initial_parameters.accel_temperature_bias,
-      &initial_parameters.accel_temperature_scale, &initial_parameters.accel_bias_drift};
-  bool on[4];
-  for (int b = 0; b < 4; ++b) {
-    on[b] = Contains(effects, kAccelBlockEffect[b]);
-    for (int i = 0; i < 3; ++i) blocks[b][i] = on[b] ? (*kInitial[b])(i) : 0.0;
+  // The effects' block: the effects switched on from their initial values,
+  // the others held at zero (effect_free: the entries that are fitted).
+  double effect_block[kAccelEffectParameters] = {};
+  std::vector<int> effect_free, effect_held;
+  for (Effect e : AccelBlockEffects()) {
+    const int offset = effects::kLayout.offset[static_cast<int>(e)];
+    const bool on = Contains(effects, e);
+    const double* initial_values = initial_parameters.Block(e);
+    for (int i = 0; i < Info(e).num_parameters; ++i) {
+      effect_block[offset + i] = on ? initial_values[i] : 0.0;
+      (on ? effect_free : effect_held).push_back(offset + i);
+    }
   }
 
   std::vector<AccelBlock> residuals =
       AccelResidualBlocks(observations, normalized, norm.scale, initial_parameters, gravity,
                           result->accel_sigmas, options.use_within_pose_trends);
-  std::vector<double*> parameter_blocks = {bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]};
+  std::vector<double*> parameter_blocks = {bias, upper, effect_block};
   // The rotations between poses, with the gyroscope's blocks.
   internal::RotationRows rotation_rows;
   bool rotations = false;
   if (options.use_between_pose_rotations) {
-    const internal::AccelBlocks held = {{bias, upper, blocks[0], blocks[1], blocks[2], blocks[3]}};
+    const internal::AccelBlocks held = {{bias, upper, effect_block}};
     std::string why;
     rotations = internal::PrepareRotationRows(observations, norm, initial_parameters, held,
                                               extra_variance, options.rotation_gyro_bias_variance,
@@ -312,13 +326,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
       residuals.push_back(std::move(b));
     }
   }
-  const double* params[8] = {bias,
-                             upper,
-                             blocks[0],
-                             blocks[1],
-                             blocks[2],
-                             blocks[3],
-                             rotation_rows.gyro_bias,
+  const double* params[5] = {bias, upper, effect_block, rotation_rows.gyro_bias,
                              rotation_rows.gyro_matrix};
   const std::vector<double> scales = internal::GraduatedLossScales(
       options.loss, options.loss_scale,
@@ -343,8 +351,11 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   if (!free_off_diagonal) {
     problem.SetManifold(upper, new ceres::SubsetManifold(6, {1, 2, 4}));
   }
-  for (int b = 0; b < 4; ++b) {
-    if (!on[b]) problem.SetParameterBlockConstant(blocks[b]);
+  if (effect_free.empty()) {
+    problem.SetParameterBlockConstant(effect_block);
+  } else if (!effect_held.empty()) {
+    problem.SetManifold(effect_block,
+                        new ceres::SubsetManifold(kAccelEffectParameters, effect_held));
   }
   // Once per loss scale, widest first (one solve without a loss).
   ceres::Solver::Summary summary;
@@ -368,14 +379,14 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   }
 
   const std::vector<int> upper_free =
-      SetAccelParameterNames(free_off_diagonal, on, rotations, &fit);
+      SetAccelParameterNames(free_off_diagonal, effect_free, rotations, &fit);
   const int np = static_cast<int>(fit.parameter_names.size());
   Eigen::MatrixXd jacobian(num_rows, np);
   Eigen::VectorXd residual_rows(num_rows);
   result->accel_trend_residuals.assign(observations.size(), Eigen::Vector3d::Zero());
-  if (!EvaluateAccelFit(residuals, params, upper_free, on, rotations, options.compute_covariance,
-                        &jacobian, &residual_rows, &fit, &result->accel_trend_residuals,
-                        &result->rotation_residuals)) {
+  if (!EvaluateAccelFit(residuals, params, upper_free, effect_free, rotations,
+                        options.compute_covariance, &jacobian, &residual_rows, &fit,
+                        &result->accel_trend_residuals, &result->rotation_residuals)) {
     result->message = "accelerometer effect fit: the model has no value at a position";
     return false;
   }
@@ -414,10 +425,7 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   if (options.parameterization == AccelParameterization::kScale && free_off_diagonal) {
     result->accel.parameterization = AccelParameterization::kScaleMisalignment;
   }
-  result->parameters.accel_quadratic = Eigen::Vector3d(blocks[0]);
-  result->parameters.accel_temperature_bias = Eigen::Vector3d(blocks[1]);
-  result->parameters.accel_temperature_scale = Eigen::Vector3d(blocks[2]);
-  result->parameters.accel_bias_drift = Eigen::Vector3d(blocks[3]);
+  std::copy(effect_block, effect_block + kAccelEffectParameters, result->parameters.accel.begin());
 
   FinishAccel(observations, gravity, norm.scale, jacobian, upper_free, options.compute_covariance,
               rotations ? &rotation_rows : nullptr, result);

@@ -35,16 +35,17 @@ bool GyroWhitening(const std::vector<StaticObservation>& observations,
 }
 
 // fit->chi2, the whitened residuals (3 rows per position) and, with
-// `covariance`, the dense Jacobian of b_g and the blocks that are on (G,
-// gamma, eta).
+// `covariance`, the dense Jacobian of b_g and the free entries of the
+// effects' block (`effect_free`, in block order).
 void EvaluateGyroFit(const std::vector<std::unique_ptr<ceres::CostFunction>>& owned,
-                     const double* const params[4], const bool on[3], bool covariance,
-                     Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals, SensorFitSummary* fit) {
+                     const double* const params[2], const std::vector<int>& effect_free,
+                     bool covariance, Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals,
+                     SensorFitSummary* fit) {
   fit->chi2 = 0.0;
   for (int k = 0; k < static_cast<int>(owned.size()); ++k) {
     double r[3];
-    double jb[9], jg[27], jt[9], jd[9];
-    double* jacobians[4] = {jb, jg, jt, jd};
+    double jb[9], je[3 * kGyroEffectParameters];
+    double* jacobians[2] = {jb, je};
     owned[k]->Evaluate(params, r, covariance ? jacobians : nullptr);
     for (int row = 0; row < 3; ++row) {
       fit->chi2 += r[row] * r[row];
@@ -52,14 +53,8 @@ void EvaluateGyroFit(const std::vector<std::unique_ptr<ceres::CostFunction>>& ow
       if (!covariance) continue;
       int col = 0;
       for (int i = 0; i < 3; ++i) (*jacobian)(3 * k + row, col++) = jb[3 * row + i];
-      if (on[0]) {
-        for (int i = 0; i < 9; ++i) (*jacobian)(3 * k + row, col++) = jg[9 * row + i];
-      }
-      if (on[1]) {
-        for (int i = 0; i < 3; ++i) (*jacobian)(3 * k + row, col++) = jt[3 * row + i];
-      }
-      if (on[2]) {
-        for (int i = 0; i < 3; ++i) (*jacobian)(3 * k + row, col++) = jd[3 * row + i];
+      for (int i : effect_free) {
+        (*jacobian)(3 * k + row, col++) = je[kGyroEffectParameters * row + i];
       }
     }
   }
@@ -75,21 +70,22 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   std::vector<Eigen::Matrix3d> whitening;
   if (!GyroWhitening(observations, &whitening, result)) return false;
   double bias[3] = {initial_gyro.bias(0), initial_gyro.bias(1), initial_gyro.bias(2)};
-  double g[9];
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) g[3 * r + c] = initial_parameters.gyro_g_sensitivity(r, c);
+  // The effects' block: the effects switched on from their initial values,
+  // the others held at zero (effect_free: the entries that are fitted).
+  double effect_block[kGyroEffectParameters] = {};
+  std::vector<int> effect_free, effect_held;
+  std::vector<Effect> fitted;
+  for (const EffectInfo& info : EffectCatalogue()) {
+    if (info.form != EffectForm::kGyroOffset) continue;
+    const int offset = effects::kLayout.offset[static_cast<int>(info.effect)];
+    const bool on = Contains(effects, info.effect);
+    if (on) fitted.push_back(info.effect);
+    const double* initial_values = initial_parameters.Block(info.effect);
+    for (int i = 0; i < info.num_parameters; ++i) {
+      effect_block[offset + i] = on ? initial_values[i] : 0.0;
+      (on ? effect_free : effect_held).push_back(offset + i);
+    }
   }
-  double temperature_bias[3], drift[3];
-  for (int i = 0; i < 3; ++i) {
-    temperature_bias[i] = initial_parameters.gyro_temperature_bias(i);
-    drift[i] = initial_parameters.gyro_bias_drift(i);
-  }
-  const bool on_g = Contains(effects, Effect::kGyroGSensitivity);
-  const bool on_t = Contains(effects, Effect::kGyroTemperatureBias);
-  const bool on_d = Contains(effects, Effect::kGyroBiasDrift);
-  if (!on_g) std::fill(g, g + 9, 0.0);
-  if (!on_t) std::fill(temperature_bias, temperature_bias + 3, 0.0);
-  if (!on_d) std::fill(drift, drift + 3, 0.0);
 
   std::vector<std::unique_ptr<ceres::CostFunction>> owned;
   for (int k = 0; k < n; ++k) {
@@ -99,7 +95,7 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
         TemperatureOffset(initial_parameters, o.temperature()),
         o.time() - initial_parameters.reference_time));
   }
-  const double* params[4] = {bias, g, temperature_bias, drift};
+  const double* params[2] = {bias, effect_block};
   // The robust loss of the accelerometer part, graduated the same way: from
   // a scale that holds every initial residual down to loss_scale.
   double largest = 0.0;
@@ -113,11 +109,14 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   ceres::Problem problem(ProblemKeepingOwnership());
   std::unique_ptr<ceres::LossFunctionWrapper> loss = GraduatedLoss(options, scales.back());
   for (const auto& cost : owned) {
-    problem.AddResidualBlock(cost.get(), loss.get(), bias, g, temperature_bias, drift);
+    problem.AddResidualBlock(cost.get(), loss.get(), bias, effect_block);
   }
-  if (!on_g) problem.SetParameterBlockConstant(g);
-  if (!on_t) problem.SetParameterBlockConstant(temperature_bias);
-  if (!on_d) problem.SetParameterBlockConstant(drift);
+  if (effect_free.empty()) {
+    problem.SetParameterBlockConstant(effect_block);
+  } else if (!effect_held.empty()) {
+    problem.SetManifold(effect_block,
+                        new ceres::SubsetManifold(kGyroEffectParameters, effect_held));
+  }
   // Once per loss scale, widest first (one solve without a loss).
   ceres::Solver::Summary summary;
   SensorFitSummary& fit = result->gyro_fit;
@@ -137,30 +136,21 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
     return false;
   }
   fit.parameter_names = {"gyro_bias_x", "gyro_bias_y", "gyro_bias_z"};
-  const Effect kGyroEffects[3] = {Effect::kGyroGSensitivity, Effect::kGyroTemperatureBias,
-                                  Effect::kGyroBiasDrift};
-  const bool on[3] = {on_g, on_t, on_d};
-  for (int b = 0; b < 3; ++b) {
-    if (!on[b]) continue;
-    for (const std::string& name : Info(kGyroEffects[b]).parameter_names) {
-      fit.parameter_names.push_back(name);
-    }
+  for (Effect e : fitted) {
+    for (const std::string& name : Info(e).parameter_names) fit.parameter_names.push_back(name);
   }
   const int np = static_cast<int>(fit.parameter_names.size());
   Eigen::MatrixXd jacobian(3 * n, np);
   Eigen::VectorXd residual_rows(3 * n);
-  EvaluateGyroFit(owned, params, on, options.compute_covariance, &jacobian, &residual_rows, &fit);
+  EvaluateGyroFit(owned, params, effect_free, options.compute_covariance, &jacobian, &residual_rows,
+                  &fit);
   if (loss && options.compute_covariance) {
     WeightRowsByLoss(std::vector<int>(n, 3), options, &jacobian, &residual_rows);
   }
   fit.num_residuals = 3 * n;
   fit.num_parameters = np;
   result->gyro.bias = Eigen::Vector3d(bias[0], bias[1], bias[2]);
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) result->parameters.gyro_g_sensitivity(r, c) = g[3 * r + c];
-  }
-  result->parameters.gyro_temperature_bias = Eigen::Vector3d(temperature_bias);
-  result->parameters.gyro_bias_drift = Eigen::Vector3d(drift);
+  std::copy(effect_block, effect_block + kGyroEffectParameters, result->parameters.gyro.begin());
   if (options.compute_covariance) {
     CovarianceFromJacobian(jacobian, 3, 3 * n, &fit);
     for (int i = 0; i < 3; ++i) result->gyro_bias_std(i) = fit.Std(fit.parameter_names[i]);

@@ -54,10 +54,7 @@ bool SimulatePlateImpl(const PlateSimulatorOptions& options, uint64_t seed, Simu
   perfect.accel_bias_instability = perfect.gyro_bias_instability = 0.0;
   perfect.accel_bias_std = perfect.accel_scale_std = perfect.accel_misalignment_std = 0.0;
   perfect.gyro_bias_std = perfect.gyro_scale_std = perfect.gyro_misalignment_std = 0.0;
-  perfect.gyro_g_sensitivity_std = 0.0;
-  perfect.accel_quadratic_std = perfect.accel_temperature_bias_std = 0.0;
-  perfect.accel_temperature_scale_std = perfect.accel_bias_drift_std = 0.0;
-  perfect.gyro_temperature_bias_std = perfect.gyro_bias_drift_std = 0.0;
+  perfect.effect_std = EffectSpreads();
   SimulatedSession plate_session;
   if (!Simulate(perfect, seed, &plate_session, error)) return false;
   const ImuLog& hi = plate_session.log;

@@ -72,6 +72,17 @@ struct HandProfile {
   }
 };
 
+// True when an effect of `sensor` has a spread.
+bool AnySpread(const SimulatorOptions& o, EffectSensor sensor) {
+  for (const EffectInfo& info : EffectCatalogue()) {
+    if (info.sensor == sensor && info.simulation.key != nullptr &&
+        o.effect_std[info.effect] > 0.0) {
+      return true;
+    }
+  }
+  return false;
+}
+
 // The effect truths, from a stream of their own (see SimulatorOptions).
 void DrawEffects(const SimulatorOptions& o, uint64_t seed, SimulatedSession* s) {
   std::mt19937_64 rng(seed ^ 0x6a09e667f3bcc909ULL);
@@ -82,14 +93,17 @@ void DrawEffects(const SimulatorOptions& o, uint64_t seed, SimulatedSession* s) 
   EffectParameters& e = s->effects;
   e.reference_temperature = o.effect_reference_temperature;
   e.reference_time = 0.0;
-  e.accel_quadratic = draw3(o.accel_quadratic_std);
-  e.accel_temperature_bias = draw3(o.accel_temperature_bias_std);
-  e.accel_temperature_scale = draw3(o.accel_temperature_scale_std);
-  e.accel_bias_drift = draw3(o.accel_bias_drift_std);
-  for (int r = 0; r < 3; ++r) e.gyro_g_sensitivity.row(r) = draw3(o.gyro_g_sensitivity_std);
-  s->gyro_g_sensitivity = e.gyro_g_sensitivity;
-  e.gyro_temperature_bias = draw3(o.gyro_temperature_bias_std);
-  e.gyro_bias_drift = draw3(o.gyro_bias_drift_std);
+  // In registry order, three values per draw (a matrix row by row).
+  for (const EffectInfo& info : EffectCatalogue()) {
+    double* values = e.Block(info.effect);
+    if (values == nullptr) continue;
+    const double std = info.simulation.key != nullptr ? o.effect_std[info.effect] : 0.0;
+    for (int i = 0; i < info.num_parameters; i += 3) {
+      const Eigen::Vector3d d = draw3(std);
+      for (int j = 0; j < 3 && i + j < info.num_parameters; ++j) values[i + j] = d(j);
+    }
+  }
+  s->gyro_g_sensitivity = e.Matrix(Effect::kGyroGSensitivity);
 }
 
 // The session's main random stream. One normal distribution serves every
@@ -234,11 +248,8 @@ class SampleWriter {
       : o_(options),
         s_(*s),
         stream_(*stream),
-        accel_effects_(
-            options.accel_quadratic_std > 0.0 || options.accel_temperature_bias_std > 0.0 ||
-            options.accel_temperature_scale_std > 0.0 || options.accel_bias_drift_std > 0.0),
-        gyro_effects_(options.gyro_g_sensitivity_std > 0.0 ||
-                      options.gyro_temperature_bias_std > 0.0 || options.gyro_bias_drift_std > 0.0),
+        accel_effects_(AnySpread(options, EffectSensor::kAccelerometer)),
+        gyro_effects_(AnySpread(options, EffectSensor::kGyroscope)),
         upper_inverse_(s->accel_truth.upper.inverse()),
         accel_inverse_(s->accel_truth.matrix().inverse()),
         gyro_inverse_(s->gyro_truth.matrix.inverse()),
@@ -274,11 +285,13 @@ class SampleWriter {
   Eigen::Vector3d Gyroscope(const Eigen::Vector3d& force, const Eigen::Vector3d& body_rate,
                             double temperature, double t) const {
     if (!gyro_effects_) return gyro_inverse_ * body_rate + s_.gyro_truth.bias;
+    // w + G f + gamma dT + eta t: every gyroscope effect's term, in rad/s.
     const double dT = temperature - s_.effects.reference_temperature;
-    return gyro_inverse_ *
-               (body_rate + s_.gyro_g_sensitivity * force + s_.effects.gyro_temperature_bias * dT +
-                s_.effects.gyro_bias_drift * t) +
-           s_.gyro_truth.bias;
+    const double* all[kNumEffects] = {};
+    PointIntoBlocks<double>(nullptr, s_.effects.gyro.data(), all);
+    Eigen::Vector3d offset;
+    GyroEffectOffset<double>(all, force.data(), dT, t, offset.data());
+    return gyro_inverse_ * (body_rate + offset) + s_.gyro_truth.bias;
   }
 
   const SimulatorOptions& o_;

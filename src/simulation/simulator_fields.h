@@ -8,6 +8,7 @@
 #define GRAVCAL_SRC_SIMULATION_SIMULATOR_FIELDS_H_
 
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -22,10 +23,26 @@ struct SimulatorField {
   // The name in truth.json's "options", e.g. "hold_seconds" (the member's).
   const char* name;
   const char* help;
+  // The member, or the effect whose spread (SimulatorOptions::effect_std)
+  // it is.
   std::variant<double SimulatorOptions::*, bool SimulatorOptions::*,
-               std::string SimulatorOptions::*>
+               std::string SimulatorOptions::*, Effect>
       member;
 };
+
+// Calls f with a reference to the field's value in `options` (const or not).
+template <typename Options, typename F>
+void WithFieldValue(const SimulatorField& field, Options& options, F&& f) {
+  std::visit(
+      [&](auto member) {
+        if constexpr (std::is_same_v<decltype(member), Effect>) {
+          f(options.effect_std.values[static_cast<int>(member)]);
+        } else {
+          f(options.*member);
+        }
+      },
+      field.member);
+}
 
 // Every field with a key, in the order `gravcal help` lists them.
 const std::vector<SimulatorField>& SimulatorFields();

@@ -2,7 +2,6 @@
 #include <exception>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <variant>
 
 #include "gravcal/simulation/simulator.h"
 #include "io/json_helpers.h"
@@ -54,18 +53,18 @@ std::string TruthToJson(const SimulatedSession& session, const SimulatorOptions&
     nlohmann::json& fields = j["options"];
     fields = nlohmann::json::object();
     for (const internal::SimulatorField& field : internal::SimulatorFields()) {
-      std::visit([&](auto member) { fields[field.name] = OptionJson(options.*member); },
-                 field.member);
+      internal::WithFieldValue(field, options,
+                               [&](const auto& value) { fields[field.name] = OptionJson(value); });
     }
+    // Every effect's values by name (a 3x3 matrix as rows).
     const EffectParameters& e = session.effects;
-    j["effects"] = {{"reference_temperature", e.reference_temperature},
-                    {"accel_quadratic_nonlinearity", JsonVector(e.accel_quadratic)},
-                    {"accel_temperature_bias", JsonVector(e.accel_temperature_bias)},
-                    {"accel_temperature_scale", JsonVector(e.accel_temperature_scale)},
-                    {"accel_bias_drift", JsonVector(e.accel_bias_drift)},
-                    {"gyro_g_sensitivity", JsonMatrix(session.gyro_g_sensitivity)},
-                    {"gyro_temperature_bias", JsonVector(e.gyro_temperature_bias)},
-                    {"gyro_bias_drift", JsonVector(e.gyro_bias_drift)}};
+    nlohmann::json& effects = j["effects"];
+    effects = {{"reference_temperature", e.reference_temperature}};
+    for (const EffectInfo& info : EffectCatalogue()) {
+      if (e.Block(info.effect) == nullptr) continue;
+      effects[info.name] = info.num_parameters == 9 ? JsonMatrix(e.Matrix(info.effect))
+                                                    : JsonVector(e.Vector(info.effect));
+    }
     return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
   } catch (const std::exception&) {
     return "{}";

@@ -163,9 +163,8 @@ bool CheckPlacement(const SimulatorOptions& o, const FieldCheck& c) {
   if (!(o.hand_max_seconds >= o.hand_min_seconds) || !std::isfinite(o.hand_max_seconds)) {
     return c.Fail("hand_max_seconds", o.hand_max_seconds, "must be at least hand_min_seconds");
   }
-  return c.NonNegative("hand_wobble_deg", o.hand_wobble_deg) &&
-         c.NonNegative("gyro_g_sensitivity_std", o.gyro_g_sensitivity_std) &&
-         c.NonNegative("tremor", o.tremor) && c.NonNegative("pose_disturbance", o.pose_disturbance);
+  return c.NonNegative("hand_wobble_deg", o.hand_wobble_deg) && c.NonNegative("tremor", o.tremor) &&
+         c.NonNegative("pose_disturbance", o.pose_disturbance);
 }
 
 // Temperature, Earth rate, fixture attitudes and the effect terms.
@@ -178,14 +177,16 @@ bool CheckEnvironmentAndEffects(const SimulatorOptions& o, const FieldCheck& c) 
   if (!std::isnan(o.latitude_deg) && !(std::fabs(o.latitude_deg) <= 90.0)) {
     return c.Fail("latitude_deg", o.latitude_deg, "must be NaN (off) or within -90..90");
   }
-  return c.NonNegative("fixture_attitude_noise_deg", o.fixture_attitude_noise_deg) &&
-         c.NonNegative("accel_quadratic_std", o.accel_quadratic_std) &&
-         c.NonNegative("accel_temperature_bias_std", o.accel_temperature_bias_std) &&
-         c.AtMost("accel_temperature_scale_std", o.accel_temperature_scale_std, 0.01) &&
-         c.NonNegative("accel_bias_drift_std", o.accel_bias_drift_std) &&
-         c.NonNegative("gyro_temperature_bias_std", o.gyro_temperature_bias_std) &&
-         c.NonNegative("gyro_bias_drift_std", o.gyro_bias_drift_std) &&
-         c.Finite("effect_reference_temperature", o.effect_reference_temperature);
+  if (!c.NonNegative("fixture_attitude_noise_deg", o.fixture_attitude_noise_deg)) return false;
+  for (const EffectInfo& info : EffectCatalogue()) {
+    const EffectSimulation& sim = info.simulation;
+    if (sim.key == nullptr) continue;
+    const double v = o.effect_std[info.effect];
+    if (!(sim.max > 0.0 ? c.AtMost(sim.name, v, sim.max) : c.NonNegative(sim.name, v))) {
+      return false;
+    }
+  }
+  return c.Finite("effect_reference_temperature", o.effect_reference_temperature);
 }
 
 // The session's length against internal::kMaxSimulatedSamples.

@@ -228,7 +228,8 @@ void CheckRotations(const std::vector<Effect>& baseline_effects,
   std::vector<Effect> richest = baseline_effects;
   for (Effect e : candidates) {
     if (!IsAccel(e) || Contains(richest, e)) continue;
-    if (e == Effect::kAccelMisalignment && ctx.parameterization != AccelParameterization::kScale) {
+    if (Info(e).form == EffectForm::kInUpper &&
+        ctx.parameterization != AccelParameterization::kScale) {
       continue;
     }
     if (Info(e).regressor == EffectRegressor::kTemperature &&

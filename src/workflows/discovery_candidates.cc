@@ -35,7 +35,8 @@ std::string NotApplicable(const DiscoveryContext& ctx, const std::vector<Effect>
   const int sensor_parameters = now.num_parameters;
   const EffectInfo& info = Info(e);
   if (Contains(current, e)) return "already in the model";
-  if (e == Effect::kAccelMisalignment && ctx.parameterization != AccelParameterization::kScale) {
+  if (Info(e).form == EffectForm::kInUpper &&
+      ctx.parameterization != AccelParameterization::kScale) {
     return "already in the baseline (parameterization " +
            std::string(ToString(ctx.parameterization)) + ")";
   }

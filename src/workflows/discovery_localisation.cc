@@ -26,14 +26,8 @@ Eigen::Vector3d SimulatedAccel(const EffectFitResult& fit, const StaticObservati
   p.reference_temperature = fit.parameters.reference_temperature;
   p.reference_time = fit.parameters.reference_time;
   for (Effect e : fit.effects) {
-    if (e == Effect::kAccelQuadratic) p.accel_quadratic = fit.parameters.accel_quadratic;
-    if (e == Effect::kAccelTemperatureBias) {
-      p.accel_temperature_bias = fit.parameters.accel_temperature_bias;
-    }
-    if (e == Effect::kAccelTemperatureScale) {
-      p.accel_temperature_scale = fit.parameters.accel_temperature_scale;
-    }
-    if (e == Effect::kAccelBiasDrift) p.accel_bias_drift = fit.parameters.accel_bias_drift;
+    if (Info(e).sensor != EffectSensor::kAccelerometer) continue;
+    p.SetValues(e, fit.parameters.Values(e));
   }
   const Eigen::Vector3d m = ApplyAccelEffects(p, s, o.temperature(), o.time());
   return fit.accel.upper.inverse() * m + fit.accel.bias;

@@ -58,7 +58,7 @@ void FillRegressor(const DiscoveryContext& ctx, const EffectFitResult& with, Eff
   const std::vector<StaticObservation>& obs = *ctx.observations;
   const EffectInfo& info = Info(e);
   EffectFitResult without = with;
-  if (e == Effect::kAccelMisalignment) {
+  if (Info(e).form == EffectForm::kInUpper) {
     without.accel.upper(0, 1) = without.accel.upper(0, 2) = without.accel.upper(1, 2) = 0.0;
   }
   without.effects.erase(std::remove(without.effects.begin(), without.effects.end(), e),

@@ -1,5 +1,6 @@
-// gravcal record's core: live detection, capture, prediction, suggestion
-// (workflows/recorder.h).
+// gravcal record's core (workflows/recorder.h): the sample loop, live
+// detection, capture and the events; the pose design (prediction,
+// suggestion) is in recorder_design.cc, the state in recorder_state.h.
 #include "gravcal/workflows/recorder.h"
 
 #include <Eigen/Cholesky>
@@ -20,6 +21,7 @@
 #include "util/statistics.h"
 #include "util/units.h"
 #include "workflows/plan_start.h"
+#include "workflows/recorder_state.h"
 
 namespace gravcal {
 
@@ -32,11 +34,8 @@ using internal::kInf;
 using internal::kRadToDeg;
 using Json = nlohmann::json;
 
+using internal::CapturedPose;
 using internal::kFaceSnapDeg;
-// A suggestion is worded as a face within this.
-constexpr double kFaceWordDeg = 2.0;
-// Holds on the needed-hold grid.
-constexpr int kHoldGrid = 24;
 // Warnings of one kind after which the rest are only counted.
 constexpr int kMaxWarningsPerKind = 5;
 
@@ -47,47 +46,7 @@ std::string Num(double v, int digits = 3) {
   return s.str();
 }
 
-std::string AxisName(int axis, bool positive) {
-  static const char* kAxes[3] = {"X", "Y", "Z"};
-  return std::string(positive ? "+" : "-") + kAxes[axis];
-}
-
-struct CapturedPose {
-  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-  Eigen::Vector3d raw_mean = Eigen::Vector3d::Zero();
-  double kept_seconds = 0.0;
-  size_t begin = 0;
-  size_t end = 0;
-  // Scale-free white-noise density per axis, m/s^2/sqrt(Hz).
-  Eigen::Vector3d density = Eigen::Vector3d::Zero();
-};
-
 }  // namespace
-
-PoseSuggestion DescribeUp(const Eigen::Vector3d& given) {
-  PoseSuggestion s;
-  s.up = given.normalized();
-  Eigen::Index face = 0;
-  s.up.cwiseAbs().maxCoeff(&face);
-  const bool positive = s.up(face) > 0.0;
-  s.face = AxisName(static_cast<int>(face), positive);
-  s.tilt_deg = std::acos(std::min(1.0, std::abs(s.up(face)))) * kRadToDeg;
-  std::ostringstream words;
-  words << s.face << " up";
-  if (s.tilt_deg > kFaceWordDeg) {
-    // The part of up across the face: the axes that rise.
-    Eigen::Vector3d across = s.up;
-    across(face) = 0.0;
-    across.normalize();
-    for (int a = 0; a < 3; ++a) {
-      if (std::abs(across(a)) > 0.3) s.toward += AxisName(a, across(a) > 0.0);
-    }
-    words << ", then tilt about " << std::lround(s.tilt_deg) << " degrees toward " << s.toward
-          << " (" << s.toward << " rises)";
-  }
-  s.instruction = words.str();
-  return s;
-}
 
 bool RecorderOptions::IsValid(std::string* error) const {
   std::string e;
@@ -130,205 +89,6 @@ const char* RecorderEventName(RecorderEventType type) {
   }
   return "warning";
 }
-
-struct Recorder::State {
-  Config config;
-  RecorderOptions options;
-  internal::PlanStart start;
-  // Parameters, weights W = 1 / target^2 and the prior information.
-  Eigen::Index p = 0;
-  Eigen::VectorXd weight;
-  Eigen::MatrixXd prior;
-  std::vector<Eigen::Vector3d> candidates;
-  // The request's noise (noise model or densities) when it gives one.
-  bool given_noise = false;
-  DesignNoise noise;
-
-  ImuLog log;
-  bool started = false;
-  bool has_gyro = false;
-  bool has_temperature = false;
-  double next_detect_t = 0.0;
-  // Detection starts here (the end of the last captured pose).
-  size_t detect_from = 0;
-  // Nominal scale (m/s^2 per raw unit), from the first hold.
-  double scale = 0.0;
-  std::vector<CapturedPose> poses;
-  Eigen::MatrixXd fisher;
-  // The largest and smallest raw accelerometer values so far.
-  Eigen::Vector3d accel_max = Eigen::Vector3d::Zero();
-  Eigen::Vector3d accel_min = Eigen::Vector3d::Zero();
-  // Holds not captured (saturated), by their first sample.
-  std::set<size_t> refused_holds;
-  std::map<std::string, int> warning_counts;
-  // The end (sample index) of the last moving stretch warned about.
-  size_t moving_warned_until = 0;
-  RecorderStatus status;
-  bool sent_first = false;
-  // The offline plan's typical kept hold (for the measured noise), the
-  // shortest hold asked for while a parameter is undetermined; 0 = not
-  // planned yet.
-  double plan_hold = 0.0;
-  int plan_poses = 0;
-  // The done event's body and sentence (Finish).
-  Json done_body;
-  std::string done_text;
-
-  // Rows of the information.
-  Eigen::RowVectorXd Row(const Eigen::Vector3d& up, double kept_seconds,
-                         const Eigen::Vector3d& density) const {
-    DesignNoise n = noise;
-    if (!given_noise) {
-      for (int a = 0; a < 3; ++a) n.accel[a].white_noise.value = density(a);
-    }
-    const Eigen::MatrixXd j =
-        DesignJacobian({{up, kept_seconds + start.model.trimmed_seconds}}, start.model, n);
-    return j.row(0);
-  }
-
-  double Phi(const Eigen::MatrixXd& f) const {
-    const Eigen::MatrixXd cov = (f + prior).ldlt().solve(Eigen::MatrixXd::Identity(p, p));
-    return (weight.asDiagonal() * cov).trace();
-  }
-
-  bool TargetsMet(const Eigen::MatrixXd& f, int pose_count) const {
-    if (pose_count < static_cast<int>(p) + options.redundancy) return false;
-    const Eigen::VectorXd std = DeterminedStd(f, start.limits);
-    for (Eigen::Index i = 0; i < p; ++i) {
-      if (start.targeted[i] && !(std(i) <= start.targets(i))) return false;
-    }
-    return true;
-  }
-
-  // The typical density of the poses so far (median per axis), or of
-  // `fallback` before any.
-  Eigen::Vector3d TypicalDensity(const Eigen::Vector3d& fallback) const {
-    if (poses.empty()) return fallback;
-    Eigen::Vector3d out;
-    for (int a = 0; a < 3; ++a) {
-      std::vector<double> v;
-      for (const CapturedPose& c : poses) v.push_back(c.density(a));
-      out(a) = internal::Median(v);
-    }
-    return out;
-  }
-
-  // The shortest kept hold of `up` that gives (1 - hold_tolerance) of what
-  // max_hold would, or meets the targets.
-  double NeededHold(const Eigen::Vector3d& up, const Eigen::Vector3d& density) const {
-    const Eigen::VectorXd std = DeterminedStd(fisher, start.limits);
-    const double t0 = std.allFinite() ? options.min_hold_seconds
-                                      : std::clamp(plan_hold, options.min_hold_seconds,
-                                                   options.max_hold_seconds),
-                 t1 = options.max_hold_seconds;
-    const Eigen::RowVectorXd r1 = Row(up, t1, density);
-    const double phi_now = Phi(fisher);
-    const double phi_best = Phi(fisher + r1.transpose() * r1);
-    const int count = static_cast<int>(poses.size()) + 1;
-    for (int k = 0; k <= kHoldGrid; ++k) {
-      const double t = t0 * std::pow(t1 / t0, static_cast<double>(k) / kHoldGrid);
-      const Eigen::RowVectorXd r = Row(up, t, density);
-      const Eigen::MatrixXd f = fisher + r.transpose() * r;
-      if (Phi(f) <= phi_best + options.hold_tolerance * (phi_now - phi_best) ||
-          TargetsMet(f, count)) {
-        return t;
-      }
-    }
-    return t1;
-  }
-
-  // The candidate that lowers phi most (ties: the nearest +Z up).
-  PoseSuggestion Suggest(const Eigen::Vector3d& density) const {
-    const double hold = std::max(options.min_hold_seconds, 10.0);
-    const double phi_now = Phi(fisher);
-    double best_phi = kInf;
-    int best = 0;
-    for (size_t c = 0; c < candidates.size(); ++c) {
-      const Eigen::RowVectorXd r = Row(candidates[c], hold, density);
-      const double phi = Phi(fisher + r.transpose() * r);
-      const double z = candidates[c].z();
-      if (phi < best_phi * (1.0 - 1e-9) ||
-          (phi <= best_phi * (1.0 + 1e-9) && z > candidates[best].z())) {
-        best_phi = std::min(best_phi, phi);
-        best = static_cast<int>(c);
-      }
-    }
-    PoseSuggestion s = DescribeUp(candidates[best]);
-    s.hold_seconds = NeededHold(candidates[best], density);
-    const Eigen::RowVectorXd r = Row(candidates[best], s.hold_seconds, density);
-    s.expected_gain = phi_now > 0.0 ? 1.0 - Phi(fisher + r.transpose() * r) / phi_now : 0.0;
-    return s;
-  }
-
-  // The offline plan for the noise of the first hold (or the request's):
-  // its median hold, less what the detector trims.
-  void Plan(const Eigen::Vector3d& density) {
-    PlanRequest request = options.request;
-    if (!given_noise) request.accel_noise_density = density.maxCoeff();
-    request.min_hold_seconds = options.min_hold_seconds + start.model.trimmed_seconds;
-    request.max_hold_seconds = options.max_hold_seconds + start.model.trimmed_seconds;
-    RecordingPlan plan;
-    std::string error;
-    plan_hold = options.min_hold_seconds;
-    if (!MakeRecordingPlan(config, request, &plan, &error) || plan.poses.empty()) return;
-    std::vector<double> holds;
-    for (const PlannedPose& pose : plan.poses) holds.push_back(pose.hold_seconds);
-    plan_hold =
-        std::max(options.min_hold_seconds, internal::Median(holds) - start.model.trimmed_seconds);
-    plan_poses = static_cast<int>(plan.poses.size());
-  }
-
-  // Why each undetermined parameter is: the parameters a null direction of
-  // the information mixes it with, and the up directions seen so far.
-  std::map<std::string, std::string> Reasons(const Eigen::VectorXd& std) const {
-    std::map<std::string, std::string> out;
-    std::map<std::string, int> faces;
-    for (const CapturedPose& c : poses) ++faces[DescribeUp(c.up).instruction];
-    std::string seen;
-    for (const auto& [face, count] : faces) {
-      seen += (seen.empty() ? "" : ", ") + face + (count > 1 ? " x" + std::to_string(count) : "");
-    }
-    if (seen.empty()) seen = "none";
-    // Null directions of the information in target units (S F S, S =
-    // diag(target)), so that the threshold is unit-free.
-    const Eigen::VectorXd t = start.targets;
-    const Eigen::MatrixXd g = t.asDiagonal() * fisher * t.asDiagonal();
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(g);
-    const double top = std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-    const std::vector<std::string>& names = start.names;
-    for (Eigen::Index i = 0; i < p; ++i) {
-      if (std::isfinite(std(i))) continue;
-      std::set<std::string> mixed;
-      bool in_null = false;
-      for (Eigen::Index k = 0; k < p; ++k) {
-        if (eig.eigenvalues()(k) > 1e-9 * top) continue;
-        const Eigen::VectorXd v = eig.eigenvectors().col(k);
-        if (std::abs(v(i)) < 0.1) continue;
-        in_null = true;
-        for (Eigen::Index j = 0; j < p; ++j) {
-          if (j != i && std::abs(v(j)) >= 0.1) mixed.insert(names[j]);
-        }
-      }
-      std::string why;
-      if (poses.empty()) {
-        why = "no pose yet";
-      } else if (in_null) {
-        why = "the " + std::to_string(poses.size()) + " pose(s) so far (" + seen +
-              ") cannot tell it apart";
-        if (!mixed.empty()) {
-          why += " from ";
-          size_t n = 0;
-          for (const std::string& m : mixed) why += (n++ ? ", " : "") + m;
-        }
-        why += ": it needs poses with other up directions";
-      } else {
-        why = "its sigma is beyond the calibration's limit with the poses so far (" + seen + ")";
-      }
-      out[names[i]] = why;
-    }
-    return out;
-  }
-};
 
 Recorder::Recorder() : state_(new State) {}
 Recorder::~Recorder() = default;

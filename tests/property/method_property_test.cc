@@ -184,7 +184,7 @@ std::vector<MethodCase> AllCases() {
                    std::vector<ParameterError>* out) {
       const SimulatedSession& s = input.session;
       AccelModel truth = s.accel_truth;
-      truth.bias += truth.upper.inverse() * s.effects.accel_temperature_bias *
+      truth.bias += truth.upper.inverse() * s.effects.Vector(Effect::kAccelTemperatureBias) *
                     (c.effects.reference_temperature - s.effects.reference_temperature);
       // The accelerometer covariance also holds the effect terms (beta_x,
       // ...): they are checked below, with the std the effects report.

@@ -13,6 +13,7 @@
 #include "gravcal/core/accel_model.h"
 #include "gravcal/core/gravity.h"
 #include "gravcal/core/gyro_model.h"
+#include "gravcal/core/imu_corrector.h"
 #include "gravcal/core/imu_log.h"
 #include "gravcal/core/model_effects.h"
 #include "gravcal/core/position.h"
@@ -145,7 +146,7 @@ struct Calibration {
   // 0) unless a thermal method filled it.
   ThermalModel thermal;
   // The method that produced this result (config key `method`).
-  std::string method = "twelve_position";
+  std::string method = ToString(Method::kTwelvePosition);
   double gravity = kStandardGravity;
   std::string gravity_source;
   // |a| - g over positions with the nominal scale, the coarse fit, the
@@ -167,6 +168,18 @@ struct Calibration {
   ConvergenceReport convergence;
   // Issue 16: the input log (set by the caller that read it).
   CalibrationProvenance provenance;
+
+  // The model this result holds, as apply, the exporters and Python apply
+  // it (core/imu_corrector.h): the accelerometer, the gyroscope when
+  // estimated, and the effects switched on with their values (their
+  // reference temperature and time; accel_misalignment lives in
+  // accel.model.upper). An effect parameter the data did not determine
+  // (NaN) counts as 0, and its key, effects.<effect>.<parameter>, is added
+  // to *undetermined (may be null). False with a one-line message naming
+  // the key when the parts disagree: an effect with the wrong number of
+  // values, a gyroscope effect without a gyroscope model, a temperature
+  // effect without a reference temperature.
+  bool Model(ImuCorrector* model, std::vector<std::string>* undetermined, std::string* error) const;
 
   // One line: the message and the fit's residual |a| - g before and after
   // (only after, when the raw data were read without a nominal scale).

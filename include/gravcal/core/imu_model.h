@@ -46,41 +46,34 @@
 namespace gravcal {
 
 // The accelerometer's parameter blocks, by name. bias and upper are always
-// set; an effect block that is null is off.
+// set; effect[e] points at the values of effect e (null = off; only the
+// accelerometer's effects are read).
 template <typename T>
 struct AccelBlocks {
   AccelBlocks() = default;
   // The blocks of the magnitude, trend and rotation residuals, in their
-  // order.
-  AccelBlocks(const T* bias_block, const T* upper_block, const T* quadratic_block,
-              const T* temperature_bias_block, const T* temperature_scale_block,
-              const T* drift_block)
-      : bias(bias_block),
-        upper(upper_block),
-        quadratic(quadratic_block),
-        temperature_bias(temperature_bias_block),
-        temperature_scale(temperature_scale_block),
-        drift(drift_block) {}
+  // order: every accelerometer effect at its place in `effects_block`
+  // (kAccelEffectParameters values; null = no effects).
+  AccelBlocks(const T* bias_block, const T* upper_block, const T* effects_block)
+      : bias(bias_block), upper(upper_block) {
+    PointIntoBlocks<T>(effects_block, nullptr, effect);
+  }
 
   const T* bias = nullptr;                    // b, 3
   const T* upper = nullptr;                   // U, 6
-  const T* quadratic = nullptr;               // k2, 3
-  const T* temperature_bias = nullptr;        // beta, 3
-  const T* temperature_scale = nullptr;       // c, 3
-  const T* drift = nullptr;                   // delta, 3
+  const T* effect[kNumEffects] = {};          // the effects' values
   const Eigen::Matrix3d* rotation = nullptr;  // R, held
 };
 
 // The gyroscope's parameter blocks, by name. bias is always set; a null
-// matrix is the identity, a null effect block is off.
+// matrix is the identity; effect[e] points at the values of effect e (null
+// = off; only the gyroscope's effects are read).
 template <typename T>
 struct GyroBlocks {
-  const T* bias = nullptr;              // b_g, 3
-  const T* matrix = nullptr;            // M_g, 9 row-major
-  const T* g_sensitivity = nullptr;     // G (rad/s per m/s^2), 9 row-major
-  const T* g_effect = nullptr;          // G' (raw units per m/s^2), 9 row-major
-  const T* temperature_bias = nullptr;  // gamma, 3
-  const T* drift = nullptr;             // eta, 3
+  const T* bias = nullptr;            // b_g, 3
+  const T* matrix = nullptr;          // M_g, 9 row-major
+  const T* g_sensitivity = nullptr;   // G (rad/s per m/s^2), 9 row-major
+  const T* effect[kNumEffects] = {};  // G' (raw units per m/s^2), gamma, eta, ...
 };
 
 template <typename T>
@@ -113,15 +106,14 @@ class ImuModel {
   bool CorrectedSensorFrame(const V& raw, double temperature_offset, double time_offset,
                             T* s) const {
     SensorFrame(raw, s);
-    return CorrectAccelEffects(accel_.quadratic, accel_.temperature_bias, accel_.temperature_scale,
-                               accel_.drift, temperature_offset, time_offset, s);
+    return RemoveAccelEffects<T>(accel_.effect, temperature_offset, time_offset, s);
   }
 
-  // q = (m - beta dT - delta dt) / (1 + c dT): the linear effect terms
-  // removed from m (the quadratic one kept), in place.
-  void RemoveLinearEffects(double temperature_offset, double time_offset, T* m) const {
-    CorrectAccelEffects<T>(nullptr, accel_.temperature_bias, accel_.temperature_scale, accel_.drift,
-                           temperature_offset, time_offset, m);
+  // The rate of m = U (v - b) within a still pose at offsets (dT, dt) whose
+  // temperature changes at Tdot (degC/s), m/s^2/s (effect_registry.h).
+  void EffectRate(const T* m, double temperature_offset, double time_offset,
+                  double temperature_slope, T* rate) const {
+    AccelEffectRate<T>(accel_.effect, m, temperature_offset, time_offset, temperature_slope, rate);
   }
 
   // a = R s (R null: a = s); a may alias nothing in s.
@@ -171,8 +163,7 @@ class ImuModel {
   // o = G' f + gamma dT + eta dt (raw units). The force f (3 values) is
   // read only with G' and G; it may be null without them.
   void GyroOffset(const double* force, double temperature_offset, double time_offset, T* o) const {
-    GyroEffectOffset(gyro_.g_effect, gyro_.temperature_bias, gyro_.drift, force, temperature_offset,
-                     time_offset, o);
+    GyroEffectOffset<T>(gyro_.effect, force, temperature_offset, time_offset, o);
   }
 
   // e = u - b_g - o (raw units): the rest level's error with the effects.
@@ -218,11 +209,6 @@ class ImuModel {
   GyroBlocks<T> gyro_;
 };
 
-// The inverse of EffectParameters::Values: sets one effect's parameters
-// from `values` (EffectInfo::num_parameters of them; accel_misalignment,
-// which lives in U, sets nothing). False when the count is wrong.
-bool SetEffectValues(Effect effect, const std::vector<double>& values, EffectParameters* p);
-
 // The free parameters of the accelerometer model of a static fit: 6
 // (kScale) or 9 for the baseline, plus the parameters of the accelerometer
 // effects in `effects` (accel_misalignment only adds to kScale, which
@@ -235,40 +221,28 @@ int AccelModelParameterCount(AccelParameterization parameterization,
 // ImuModel<double>. Effects that are not switched on have no block.
 class ImuParameters {
  public:
-  // gyro null: no gyroscope model. Only the effects in `active` get blocks.
+  // gyro null: no gyroscope model. Only the effects in `active` are on.
   ImuParameters(const AccelModel& accel, const GyroModel* gyro, const EffectParameters& effects,
                 const std::vector<Effect>& active)
-      : rotation_(accel.rotation),
-        reference_temperature_(effects.reference_temperature),
-        reference_time_(effects.reference_time) {
+      : rotation_(accel.rotation), effects_(effects) {
     for (int i = 0; i < 3; ++i) accel_bias_[i] = accel.bias(i);
     accel.GetUpper(upper_);
     accel_.bias = accel_bias_;
     accel_.upper = upper_;
     accel_.rotation = &rotation_;
-    auto take = [&](Effect e, const Eigen::Vector3d& v, double* storage, const double** block) {
-      if (!Contains(active, e)) return;
-      for (int i = 0; i < 3; ++i) storage[i] = v(i);
-      *block = storage;
-    };
-    take(Effect::kAccelQuadratic, effects.accel_quadratic, quadratic_, &accel_.quadratic);
-    take(Effect::kAccelTemperatureBias, effects.accel_temperature_bias, temperature_bias_,
-         &accel_.temperature_bias);
-    take(Effect::kAccelTemperatureScale, effects.accel_temperature_scale, temperature_scale_,
-         &accel_.temperature_scale);
-    take(Effect::kAccelBiasDrift, effects.accel_bias_drift, drift_, &accel_.drift);
-    if (gyro == nullptr) return;
+    const double* on[kNumEffects];
+    effects_.Pointers(active, on);
+    for (int k = 0; k < kNumEffects; ++k) accel_.effect[k] = gyro_.effect[k] = on[k];
+    if (gyro == nullptr) {
+      for (const double*& p : gyro_.effect) p = nullptr;
+      return;
+    }
     for (int i = 0; i < 3; ++i) gyro_bias_[i] = gyro->bias(i);
-    RowMajor(gyro->matrix, gyro_matrix_);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) gyro_matrix_[3 * r + c] = gyro->matrix(r, c);
+    }
     gyro_.bias = gyro_bias_;
     gyro_.matrix = gyro_matrix_;
-    if (Contains(active, Effect::kGyroGSensitivity)) {
-      RowMajor(effects.gyro_g_sensitivity, g_effect_);
-      gyro_.g_effect = g_effect_;
-    }
-    take(Effect::kGyroTemperatureBias, effects.gyro_temperature_bias, gyro_temperature_bias_,
-         &gyro_.temperature_bias);
-    take(Effect::kGyroBiasDrift, effects.gyro_bias_drift, gyro_drift_, &gyro_.drift);
   }
   ImuParameters(const ImuParameters&) = delete;
   ImuParameters& operator=(const ImuParameters&) = delete;
@@ -278,24 +252,16 @@ class ImuParameters {
   bool has_gyro() const { return gyro_.bias != nullptr; }
   // dT = T - T_ref (0 when T is NaN) and dt = t - t_ref.
   double TemperatureOffset(double temperature) const {
-    return std::isfinite(temperature) ? temperature - reference_temperature_ : 0.0;
+    return std::isfinite(temperature) ? temperature - effects_.reference_temperature : 0.0;
   }
-  double TimeOffset(double time) const { return time - reference_time_; }
+  double TimeOffset(double time) const { return time - effects_.reference_time; }
 
  private:
-  static void RowMajor(const Eigen::Matrix3d& m, double* out) {
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) out[3 * r + c] = m(r, c);
-    }
-  }
-
   double accel_bias_[3] = {0.0, 0.0, 0.0};
   double upper_[6] = {1.0, 0.0, 0.0, 1.0, 0.0, 1.0};
-  double quadratic_[3], temperature_bias_[3], temperature_scale_[3], drift_[3];
   Eigen::Matrix3d rotation_;
-  double gyro_bias_[3], gyro_matrix_[9], g_effect_[9], gyro_temperature_bias_[3], gyro_drift_[3];
-  double reference_temperature_ = 0.0;
-  double reference_time_ = 0.0;
+  double gyro_bias_[3], gyro_matrix_[9];
+  const EffectParameters effects_;
   AccelBlocks<double> accel_;
   GyroBlocks<double> gyro_;
 };

@@ -127,21 +127,11 @@ enum class BatchStatus {
 const char* ToString(BatchStatus status);
 bool FromString(const std::string& name, BatchStatus* status);
 
-// The sensor effects beyond the textbook model (model_effects.h holds their
-// catalogue: meaning, parameters, units).
-enum class Effect {
-  kAccelMisalignment,
-  kAccelQuadratic,
-  kAccelTemperatureBias,
-  kAccelTemperatureScale,
-  kAccelBiasDrift,
-  kGyroGSensitivity,
-  kGyroTemperatureBias,
-  kGyroBiasDrift,
-};
-// "accel_misalignment", "accel_quadratic_nonlinearity",
-// "accel_temperature_bias", "accel_temperature_scale", "accel_bias_drift",
-// "gyro_g_sensitivity", "gyro_temperature_bias", "gyro_bias_drift".
+// The sensor effects beyond the textbook model: one value per effect of the
+// registry (core/effect_registry.h defines the enum; model_effects.h holds
+// their catalogue: meaning, parameters, units). Names as the effects'
+// definitions give them, e.g. "accel_temperature_bias".
+enum class Effect : int;
 const char* ToString(Effect effect);
 bool FromString(const std::string& name, Effect* effect);
 

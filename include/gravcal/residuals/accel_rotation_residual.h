@@ -8,8 +8,7 @@
 // pose with mean raw vector v at offsets (dT, dt) is
 //
 //   m = U (v - b_a)                                m/s^2, orthogonalised frame
-//   a = effect correction of m at (dT, dt)         model_effects.h (k2, beta,
-//                                                  c, delta)
+//   a = effect correction of m at (dT, dt)         model_effects.h
 //   d = a / |a|
 //
 // The gyroscope rate in the same frame is w_i = M_g (u_i - b_g) (M_g: 9
@@ -35,10 +34,11 @@
 // what it cannot see is a common scale of a (normalised away) and a common
 // rotation (absorbed by M_g).
 //
-// Parameter blocks, in order: b_a (3), U (6: u00 u01 u02 u11 u12 u22), k2
-// (3), beta (3), c (3), delta (3) as GravityMagnitudeResidual::
-// CreateWithEffects, then b_g (3) and M_g (9, row-major). An effect that is
-// off has its block held at zero, which leaves its term the identity.
+// Parameter blocks, in order: b_a (3), U (6: u00 u01 u02 u11 u12 u22) and
+// the accelerometer effects' block (kAccelEffectParameters) as
+// GravityMagnitudeResidual::CreateWithEffects, then b_g (3) and M_g (9,
+// row-major). An effect that is off has its values held at zero, which
+// leaves its term the identity.
 #ifndef GRAVCAL_RESIDUALS_ACCEL_ROTATION_RESIDUAL_H_
 #define GRAVCAL_RESIDUALS_ACCEL_ROTATION_RESIDUAL_H_
 
@@ -77,11 +77,9 @@ struct AccelRotationResidual {
   explicit AccelRotationResidual(AccelRotationData data) : data_(std::move(data)) {}
 
   template <typename T>
-  bool operator()(const T* const bias, const T* const upper, const T* const quadratic,
-                  const T* const temperature_bias, const T* const temperature_scale,
-                  const T* const drift, const T* const gyro_bias, const T* const gyro_matrix,
-                  T* residual) const {
-    const AccelBlocks<T> accel(bias, upper, quadratic, temperature_bias, temperature_scale, drift);
+  bool operator()(const T* const bias, const T* const upper, const T* const effects,
+                  const T* const gyro_bias, const T* const gyro_matrix, T* residual) const {
+    const AccelBlocks<T> accel(bias, upper, effects);
     const ImuModel<T> model(accel);
     T start[3], end[3];
     if (!model.Direction(data_.start_raw, data_.start_temperature_offset, data_.start_time_offset,
@@ -97,8 +95,8 @@ struct AccelRotationResidual {
   }
 
   static ceres::CostFunction* Create(AccelRotationData data) {
-    return new ceres::AutoDiffCostFunction<AccelRotationResidual, 2, 3, 6, 3, 3, 3, 3, 3, 9>(
-        new AccelRotationResidual(std::move(data)));
+    return new ceres::AutoDiffCostFunction<AccelRotationResidual, 2, 3, 6, kAccelEffectParameters,
+                                           3, 9>(new AccelRotationResidual(std::move(data)));
   }
 
  private:

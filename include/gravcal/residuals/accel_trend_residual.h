@@ -7,8 +7,11 @@
 //
 //   m_i(t) = (1 + c_i dT(t)) q_i + beta_i dT(t) + delta_i dt(t),   q_i = s_i + k2_i s_i^2,
 //
-// affine in dT and dt. The least-squares slope against time of the raw mean
-// v(t) = b + U^-1 m(t) over the pose is therefore exactly
+// affine in dT and dt (the general form, for every registered effect, is
+// AccelEffectRate in core/effect_registry.h: the offsets' rates plus the
+// shapes' carried through the slopes of the shapes above them). The
+// least-squares slope against time of the raw mean v(t) = b + U^-1 m(t)
+// over the pose is therefore exactly
 //
 //   g_k = U^-1 mdot_k,   mdot_{k,i} = (c_i q_i + beta_i) Tdot_k + delta_i,
 //
@@ -27,14 +30,15 @@
 // the single row W_k = n_k^T / sqrt(n_k^T L_k L_k^T n_k) with n_k the unit
 // direction of the pose's raw mean, which keeps the slope along gravity
 // only (a slow tilt of the placement or tremor turns the cross-gravity
-// components by g dtheta but the along-gravity one only by g dtheta^2 / 2). The quadratic term
-// drops out (q is constant within a pose), so k2 only enters through the magnitude residual; a
-// bias, scale or non-orthogonality error alone predicts no trend. Blocks as
+// components by g dtheta but the along-gravity one only by g dtheta^2 / 2).
+// A term that does not vary within a pose (the quadratic one) drops out, so
+// k2 only enters through the magnitude residual; a bias, scale or
+// non-orthogonality error alone predicts no trend. Blocks as
 // GravityMagnitudeResidual::CreateWithEffects: b (3), U (6: u00 u01 u02 u11
-// u12 u22), k2 (3, unused here), beta (3), c (3), delta (3), so both
-// residuals of a pose share one parameter list. The slope is uncorrelated
-// with the pose's mean (the regression is centred on the mean time), so the
-// two residuals of a pose add independently to chi2.
+// u12 u22) and the accelerometer effects' block, so both residuals of a pose
+// share one parameter list. The slope is uncorrelated with the pose's mean
+// (the regression is centred on the mean time), so the two residuals of a
+// pose add independently to chi2.
 #ifndef GRAVCAL_RESIDUALS_ACCEL_TREND_RESIDUAL_H_
 #define GRAVCAL_RESIDUALS_ACCEL_TREND_RESIDUAL_H_
 
@@ -65,19 +69,13 @@ struct AccelTrendResidual {
         time_offset_(time_offset) {}
 
   template <typename T>
-  bool operator()(const T* const bias, const T* const upper, const T* const /*quadratic*/,
-                  const T* const temperature_bias, const T* const temperature_scale,
-                  const T* const drift, T* residual) const {
-    const AccelBlocks<T> accel(bias, upper, nullptr, temperature_bias, temperature_scale, drift);
-    const ImuModel<T> model(accel);
-    T q[3];
-    model.SensorFrame(raw_mean_, q);
-    model.RemoveLinearEffects(temperature_offset_, time_offset_, q);
+  bool operator()(const T* const bias, const T* const upper, const T* const effects,
+                  T* residual) const {
+    const ImuModel<T> model(AccelBlocks<T>(bias, upper, effects));
+    T m[3];
+    model.SensorFrame(raw_mean_, m);
     T rate[3];
-    for (int i = 0; i < 3; ++i) {
-      rate[i] =
-          (temperature_scale[i] * q[i] + temperature_bias[i]) * T(temperature_slope_) + drift[i];
-    }
+    model.EffectRate(m, temperature_offset_, time_offset_, temperature_slope_, rate);
     // U^-1 mdot.
     T predicted[3];
     model.UpperSolve(rate, predicted);
@@ -94,7 +92,8 @@ struct AccelTrendResidual {
   static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& slope,
                                      const Whitening& whitening, double temperature_slope,
                                      double temperature_offset, double time_offset) {
-    return new ceres::AutoDiffCostFunction<AccelTrendResidual, ceres::DYNAMIC, 3, 6, 3, 3, 3, 3>(
+    return new ceres::AutoDiffCostFunction<AccelTrendResidual, ceres::DYNAMIC, 3, 6,
+                                           kAccelEffectParameters>(
         new AccelTrendResidual(raw_mean, slope, whitening, temperature_slope, temperature_offset,
                                time_offset),
         static_cast<int>(whitening.rows()));

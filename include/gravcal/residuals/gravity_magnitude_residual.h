@@ -16,11 +16,12 @@
 // ceres::SubsetManifold.
 //
 // Without effects (Create: blocks b, U) a = m, the usual calibration
-// residual. With effects (CreateWithEffects: blocks b, U, k2, beta, c,
-// delta, 3 each; dT_k = T_k - T_ref and dt_k = t_k - t_ref) a is m with the
-// accelerometer effect terms removed; an effect that is off has its block
-// held constant at zero, which leaves its term the identity. The model is
-// ImuModel (core/imu_model.h) over these blocks.
+// residual. With effects (CreateWithEffects: blocks b, U and the
+// accelerometer effects' block, kAccelEffectParameters values in the
+// registry's layout, core/effect_registry.h; dT_k = T_k - T_ref and dt_k =
+// t_k - t_ref) a is m with the accelerometer effect terms removed; an effect
+// that is off has its values held at zero, which leaves its term the
+// identity. The model is ImuModel (core/imu_model.h) over these blocks.
 //
 // Another estimator can add this residual to its own problem, sharing the
 // bias and upper blocks with its other residuals.
@@ -49,15 +50,13 @@ struct GravityMagnitudeResidual {
   // Without effects.
   template <typename T>
   bool operator()(const T* const bias, const T* const upper, T* residual) const {
-    return Evaluate<T>(bias, upper, nullptr, nullptr, nullptr, nullptr, residual);
+    return Evaluate<T>(bias, upper, nullptr, residual);
   }
   // With the accelerometer effects.
   template <typename T>
-  bool operator()(const T* const bias, const T* const upper, const T* const quadratic,
-                  const T* const temperature_bias, const T* const temperature_scale,
-                  const T* const drift, T* residual) const {
-    return Evaluate<T>(bias, upper, quadratic, temperature_bias, temperature_scale, drift,
-                       residual);
+  bool operator()(const T* const bias, const T* const upper, const T* const effects,
+                  T* residual) const {
+    return Evaluate<T>(bias, upper, effects, residual);
   }
 
   static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean, double gravity,
@@ -71,16 +70,16 @@ struct GravityMagnitudeResidual {
   static ceres::CostFunction* CreateWithEffects(const Eigen::Vector3d& raw_mean,
                                                 double temperature_offset, double time_offset,
                                                 double gravity, double sigma) {
-    return new ceres::AutoDiffCostFunction<GravityMagnitudeResidual, 1, 3, 6, 3, 3, 3, 3>(
+    return new ceres::AutoDiffCostFunction<GravityMagnitudeResidual, 1, 3, 6,
+                                           kAccelEffectParameters>(
         new GravityMagnitudeResidual(raw_mean, gravity, sigma, temperature_offset, time_offset));
   }
 
  private:
-  // Null effect blocks skip their terms.
+  // A null effects block skips the terms.
   template <typename T>
-  bool Evaluate(const T* bias, const T* upper, const T* quadratic, const T* temperature_bias,
-                const T* temperature_scale, const T* drift, T* residual) const {
-    const AccelBlocks<T> accel(bias, upper, quadratic, temperature_bias, temperature_scale, drift);
+  bool Evaluate(const T* bias, const T* upper, const T* effects, T* residual) const {
+    const AccelBlocks<T> accel(bias, upper, effects);
     T m[3];
     if (!ImuModel<T>(accel).CorrectedSensorFrame(raw_mean_, temperature_offset_, time_offset_, m)) {
       return false;

@@ -19,9 +19,10 @@
 //
 // With effects (CreateWithEffects, the effects fit of effect_fit.h, which
 // works in raw units) M_g = I and G = 0 are not blocks; the blocks are b_g
-// (3), G' (9, row-major, raw units per m/s^2), gamma (3) and eta (3), with
-// dT_k = T_k - T_ref and dt_k = t_k - t_ref (GyroEffectOffset in
-// model_effects.h). An effect that is off has its block held at zero.
+// (3) and the gyroscope effects' block (kGyroEffectParameters values in the
+// registry's layout, core/effect_registry.h: G' raw units per m/s^2, gamma,
+// eta), with dT_k = T_k - T_ref and dt_k = t_k - t_ref. An effect that is
+// off has its values held at zero.
 #ifndef GRAVCAL_RESIDUALS_GYRO_STATIC_RESIDUAL_H_
 #define GRAVCAL_RESIDUALS_GYRO_STATIC_RESIDUAL_H_
 
@@ -47,20 +48,17 @@ struct GyroStaticResidual {
   // Without effects: b_g, M_g.
   template <typename T>
   bool operator()(const T* const bias, const T* const matrix, T* residual) const {
-    return Evaluate<false, T>(bias, matrix, nullptr, nullptr, nullptr, residual);
+    return Evaluate<false, T>(bias, matrix, nullptr, nullptr, residual);
   }
   // Without effects: b_g, M_g, G.
   template <typename T>
   bool operator()(const T* const bias, const T* const matrix, const T* const g_sensitivity,
                   T* residual) const {
-    return Evaluate<false, T>(bias, matrix, g_sensitivity, nullptr, nullptr, residual);
+    return Evaluate<false, T>(bias, matrix, g_sensitivity, nullptr, residual);
   }
-  // With effects: b_g, G', gamma, eta.
-  template <typename T>
-  bool operator()(const T* const bias, const T* const g_sensitivity,
-                  const T* const temperature_bias, const T* const drift, T* residual) const {
-    return Evaluate<true, T>(bias, nullptr, g_sensitivity, temperature_bias, drift, residual);
-  }
+  // With effects: b_g and the effects' block (a functor of its own: the
+  // form without effects also takes two blocks).
+  struct WithEffects;
 
   static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& force,
                                      const Eigen::Matrix3d& sqrt_information, bool g_sensitivity) {
@@ -76,25 +74,20 @@ struct GyroStaticResidual {
   static ceres::CostFunction* CreateWithEffects(const Eigen::Vector3d& raw_mean,
                                                 const Eigen::Matrix3d& sqrt_information,
                                                 const Eigen::Vector3d& force,
-                                                double temperature_offset, double time_offset) {
-    return new ceres::AutoDiffCostFunction<GyroStaticResidual, 3, 3, 9, 3, 3>(
-        new GyroStaticResidual(raw_mean, force, sqrt_information, temperature_offset, time_offset));
-  }
+                                                double temperature_offset, double time_offset);
 
  private:
-  // kEffects: matrix is unused (M_g = I) and g_sensitivity is G' inside o_k;
+  // kEffects: matrix is unused (M_g = I) and the effects make o_k;
   // otherwise o_k = 0 and g_sensitivity is G (may be null). Each form keeps
   // its own order of operations.
   template <bool kEffects, typename T>
-  bool Evaluate(const T* bias, const T* matrix, const T* g_sensitivity, const T* temperature_bias,
-                const T* drift, T* residual) const {
+  bool Evaluate(const T* bias, const T* matrix, const T* g_sensitivity, const T* effects,
+                T* residual) const {
     GyroBlocks<T> gyro;
     gyro.bias = bias;
     T e[3];
     if constexpr (kEffects) {
-      gyro.g_effect = g_sensitivity;
-      gyro.temperature_bias = temperature_bias;
-      gyro.drift = drift;
+      PointIntoBlocks<T>(nullptr, effects, gyro.effect);
       ImuModel<T>(gyro).GyroRestError(raw_mean_, force_.data(), temperature_offset_, time_offset_,
                                       e);
       for (int r = 0; r < 3; ++r) {
@@ -119,6 +112,21 @@ struct GyroStaticResidual {
   const double temperature_offset_;
   const double time_offset_;
 };
+
+struct GyroStaticResidual::WithEffects {
+  template <typename T>
+  bool operator()(const T* const bias, const T* const effects, T* residual) const {
+    return residual_.template Evaluate<true, T>(bias, nullptr, nullptr, effects, residual);
+  }
+  const GyroStaticResidual residual_;
+};
+
+inline ceres::CostFunction* GyroStaticResidual::CreateWithEffects(
+    const Eigen::Vector3d& raw_mean, const Eigen::Matrix3d& sqrt_information,
+    const Eigen::Vector3d& force, double temperature_offset, double time_offset) {
+  return new ceres::AutoDiffCostFunction<WithEffects, 3, 3, kGyroEffectParameters>(new WithEffects{
+      GyroStaticResidual(raw_mean, force, sqrt_information, temperature_offset, time_offset)});
+}
 
 }  // namespace gravcal
 

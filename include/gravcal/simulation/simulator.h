@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -46,6 +47,13 @@ struct PlannedHold {
   Eigen::Vector3d turn_axis = Eigen::Vector3d::Zero();
   double turn_angle_deg = 0.0;
   double turn_seconds = 0.0;
+};
+
+// The truth spread of every effect, by effect (SimulatorOptions::effect_std).
+struct EffectSpreads {
+  std::array<double, kNumEffects> values{};
+  double& operator[](Effect e) { return values[static_cast<int>(e)]; }
+  double operator[](Effect e) const { return values[static_cast<int>(e)]; }
 };
 
 struct SimulatorOptions {
@@ -127,10 +135,6 @@ struct SimulatorOptions {
   double hand_min_seconds = 1.0;
   double hand_max_seconds = 4.0;
   double hand_wobble_deg = 10.0;
-  // Gyroscope g-sensitivity: each element of the truth G drawn N(0, std),
-  // rad/s per m/s^2; the raw gyroscope is u = M_g^-1 (w + G f) + b_g + n_g.
-  // 0 = off.
-  double gyro_g_sensitivity_std = 0.0;
 
   // Temperature: starts at temperature_start and relaxes towards
   // temperature_end with time constant temperature_tau seconds.
@@ -161,18 +165,12 @@ struct SimulatorOptions {
   // few mg over minutes (1e-5 to 1e-4 m/s^2/s); gyroscope g-sensitivity
   // about 0.1 deg/s/g (1.8e-4 rad/s per m/s^2); gyroscope bias tempco
   // 0.01-0.05 deg/s/K (2e-4 to 9e-4 rad/s/K).
-  // k2 per axis, 1/(m/s^2).
-  double accel_quadratic_std = 0.0;
-  // beta per axis, m/s^2 per degree C.
-  double accel_temperature_bias_std = 0.0;
-  // c per axis, fraction per degree C.
-  double accel_temperature_scale_std = 0.0;
-  // delta per axis, m/s^2 per second.
-  double accel_bias_drift_std = 0.0;
-  // gamma per axis, rad/s per degree C.
-  double gyro_temperature_bias_std = 0.0;
-  // eta per axis, rad/s per second.
-  double gyro_bias_drift_std = 0.0;
+  // The spread of each effect of the registry (core/effect_registry.h) that
+  // has a simulation key (its definition's kSimulation: the key sim_<...>,
+  // e.g. sim_accel_quadratic for k2 per axis, 1/(m/s^2)), indexed by the
+  // effect; 0 = off. The gyroscope g-sensitivity G (sim_gyro_g_sensitivity)
+  // is in rad/s per m/s^2: u = M_g^-1 (w + G f) + b_g + n_g.
+  EffectSpreads effect_std;
   // The temperature at which the temperature terms are zero, degrees C.
   double effect_reference_temperature = 25.0;
 

@@ -2,7 +2,6 @@
 // calibration method: "simulator" (SimulatorOptions, every sim_* key, made
 // from the options' own table, simulation/simulator_fields.h) and "motion
 // simulator" (sim_motion and MotionOptions, the hh_* keys).
-#include <variant>
 
 #include "simulation/simulator_fields.h"
 #include "workflows/config/config_key.h"
@@ -17,14 +16,16 @@ KeyHandlerOf<SimulationConfig> FieldHandler(const SimulatorField& field) {
   KeyHandlerOf<SimulationConfig> h;
   h.name = field.key;
   h.help = field.help;
-  std::visit(
-      [&h](auto member) {
-        h.set = [member](const YAML::Node& n, SimulationConfig* c, std::string* e) {
-          return ReadValue(n, &(c->simulation.*member), e);
-        };
-        h.get = [member](const SimulationConfig& c) { return ValueText(c.simulation.*member); };
-      },
-      field.member);
+  h.set = [field](const YAML::Node& n, SimulationConfig* c, std::string* e) {
+    bool ok = false;
+    WithFieldValue(field, c->simulation, [&](auto& value) { ok = ReadValue(n, &value, e); });
+    return ok;
+  };
+  h.get = [field](const SimulationConfig& c) {
+    std::string text;
+    WithFieldValue(field, c.simulation, [&](const auto& value) { text = ValueText(value); });
+    return text;
+  };
   return h;
 }
 
