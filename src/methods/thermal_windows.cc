@@ -1,9 +1,9 @@
 // The static windows of a thermal session (thermal_calibration.h, ThermalWindows).
-#include "gravcal/methods/thermal_calibration.h"
-
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+
+#include "gravcal/methods/thermal_calibration.h"
 
 namespace gravcal {
 namespace {
