@@ -10,11 +10,12 @@
 
 #include "gravcal/core/gravity.h"
 #include "gravcal/workflows/multi_imu_log.h"
+#include "util/units.h"
 
 namespace gravcal {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using internal::kDegToRad;
 
 std::string At(const std::string& name, const YAML::Node& node) {
   std::ostringstream s;
