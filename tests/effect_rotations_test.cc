@@ -107,14 +107,7 @@ TEST(AccelRotationResidual, JacobianMatchesNumericDifferences) {
   std::unique_ptr<ceres::CostFunction> cost(AccelRotationResidual::Create(d));
   double bias[3] = {0.02, -0.03, 0.05};
   double upper[6] = {1.01, 0.002, -0.003, 0.99, 0.001, 1.02};
-  // The effects' block (core/effect_registry.h), every term switched on.
-  EffectParameters p;
-  p.Vector(Effect::kAccelQuadratic) << 1e-4, -2e-4, 5e-5;
-  p.Vector(Effect::kAccelTemperatureBias) << 0.002, -0.001, 0.003;
-  p.Vector(Effect::kAccelTemperatureScale) << 1e-4, -2e-4, 3e-4;
-  p.Vector(Effect::kAccelBiasDrift) << 8e-5, -5e-5, 2e-5;
-  p.Vector(Effect::kAccelTemperatureBiasQuadratic) << 2e-4, -1e-4, 3e-4;
-  std::vector<double> effects(p.accel.begin(), p.accel.end());
+  std::vector<double> effects = testing_util::EveryAccelEffectOn();
   double gyro_bias[3] = {0.01, -0.02, 0.005};
   double gyro_matrix[9] = {1.0, 0.01, -0.02, 0.005, 0.98, 0.01, -0.01, 0.02, 1.03};
   std::vector<std::vector<double>> jacobians;

@@ -97,6 +97,18 @@ inline AccelModel Nominal(const SimulatedSession& session) {
   return m;
 }
 
+// The accelerometer effects' block (core/effect_registry.h) with every term
+// switched on, for the residuals' Jacobian checks.
+inline std::vector<double> EveryAccelEffectOn() {
+  EffectParameters p;
+  p.Vector(Effect::kAccelQuadratic) << 1e-4, -2e-4, 5e-5;
+  p.Vector(Effect::kAccelTemperatureBias) << 0.002, -0.001, 0.003;
+  p.Vector(Effect::kAccelTemperatureScale) << 1e-4, -2e-4, 3e-4;
+  p.Vector(Effect::kAccelBiasDrift) << 8e-5, -5e-5, 2e-5;
+  p.Vector(Effect::kAccelTemperatureBiasQuadratic) << 2e-4, -1e-4, 3e-4;
+  return std::vector<double>(p.accel.begin(), p.accel.end());
+}
+
 }  // namespace testing_util
 }  // namespace gravcal
 

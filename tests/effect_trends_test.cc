@@ -92,14 +92,7 @@ TEST(AccelTrendResidual, JacobianMatchesNumericDifferences) {
       AccelTrendResidual::Create(raw, slope, whitening, 0.03, 4.0, -50.0));
   double bias[3] = {20.0, -30.0, 45.0};
   double upper[6] = {6.0e-4, 2e-6, -3e-6, 6.1e-4, 1e-6, 5.9e-4};
-  // The effects' block (core/effect_registry.h), every term switched on.
-  EffectParameters p;
-  p.Vector(Effect::kAccelQuadratic) << 1e-4, -2e-4, 5e-5;
-  p.Vector(Effect::kAccelTemperatureBias) << 0.002, -0.001, 0.003;
-  p.Vector(Effect::kAccelTemperatureScale) << 1e-4, -2e-4, 3e-4;
-  p.Vector(Effect::kAccelBiasDrift) << 8e-5, -5e-5, 2e-5;
-  p.Vector(Effect::kAccelTemperatureBiasQuadratic) << 2e-4, -1e-4, 3e-4;
-  std::vector<double> effects(p.accel.begin(), p.accel.end());
+  std::vector<double> effects = testing_util::EveryAccelEffectOn();
   std::vector<std::vector<double>> jac;
   testing_util::ExpectJacobianMatchesCentralDifferences(*cost, {bias, upper, effects.data()},
                                                         {3, 6, kAccelEffectParameters},
