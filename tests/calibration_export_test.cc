@@ -257,7 +257,7 @@ TEST(Apply, RowsCorrectedOnWorkerThreadsAreTheOneThreadBytes) {
   ImuCsvStreamWriter writer;
   ASSERT_TRUE(reader.Open(raw, &error)) << error;
   ASSERT_TRUE(writer.Open(scratch / "one_thread.csv", true, true, {}, &error)) << error;
-  ThermalRate rate;
+  ThermalElementRate rate(loaded.corrector.thermal.lag_time_constant);
   ImuSample s;
   while (reader.Next(&s, &error)) {
     bool clamped = false;
