@@ -129,6 +129,7 @@ int RunCalibrate(const CalibrateArgs& args) {
   Session session;
   CalibrationProvenance provenance;
   LongLogReading reading;
+  reading.max_samples = static_cast<size_t>(args.config.input.max_log_entries);
   if (!ReadImuLogBounded(args.input, args.config.input, &reading, &session.log, &provenance,
                          &error)) {
     return Fail(error);
