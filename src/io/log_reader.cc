@@ -164,9 +164,10 @@ bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std
     }
     add_rows(parser.values(), 1);
     // The rest of a long file on several threads (io/log_blocks.h): the
-    // same rows and errors.
-    if (threads > 1 && internal::CanParseLogBlocks(*source, parser) &&
-        (bytes == 0 || bytes - source->bytes_read() >= internal::kMinBlockParseBytes)) {
+    // same rows and errors. Not a pipe (bytes 0): its reader thread could
+    // wait on the writer after an error.
+    if (threads > 1 && internal::CanParseLogBlocks(*source, parser) && bytes > 0 &&
+        bytes - source->bytes_read() >= internal::kMinBlockParseBytes) {
       if (!internal::ParseLogBlocks(source, &parser, threads, add_rows, &why)) break;
     }
   }
