@@ -84,7 +84,9 @@ class BlockPipeline {
   // Blocks of `block_bytes` of text read, plus the unfinished line carried
   // over from the one before (at most kMaxLogLineBytes).
   BlockPipeline(LogLines* source, const LogRowParser& rules, int threads, size_t block_bytes)
-      : source_(source), block_bytes_(block_bytes), slots_(2 * static_cast<size_t>(threads) + 2) {
+      : source_(source),
+        block_bytes_(block_bytes),
+        slots_(std::min(2 * static_cast<size_t>(threads) + 2, kMaxLogBlocksInFlight)) {
     // The reader starts with the bytes the line reader held.
     const std::string_view head = source->TakeBuffered();
     head_.assign(head.begin(), head.end());

@@ -29,8 +29,13 @@ using LogRowSink = std::function<void(const double* rows, size_t count)>;
 // A file with fewer bytes left than this is read line by line: threads
 // would not pay for themselves.
 constexpr uint64_t kMinBlockParseBytes = uint64_t{16} << 20;
-// Text read per block (tests use smaller blocks).
-constexpr size_t kLogBlockBytes = size_t{2} << 20;
+// Text read per block (tests use smaller blocks), and the most blocks in
+// flight (read, parsed or being taken). A block's rows cost at most about
+// 11 times its text (8 doubles for a row of at least 6 bytes, "1,2,3\n"), so
+// the blocks cost at most about 100 MB whatever the log and the threads (2
+// MB for rows of 40 bytes).
+constexpr size_t kLogBlockBytes = size_t{1} << 20;
+constexpr size_t kMaxLogBlocksInFlight = 8;
 
 // Whether ParseLogBlocks can take over `source` now: a file (not text in
 // memory) whose line ends are newlines, read by `parser` up to a row (its

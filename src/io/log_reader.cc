@@ -86,10 +86,12 @@ size_t EstimateRows(std::string_view rest, uint64_t total) {
   return static_cast<size_t>(rows * 1.02) + 16;
 }
 
-// Threads that parse a long log (LongLogReading::threads; 0: the cores).
+// Threads that parse a long log (LongLogReading::threads; 0: the cores, at
+// most as many as blocks can be in flight).
 int ReadingThreads(const LongLogReading& reading) {
   if (reading.threads > 0) return reading.threads;
-  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  return static_cast<int>(std::min<unsigned>(cores, internal::kMaxLogBlocksInFlight - 2));
 }
 
 // Parses the lines of one text log (io/log_text.h; text in memory or a file
