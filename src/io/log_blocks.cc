@@ -18,7 +18,7 @@ namespace gravcal {
 namespace internal {
 namespace {
 
-inline bool IsBlank(char c) { return c == ' ' || c == '\t'; }
+inline bool IsRowBlank(char c) { return c == ' ' || c == '\t'; }
 
 struct TextBlock {
   // Set by the reader: whole lines (the last block: up to the end of the
@@ -58,7 +58,7 @@ void ParseBlock(LogRowParser* rules, TextBlock* block) {
     ++lines;
     const char* s = p;
     p = newline != nullptr ? newline + 1 : end;
-    while (s < stop && IsBlank(*s)) ++s;
+    while (s < stop && IsRowBlank(*s)) ++s;
     if (s == stop || *s == '#') continue;
     if (!rules->ParseFields(s, stop, 0, &why)) return;
     if ((count + 1) * kNumSlots > block->rows.size()) {
