@@ -98,7 +98,7 @@ std::string ExpectSameAsLineByLine(const std::string& name, const std::string& t
 
 // Rows of raw counts and decimals, with comments, blank lines, blanks
 // around cells, '+' signs and exponents among them.
-std::string Rows(int n, const char* end = "\n", int first = 0) {
+std::string MixedRows(int n, const char* end = "\n", int first = 0) {
   std::mt19937_64 rng(5);
   std::uniform_int_distribution<int> counts(-40000, 40000);
   std::string text;
@@ -127,10 +127,11 @@ std::string Rows(int n, const char* end = "\n", int first = 0) {
 const char kHeader[] = "t,ax,ay,az,gx,gy,gz,temp\n";
 
 TEST(LogReaderBlocks, GoodLogsGiveTheSameRows) {
-  EXPECT_EQ(ExpectSameAsLineByLine("good.csv", kHeader + Rows(1500)), "");
-  EXPECT_EQ(ExpectSameAsLineByLine("crlf.csv", "t,ax,ay,az,gx,gy,gz,temp\r\n" + Rows(800, "\r\n")),
-            "");
-  std::string no_end = kHeader + Rows(700);
+  EXPECT_EQ(ExpectSameAsLineByLine("good.csv", kHeader + MixedRows(1500)), "");
+  EXPECT_EQ(
+      ExpectSameAsLineByLine("crlf.csv", "t,ax,ay,az,gx,gy,gz,temp\r\n" + MixedRows(800, "\r\n")),
+      "");
+  std::string no_end = kHeader + MixedRows(700);
   no_end.pop_back();  // The last line has no line end.
   EXPECT_EQ(ExpectSameAsLineByLine("no_end.csv", no_end), "");
   // No time column: t = row / sample_rate, counted across blocks.
@@ -154,7 +155,7 @@ TEST(LogReaderBlocks, GoodLogsGiveTheSameRows) {
 }
 
 TEST(LogReaderBlocks, BadLogsGiveTheSameErrorAtTheSameLine) {
-  const std::string good = Rows(600);
+  const std::string good = MixedRows(600);
   // Each fault replaces one line, at several places (so that some fall on a
   // block's first or last line).
   const std::vector<std::string> faults = {
@@ -190,12 +191,14 @@ TEST(LogReaderBlocks, BadLogsGiveTheSameErrorAtTheSameLine) {
   }
   // A last line too long, without a line end; a time equal to the one before
   // in the last row.
-  EXPECT_NE(ExpectSameAsLineByLine("long_end.csv", kHeader + Rows(300) + std::string(66000, '1'))
-                .find("66000 bytes long"),
-            std::string::npos);
-  EXPECT_NE(ExpectSameAsLineByLine("repeat_end.csv", kHeader + Rows(300) + "2.99,1,2,3,4,5,6,7\n")
-                .find("does not increase"),
-            std::string::npos);
+  EXPECT_NE(
+      ExpectSameAsLineByLine("long_end.csv", kHeader + MixedRows(300) + std::string(66000, '1'))
+          .find("66000 bytes long"),
+      std::string::npos);
+  EXPECT_NE(
+      ExpectSameAsLineByLine("repeat_end.csv", kHeader + MixedRows(300) + "2.99,1,2,3,4,5,6,7\n")
+          .find("does not increase"),
+      std::string::npos);
 }
 
 TEST(LogReaderBlocks, ALongFileReadOnTwoThreadsEqualsOneThread) {
