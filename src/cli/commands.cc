@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "cli/read_long_log.h"
 #include "gravcal/io/attitude_fixture.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/files.h"
@@ -27,6 +28,16 @@ namespace cli {
 int Fail(const std::string& message, int code) {
   std::fprintf(stderr, "gravcal: error: %s\n", message.c_str());
   return code;
+}
+
+bool ReadLongLog(const std::string& path, const LogReaderOptions& input, ImuLog* log,
+                 std::string* error) {
+  LongLogReading reading;
+  reading.max_samples = static_cast<size_t>(input.max_log_entries);
+  if (!ReadImuLogBounded(path, input, &reading, log, nullptr, error)) return false;
+  const std::string said = reading.Describe();
+  if (!said.empty()) std::fprintf(stderr, "gravcal: warning: %s\n", said.c_str());
+  return true;
 }
 
 namespace {
@@ -129,6 +140,7 @@ int RunCalibrate(const CalibrateArgs& args) {
   Session session;
   CalibrationProvenance provenance;
   LongLogReading reading;
+  reading.max_samples = static_cast<size_t>(args.config.input.max_log_entries);
   if (!ReadImuLogBounded(args.input, args.config.input, &reading, &session.log, &provenance,
                          &error)) {
     return Fail(error);

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "cli/read_long_log.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
 #include "gravcal/workflows/discovery.h"
@@ -17,7 +18,7 @@ int RunDiscover(const LogReportArgs& args) {
   std::string error;
   if (!args.config.IsValid(&error)) return Fail(error);
   ImuLog log;
-  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  if (!ReadLongLog(args.input, args.config.input, &log, &error)) return Fail(error);
   DiscoveryResult result;
   if (!DiscoverEffects(log, args.config.calibration, args.config.effects, args.config.discovery,
                        &result)) {

@@ -39,6 +39,7 @@ int RunNoise(const LogReportArgs& args) {
   // In bounded memory: a long log is read as block means (io/long_log.h).
   ImuLog log;
   LongLogReading reading;
+  reading.max_samples = static_cast<size_t>(args.config.input.max_log_entries);
   if (!ReadImuLogBounded(args.input, args.config.input, &reading, &log, nullptr, &error)) {
     return Fail(error);
   }

@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "cli/read_long_log.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/log_reader.h"
@@ -56,7 +57,7 @@ int RunCheck(const PlanArgs& args) {
   if (!RequestWithNoise(args.request, args.noise, &noise, &request, &error)) return Fail(error);
   if (!args.config.input.IsValid(&error)) return Fail("input: " + error);
   ImuLog log;
-  if (!ReadImuLog(args.input, args.config.input, &log, &error)) return Fail(error);
+  if (!ReadLongLog(args.input, args.config.input, &log, &error)) return Fail(error);
   CoverageReport report;
   if (!CheckRecording(log, args.config, request, &report, &error)) return Fail(error);
   std::printf("%s", CoverageReportText(report).c_str());

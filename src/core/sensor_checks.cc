@@ -21,49 +21,90 @@ std::string Num(double v) {
   return buf;
 }
 
-// The warning for one extreme `value` of axis `axis` of `x`, or "".
-std::string SaturatedAt(const std::string& sensor, const std::vector<Eigen::Vector3d>& x, int axis,
-                        double value, double band, const char* which) {
+// The samples of one axis at one of its extreme values: how many, in how
+// many runs (of consecutive samples), the first and the longest run, and
+// how many other samples are near it (within `band`).
+struct ExtremeRuns {
+  double value = 0.0, band = 0.0;
   size_t at = 0, near = 0, runs = 0, longest = 0, longest_begin = 0, first_begin = 0;
-  for (size_t i = 0; i < x.size();) {
-    const double v = x[i][axis];
-    if (v != value) {
-      if (std::abs(v - value) <= band) ++near;
-      ++i;
-      continue;
+  size_t run_begin = 0;
+  bool in_run = false;
+
+  void Add(double v, size_t i) {
+    if (v == value) {
+      if (!in_run) {
+        in_run = true;
+        run_begin = i;
+        if (runs++ == 0) first_begin = i;
+      }
+      ++at;
+      return;
     }
-    const size_t begin = i;
-    while (i < x.size() && x[i][axis] == value) ++i;
-    at += i - begin;
-    if (runs++ == 0) first_begin = begin;
-    if (i - begin > longest) {
-      longest = i - begin;
-      longest_begin = begin;
+    End(i);
+    if (std::abs(v - value) <= band) ++near;
+  }
+  void End(size_t i) {
+    if (!in_run) return;
+    in_run = false;
+    if (i - run_begin > longest) {
+      longest = i - run_begin;
+      longest_begin = run_begin;
     }
   }
-  if (at < 3 || longest < 2 || at <= near) return "";
-  return sensor + " " + kAxis[axis] + ": " + std::to_string(at) + " samples in " +
-         std::to_string(runs) + " run" + (runs == 1 ? "" : "s") + " sit at its " + which +
-         " value " + Num(value) + " (first at sample " + std::to_string(first_begin) +
-         ", longest samples " + std::to_string(longest_begin) + "-" +
-         std::to_string(longest_begin + longest) +
+};
+
+// The warning for one extreme of axis `axis` (counted in `e`), or "".
+std::string SaturatedAt(const std::string& sensor, int axis, const ExtremeRuns& e,
+                        const char* which) {
+  if (e.at < 3 || e.longest < 2 || e.at <= e.near) return "";
+  return sensor + " " + kAxis[axis] + ": " + std::to_string(e.at) + " samples in " +
+         std::to_string(e.runs) + " run" + (e.runs == 1 ? "" : "s") + " sit at its " + which +
+         " value " + Num(e.value) + " (first at sample " + std::to_string(e.first_begin) +
+         ", longest samples " + std::to_string(e.longest_begin) + "-" +
+         std::to_string(e.longest_begin + e.longest) +
          "): the axis looks saturated (clipped at its full scale), and the poses or turns "
          "with those samples are wrong; record with a larger range or turn more slowly";
 }
 
+// Two passes over the samples: the extremes of each axis, then their runs
+// (every axis and both extremes at once).
 void CheckSensor(const std::string& sensor, const std::vector<Eigen::Vector3d>& x,
                  std::vector<std::string>* warnings) {
   if (x.size() < 3) return;
+  double lo[3], hi[3];
   for (int axis = 0; axis < 3; ++axis) {
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const Eigen::Vector3d& v : x) {
-      lo = std::min(lo, v[axis]);
-      hi = std::max(hi, v[axis]);
+    lo[axis] = std::numeric_limits<double>::infinity();
+    hi[axis] = -lo[axis];
+  }
+  for (const Eigen::Vector3d& v : x) {
+    for (int axis = 0; axis < 3; ++axis) {
+      lo[axis] = std::min(lo[axis], v[axis]);
+      hi[axis] = std::max(hi[axis], v[axis]);
     }
-    if (!(hi > lo) || !std::isfinite(hi - lo)) continue;
-    const double band = 0.01 * (hi - lo);
-    for (const std::string& w : {SaturatedAt(sensor, x, axis, hi, band, "largest"),
-                                 SaturatedAt(sensor, x, axis, lo, band, "smallest")}) {
+  }
+  // [axis][0]: the largest value, [axis][1]: the smallest.
+  ExtremeRuns extremes[3][2];
+  bool checked[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    checked[axis] = hi[axis] > lo[axis] && std::isfinite(hi[axis] - lo[axis]);
+    const double band = checked[axis] ? 0.01 * (hi[axis] - lo[axis]) : 0.0;
+    extremes[axis][0].value = hi[axis];
+    extremes[axis][1].value = lo[axis];
+    extremes[axis][0].band = extremes[axis][1].band = band;
+  }
+  for (size_t i = 0; i < x.size(); ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!checked[axis]) continue;
+      extremes[axis][0].Add(x[i][axis], i);
+      extremes[axis][1].Add(x[i][axis], i);
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!checked[axis]) continue;
+    for (int k = 0; k < 2; ++k) {
+      extremes[axis][k].End(x.size());
+      const std::string w =
+          SaturatedAt(sensor, axis, extremes[axis][k], k == 0 ? "largest" : "smallest");
       if (!w.empty()) warnings->push_back(w);
     }
   }

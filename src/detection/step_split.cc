@@ -15,16 +15,27 @@ namespace gravcal {
 namespace internal {
 namespace {
 
-// Prefix sums over one run for the line fits of SplitRunAtSteps: of x - r,
+// The line fitted to every window of w samples of one run (window j: the
+// run's samples [j, j + w)), from prefix sums over the run of x - r,
 // j (x - r) and |x - r|^2 per axis, j the sample's index in the run and r
 // its first sample (small magnitudes: no cancellation with raw counts).
-struct LinePrefix {
-  std::vector<Eigen::Vector3d> s0, s1, s2;
-  LinePrefix(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end) {
+// SplitRunAtSteps compares the windows either side of each sample, at every
+// level of its recursion: each window is fitted once, here.
+struct WindowLines {
+  struct Line {
+    // The window's mean and the line's slope per sample; the residual
+    // variance about the line and the variance about the mean, summed over
+    // the axes.
+    Eigen::Vector3d mean, slope;
+    double residual, variance;
+  };
+  std::vector<Line> lines;
+  double mean_j;  // the window's mean local position
+
+  WindowLines(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end, size_t w) {
     const size_t n = end - begin;
-    s0.assign(n + 1, Eigen::Vector3d::Zero());
-    s1 = s0;
-    s2 = s0;
+    std::vector<Eigen::Vector3d> s0(n + 1, Eigen::Vector3d::Zero());
+    std::vector<Eigen::Vector3d> s1 = s0, s2 = s0;
     const Eigen::Vector3d r = x[begin];
     for (size_t j = 0; j < n; ++j) {
       const Eigen::Vector3d d = x[begin + j] - r;
@@ -32,24 +43,27 @@ struct LinePrefix {
       s1[j + 1] = s1[j] + static_cast<double>(j) * d;
       s2[j + 1] = s2[j] + d.cwiseProduct(d);
     }
+    const double len = static_cast<double>(w);
+    mean_j = 0.5 * (len - 1.0);
+    const double sjj = len * (len * len - 1.0) / 12.0;
+    lines.resize(n - w + 1);
+    for (size_t a = 0; a + w <= n; ++a) {
+      const Eigen::Vector3d sx = s0[a + w] - s0[a];
+      const Eigen::Vector3d sjx = s1[a + w] - s1[a] - static_cast<double>(a) * sx;
+      const Eigen::Vector3d sxx = s2[a + w] - s2[a];
+      Line& line = lines[a];
+      line.slope = (sjx - mean_j * sx) / sjj;
+      line.mean = sx / len;
+      const double rss =
+          (sxx - sx.cwiseProduct(sx) / len - line.slope.cwiseProduct(line.slope) * sjj).sum();
+      line.residual = std::max(rss, 0.0) / std::max(len - 2.0, 1.0);
+      line.variance =
+          std::max((sxx - sx.cwiseProduct(sx) / len).sum(), 0.0) / std::max(len - 1.0, 1.0);
+    }
   }
-  // The line fitted to run samples [a, a + len): its value at local position
-  // t (0 = sample a) and its residual variance summed over the axes; the
-  // samples' mean and variance about it.
-  void Fit(size_t a, size_t len, double t, Eigen::Vector3d* value, double* residual,
-           Eigen::Vector3d* mean, double* variance) const {
-    const double n = static_cast<double>(len);
-    const Eigen::Vector3d sx = s0[a + len] - s0[a];
-    const Eigen::Vector3d sjx = s1[a + len] - s1[a] - static_cast<double>(a) * sx;
-    const Eigen::Vector3d sxx = s2[a + len] - s2[a];
-    const double mean_j = 0.5 * (n - 1.0);
-    const double sjj = n * (n * n - 1.0) / 12.0;
-    const Eigen::Vector3d slope = (sjx - mean_j * sx) / sjj;
-    *value = sx / n + slope * (t - mean_j);
-    const double rss = (sxx - sx.cwiseProduct(sx) / n - slope.cwiseProduct(slope) * sjj).sum();
-    *residual = std::max(rss, 0.0) / std::max(n - 2.0, 1.0);
-    *mean = sx / n;
-    *variance = std::max((sxx - sx.cwiseProduct(sx) / n).sum(), 0.0) / std::max(n - 1.0, 1.0);
+  // The line of window a at local position t (0 = its first sample).
+  Eigen::Vector3d Value(const Line& line, double t) const {
+    return line.mean + line.slope * (t - mean_j);
   }
 };
 
@@ -61,7 +75,7 @@ struct LinePrefix {
 // has no direction), |b - a|^2 >= min_change2 apart. `floor` (the noise
 // floor, summed over the axes) bounds the residual variances from below
 // (quantised data can fit a line exactly). Appends the parts.
-void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& prefix, size_t base,
+void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const WindowLines& fits, size_t base,
                      size_t begin, size_t end, size_t w, double floor, double min_change2,
                      const StaticDetectorOptions& options, std::vector<QuietRun>* parts) {
   if (end - begin < 2 * w) {
@@ -75,14 +89,15 @@ void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& pr
   double best = options.step_factor;
   size_t split = 0;
   for (size_t s = begin + w; s + w <= end; ++s) {
-    Eigen::Vector3d left, right, m1, m2;
-    double r1, r2, v1, v2;
-    prefix.Fit(s - w - base, w, len - 0.5, &left, &r1, &m1, &v1);
-    prefix.Fit(s - base, w, -0.5, &right, &r2, &m2, &v2);
+    const WindowLines::Line& before = fits.lines[s - w - base];
+    const WindowLines::Line& after = fits.lines[s - base];
+    const Eigen::Vector3d left = fits.Value(before, len - 0.5);
+    const Eigen::Vector3d right = fits.Value(after, -0.5);
     const double t_line =
-        (right - left).squaredNorm() / (c * (std::max(r1, floor) + std::max(r2, floor)));
-    const double t_mean =
-        (m2 - m1).squaredNorm() * len / (std::max(v1, floor) + std::max(v2, floor));
+        (right - left).squaredNorm() /
+        (c * (std::max(before.residual, floor) + std::max(after.residual, floor)));
+    const double t_mean = (after.mean - before.mean).squaredNorm() * len /
+                          (std::max(before.variance, floor) + std::max(after.variance, floor));
     const double t = std::min(t_line, t_mean);
     if (!(t > best)) continue;
     const Eigen::Vector3d a = left + r, b = right + r;
@@ -97,8 +112,8 @@ void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const LinePrefix& pr
     parts->push_back({begin, end});
     return;
   }
-  SplitRunAtSteps(x, prefix, base, begin, split, w, floor, min_change2, options, parts);
-  SplitRunAtSteps(x, prefix, base, split, end, w, floor, min_change2, options, parts);
+  SplitRunAtSteps(x, fits, base, begin, split, w, floor, min_change2, options, parts);
+  SplitRunAtSteps(x, fits, base, split, end, w, floor, min_change2, options, parts);
 }
 
 }  // namespace
@@ -115,8 +130,8 @@ size_t SplitRunsAtSteps(const std::vector<Eigen::Vector3d>& x, size_t w, double 
       out.push_back(run);
       continue;
     }
-    const LinePrefix prefix(x, run.begin, run.end);
-    SplitRunAtSteps(x, prefix, run.begin, run.begin, run.end, w, floor, min_change2, options, &out);
+    const WindowLines fits(x, run.begin, run.end, w);
+    SplitRunAtSteps(x, fits, run.begin, run.begin, run.end, w, floor, min_change2, options, &out);
   }
   const size_t steps = out.size() - runs->size();
   *runs = std::move(out);

@@ -4,13 +4,20 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "util/source_prefix.h"
+#include "util/thread_pool.h"
 
 namespace gravcal {
 namespace internal {
 namespace {
+
+// Still intervals of this many samples or more have their axes worked on
+// every core (a long log's noise model: about 1 s of CPU per axis for 2^21
+// samples); shorter ones on the calling thread.
+constexpr size_t kParallelNoiseSamples = size_t{1} << 20;
 
 // Allan curve and fit of one axis of `samples` (already SI) over the still
 // interval.
@@ -170,31 +177,41 @@ bool CharacteriseNoise(const ImuLog& log, const NoiseOptions& options, ImuNoise*
   }
 
   const char* axes = "xyz";
+  // The axes (accelerometer x, y, z, then gyroscope x, y, z) are
+  // independent: for a long interval on every core, each with its own
+  // samples (the same results); the first failure in that order is the one
+  // reported, as on one thread.
+  const size_t sensors = log.has_gyro() ? 2 : 1;
+  std::vector<std::string> errors(3 * sensors);
+  std::vector<char> ok(3 * sensors, 0);
+  const int threads = end - begin >= internal::kParallelNoiseSamples
+                          ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
+                          : 1;
+  internal::ParallelFor(3 * sensors, threads, [&](size_t k) {
+    const int a = static_cast<int>(k % 3);
+    const bool gyro = k >= 3;
+    const std::vector<Eigen::Vector3d>& x = gyro ? log.gyro : log.accel;
+    const double scale = gyro ? options.gyro_scale : options.accel_scale;
+    std::vector<double> samples(end - begin);
+    for (size_t i = begin; i < end; ++i) samples[i - begin] = scale * x[i](a);
+    ok[k] = internal::CharacteriseAxis(
+        samples, model, options, std::string(gyro ? "gyro " : "accel ") + axes[a],
+        gyro ? &result->gyro_curves[a] : &result->accel_curves[a],
+        gyro ? &model.gyro[a] : &model.accel[a],
+        gyro ? &result->gyro_lines[a] : &result->accel_lines[a], &errors[k]);
+  });
+  for (size_t k = 0; k < ok.size(); ++k) {
+    if (!ok[k]) {
+      result->message = log.source + ": " + errors[k];
+      return false;
+    }
+  }
+  if (!log.has_gyro()) {
+    NoiseTerm missing;
+    missing.reason = "the log has no gyroscope";
+    for (int a = 0; a < 3; ++a) model.gyro[a] = {missing, missing, missing, missing};
+  }
   std::vector<double> samples(end - begin);
-  for (int a = 0; a < 3; ++a) {
-    for (size_t i = begin; i < end; ++i) samples[i - begin] = options.accel_scale * log.accel[i](a);
-    if (!internal::CharacteriseAxis(samples, model, options, std::string("accel ") + axes[a],
-                                    &result->accel_curves[a], &model.accel[a],
-                                    &result->accel_lines[a], &error)) {
-      result->message = log.source + ": " + error;
-      return false;
-    }
-  }
-  for (int a = 0; a < 3; ++a) {
-    if (!log.has_gyro()) {
-      NoiseTerm missing;
-      missing.reason = "the log has no gyroscope";
-      model.gyro[a] = {missing, missing, missing, missing};
-      continue;
-    }
-    for (size_t i = begin; i < end; ++i) samples[i - begin] = options.gyro_scale * log.gyro[i](a);
-    if (!internal::CharacteriseAxis(samples, model, options, std::string("gyro ") + axes[a],
-                                    &result->gyro_curves[a], &model.gyro[a], &result->gyro_lines[a],
-                                    &error)) {
-      result->message = log.source + ": " + error;
-      return false;
-    }
-  }
   if (log.has_temperature()) {
     for (size_t i = begin; i < end; ++i) samples[i - begin] = log.temperature[i];
     if (!ComputeAllanDeviation(samples, 0, samples.size(), model.rate_hz, options.allan,

@@ -16,15 +16,18 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include "core/warnings.h"
 #include "gravcal/io/long_log.h"
+#include "io/block_averager.h"
 #include "io/csv_table.h"
 #include "io/file_text.h"
 #include "io/formats/file_format.h"
 #include "io/formats/message_log.h"
+#include "io/log_blocks.h"
 #include "io/log_text.h"
 #include "util/cancellation.h"
 #include "util/content_hash.h"
@@ -35,6 +38,7 @@
 namespace gravcal {
 namespace {
 
+using internal::BlockAverager;
 using internal::FileText;
 
 using internal::ExactNumber;
@@ -82,6 +86,14 @@ size_t EstimateRows(std::string_view rest, uint64_t total) {
   return static_cast<size_t>(rows * 1.02) + 16;
 }
 
+// Threads that parse a long log (LongLogReading::threads; 0: the cores, at
+// most as many as blocks can be in flight).
+int ReadingThreads(const LongLogReading& reading) {
+  if (reading.threads > 0) return reading.threads;
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  return static_cast<int>(std::min<unsigned>(cores, internal::kMaxLogBlocksInFlight - 2));
+}
+
 // Parses the lines of one text log (io/log_text.h; text in memory or a file
 // read block by block, `bytes` long, 0 for text in memory): the main log, or
 // (`reference` not null) the second file holding the gyroscope, whose times
@@ -90,74 +102,6 @@ size_t EstimateRows(std::string_view rest, uint64_t total) {
 // it). Fills out->t, accel, gyro, temperature (only out->gyro for the
 // gyroscope file); does not check for an empty result. *lines is the number
 // of lines.
-// Rows into a log in bounded memory (LogReaderOptions::max_samples): pushed
-// as they are until the log holds `max` entries, then each two neighbours
-// merged into their mean and from then on every `block` rows pushed as one
-// mean.
-class BlockAverager {
- public:
-  BlockAverager(size_t max, ImuLog* out) : max_(max - max % 2), out_(out) {}
-
-  void Add(double t, const Eigen::Vector3d& accel, const Eigen::Vector3d* gyro,
-           const double* temperature) {
-    ImuLog& o = *out_;
-    // Full when a new block begins: halve first, so that a log of max_
-    // rows is kept as it is.
-    if (count_ == 0 && max_ > 0 && o.t.size() >= max_) Halve();
-    if (block_ == 1) {
-      o.t.push_back(t);
-      o.accel.push_back(accel);
-      if (gyro != nullptr) o.gyro.push_back(*gyro);
-      if (temperature != nullptr) o.temperature.push_back(*temperature);
-    } else {
-      t_ += t;
-      accel_ += accel;
-      if (gyro != nullptr) gyro_ += *gyro;
-      if (temperature != nullptr) temperature_ += *temperature;
-      if (++count_ < block_) return;
-      const double inv = 1.0 / static_cast<double>(block_);
-      o.t.push_back(t_ * inv);
-      o.accel.push_back(accel_ * inv);
-      if (gyro != nullptr) o.gyro.push_back(gyro_ * inv);
-      if (temperature != nullptr) o.temperature.push_back(temperature_ * inv);
-      t_ = 0.0;
-      temperature_ = 0.0;
-      accel_.setZero();
-      gyro_.setZero();
-      count_ = 0;
-    }
-  }
-
-  size_t block() const { return block_; }
-
- private:
-  // Each two neighbouring entries become their mean.
-  void Halve() {
-    ImuLog& o = *out_;
-    const size_t half = o.t.size() / 2;
-    for (size_t i = 0; i < half; ++i) {
-      o.t[i] = 0.5 * (o.t[2 * i] + o.t[2 * i + 1]);
-      o.accel[i] = 0.5 * (o.accel[2 * i] + o.accel[2 * i + 1]);
-      if (!o.gyro.empty()) o.gyro[i] = 0.5 * (o.gyro[2 * i] + o.gyro[2 * i + 1]);
-      if (!o.temperature.empty()) {
-        o.temperature[i] = 0.5 * (o.temperature[2 * i] + o.temperature[2 * i + 1]);
-      }
-    }
-    o.t.resize(half);
-    o.accel.resize(half);
-    if (!o.gyro.empty()) o.gyro.resize(half);
-    if (!o.temperature.empty()) o.temperature.resize(half);
-    block_ *= 2;
-  }
-
-  const size_t max_;
-  ImuLog* out_;
-  size_t block_ = 1;
-  size_t count_ = 0;
-  double t_ = 0.0, temperature_ = 0.0;
-  Eigen::Vector3d accel_ = Eigen::Vector3d::Zero(), gyro_ = Eigen::Vector3d::Zero();
-};
-
 bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std::string& name,
                const LogReaderOptions& options, const ImuLog* reference,
                const std::string& reference_name, ImuLog* out, size_t* lines,
@@ -167,6 +111,16 @@ bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std
   const size_t max_samples =
       bounded != nullptr && options.gyro_path.empty() ? bounded->max_samples : 0;
   BlockAverager averager(max_samples, out);
+  // Rows of kNumSlots values (LogRowParser::values) into the log.
+  const internal::LogRowSink add_rows = [&](const double* rows, size_t count) {
+    const bool gyro = parser.has(kGx), temperature = parser.has(kTemp);
+    for (const double* v = rows; v < rows + count * kNumSlots; v += kNumSlots) {
+      const Eigen::Vector3d accel(v[internal::kAx], v[internal::kAy], v[internal::kAz]);
+      const Eigen::Vector3d w = gyro ? Eigen::Vector3d(v[kGx], v[kGy], v[kGz]) : accel;
+      averager.Add(v[kT], accel, gyro ? &w : nullptr, temperature ? v + kTemp : nullptr);
+    }
+  };
+  const int threads = bounded != nullptr ? ReadingThreads(*bounded) : 1;
   std::string_view line;
   std::string why;
   bool reserved = false;
@@ -210,14 +164,14 @@ bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std
       if (parser.has(kTemp)) out->temperature.reserve(rows);
       reserved = true;
     }
-    const Eigen::Vector3d accel(parser.value(internal::kAx), parser.value(internal::kAy),
-                                parser.value(internal::kAz));
-    const Eigen::Vector3d gyro =
-        parser.has(kGx) ? Eigen::Vector3d(parser.value(kGx), parser.value(kGy), parser.value(kGz))
-                        : Eigen::Vector3d::Zero();
-    const double temperature = parser.has(kTemp) ? parser.value(kTemp) : 0.0;
-    averager.Add(parser.value(kT), accel, parser.has(kGx) ? &gyro : nullptr,
-                 parser.has(kTemp) ? &temperature : nullptr);
+    add_rows(parser.values(), 1);
+    // The rest of a long file on several threads (io/log_blocks.h): the
+    // same rows and errors. Not a pipe (bytes 0): its reader thread could
+    // wait on the writer after an error.
+    if (threads > 1 && internal::CanParseLogBlocks(*source, parser) && bytes > 0 &&
+        bytes - source->bytes_read() >= internal::kMinBlockParseBytes) {
+      if (!internal::ParseLogBlocks(source, &parser, threads, add_rows, &why)) break;
+    }
   }
   if (!why.empty()) return SetError(error, why);
   *lines = source->number();
@@ -334,6 +288,10 @@ bool LogReaderOptions::IsValid(std::string* error) const {
   }
   if (!std::isfinite(time_scale) || time_scale <= 0.0) {
     return SetError(error, "time_scale is " + ExactNumber(time_scale) + ", must be finite and > 0");
+  }
+  if (max_log_entries != 0 && max_log_entries < 16) {
+    return SetError(error, "max_log_entries is " + std::to_string(max_log_entries) +
+                               ", must be 0 (no limit) or at least 16");
   }
   if (format == LogFormat::kWhitespace && columns.empty()) {
     return SetError(error, "the whitespace format needs columns");

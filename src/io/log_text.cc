@@ -87,6 +87,12 @@ std::string LogWhere(const std::string& name, size_t line) {
   return name + ":" + std::to_string(line) + ": ";
 }
 
+std::string LongLineMessage(const std::string& name, size_t line, uint64_t bytes) {
+  return LogWhere(name, line) + "the line is " + std::to_string(bytes) +
+         " bytes long; a log line has at most " + std::to_string(kMaxLogLineBytes) +
+         " (is this a text log? are the line ends newlines?)";
+}
+
 std::string LogFileColumnName(const LogReaderOptions& options, int slot) {
   const auto it = options.rename.find(kLogSlotNames[slot]);
   return it == options.rename.end() ? std::string(kLogSlotNames[slot]) : it->second;
@@ -119,6 +125,27 @@ bool LogLines::Fill(std::string* error) {
   bytes_read_ += n;
   end_ += n;
   return true;
+}
+
+std::string_view LogLines::TakeBuffered() {
+  const std::string_view rest(data_ + begin_, end_ - begin_);
+  begin_ = end_;
+  return rest;
+}
+
+size_t LogLines::ReadRaw(char* out, size_t size, std::string* error) {
+  if (file_ == nullptr || eof_) return 0;
+  const size_t n = std::fread(out, 1, size, file_);
+  if (n == 0) {
+    if (std::ferror(file_)) {
+      SetError(error, name_ + ": cannot read: " + std::generic_category().message(errno));
+      return 0;
+    }
+    eof_ = true;
+  }
+  if (hash_ != nullptr) hash_->Append(std::string_view(out, n));
+  bytes_read_ += n;
+  return n;
 }
 
 std::string_view LogLines::Head(size_t bytes, std::string* error) {
@@ -190,10 +217,7 @@ bool LogLines::Next(std::string_view* line, std::string* error) {
           }
           bytes += end_ - begin_;
         }
-        return SetError(error, LogWhere(name_, number_) + "the line is " + std::to_string(bytes) +
-                                   " bytes long; a log line has at most " +
-                                   std::to_string(kMaxLogLineBytes) +
-                                   " (is this a text log? are the line ends newlines?)");
+        return SetError(error, LongLineMessage(name_, number_, bytes));
       }
       if (found && ends_ == Ends::kNewline && stop > begin_ && data_[stop - 1] == '\r') --stop;
       *line = std::string_view(data_ + begin_, stop - begin_);
@@ -234,7 +258,7 @@ bool LogRowParser::Line(std::string_view text, size_t line, bool* row, std::stri
     // skipped and `columns` names the fields instead.
     if (csv) return true;
   }
-  const bool ok = csv ? ParseRow<true>(s, end, line, error) : ParseRow<false>(s, end, line, error);
+  const bool ok = ParseFields(s, end, line, error);
   if (!ok || !CheckTime(line, error)) return false;
   ++rows_;
   *row = true;

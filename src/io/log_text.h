@@ -43,6 +43,9 @@ constexpr size_t kMaxLogColumns = 4096;
 // "name:line: ".
 std::string LogWhere(const std::string& name, size_t line);
 
+// "name:line: the line is 200000 bytes long; ..." (bytes up to its line end).
+std::string LongLineMessage(const std::string& name, size_t line, uint64_t bytes);
+
 // The name the file uses for a contract column (options.rename applied).
 std::string LogFileColumnName(const LogReaderOptions& options, int slot);
 
@@ -72,6 +75,24 @@ class LogLines {
   void HashInto(ContentHash* hash) { hash_ = hash; }
   // A file: the bytes read from it so far.
   uint64_t bytes_read() const { return bytes_read_; }
+
+  // For a reader that takes over the rest of a file (io/log_blocks.h):
+  // whether the lines end at "\n" (or "\r\n"), decided by the first line end;
+  // the bytes read but not yet returned as lines (taken: Next no longer sees
+  // them); the next bytes of the file into `out` (hashed and counted as Next
+  // would; 0 at the end, or on a read error with *error set); and the line
+  // number to continue from.
+  bool newline_ends() const { return ends_ == Ends::kNewline; }
+  bool is_file() const { return file_ != nullptr; }
+  std::string_view TakeBuffered();
+  size_t ReadRaw(char* out, size_t size, std::string* error);
+  void set_number(size_t number) { number_ = number; }
+  // Text in memory that continues a newline-ended text after its line
+  // `number` (the next line is number + 1).
+  void ContinueNewlineText(size_t number) {
+    number_ = number;
+    ends_ = Ends::kNewline;
+  }
 
  private:
   // Reads more of the file into the buffer; false on a read error.
@@ -105,6 +126,24 @@ class LogRowParser {
   // was a row: its values are value(slot), its time checked and scaled.
   bool Line(std::string_view line, size_t number, bool* row, std::string* error);
 
+  // The fields of one row that is not blank or a comment, [begin, end)
+  // without leading blanks, into value(slot), checked as Line checks them
+  // (messages name line `line`); time is left as in the file (no
+  // time_scale, no order check: Line does those).
+  bool ParseFields(const char* begin, const char* end, size_t line, std::string* error) {
+    return format_ == LogFormat::kCsv ? ParseRow<true>(begin, end, line, error)
+                                      : ParseRow<false>(begin, end, line, error);
+  }
+  // Rows read and the last time, as if Line had read rows up to here (for a
+  // reader that parsed some rows elsewhere).
+  void Resume(size_t rows, double previous_t) {
+    rows_ = rows;
+    previous_t_ = previous_t;
+  }
+  double previous_t() const { return previous_t_; }
+  const LogReaderOptions& options() const { return options_; }
+  const double* values() const { return values_; }
+
   bool has_layout() const { return have_layout_; }
   bool has(int slot) const { return has_[slot]; }
   // A row's value: t in seconds (time_scale applied, or index / sample_rate
@@ -112,6 +151,7 @@ class LogRowParser {
   double value(int slot) const { return values_[slot]; }
   size_t rows() const { return rows_; }
   const std::string& name() const { return name_; }
+  bool gyro_file() const { return gyro_file_; }
 
  private:
   bool BuildLayout(const char* begin, const char* end, size_t line, std::string* error);

@@ -171,6 +171,8 @@ void RunUnit(const BatchUnit& unit, const Config& base, const SkipFunction& skip
   files.attitudes_path = unit.attitudes_path;
   Session session;
   LongLogReading reading;
+  reading.max_samples = static_cast<size_t>(config.input.max_log_entries);
+  reading.threads = 1;  // The batch runs units on its threads already.
   CalibrationProvenance provenance;
   if (unit.path.empty()) {
     session.log = unit.log;

@@ -60,6 +60,11 @@ struct LogReaderOptions {
   // Bags and MCAP files: t is the time the recorder received each message
   // instead of its header.stamp.
   bool record_time = false;
+  // Text logs read in bounded memory (gravcal/io/long_log.h: calibrate,
+  // noise, batch): at most this many entries held, a longer log read as
+  // means of 2^k rows; 0 = no limit (read whole, memory permitting), else at
+  // least 16. 2^21 entries are about 128 MiB with gyroscope and temperature.
+  int max_log_entries = 1 << 21;
 
   bool IsValid(std::string* error) const;
 };

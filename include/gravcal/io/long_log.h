@@ -30,6 +30,10 @@ constexpr size_t kDefaultLongLogSamples = size_t{1} << 21;
 struct LongLogReading {
   // Most entries held (at least 16; 0 = no limit, as ReadImuLog).
   size_t max_samples = kDefaultLongLogSamples;
+  // Threads that parse a long text file (16 MiB or more; a reader thread
+  // besides): 0 = one per core, 1 = the calling thread only (for a caller
+  // that runs several reads at once). The result is the same.
+  int threads = 0;
   // Set by the read: the rows each entry averages (1: the rows as recorded,
   // else a power of two) and the rows read (those of an incomplete last
   // block included).

@@ -93,6 +93,9 @@ SectionOf<CalibrationConfig> InputSection() {
                          "bags and MCAP: the sensor_msgs/Imu topic (empty: the only one)"),
           GRAVCAL_BOOL("record_time", input.record_time,
                        "bags and MCAP: t from the recorder's receive time, not header.stamp"),
+          GRAVCAL_INT("max_log_entries", input.max_log_entries,
+                      "calibrate, noise, batch: most entries of a text log held (a longer log "
+                      "is read as means of 2^k rows); 0 = no limit, else >= 16"),
       }};
 }
 
