@@ -335,6 +335,13 @@ bool LogReaderOptions::IsValid(std::string* error) const {
   if (!std::isfinite(time_scale) || time_scale <= 0.0) {
     return SetError(error, "time_scale is " + ExactNumber(time_scale) + ", must be finite and > 0");
   }
+  if (!std::isfinite(temp_scale) || temp_scale == 0.0) {
+    return SetError(error,
+                    "temp_scale is " + ExactNumber(temp_scale) + ", must be finite and not 0");
+  }
+  if (!std::isfinite(temp_offset)) {
+    return SetError(error, "temp_offset is " + ExactNumber(temp_offset) + ", must be finite");
+  }
   if (format == LogFormat::kWhitespace && columns.empty()) {
     return SetError(error, "the whitespace format needs columns");
   }

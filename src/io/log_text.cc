@@ -242,6 +242,8 @@ bool LogRowParser::Line(std::string_view text, size_t line, bool* row, std::stri
 }
 
 bool LogRowParser::CheckTime(size_t line, std::string* error) {
+  // The temperature in degC (temp_scale, temp_offset; log_reader.h).
+  if (has_[kTemp]) values_[kTemp] = options_.temp_offset + options_.temp_scale * values_[kTemp];
   if (gyro_file_) {
     values_[kT] *= options_.time_scale;  // Matched to the main file's by the caller.
     return true;
