@@ -23,7 +23,8 @@ error (plus an off-diagonal misalignment in the sessions the targets cannot
 hold). K = 1 for SI output, the datasheet sensitivity for counts.
 
 Usage: thermal_heldout.py GRAVCAL_BINARY SOURCE_DIR WORK_DIR [--seeds=N]
-[--quick | --smoke] (--smoke: the representable session and its exports
+[--only=base,gyro_scale,quantised,raw_temp,verify] (default all; base = the
+first round's checks) [--quick | --smoke] (--smoke: the representable session and its exports
 only, for tests/thermal_heldout_test.cc; --quick: 3 seeds at 25 Hz; the
 default: 10 seeds at 50 Hz and every layout). Prints one JSON line of measurements and a verdict per check;
 exit 0 when every check passes, 1 otherwise, 77 when numpy is missing.
@@ -256,6 +257,9 @@ def write_csv(path, s, layout):
         gyr = np.round(gyr * GYR_LSB)
         keys['nominal_scale'] = 1.0 / ACC_LSB
         keys['gyro_nominal_scale'] = 1.0 / GYR_LSB
+    if layout == 'whole_degree':  # SI, the temperature in whole degrees
+        temp = np.round(temp)
+        layout = 'contract'
     if layout == 'contract' or layout == 'counts':
         header = 't,ax,ay,az,gx,gy,gz,temp'
         data = np.column_stack([t, acc, gyr, temp])
@@ -492,6 +496,172 @@ def remaining_after_targets(runner, tag, truth, layout, cal, device=(1310988, 22
     return worst, (se1 + se2)
 
 
+def bias_z(cal, truth, temps):
+    """z of the accel and gyro bias at `temps` against the truth."""
+    out = {}
+    for sensor, fn in (('accel', truth.accel_bias), ('gyro', truth.gyro_bias)):
+        est, std = bias_and_std(cal, sensor, temps)
+        out[sensor] = ((est - fn(temps)) / std).ravel().tolist()
+    return out
+
+
+def gyro_scale_z(cal, truth, temps):
+    """z of the gyroscope's scale change D_ii(x) (relative to T_ref) and of
+    the base matrix's diagonal (SI layout) against the truth:
+    u = M^-1 (I + D(x)) w = diag(sigma(T)) w, sigma = 1 + sg + qg (T - 20)."""
+    th = cal['thermal']
+    tref = th['reference_temperature']
+    term = th.get('gyro', {}).get('scale', {})
+    sig = lambda T: 1.0 + truth.sg + truth.qg[:, 0] * (T - T0) + truth.qg[:, 1] * (T - T0) ** 2
+    zs, dz = [], []
+    if term.get('order', 0) > 0:
+        for T in temps:
+            x = T - tref
+            want = sig(T) / sig(tref) - 1.0
+            for i in range(3):
+                row = term['coefficients'][i]
+                if any(c is None for c in row):
+                    continue
+                est = sum(c * x ** (k + 1) for k, c in enumerate(row))
+                c = np.array(term['covariance'][i], float)
+                phi = np.array([0.0] + [x ** (k + 1) for k in range(len(row))])
+                zs.append((est - want[i]) / math.sqrt(phi @ c @ phi))
+    m = np.array(cal['gyro']['matrix'], float)
+    ms = cal['gyro'].get('std', {}).get('matrix')
+    if ms is not None:
+        want = 1.0 / sig(tref)
+        for i in range(3):
+            if ms[i][i] is not None:
+                dz.append((m[i][i] - want[i]) / ms[i][i])
+    return zs, dz
+
+
+def extra_sections(r, binary, source_dir, rate, seeds, only):
+    """The checks of issue 35's second round: gyro scale(T) from the
+    turns, whole-degree temperatures, the temperature in register counts,
+    verify's false alarms away from T_ref."""
+    soaks = [-5.0, 10.0, 25.0, 40.0, 55.0]
+    ramp = {'start': 0.0, 'end': 55.0, 'tau': 700.0, 'seconds': 3000.0}
+    if 'gyro_scale' in only:
+        zs, dz, orders = [], [], []
+        for seed in range(200, 200 + seeds):
+            truth = Truth(np.random.default_rng(seed), lag=(0.0, 30.0)[seed % 2])
+            kind = ('soak', 'warmcool')[seed % 2]
+            s = make_session(seed, kind, truth, rate=rate, soaks=soaks, ramp=ramp)
+            rc, se, cal, _, _ = r.calibrate('gscale_%d' % seed, s)
+            if cal is None:
+                r.check('gyro_scale_seed_%d' % seed, False, se.strip()[-300:])
+                continue
+            lo, hi = cal['thermal']['valid_range']
+            a, b = gyro_scale_z(cal, truth, np.linspace(lo + 2, hi - 2, 5))
+            zs += a
+            dz += b
+            orders.append(cal['thermal']['gyro'].get('scale', {}).get('order', 0))
+        rms = float(np.sqrt(np.mean(np.square(zs)))) if zs else float('nan')
+        rms_m = float(np.sqrt(np.mean(np.square(dz)))) if dz else float('nan')
+        r.check('gyro_scale_honest', bool(zs) and 0.7 <= rms <= 1.4 and 0.6 <= rms_m <= 1.6,
+                {'rms_z_scale': rms, 'values': len(zs), 'rms_z_matrix_diag': rms_m,
+                 'orders': orders})
+        # Turns at one temperature: scale(T) undetermined, said plainly.
+        truth = Truth(np.random.default_rng(5))
+        s = make_session(5, 'warmcool', truth, rate=rate,
+                         ramp={'start': 24.0, 'end': 26.0, 'tau': 700.0, 'seconds': 600.0})
+        rc, se, cal, _, _ = r.calibrate('gscale_flat', s)
+        notes = ' '.join(cal['thermal'].get('notes', [])) if cal else se
+        order = cal['thermal']['gyro'].get('scale', {}).get('order', 0) if cal else -1
+        r.check('gyro_scale_flat_undetermined',
+                cal is not None and order == 0 and 'scale against temperature undetermined' in notes,
+                {'order': order, 'notes': [n for n in notes.split('; ') if 'gyro' in n][:3]})
+    if 'quantised' in only:
+        zs = {'accel': [], 'gyro': []}
+        warned = 0
+        for seed in range(300, 300 + seeds):
+            truth = Truth(np.random.default_rng(seed), lag=(0.0, 30.0, 0.0)[seed % 3])
+            kind = ('soak', 'warmcool', 'soak')[seed % 3]
+            # Soaks that do not sit on whole degrees.
+            off = np.random.default_rng(seed + 7).uniform(-0.5, 0.5, len(soaks))
+            s = make_session(seed, kind, truth, rate=rate, soaks=list(np.add(soaks, off)),
+                             ramp=ramp)
+            rc, se, cal, _, _ = r.calibrate('whole_%d' % seed, s, 'whole_degree')
+            if cal is None:
+                r.check('whole_degree_seed_%d' % seed, False, se.strip()[-300:])
+                continue
+            warned += any('quantised' in w for w in cal.get('warnings', []))
+            lo, hi = cal['thermal']['valid_range']
+            z = bias_z(cal, truth, np.linspace(lo + 2, hi - 2, 5))
+            for k in zs:
+                zs[k] += z[k]
+        allz = np.array(zs['accel'] + zs['gyro'])
+        rms = {k: float(np.sqrt(np.mean(np.square(v)))) for k, v in zs.items() if v}
+        rms['all'] = float(np.sqrt(np.mean(allz ** 2))) if len(allz) else float('nan')
+        r.check('whole_degree', len(allz) > 0 and warned == seeds and 0.7 <= rms['all'] <= 1.4,
+                {'rms_z': rms, 'warned': warned, 'seeds': seeds,
+                 'max_abs_z': float(np.abs(allz).max()) if len(allz) else None})
+    if 'raw_temp' in only:
+        truth = Truth(np.random.default_rng(11), scale_t=False, misalign=False)
+        s = make_session(11, 'soak', truth, rate=rate, soaks=soaks)
+        rc, se, cal, csv, cfg = r.calibrate('rawtemp', s, 'raw_temp')
+        ok = cal is not None
+        detail = {}
+        if ok:
+            lo, hi = cal['thermal']['valid_range']
+            temps = np.linspace(lo, hi, 25)
+            ka, kg = raw_units('raw_temp')
+            ea, _ = bias_and_std(cal, 'accel', temps)
+            eg, _ = bias_and_std(cal, 'gyro', temps)
+            floor_a = s['accel_noise'] / math.sqrt(s['hold'] * s['rate'])
+            floor_g = s['gyro_noise'] / math.sqrt(s['hold'] * s['rate'])
+            detail = {'range': [lo, hi],
+                      'accel_bias': float(np.abs(ea / ka - truth.accel_bias(temps)).max()),
+                      'gyro_bias': float(np.abs(eg / kg - truth.gyro_bias(temps)).max()),
+                      'floor_accel': floor_a, 'floor_gyro': floor_g}
+            ok = (lo > -10 and hi < 60 and detail['accel_bias'] < 3 * floor_a and
+                  detail['gyro_bias'] < 3 * floor_g)
+        # Without temp_scale: refused, naming the key.
+        text = open(cfg).read().replace('temp_scale:', '#').replace('temp_offset:', '#')
+        with open(cfg, 'w') as f:
+            f.write(text)
+        rc2, so2, se2 = run([binary, 'calibrate', '--config', cfg, '--input', csv, '--output',
+                             r.path('rawtemp_nokey.json')])
+        detail['without_key'] = {'exit': rc2, 'message': se2.strip()[-200:]}
+        ok = ok and rc2 != 0 and 'temp_scale' in se2
+        # A zero scale: a one-line error naming the key.
+        rc3, so3, se3 = run([binary, 'calibrate', '--config', cfg, '--input', csv, '--output',
+                             r.path('rawtemp_zero.json'), '--temp_scale', '0'])
+        detail['zero_scale'] = {'exit': rc3, 'message': se3.strip()[-200:]}
+        ok = ok and rc3 != 0 and 'temp_scale' in se3 and len(se3.strip().splitlines()) == 1
+        r.check('raw_temp', ok, detail)
+    if 'verify' in only:
+        # Check sessions (new noise, same unit) at temperatures away from
+        # T_ref, tested against the stored calibration at level 0.1.
+        level = 0.1
+        trials, alarms = 0, 0
+        for seed in range(400, 400 + seeds):
+            truth = Truth(np.random.default_rng(seed), scale_t=True, misalign=True)
+            s = make_session(seed, 'soak', truth, rate=rate, soaks=soaks)
+            tag = 'verify_%d' % seed
+            rc, se, cal, _, cfg = r.calibrate(tag, s)
+            if cal is None:
+                r.check('verify_seed_%d' % seed, False, se.strip()[-300:])
+                continue
+            for j, temp in enumerate((-2.0, 8.0, 42.0, 52.0)):
+                c = make_session(seed * 10 + j + 5000, 'soak', truth, rate=rate, soaks=[temp])
+                csv = r.path('%s_check%d.csv' % (tag, j))
+                write_csv(csv, c, 'contract')
+                rc2, so2, se2 = run([binary, 'verify', '--calibration', r.path(tag + '.json'),
+                                     '--input', csv, '--config', cfg, '--level', str(level)])
+                if rc2 not in (0, 3):
+                    r.check('verify_run_%d_%d' % (seed, j), False, se2.strip()[-300:])
+                    continue
+                trials += 1
+                alarms += rc2 == 3
+        rate_fa = alarms / trials if trials else float('nan')
+        # Binomial: within about 2.5 sigma of the level.
+        band = 2.5 * math.sqrt(level * (1 - level) / max(trials, 1))
+        r.check('verify_false_alarms', trials > 0 and abs(rate_fa - level) <= band + 0.02,
+                {'level': level, 'trials': trials, 'alarms': alarms, 'rate': rate_fa})
+
+
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith('--')]
     smoke = '--smoke' in sys.argv  # the test's cheap subset
@@ -503,6 +673,16 @@ def main():
     binary, source_dir, work = args[0], args[1], args[2]
     r = Runner(binary, source_dir, work)
     rate = 25.0 if quick else 50.0
+    extra = {'gyro_scale', 'quantised', 'raw_temp', 'verify'}
+    only = set(['base'] + list(extra))
+    for a in sys.argv:
+        if a.startswith('--only='):
+            only = set(a.split('=')[1].split(','))
+    if smoke:
+        only = {'base'}
+    if 'base' not in only:
+        extra_sections(r, binary, source_dir, rate, max(seeds, 1), only)
+        return r.finish()
     soaks = [-5.0, 10.0, 25.0, 40.0, 55.0]
 
     # 1. Representable truth (cubic bias, diagonal scale, no scale(T), no
@@ -665,6 +845,7 @@ def main():
                  'lines': [l for l in (so + se).splitlines() if 'hyster' in l.lower() or
                            'lag' in l.lower()][:4]})
 
+    extra_sections(r, binary, source_dir, rate, max(seeds, 1), only)
     return r.finish()
 
 

@@ -51,7 +51,8 @@ Eigen::VectorXd Residuals(const std::vector<Position>& positions, const Eigen::V
 }  // namespace
 
 bool VerifyCheckSession(const std::vector<Position>& positions, const Calibration& stored,
-                        const ComparisonOptions& options, CheckSessionResult* result) {
+                        const ComparisonOptions& options, CheckSessionResult* result,
+                        const Eigen::MatrixXd* extra_covariance) {
   CHECK(result != nullptr);
   *result = CheckSessionResult();
   ComparisonResult& out = result->comparison;
@@ -96,6 +97,10 @@ bool VerifyCheckSession(const std::vector<Position>& positions, const Calibratio
     for (int j = 0; j < nc; ++j) cp(i, j) = a.covariance(columns[i], columns[j]);
   }
   Eigen::MatrixXd s = h * cp * h.transpose();
+  if (extra_covariance != nullptr && extra_covariance->rows() == k &&
+      extra_covariance->cols() == k) {
+    s += *extra_covariance;
+  }
   for (int i = 0; i < k; ++i) {
     const Eigen::Vector3d f = m * (positions[i].raw_mean - model.bias);
     const Eigen::Vector3d u = f.normalized();

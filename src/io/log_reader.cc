@@ -293,6 +293,13 @@ bool LogReaderOptions::IsValid(std::string* error) const {
     return SetError(error, "max_log_entries is " + std::to_string(max_log_entries) +
                                ", must be 0 (no limit) or at least 16");
   }
+  if (!std::isfinite(temp_scale) || temp_scale == 0.0) {
+    return SetError(error,
+                    "temp_scale is " + ExactNumber(temp_scale) + ", must be finite and not 0");
+  }
+  if (!std::isfinite(temp_offset)) {
+    return SetError(error, "temp_offset is " + ExactNumber(temp_offset) + ", must be finite");
+  }
   if (format == LogFormat::kWhitespace && columns.empty()) {
     return SetError(error, "the whitespace format needs columns");
   }

@@ -128,11 +128,16 @@ class LogRowParser {
 
   // The fields of one row that is not blank or a comment, [begin, end)
   // without leading blanks, into value(slot), checked as Line checks them
-  // (messages name line `line`); time is left as in the file (no
+  // (messages name line `line`), the temperature in degC (temp_scale,
+  // temp_offset; log_reader.h); time is left as in the file (no
   // time_scale, no order check: Line does those).
   bool ParseFields(const char* begin, const char* end, size_t line, std::string* error) {
-    return format_ == LogFormat::kCsv ? ParseRow<true>(begin, end, line, error)
-                                      : ParseRow<false>(begin, end, line, error);
+    const bool ok = format_ == LogFormat::kCsv ? ParseRow<true>(begin, end, line, error)
+                                               : ParseRow<false>(begin, end, line, error);
+    if (ok && has_[kTemp]) {
+      values_[kTemp] = options_.temp_offset + options_.temp_scale * values_[kTemp];
+    }
+    return ok;
   }
   // Rows read and the last time, as if Line had read rows up to here (for a
   // reader that parsed some rows elsewhere).

@@ -344,10 +344,14 @@ void DescribeThermalTruncation(const LoadedCalibration& calibration, const ImuCo
           ": changes the bias by up to " + Format("%.3g", change) + " raw units" + over);
     }
     if (f.scale.active() && !h.scale.active()) {
-      dropped->push_back(
-          name + " scale against temperature (order " + std::to_string(f.scale.order) +
-          "): up to " + Format("%.3g", 100.0 * (range ? LargestOverRange(full, f.scale, 3) : NAN)) +
-          "% of the reading" + over);
+      const double largest = range ? LargestOverRange(full, f.scale, 3) : NAN;
+      // The gyroscope's share at a brisk 100 deg/s (static poses show none).
+      const std::string rate = s == ThermalSensor::kGyro
+                                   ? " (" + Format("%.3g", 100.0 * largest) + " deg/s at 100 deg/s)"
+                                   : "";
+      dropped->push_back(name + " scale against temperature (order " +
+                         std::to_string(f.scale.order) + "): up to " +
+                         Format("%.3g", 100.0 * largest) + "% of the reading" + rate + over);
     }
     if (f.misalignment.active() && !h.misalignment.active()) {
       const int n = ThermalComponents(s, ThermalQuantity::kMisalignment);

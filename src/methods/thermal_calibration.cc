@@ -9,6 +9,7 @@
 #include "gravcal/core/imu_corrector.h"
 #include "methods/thermal_fitter.h"
 #include "methods/thermal_residual.h"
+#include "methods/thermal_turns.h"
 
 namespace gravcal {
 
@@ -54,7 +55,8 @@ bool ThermalCalibrationOptions::IsValid(std::string* error) const {
       {"thermal_accel_bias_max_order", accel_bias_max_order},
       {"thermal_accel_scale_max_order", accel_scale_max_order},
       {"thermal_accel_misalignment_max_order", accel_misalignment_max_order},
-      {"thermal_gyro_bias_max_order", gyro_bias_max_order}};
+      {"thermal_gyro_bias_max_order", gyro_bias_max_order},
+      {"thermal_gyro_scale_max_order", gyro_scale_max_order}};
   for (const auto& [key, v] : maxima) {
     if (v < 0 || v > kMaxThermalOrder) {
       return fail(std::string(key) + " must be between 0 and " + std::to_string(kMaxThermalOrder));
@@ -64,7 +66,8 @@ bool ThermalCalibrationOptions::IsValid(std::string* error) const {
       {"thermal_accel_bias_order", accel_bias_order},
       {"thermal_accel_scale_order", accel_scale_order},
       {"thermal_accel_misalignment_order", accel_misalignment_order},
-      {"thermal_gyro_bias_order", gyro_bias_order}};
+      {"thermal_gyro_bias_order", gyro_bias_order},
+      {"thermal_gyro_scale_order", gyro_scale_order}};
   for (const auto& [key, v] : fixed) {
     if (v < -1 || v > kMaxThermalOrder) {
       return fail(std::string(key) + " must be -1 (chosen from the data) or between 0 and " +
@@ -164,7 +167,8 @@ std::vector<std::string> ThermalSpanMessages(double span, const ThermalCalibrati
   const std::pair<const char*, int> fixed[] = {{"accel bias", o.accel_bias_order},
                                                {"accel scale", o.accel_scale_order},
                                                {"accel misalignment", o.accel_misalignment_order},
-                                               {"gyro bias", o.gyro_bias_order}};
+                                               {"gyro bias", o.gyro_bias_order},
+                                               {"gyro scale", o.gyro_scale_order}};
   for (const auto& [name, order] : fixed) {
     if (order <= supported) continue;
     out.push_back("your session spans " + Degrees(span) + "; the " + OrderName(order) + " " + name +
@@ -291,7 +295,10 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
   }
   StaticDetection detection;
   if (!DetectStaticIntervals(log, options.detector, &detection)) return fail(detection.message);
-  const std::vector<ThermalWindow> windows = ThermalWindows(log, detection.intervals, options);
+  const TemperatureColumn column = InspectTemperatureColumn(log);
+  if (column.implausible) return fail(log.source + ": " + column.warnings.front());
+  std::vector<ThermalWindow> windows = ThermalWindows(log, detection.intervals, options);
+  SetTemperatureQuantisation(log, column.step, &windows);
   if (windows.size() < 3) {
     return fail(log.source + ": " + std::to_string(windows.size()) +
                 " static windows; the thermal calibration needs at least 3");
@@ -485,10 +492,12 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
       }
     }
   }
+  if (has_gyro && (options.gyro_scale_max_order > 0 || options.gyro_scale_order > 0)) {
+    internal::AddThermalTurns(log, detection.intervals, windows, options, &out);
+  }
   if (has_gyro) {
     model.notes.push_back(
-        "gyro scale and misalignment against temperature are not estimated (static windows see "
-        "no rotation rate)");
+        "gyro misalignment against temperature is not estimated (the turns fit the scale only)");
   }
   if (model.lag_estimated) {
     std::ostringstream s;
@@ -496,6 +505,10 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
     s << "the heating and cooling branches disagree: the element lags the temperature sensor by "
       << model.lag_time_constant << " s (std " << model.lag_time_constant_std << " s)";
     model.notes.push_back(s.str());
+  }
+  for (const std::string& m : column.warnings) {
+    out.warnings.push_back(m);
+    out.warning_codes.push_back(WarningCode::kSensorData);
   }
   for (const std::string& m : ThermalSpanMessages(span, options)) {
     out.warnings.push_back(m);

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 namespace gravcal {
@@ -352,10 +353,43 @@ void ThermalFitter::Covariance(const ThermalLayout& layout, const std::vector<do
   Eigen::MatrixXd inv = info.ldlt().solve(Eigen::MatrixXd::Identity(info.rows(), info.cols()));
   const int dof = fit->residuals - fit->free;
   const double factor = dof > 0 ? std::max(1.0, fit->chi2 / dof) : 1.0;
+  // Quantised temperatures (thermal_calibration.h): the error e_g a group
+  // of windows shares moves the solution by K_g e_g, K_g = (J^T J)^-1 J^T
+  // a_g, a_g the whitened residuals' derivative in the group's
+  // temperatures; the covariance gains sum_g var_g K_g K_g^T.
+  Eigen::MatrixXd extra = Eigen::MatrixXd::Zero(free.size(), free.size());
+  std::map<int, std::pair<Eigen::VectorXd, double>> groups;
+  const int rows = layout.has_gyro ? 4 : 1;
+  for (size_t k = 0; k < windows_.size(); ++k) {
+    const ThermalWindow& w = windows_[k];
+    if (!(w.temperature_variance > 0.0)) continue;
+    constexpr double kStep = 0.01;  // degC
+    double r[2][4];
+    for (int side = 0; side < 2; ++side) {
+      ThermalWindow moved = w;
+      moved.temperature += side == 0 ? kStep : -kStep;
+      const ThermalWindowResidual f(layout, moved, &element_, reference_, o_.gravity, sigmas[k]);
+      const double* p[1] = {fit->theta.data()};
+      f(p, r[side]);
+    }
+    const int key = w.temperature_group >= 0 ? w.temperature_group : -1 - static_cast<int>(k);
+    auto it = groups.find(key);
+    if (it == groups.end()) {
+      it = groups.emplace(key, std::make_pair(Eigen::VectorXd::Zero(j.rows()), 0.0)).first;
+    }
+    for (int i = 0; i < rows; ++i) {
+      it->second.first(k * rows + i) = (r[0][i] - r[1][i]) / (2.0 * kStep);
+    }
+    it->second.second = w.temperature_variance;
+  }
+  for (const auto& [key, g] : groups) {
+    const Eigen::VectorXd gain = inv * (jf.transpose() * g.first);
+    extra += g.second * gain * gain.transpose();
+  }
   fit->covariance = Eigen::MatrixXd::Zero(layout.size, layout.size);
   for (size_t a = 0; a < free.size(); ++a) {
     for (size_t b = 0; b < free.size(); ++b) {
-      fit->covariance(free[a], free[b]) = factor * inv(a, b) / (d(a) * d(b));
+      fit->covariance(free[a], free[b]) = (factor * inv(a, b) + extra(a, b)) / (d(a) * d(b));
     }
   }
 }

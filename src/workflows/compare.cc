@@ -78,9 +78,24 @@ std::string VerifyDegrees(double v) {
 // (clamped to the valid range, rate 0: the poses are static). Poses more
 // than 0.5 degC outside the range are named in a warning, as apply does;
 // a log without temperature is tested at T_ref, with a warning.
+//
+// The thermal coefficients' uncertainty enters the test through
+// *covariance (K x K): the residual r_k = |s_k| - g depends on the
+// coefficients theta_i = [c_i0 .. c_in] of every component i of every
+// accelerometer term (c_i0 the base bias, zero for scale and
+// misalignment), each with its stored covariance C_i, so
+//
+//   Cov(r) += sum_i J_i C_i J_i^T - j_i0 C_i,00 j_i0^T,   J_i = d r / d theta_i
+//
+// (central differences; the second part, the base bias alone, is already
+// in the stored accelerometer covariance the test uses). Poses at one
+// temperature share the same coefficient errors, hence a full matrix.
 void ThermalCheckPoses(const ImuLog& log, const Calibration& stored,
-                       std::vector<Position>* positions, std::vector<std::string>* warnings) {
+                       std::vector<Position>* positions, std::vector<std::string>* warnings,
+                       Eigen::MatrixXd* covariance) {
   const ThermalModel& th = stored.thermal;
+  const int k = static_cast<int>(positions->size());
+  *covariance = Eigen::MatrixXd::Zero(k, k);
   if (!th.active()) return;
   if (!log.has_temperature()) {
     warnings->push_back(log.source +
@@ -90,6 +105,51 @@ void ThermalCheckPoses(const ImuLog& log, const Calibration& stored,
     return;
   }
   const AccelModel& a = stored.accel.model;
+  const double step_floor = 1e-9;
+  bool missing = false;
+  for (ThermalQuantity q :
+       {ThermalQuantity::kBias, ThermalQuantity::kScale, ThermalQuantity::kMisalignment}) {
+    const ThermalPolynomial& p = th.accel.Term(q);
+    if (!p.active()) continue;
+    for (int i = 0; i < p.coefficients.rows(); ++i) {
+      if (i >= static_cast<int>(p.covariance.size()) || p.covariance[i].rows() != p.order + 1) {
+        missing = true;
+        continue;
+      }
+      const Eigen::MatrixXd& c = p.covariance[i];
+      Eigen::MatrixXd j = Eigen::MatrixXd::Zero(k, p.order + 1);
+      for (int power = 0; power <= p.order; ++power) {
+        if (power == 0 && q != ThermalQuantity::kBias) continue;
+        if (power > 0 && !p.Determined(i, power)) continue;
+        const double h = std::max(step_floor, 1e-3 * std::sqrt(std::max(0.0, c(power, power))));
+        for (int side = 0; side < 2; ++side) {
+          ThermalModel moved = th;
+          Eigen::Vector3d bias = a.bias;
+          const double d = side == 0 ? h : -h;
+          if (power == 0) {
+            bias(i) += d;
+          } else {
+            moved.MutableSensor(ThermalSensor::kAccel)
+                ->MutableTerm(q)
+                ->coefficients(i, power - 1) += d;
+          }
+          for (int r = 0; r < k; ++r) {
+            const Position& pose = (*positions)[r];
+            if (!std::isfinite(pose.temperature)) continue;
+            const Eigen::Vector3d s = CorrectAccelThermal(
+                moved, bias, a.upper, pose.raw_mean, moved.Offset(pose.temperature, 0.0, nullptr));
+            j(r, power) += (side == 0 ? 1.0 : -1.0) * s.norm() / (2.0 * h);
+          }
+        }
+      }
+      *covariance += j * c * j.transpose() - c(0, 0) * j.col(0) * j.col(0).transpose();
+    }
+  }
+  if (missing) {
+    warnings->push_back(log.source +
+                        ": the stored thermal model has no covariance for some terms: their "
+                        "uncertainty is not part of the test");
+  }
   size_t outside = 0;
   double lowest = INFINITY, highest = -INFINITY;
   for (Position& p : *positions) {
@@ -131,8 +191,9 @@ bool VerifyCheckLog(const ImuLog& log, const Calibration& stored, const Calibrat
     return false;
   }
   std::vector<std::string> warnings;
-  ThermalCheckPoses(log, stored, &positions, &warnings);
-  if (!VerifyCheckSession(positions, stored, comparison, result)) {
+  Eigen::MatrixXd thermal_covariance;
+  ThermalCheckPoses(log, stored, &positions, &warnings, &thermal_covariance);
+  if (!VerifyCheckSession(positions, stored, comparison, result, &thermal_covariance)) {
     *error = internal::PrefixSource(log.source, result->comparison.message);
     return false;
   }

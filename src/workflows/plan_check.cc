@@ -197,6 +197,8 @@ bool CheckRecording(const Session& session, const Config& config, const PlanRequ
     }
     out.temperature_span = hi - lo;
     out.temperature = ThermalSpanMessages(out.temperature_span, config.thermal);
+    for (const std::string& m : InspectTemperatureColumn(log).warnings)
+      out.temperature.push_back(m);
     if (positions.size() == 1 || out.positions == 1) {
       out.temperature.push_back(
           "one static pose: a ramp determines only the bias change along gravity; turn the unit "

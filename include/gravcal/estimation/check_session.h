@@ -55,9 +55,13 @@ struct CheckSessionResult {
 // `stored` needs accel.model and accel.covariance (with names, std as read
 // by io/calibration_uncertainty_io.h); gravity is stored.gravity. False
 // with result->comparison.message for invalid options, no pose, or a stored
-// calibration without covariance.
+// calibration without covariance. `extra_covariance` (K x K, may be null)
+// is added to S: what the caller's own correction of the poses adds (the
+// thermal coefficients' uncertainty when the poses were taken to T_ref,
+// workflows/compare.h).
 bool VerifyCheckSession(const std::vector<Position>& positions, const Calibration& stored,
-                        const ComparisonOptions& options, CheckSessionResult* result);
+                        const ComparisonOptions& options, CheckSessionResult* result,
+                        const Eigen::MatrixXd* extra_covariance = nullptr);
 
 // The shortest check session with a given power (plan --verify): poses
 // along `directions` (body frame; default the four tetrahedral directions),

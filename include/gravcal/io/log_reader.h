@@ -50,6 +50,11 @@ struct LogReaderOptions {
   double sample_rate = 0.0;
   // t in the file is multiplied by this (1e-9 for nanoseconds).
   double time_scale = 1.0;
+  // The temperature column in degC: temp = temp_offset + temp_scale * value
+  // (a sensor's raw register counts, e.g. ICM-42688: temp_scale 1/132.48,
+  // temp_offset 25). temp_scale must be finite and non-zero.
+  double temp_scale = 1.0;
+  double temp_offset = 0.0;
   // Optional second file holding the gyroscope (kWhitespace layout, columns
   // gyro_columns), sample for sample with the first.
   std::string gyro_path;

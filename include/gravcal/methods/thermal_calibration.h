@@ -77,10 +77,15 @@ struct ThermalCalibrationOptions {
   int accel_scale_max_order = 2;
   int accel_misalignment_max_order = 1;
   int gyro_bias_max_order = 3;
+  // The gyroscope's scale(T), from the turns between poses
+  // (methods/thermal_turns.h); 0 = off (the gyroscope matrix is then not
+  // estimated either).
+  int gyro_scale_max_order = 2;
   int accel_bias_order = -1;
   int accel_scale_order = -1;
   int accel_misalignment_order = -1;
   int gyro_bias_order = -1;
+  int gyro_scale_order = -1;
   // Try the first-order lag tau as one more term.
   bool fit_lag = true;
   ThermalOrderSelection selection = ThermalOrderSelection::kBic;
@@ -126,6 +131,12 @@ struct ThermalWindow {
   Eigen::Matrix3d accel_mean_cov = Eigen::Matrix3d::Identity();
   Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d gyro_mean_var = Eigen::Vector3d::Ones();
+  // Quantised temperature readings (TemperatureColumn): the variance of the
+  // error of `temperature` the rounding leaves (degC^2; 0 = none) and the
+  // group of windows that share that error (one plateau of a single
+  // reading; -1 = its own).
+  double temperature_variance = 0.0;
+  int temperature_group = -1;
 };
 
 // The windows of `log` in the static intervals `intervals`. The log must
@@ -133,6 +144,35 @@ struct ThermalWindow {
 std::vector<ThermalWindow> ThermalWindows(const ImuLog& log,
                                           const std::vector<StaticInterval>& intervals,
                                           const ThermalCalibrationOptions& options);
+
+// What the temperature column looks like (issue 35): its range and
+// whether its readings are quantised (whole degrees, or a register's
+// least significant bit).
+struct TemperatureColumn {
+  double min = NAN;
+  double max = NAN;
+  // The quantisation step, degC; 0 = not quantised (or too few readings
+  // to tell): at least 20 readings per distinct value, every distinct value
+  // a multiple of the smallest gap between them, and that gap >= 0.05 degC
+  // (a finer step's error, step / sqrt(12), is below a MEMS part's
+  // temperature noise).
+  double step = 0.0;
+  size_t distinct = 0;
+  // Readings outside [-80, 200] degC: not degrees (raw register counts?).
+  bool implausible = false;
+  // One sentence each, for check, plan and the calibration's warnings.
+  std::vector<std::string> warnings;
+};
+TemperatureColumn InspectTemperatureColumn(const ImuLog& log);
+
+// For quantised readings (step > 0), sets each window's
+// temperature_variance and temperature_group: a window whose readings are
+// one value has the rounding's error, uniform over a step (variance
+// step^2 / 12), shared by the consecutive windows of that value; a window
+// whose readings cross n steps averages it down to step^2 / (12 (n+1)^2),
+// its own. The fit's covariance then carries these errors (thermal_fitter.h).
+void SetTemperatureQuantisation(const ImuLog& log, double step,
+                                std::vector<ThermalWindow>* windows);
 
 // What a session's temperature span allows, in sentences for check and
 // plan: for each fixed order above ThermalMaxOrderForSpan ("your session

@@ -87,6 +87,11 @@ SectionOf<CalibrationConfig> InputSection() {
                          "Hz; gives t = index / sample_rate when the log has no time column"),
           GRAVCAL_DOUBLE("time_scale", input.time_scale,
                          "multiplies the time column (1e-9 for nanoseconds)"),
+          GRAVCAL_DOUBLE("temp_scale", input.temp_scale,
+                         "degC per unit of the temp column: temp = temp_offset + temp_scale * "
+                         "value (raw register counts, e.g. 1/132.48 for an ICM-42688)"),
+          GRAVCAL_DOUBLE("temp_offset", input.temp_offset,
+                         "degC added to the scaled temp column (25 for an ICM-42688's register)"),
           GRAVCAL_STRING("gyro_path", input.gyro_path,
                          "second whitespace file with t gx gy gz sharing the timestamps"),
           GRAVCAL_STRING("topic", input.topic,
