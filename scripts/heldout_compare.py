@@ -103,23 +103,23 @@ def check_session(truth, seed, hold):
 
 
 def checks(truth, name, k, n, first_seed, hold, at_mdc=False):
-    """Four-pose (tetrahedral) check sessions of the truth moved by k stored sigmas (or k
-    times the check's own minimal detectable change) against stored
-    calibrations of the truth."""
-    stored = calibrate(truth, first_seed + 500000)
-    index = ["accel." + p["name"] if not p["name"].startswith("accel.") else p["name"]
-             for p in gravcal.compare(stored, stored)["parameters"]].index("accel." + name)
-    sigma = gravcal.compare(stored, stored)["parameters"][index]["std"] / np.sqrt(2.0)
-    delta = k * sigma
-    if at_mdc:
-        t, v = check_session(truth, first_seed, hold)
-        probe = gravcal.verify(stored, t=t, accel=v, config=CONFIG)
-        delta = k * probe["parameters"][index]["minimal_detectable_change"]
-    other = moved(truth, name, delta)
+    """Four-pose (tetrahedral) check sessions of the truth moved by k stored
+    sigmas, or by k times the minimal detectable change the report of that
+    session's check claims (its stored calibration's covariance varies with
+    the pose scatter each calibration estimated), each against its own
+    stored calibration of the truth."""
     alarms = hits = 0
     for i in range(n):
         stored = calibrate(truth, first_seed + 500000 + i)
-        t, v = check_session(other, first_seed + i, hold)
+        same = gravcal.compare(stored, stored)["parameters"]
+        index = [p["name"] for p in same].index("accel." + name)
+        delta = k * same[index]["std"] / np.sqrt(2.0)
+        if at_mdc:
+            # The report of a check of the unchanged unit: its claim.
+            t, v = check_session(truth, first_seed + 700000 + i, hold)
+            probe = gravcal.verify(stored, t=t, accel=v, config=CONFIG)
+            delta = k * probe["parameters"][index]["minimal_detectable_change"]
+        t, v = check_session(moved(truth, name, delta), first_seed + i, hold)
         r = gravcal.verify(stored, t=t, accel=v, config=CONFIG)
         if not r["consistent"]:
             alarms += 1
