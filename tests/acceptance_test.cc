@@ -406,6 +406,8 @@ TEST(Acceptance, BadLimitsFileIsOneLineAndNothingWritten) {
       {"gyro_noise_density: {min: 2e-4, max: 1e-4}\n", "min is above max"},
       {"gyro_noise: 1e-4\n", "'gyro_noise'"},
       {"parameters:\n  accel.bias_q: {max: 1}\n", "'parameters.accel.bias_q'"},
+      {"residual_rms: 0.001\nresidual_rms: 1\n", "'residual_rms': given twice"},
+      {"parameters:\n  accel.u_xx: {max: 1, max: 2}\n", "'parameters.accel.u_xx.max'"},
   };
   for (const auto& c : cases) {
     WriteText(dir / "bad.yaml", c.text);

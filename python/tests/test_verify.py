@@ -82,6 +82,12 @@ def test_limits_and_certificate(session, tmp_path):
     assert gravcal.check_limits(session / "c1.json", tmp_path / "limits.yaml") == result
     with pytest.raises(gravcal.Error, match="accel_noise_density"):
         gravcal.check_limits(session / "c1.json", {"accel_noise_density": -1})
+    # No gyroscope model and no gyro_nominal_scale: the gyroscope's unit is
+    # unknown, so a gyroscope noise limit fails as not measured, said why.
+    gyro = gravcal.check_limits(session / "c1.json", {"gyro_noise_density": {"max": 1e-3}})
+    assert gyro.verdict == "fail" and "gyro_nominal_scale" in gyro.limits[0].why
+    with pytest.raises(gravcal.Error, match="gyro_noise_density.typical"):
+        gravcal.check_limits(session / "c1.json", {"gyro_noise_density": {"typical": 1e-3}})
     cert, html = gravcal.certificate(session / "c1.json", limits=limits, unit="SN1",
                                      station="line-3", output=tmp_path / "cert")
     assert cert.unit == "SN1" and cert.station == "line-3" and cert.verdict == "fail"

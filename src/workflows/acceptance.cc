@@ -4,11 +4,9 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <nlohmann/json.hpp>
 
 #include "gravcal/estimation/calibration_comparison.h"
 #include "gravcal/io/files.h"
-#include "io/json_helpers.h"
 #include "workflows/acceptance_internal.h"
 
 namespace gravcal {
@@ -41,6 +39,23 @@ bool ReadNumber(const YAML::Node& node, const std::string& name, const std::stri
     return KeyError(name, key, "must be a number", error);
   }
   if (!std::isfinite(*value)) return KeyError(name, key, "must be finite", error);
+  return true;
+}
+
+// False with *error naming the first key given twice in any map of `node`
+// (yaml-cpp keeps both, so the later one would silently win).
+bool NoKeyTwice(const YAML::Node& node, const std::string& name, const std::string& prefix,
+                std::string* error) {
+  if (!node.IsMap()) return true;
+  std::vector<std::string> seen;
+  for (const auto& entry : node) {
+    const std::string key = prefix + entry.first.as<std::string>();
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
+      return KeyError(name, key, "given twice (a limit may be set once)", error);
+    }
+    seen.push_back(key);
+    if (!NoKeyTwice(entry.second, name, key + ".", error)) return false;
+  }
   return true;
 }
 
@@ -215,6 +230,7 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
              "'temperature_sensitivity'";
     return false;
   }
+  if (!NoKeyTwice(root, name, "", error)) return false;
   AcceptanceLimits out;
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
@@ -528,90 +544,6 @@ bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
   }
   *certificate = out;
   return true;
-}
-
-namespace {
-
-nlohmann::ordered_json ChecksJson(const AcceptanceResult& result) {
-  using Json = nlohmann::ordered_json;
-  using internal::JsonNumber;
-  Json checks = Json::array();
-  for (const LimitCheck& c : result.checks) {
-    checks.push_back({{"name", c.name},
-                      {"measured", JsonNumber<Json>(c.measured)},
-                      {"min", JsonNumber<Json>(c.min)},
-                      {"max", JsonNumber<Json>(c.max)},
-                      {"pass", c.pass},
-                      {"checked", c.checked},
-                      {"why", c.why}});
-  }
-  return checks;
-}
-
-}  // namespace
-
-std::string AcceptanceToJson(const AcceptanceResult& result) {
-  nlohmann::ordered_json j;
-  j["verdict"] = result.pass ? "pass" : "fail";
-  j["message"] = result.message;
-  j["limits"] = ChecksJson(result);
-  return j.dump(2) + "\n";
-}
-
-std::string CertificateToJson(const Certificate& cert) {
-  using Json = nlohmann::ordered_json;
-  using internal::JsonNumber;
-  Json j;
-  j["unit"] = cert.info.unit;
-  j["date"] = cert.info.date;
-  j["station"] = cert.info.station;
-  j["software"] = {{"name", "gravcal"},
-                   {"version", cert.info.software_version},
-                   {"hash", cert.info.software_hash}};
-  j["input"] = {{"file", cert.info.input_file}, {"hash", cert.info.input_hash}};
-  j["config"] = {{"file", cert.info.config_name}, {"text", cert.info.config_text}};
-  j["method"] = cert.method;
-  j["gravity"] = {{"value", cert.gravity},
-                  {"source", cert.gravity_source},
-                  {"standard_uncertainty", cert.gravity_std}};
-  j["residual_rms"] = JsonNumber<Json>(cert.residual_rms);
-  j["measured"] = {
-      {"accel_noise_density",
-       {JsonNumber<Json>(cert.accel_noise_density(0)),
-        JsonNumber<Json>(cert.accel_noise_density(1)),
-        JsonNumber<Json>(cert.accel_noise_density(2))}},
-      {"gyro_noise_density",
-       {JsonNumber<Json>(cert.gyro_noise_density(0)), JsonNumber<Json>(cert.gyro_noise_density(1)),
-        JsonNumber<Json>(cert.gyro_noise_density(2))}},
-      {"temperature_min", JsonNumber<Json>(cert.temperature_min)},
-      {"temperature_max", JsonNumber<Json>(cert.temperature_max)}};
-  j["coverage_factor"] = cert.info.coverage_factor;
-  Json parameters = Json::array();
-  for (const CertificateEntry& e : cert.parameters) {
-    Json p;
-    p["name"] = e.name;
-    p["unit"] = e.unit;
-    p["value"] = JsonNumber<Json>(e.value);
-    p["standard_uncertainty"] = JsonNumber<Json>(e.standard_uncertainty);
-    p["expanded_uncertainty"] = JsonNumber<Json>(e.expanded_uncertainty);
-    Json budget = Json::array();
-    for (const auto& [source, u] : e.budget) {
-      budget.push_back({{"source", source}, {"standard_uncertainty", JsonNumber<Json>(u)}});
-    }
-    p["budget"] = budget;
-    parameters.push_back(p);
-  }
-  j["parameters"] = parameters;
-  j["notes"] = cert.notes;
-  if (cert.has_limits) {
-    j["verdict"] = cert.acceptance.pass ? "pass" : "fail";
-    j["limits"] = ChecksJson(cert.acceptance);
-    j["verdict_message"] = cert.acceptance.message;
-  } else {
-    j["verdict"] = nullptr;
-    j["verdict_message"] = "no limits given";
-  }
-  return j.dump(2) + "\n";
 }
 
 }  // namespace gravcal

@@ -1,15 +1,101 @@
-// The calibration certificate as a self-contained HTML page
-// (workflows/acceptance.h).
+// The calibration certificate and the acceptance verdict as JSON, and the
+// certificate as a self-contained HTML page (workflows/acceptance.h).
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 
 #include "gravcal/workflows/acceptance.h"
+#include "io/json_helpers.h"
 #include "workflows/acceptance_internal.h"
 #include "workflows/report/svg_plot.h"
 
 namespace gravcal {
 
 using internal::LimitNumber;
+
+namespace {
+
+nlohmann::ordered_json ChecksJson(const AcceptanceResult& result) {
+  using Json = nlohmann::ordered_json;
+  using internal::JsonNumber;
+  Json checks = Json::array();
+  for (const LimitCheck& c : result.checks) {
+    checks.push_back({{"name", c.name},
+                      {"measured", JsonNumber<Json>(c.measured)},
+                      {"min", JsonNumber<Json>(c.min)},
+                      {"max", JsonNumber<Json>(c.max)},
+                      {"pass", c.pass},
+                      {"checked", c.checked},
+                      {"why", c.why}});
+  }
+  return checks;
+}
+
+}  // namespace
+
+std::string AcceptanceToJson(const AcceptanceResult& result) {
+  nlohmann::ordered_json j;
+  j["verdict"] = result.pass ? "pass" : "fail";
+  j["message"] = result.message;
+  j["limits"] = ChecksJson(result);
+  return j.dump(2) + "\n";
+}
+
+std::string CertificateToJson(const Certificate& cert) {
+  using Json = nlohmann::ordered_json;
+  using internal::JsonNumber;
+  Json j;
+  j["unit"] = cert.info.unit;
+  j["date"] = cert.info.date;
+  j["station"] = cert.info.station;
+  j["software"] = {{"name", "gravcal"},
+                   {"version", cert.info.software_version},
+                   {"hash", cert.info.software_hash}};
+  j["input"] = {{"file", cert.info.input_file}, {"hash", cert.info.input_hash}};
+  j["config"] = {{"file", cert.info.config_name}, {"text", cert.info.config_text}};
+  j["method"] = cert.method;
+  j["gravity"] = {{"value", cert.gravity},
+                  {"source", cert.gravity_source},
+                  {"standard_uncertainty", cert.gravity_std}};
+  j["residual_rms"] = JsonNumber<Json>(cert.residual_rms);
+  j["measured"] = {
+      {"accel_noise_density",
+       {JsonNumber<Json>(cert.accel_noise_density(0)),
+        JsonNumber<Json>(cert.accel_noise_density(1)),
+        JsonNumber<Json>(cert.accel_noise_density(2))}},
+      {"gyro_noise_density",
+       {JsonNumber<Json>(cert.gyro_noise_density(0)), JsonNumber<Json>(cert.gyro_noise_density(1)),
+        JsonNumber<Json>(cert.gyro_noise_density(2))}},
+      {"temperature_min", JsonNumber<Json>(cert.temperature_min)},
+      {"temperature_max", JsonNumber<Json>(cert.temperature_max)}};
+  j["coverage_factor"] = cert.info.coverage_factor;
+  Json parameters = Json::array();
+  for (const CertificateEntry& e : cert.parameters) {
+    Json p;
+    p["name"] = e.name;
+    p["unit"] = e.unit;
+    p["value"] = JsonNumber<Json>(e.value);
+    p["standard_uncertainty"] = JsonNumber<Json>(e.standard_uncertainty);
+    p["expanded_uncertainty"] = JsonNumber<Json>(e.expanded_uncertainty);
+    Json budget = Json::array();
+    for (const auto& [source, u] : e.budget) {
+      budget.push_back({{"source", source}, {"standard_uncertainty", JsonNumber<Json>(u)}});
+    }
+    p["budget"] = budget;
+    parameters.push_back(p);
+  }
+  j["parameters"] = parameters;
+  j["notes"] = cert.notes;
+  if (cert.has_limits) {
+    j["verdict"] = cert.acceptance.pass ? "pass" : "fail";
+    j["limits"] = ChecksJson(cert.acceptance);
+    j["verdict_message"] = cert.acceptance.message;
+  } else {
+    j["verdict"] = nullptr;
+    j["verdict_message"] = "no limits given";
+  }
+  return j.dump(2) + "\n";
+}
 
 std::string CertificateToHtml(const Certificate& cert) {
   std::string h =
