@@ -10,8 +10,9 @@ Without a LOG (``--simulate SEED``) it simulates the session first. It exits
 0 when the unit passes, 1 when a limit fails. Plain Python: the small
 ``TestRecord`` below plays OpenHTF's role (phases, measurements with limits,
 attachments, an outcome). When ``openhtf`` is importable,
-``openhtf_test()`` builds the same phases as an ``openhtf.Test`` (each limit
-a measurement, the certificate an attachment).
+``openhtf_test()`` builds the same station as an ``openhtf.Test`` (each
+limit's value a measurement, the verdict a measurement that must equal
+"pass", the certificate an attachment).
 """
 import argparse
 import datetime
@@ -119,18 +120,25 @@ def write_record(record, folder):
 
 
 def openhtf_test(unit, settings):
-    """The same phases as an openhtf.Test (needs openhtf): each limit of the
-    limits file a measurement, the certificate attached."""
+    """The same station as an openhtf.Test (needs openhtf): one phase that
+    runs the station and records every acceptance limit's measured value in
+    the dimensioned measurement ``limit_value`` (by limit name) and the
+    verdict in ``verdict``, which must equal "pass" (OpenHTF's validator
+    decides the outcome); the certificate and the calibration are attached."""
     import openhtf as htf
 
+    @htf.measures(
+        htf.Measurement("limit_value").with_dimensions("limit")
+        .doc("each acceptance limit's measured value (gravcal check_limits)"),
+        htf.Measurement("verdict").equals("pass").doc("gravcal's acceptance verdict"))
     def station_phase(test):
         record = run_station(unit, settings)
         for name, m in record.measurements.items():
-            key = name.replace(".", "_").replace(" ", "_")
-            test.measurements[key] = m["value"]
+            if m["value"] is not None:
+                test.measurements.limit_value[name] = m["value"]
         for name, data in record.attachments.items():
             test.attach(name, data)
-        return htf.PhaseResult.CONTINUE if record.outcome == "PASS" else htf.PhaseResult.STOP
+        test.measurements.verdict = "pass" if record.outcome == "PASS" else "fail"
 
     return htf.Test(station_phase)
 

@@ -46,11 +46,13 @@ std::string Compare(const PyCalibration& a, const PyCalibration& b, double level
   ComparisonSpace space;
   Check(FromString(space_name, &space), "space: '" + space_name + "' is not model or intrinsic");
   ParameterVector p[2];
-  const PyCalibration* c[2] = {&a, &b};
+  const Calibration c[2] = {WithUncertainty(a), WithUncertainty(b)};
+  const std::string names[2] = {a.name, b.name};
   std::string error;
+  Check(SameRawUnits(c[0], c[1], &error), names[0] + ", " + names[1] + ": " + error);
   for (int i = 0; i < 2; ++i) {
-    Check(CalibrationParameters(WithUncertainty(*c[i]), space, &p[i], &error),
-          c[i]->name + ": cannot be tested: " + error);
+    Check(CalibrationParameters(c[i], space, &p[i], &error),
+          names[i] + ": cannot be tested: " + error);
   }
   ComparisonResult result;
   Check(CompareParameters(p[0], p[1], options, &result), result.message);

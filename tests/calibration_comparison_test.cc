@@ -25,6 +25,7 @@
 #include "gravcal/estimation/check_session.h"
 #include "gravcal/methods/twelve_position.h"
 #include "test_util.h"
+#include "twelve_pose_unit.h"
 
 namespace gravcal {
 namespace {
@@ -41,16 +42,10 @@ AccelModel CompareTruth() {
   return m;
 }
 
-// The calibration of `truth` from twelve simulated poses with `seed`.
+// The calibration of `truth` from twelve simulated poses with `seed`
+// (kNoise per sample, kSamples per pose).
 Calibration CalibrateTruth(const AccelModel& truth, uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  const std::vector<Position> positions = testing_util::MakePositions(
-      truth, testing_util::TwelveDirections(), kGravity, 0.01, kNoise, kSamples, true, &rng);
-  CalibrationOptions options;
-  options.gravity.gravity = kGravity;
-  Calibration c;
-  EXPECT_TRUE(CalibrateFromPositions(positions, options, &c)) << c.message;
-  return c;
+  return testing_util::CalibrateTwelvePoseUnit(truth, seed);
 }
 
 ParameterVector Parameters(const Calibration& c, ComparisonSpace space) {

@@ -5,6 +5,7 @@
 // (skipped when absent) consistent under the shipped config.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -21,6 +22,8 @@ using testing_util::ScratchDir;
 using testing_util::Slurp;
 
 const std::string kTwelve = testing_util::SourceDir() + "/configs/twelve_position.yaml";
+// m/s^2 per count of the simulated accelerometer (16384 counts per g).
+constexpr double kCounts = 9.80665 / 16384.0;
 
 // Simulates the unit of `seed` (twelve_position.yaml: the truth is drawn
 // per seed) and calibrates it: <name>/raw.csv, <name>/cal.json.
@@ -161,6 +164,42 @@ TEST(CompareCli, BadInputIsOneLineAndWritesNothing) {
   WriteJson(dir / "asym.json", cal);
   expect_refused({"compare", a, dir / "asym.json", "--output", out}, "accel.covariance.matrix");
   expect_refused({"verify", "--calibration", a, "--output", out}, "--input");
+  // The same session in m/s^2 instead of counts (t,ax,ay,az first): not a
+  // change of the unit but of the raw unit, refused by compare and verify.
+  {
+    std::string si = "t,ax,ay,az\n";
+    const std::string raw = Slurp(dir / "a/raw.csv");
+    size_t at = raw.find('\n') + 1;
+    while (at < raw.size()) {
+      const size_t end = raw.find('\n', at);
+      double v[4];
+      ASSERT_EQ(std::sscanf(raw.c_str() + at, "%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3]), 4);
+      char line[160];
+      std::snprintf(line, sizeof(line), "%.9g,%.9g,%.9g,%.9g\n", v[0], v[1] * kCounts,
+                    v[2] * kCounts, v[3] * kCounts);
+      si += line;
+      at = end == std::string::npos ? raw.size() : end + 1;
+    }
+    FILE* f = std::fopen((dir / "si.csv").c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(si.data(), 1, si.size(), f);
+    std::fclose(f);
+  }
+  expect_refused({"verify", "--calibration", a, "--input", dir / "si.csv", "--config", kTwelve,
+                  "--output", out},
+                 "raw unit is not the calibration's");
+  {
+    const std::string config = Slurp(kTwelve) + "\nnominal_scale: 1.0\n";
+    FILE* f = std::fopen((dir / "si.yaml").c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(config.data(), 1, config.size(), f);
+    std::fclose(f);
+  }
+  const CliResult si = RunCli({"calibrate", "--config", dir / "si.yaml", "--input", dir / "si.csv",
+                               "--output", dir / "si.json"},
+                              dir);
+  ASSERT_EQ(si.exit_code, 0) << si.err;
+  expect_refused({"compare", a, dir / "si.json", "--output", out}, "different raw units");
   expect_refused(
       {"verify", "--calibration", dir / "bare.json", "--input", dir / "a/raw.csv", "--output", out},
       "no accelerometer covariance");

@@ -756,9 +756,10 @@ def _limits_source(limits):
 def check_limits(calibration, limits):
     """The calibration against acceptance limits (a limits YAML path, or a
     dict of the same keys: ``parameters``, ``residual_rms``,
-    ``accel_noise_density``, ``temperature``...): a :class:`Result` with
-    ``verdict`` (pass or fail), ``message`` and ``limits`` (each ``name``,
-    ``measured``, ``min``, ``max``, ``pass``, ``checked``, ``why``)."""
+    ``accel_noise_density``, ``gyro_noise_density``, ``temperature``...): a
+    :class:`Result` with ``verdict`` (pass or fail), ``message`` and
+    ``limits`` (each ``name``, ``measured``, ``min``, ``max``, ``pass``,
+    ``checked``, ``why``)."""
     return _result(_gravcal.check_limits(_calibration(calibration)._core,
                                          *_limits_source(limits)))
 

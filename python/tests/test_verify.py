@@ -82,6 +82,12 @@ def test_limits_and_certificate(session, tmp_path):
     assert gravcal.check_limits(session / "c1.json", tmp_path / "limits.yaml") == result
     with pytest.raises(gravcal.Error, match="accel_noise_density"):
         gravcal.check_limits(session / "c1.json", {"accel_noise_density": -1})
+    # No gyroscope model and no gyro_nominal_scale: the gyroscope's unit is
+    # unknown, so a gyroscope noise limit fails as not measured, said why.
+    gyro = gravcal.check_limits(session / "c1.json", {"gyro_noise_density": {"max": 1e-3}})
+    assert gyro.verdict == "fail" and "gyro_nominal_scale" in gyro.limits[0].why
+    with pytest.raises(gravcal.Error, match="gyro_noise_density.typical"):
+        gravcal.check_limits(session / "c1.json", {"gyro_noise_density": {"typical": 1e-3}})
     cert, html = gravcal.certificate(session / "c1.json", limits=limits, unit="SN1",
                                      station="line-3", output=tmp_path / "cert")
     assert cert.unit == "SN1" and cert.station == "line-3" and cert.verdict == "fail"
@@ -124,6 +130,18 @@ def test_station_as_openhtf_test(session, tmp_path):
     pytest.importorskip("openhtf")
     station = _station()
     (tmp_path / "pass.yaml").write_text("residual_rms: 0.01\n")
-    test = station.openhtf_test("SN1", {"log": str(session / "s1/raw.csv"), "config": TWELVE,
-                                        "limits": str(tmp_path / "pass.yaml")})
-    assert test.execute(test_start=lambda: "SN1")
+    (tmp_path / "fail.yaml").write_text("residual_rms: 0.01\naccel_noise_density: 0.001\n")
+    records = []
+    for limits, passes in (("pass.yaml", True), ("fail.yaml", False)):
+        test = station.openhtf_test("SN1", {"log": str(session / "s1/raw.csv"), "config": TWELVE,
+                                            "limits": str(tmp_path / limits)})
+        test.add_output_callbacks(records.append)
+        assert test.execute(test_start=lambda: "SN1") == passes
+    # The record: the verdict and each limit measured, the certificate attached.
+    for record, verdict in zip(records, ("pass", "fail")):
+        phase = [p for p in record.phases if p.name == "station_phase"][0]
+        assert phase.measurements["verdict"].measured_value.value == verdict
+        limits = dict(phase.measurements["limit_value"].measured_value.value)
+        assert "residual_rms" in limits
+        assert ("accel_noise_density" in limits) == (verdict == "fail")
+        assert any(name.endswith("certificate.json") for name in phase.attachments)

@@ -74,6 +74,9 @@ int RunCompare(const CompareArgs& args) {
       return Fail(args.positional[i] + ": cannot be tested: " + error);
     }
   }
+  if (!SameRawUnits(cal[0], cal[1], &error)) {
+    return Fail(args.positional[0] + ", " + args.positional[1] + ": " + error);
+  }
   if (cal[0].gravity != cal[1].gravity) {
     std::fprintf(stderr,
                  "gravcal: warning: the calibrations used different gravity (%.6f, %.6f m/s^2): "

@@ -398,6 +398,20 @@ bool CompareParameters(const ParameterVector& a, const ParameterVector& b,
   }
   result->message =
       m == 0 ? "not tested: no parameter both calibrations determine" : ComparisonSummary(*result);
+  // A verdict on part of the calibrations says which part: matrix terms
+  // left out mean different models (u_* against m_*), which only the
+  // mount-invariant intrinsic parameters compare.
+  if (m > 0 && !result->not_compared.empty()) {
+    bool matrix = false;
+    for (const std::string& n : result->not_compared) {
+      matrix = matrix || n.find(".u_") != std::string::npos || n.find(".m_") != std::string::npos;
+    }
+    result->message += "; " + std::to_string(result->not_compared.size()) +
+                       " parameters of one calibration only not compared" +
+                       (matrix ? " (the calibrations model the matrix differently: compare them "
+                                 "in intrinsic parameters)"
+                               : "");
+  }
   return true;
 }
 

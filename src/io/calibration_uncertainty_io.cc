@@ -135,6 +135,9 @@ bool CalibrationUncertaintyFromJson(const std::string& text, const std::string& 
   out.method = models.method;
   out.gravity = models.gravity;
   out.provenance = models.provenance;
+  // The thermal model: verify takes check poses to T_ref with it, and the
+  // acceptance limits read its temperature sensitivity.
+  out.thermal = models.corrector.thermal;
   if (j.contains("gravity") && j["gravity"].is_object() && j["gravity"].contains("source") &&
       j["gravity"]["source"].is_string()) {
     out.gravity_source = j["gravity"]["source"].get<std::string>();
@@ -162,6 +165,19 @@ bool CalibrationUncertaintyFromJson(const std::string& text, const std::string& 
       if (p.contains("raw_std") && p["raw_std"].is_array() && p["raw_std"].size() == 3) {
         for (int i = 0; i < 3; ++i) {
           if (p["raw_std"][i].is_number()) r.raw_std(i) = p["raw_std"][i].get<double>();
+        }
+      }
+      if (p.contains("gyro_std")) {
+        const std::string key = "positions[" + std::to_string(out.positions.size()) + "].gyro_std";
+        const json& g = p["gyro_std"];
+        if (!g.is_array() || g.size() != 3) {
+          return Fail(name, key, "must be an array of 3 numbers (rad/s)", error);
+        }
+        for (int i = 0; i < 3; ++i) {
+          if (!g[i].is_number() || !(g[i].get<double>() >= 0.0)) {
+            return Fail(name, key, "must hold non-negative numbers (rad/s)", error);
+          }
+          r.gyro_std(i) = g[i].get<double>();
         }
       }
       r.position.temperature = NAN;

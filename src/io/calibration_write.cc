@@ -116,6 +116,8 @@ json PositionJson(const PositionReport& r) {
             {"residual_after", JsonNumber(r.residual_after)},
             {"sigma", JsonNumber(r.sigma)}};
   if (std::isfinite(r.position.temperature)) p["temperature"] = r.position.temperature;
+  // Issue 36: rad/s per sample, where the gyroscope's unit is known.
+  if (r.gyro_std.allFinite()) p["gyro_std"] = JsonVector(r.gyro_std);
   // Only the methods that use an attitude per position have one.
   if (std::isfinite(r.roll_deg) && std::isfinite(r.pitch_deg)) {
     p["attitude_deg"] = {{"roll", r.roll_deg},

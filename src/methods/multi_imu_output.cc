@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "methods/multi_imu_internal.h"
+#include "methods/static_positions.h"
 
 namespace gravcal {
 namespace internal {
@@ -70,6 +71,7 @@ void FillCalibration(const PlateImuData& imu, const PlateImuParameters& p,
     c->positions.push_back(r);
   }
   c->residual_refined = SummarizeResiduals(residuals);
+  MeasureGyroHoldNoise(log, NAN, c);
   c->message = "multi_imu: calibrated on the plate's shared poses";
 }
 

@@ -1,6 +1,7 @@
 #include "methods/static_positions.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/calibration_gravity.h"
 #include "core/sensor_checks.h"
@@ -134,6 +135,40 @@ void ReportPositions(const std::vector<Position>& positions, const AccelModel& n
     c.positions.push_back(
         MakePositionReport(positions[k], before[k], after[k], k < sigmas.size() ? sigmas[k] : NAN));
     c.positions.back().residual_nominal = before[k];
+  }
+}
+
+void MeasureGyroHoldNoise(const ImuLog& log, double nominal_scale, Calibration* calibration) {
+  Calibration& c = *calibration;
+  if (!log.has_gyro()) return;
+  Eigen::Matrix3d m;
+  if (c.gyro.estimated) {
+    m = c.gyro.model.matrix;
+  } else if (std::isfinite(nominal_scale) && nominal_scale > 0.0) {
+    m = nominal_scale * Eigen::Matrix3d::Identity();
+  } else {
+    return;
+  }
+  for (PositionReport& r : c.positions) {
+    const Position& p = r.position;
+    if (!std::isfinite(p.t_begin) || !std::isfinite(p.t_end)) continue;
+    const auto first = std::lower_bound(log.t.begin(), log.t.end(), p.t_begin);
+    auto last = std::upper_bound(first, log.t.end(), p.t_end);
+    if (p.sample_count > 0 && static_cast<size_t>(last - first) > p.sample_count) {
+      last = first + static_cast<std::ptrdiff_t>(p.sample_count);
+    }
+    const size_t begin = first - log.t.begin(), end = last - log.t.begin();
+    if (end < begin + 2) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (size_t i = begin; i < end; ++i) mean += log.gyro[i];
+    mean /= static_cast<double>(end - begin);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (size_t i = begin; i < end; ++i) {
+      const Eigen::Vector3d d = log.gyro[i] - mean;
+      cov += d * d.transpose();
+    }
+    cov /= static_cast<double>(end - begin - 1);
+    r.gyro_std = (m * cov * m.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
   }
 }
 

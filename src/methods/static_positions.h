@@ -77,6 +77,13 @@ void ReportPositions(const std::vector<Position>& positions, const AccelModel& n
                      const AccelModel& final_model, double gravity,
                      const std::vector<double>& sigmas, Calibration* calibration);
 
+// Fills each position's gyro_std (core/calibration.h) from the log's
+// gyroscope samples in the hold (times t_begin to t_end, at most
+// sample_count of them): through calibration->gyro.model.matrix when the
+// gyroscope was estimated, else through `nominal_scale` (rad/s per raw
+// unit) when it is positive; left NaN otherwise, or without a gyroscope.
+void MeasureGyroHoldNoise(const ImuLog& log, double nominal_scale, Calibration* calibration);
+
 }  // namespace internal
 }  // namespace gravcal
 

@@ -4,16 +4,26 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <nlohmann/json.hpp>
 
 #include "gravcal/estimation/calibration_comparison.h"
 #include "gravcal/io/files.h"
-#include "io/json_helpers.h"
-#include "workflows/report/svg_plot.h"
+#include "workflows/acceptance_internal.h"
 
 namespace gravcal {
 
+namespace internal {
+
+std::string LimitNumber(double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
+  return buffer;
+}
+
+}  // namespace internal
+
 namespace {
+
+using internal::LimitNumber;
 
 bool KeyError(const std::string& name, const std::string& key, const std::string& what,
               std::string* error) {
@@ -32,10 +42,99 @@ bool ReadNumber(const YAML::Node& node, const std::string& name, const std::stri
   return true;
 }
 
-std::string Number(double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
-  return buffer;
+// False with *error naming the first key given twice in any map of `node`
+// (yaml-cpp keeps both, so the later one would silently win).
+bool NoKeyTwice(const YAML::Node& node, const std::string& name, const std::string& prefix,
+                std::string* error) {
+  if (!node.IsMap()) return true;
+  std::vector<std::string> seen;
+  for (const auto& entry : node) {
+    const std::string key = prefix + entry.first.as<std::string>();
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
+      return KeyError(name, key, "given twice (a limit may be set once)", error);
+    }
+    seen.push_back(key);
+    if (!NoKeyTwice(entry.second, name, key + ".", error)) return false;
+  }
+  return true;
+}
+
+// A noise-density limit: a number (the largest axis' maximum) or a map
+// with min and/or max; each positive, `unit` named in the messages.
+bool ReadDensityLimit(const YAML::Node& node, const std::string& name, const std::string& key,
+                      const std::string& unit, double* min, double* max, std::string* error) {
+  if (node.IsMap()) {
+    if (node.size() == 0) {
+      return KeyError(name, key, "must be a number or a map with min and/or max (" + unit + ")",
+                      error);
+    }
+    for (const auto& field : node) {
+      const std::string f = field.first.as<std::string>();
+      double* target = f == "min" ? min : f == "max" ? max : nullptr;
+      if (target == nullptr) {
+        return KeyError(name, key + "." + f, "unknown (min, max; " + unit + ")", error);
+      }
+      if (!ReadNumber(field.second, name, key + "." + f, target, error)) return false;
+      if (!(*target > 0.0)) {
+        return KeyError(name, key + "." + f, "must be positive (" + unit + ")", error);
+      }
+    }
+    if (*min > *max) return KeyError(name, key, "min is above max", error);
+    return true;
+  }
+  if (!ReadNumber(node, name, key, max, error)) return false;
+  if (!(*max > 0.0)) return KeyError(name, key, "must be positive (" + unit + ")", error);
+  return true;
+}
+
+// The median over the holds, per axis, of the white-noise density N_i =
+// sigma_i / sqrt(f_s) from each hold's per-sample standard deviation
+// sigma = per_sample(hold) (SI) and its rate f_s = (samples - 1) / T; NaN
+// on an axis no hold measures.
+template <typename PerSample>
+Eigen::Vector3d HoldNoiseDensity(const Calibration& c, PerSample per_sample) {
+  std::vector<double> per_axis[3];
+  for (const PositionReport& p : c.positions) {
+    const double duration = p.position.t_end - p.position.t_begin;
+    if (p.position.sample_count < 2 || !(duration > 0.0)) continue;
+    const Eigen::Vector3d sigma = per_sample(p);
+    if (!sigma.allFinite() || !(sigma.maxCoeff() > 0.0)) continue;
+    const double rate = (p.position.sample_count - 1) / duration;
+    for (int i = 0; i < 3; ++i) per_axis[i].push_back(sigma(i) / std::sqrt(rate));
+  }
+  Eigen::Vector3d out = Eigen::Vector3d::Constant(NAN);
+  for (int i = 0; i < 3; ++i) {
+    std::vector<double>& v = per_axis[i];
+    if (v.empty()) continue;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    double median = v[v.size() / 2];
+    if (v.size() % 2 == 0) {
+      median = 0.5 * (median + *std::max_element(v.begin(), v.begin() + v.size() / 2));
+    }
+    out(i) = median;
+  }
+  return out;
+}
+
+// Whether `name` is a parameter name compare knows (model: accel. or gyro.
+// followed by bias_x, u_xy, m_xy or rot_x; intrinsic: accel.sensitivity_x,
+// accel.nonorth_xy, xz, yz); a limit on any other name is a typo.
+bool KnownParameterName(const std::string& name) {
+  const auto axis = [](char c) { return c == 'x' || c == 'y' || c == 'z'; };
+  std::string rest;
+  if (name.rfind("accel.", 0) == 0) {
+    rest = name.substr(6);
+    if (rest.size() == 13 && rest.rfind("sensitivity_", 0) == 0 && axis(rest[12])) return true;
+    if (rest == "nonorth_xy" || rest == "nonorth_xz" || rest == "nonorth_yz") return true;
+  } else if (name.rfind("gyro.", 0) == 0) {
+    rest = name.substr(5);
+  } else {
+    return false;
+  }
+  if (rest.size() == 6 && rest.rfind("bias_", 0) == 0) return axis(rest[5]);
+  if (rest.size() == 5 && rest.rfind("rot_", 0) == 0) return axis(rest[4]);
+  return rest.size() == 4 && (rest[0] == 'u' || rest[0] == 'm') && rest[1] == '_' &&
+         axis(rest[2]) && axis(rest[3]);
 }
 
 // The value, standard deviation and determined flag of every parameter the
@@ -73,11 +172,20 @@ LimitCheck Range(const std::string& name, double measured, double min, double ma
   if (!std::isfinite(measured)) {
     c.why = "not determined";
   } else if (measured < min) {
-    c.why = Number(measured) + " below min " + Number(min);
+    c.why = LimitNumber(measured) + " below min " + LimitNumber(min);
   } else if (measured > max) {
-    c.why = Number(measured) + " above max " + Number(max);
+    c.why = LimitNumber(measured) + " above max " + LimitNumber(max);
   }
   return c;
+}
+
+// The check of a measured noise density (largest axis) against [min, max].
+void CheckDensity(const std::string& name, const Eigen::Vector3d& density, double min, double max,
+                  const std::string& not_measured, AcceptanceResult* result) {
+  if (!std::isfinite(min) && !std::isfinite(max)) return;
+  result->checks.push_back(Range(name, density.allFinite() ? density.maxCoeff() : NAN,
+                                 std::isfinite(min) ? min : 0.0, max));
+  if (!density.allFinite()) result->checks.back().why = not_measured;
 }
 
 // The unit of a parameter (accelerometer raw unit "raw").
@@ -118,9 +226,11 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
   if (!root.IsMap()) {
     *error = name +
              ": must be a map with 'parameters', 'residual_rms', 'gravity_std', "
-             "'accel_noise_density', 'temperature'";
+             "'accel_noise_density', 'gyro_noise_density', 'temperature', "
+             "'temperature_sensitivity'";
     return false;
   }
+  if (!NoKeyTwice(root, name, "", error)) return false;
   AcceptanceLimits out;
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
@@ -130,9 +240,14 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
       if (!ReadNumber(entry.second, name, key, &out.gravity_std, error)) return false;
       if (!(out.gravity_std > 0.0)) return KeyError(name, key, "must be positive", error);
     } else if (key == "accel_noise_density") {
-      if (!ReadNumber(entry.second, name, key, &out.max_accel_noise_density, error)) return false;
-      if (!(out.max_accel_noise_density > 0.0)) {
-        return KeyError(name, key, "must be positive", error);
+      if (!ReadDensityLimit(entry.second, name, key, "m/s^2/sqrt(Hz)", &out.min_accel_noise_density,
+                            &out.max_accel_noise_density, error)) {
+        return false;
+      }
+    } else if (key == "gyro_noise_density") {
+      if (!ReadDensityLimit(entry.second, name, key, "rad/s/sqrt(Hz)", &out.min_gyro_noise_density,
+                            &out.max_gyro_noise_density, error)) {
+        return false;
       }
     } else if (key == "temperature") {
       if (!entry.second.IsMap() || entry.second.size() == 0) {
@@ -171,6 +286,13 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
         ParameterLimit limit;
         limit.name = p.first.as<std::string>();
         const std::string base = "parameters." + limit.name;
+        if (!KnownParameterName(limit.name)) {
+          return KeyError(name, base,
+                          "not a parameter name (accel.bias_x, accel.u_xy, accel.m_xy, "
+                          "accel.rot_x, accel.sensitivity_x, accel.nonorth_xy, gyro.bias_x, "
+                          "gyro.m_xy)",
+                          error);
+        }
         if (!p.second.IsMap() || p.second.size() == 0) {
           return KeyError(name, base, "must be a map with min, max and/or max_std", error);
         }
@@ -193,7 +315,7 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
     } else {
       return KeyError(name, key,
                       "unknown (parameters, residual_rms, gravity_std, accel_noise_density, "
-                      "temperature, temperature_sensitivity)",
+                      "gyro_noise_density, temperature, temperature_sensitivity)",
                       error);
     }
   }
@@ -203,30 +325,15 @@ bool AcceptanceLimitsFromYaml(const std::string& text, const std::string& name,
 
 Eigen::Vector3d MeasuredAccelNoiseDensity(const Calibration& c) {
   const Eigen::Matrix3d m = c.accel.model.matrix();
-  std::vector<double> per_axis[3];
-  for (const PositionReport& p : c.positions) {
-    const double duration = p.position.t_end - p.position.t_begin;
-    if (p.position.sample_count < 2 || !(duration > 0.0) || !p.raw_std.allFinite() ||
-        !(p.raw_std.maxCoeff() > 0.0)) {
-      continue;
-    }
-    const double rate = (p.position.sample_count - 1) / duration;
+  return HoldNoiseDensity(c, [&m](const PositionReport& p) -> Eigen::Vector3d {
     const Eigen::Matrix3d cov =
         m * p.raw_std.array().square().matrix().asDiagonal() * m.transpose();
-    for (int i = 0; i < 3; ++i) per_axis[i].push_back(std::sqrt(cov(i, i) / rate));
-  }
-  Eigen::Vector3d out = Eigen::Vector3d::Constant(NAN);
-  for (int i = 0; i < 3; ++i) {
-    std::vector<double>& v = per_axis[i];
-    if (v.empty()) continue;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    double median = v[v.size() / 2];
-    if (v.size() % 2 == 0) {
-      median = 0.5 * (median + *std::max_element(v.begin(), v.begin() + v.size() / 2));
-    }
-    out(i) = median;
-  }
-  return out;
+    return cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  });
+}
+
+Eigen::Vector3d MeasuredGyroNoiseDensity(const Calibration& c) {
+  return HoldNoiseDensity(c, [](const PositionReport& p) { return p.gyro_std; });
 }
 
 bool ReadAcceptanceLimits(const std::string& path, AcceptanceLimits* limits, std::string* error) {
@@ -267,12 +374,15 @@ void CheckAcceptance(const Calibration& calibration, const AcceptanceLimits& lim
     result->checks.push_back(
         Range("residual_rms", calibration.residual_refined.rms, 0.0, limits.max_residual_rms));
   }
-  if (std::isfinite(limits.max_accel_noise_density)) {
-    const Eigen::Vector3d n = MeasuredAccelNoiseDensity(calibration);
-    result->checks.push_back(Range("accel_noise_density", n.allFinite() ? n.maxCoeff() : NAN, 0.0,
-                                   limits.max_accel_noise_density));
-    if (!n.allFinite()) result->checks.back().why = "not measured (no hold with samples)";
-  }
+  CheckDensity("accel_noise_density", MeasuredAccelNoiseDensity(calibration),
+               limits.min_accel_noise_density, limits.max_accel_noise_density,
+               "not measured (no hold with samples)", result);
+  CheckDensity("gyro_noise_density", MeasuredGyroNoiseDensity(calibration),
+               limits.min_gyro_noise_density, limits.max_gyro_noise_density,
+               "not measured (no hold with gyroscope samples in a known unit: the log has no "
+               "gyroscope, or the calibration no gyroscope model and the config no "
+               "gyro_nominal_scale)",
+               result);
   if (std::isfinite(limits.min_temperature) || std::isfinite(limits.max_temperature)) {
     // The hold farthest outside [min, max] (or the coldest when all inside).
     double coldest = NAN, hottest = NAN;
@@ -370,6 +480,7 @@ bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
   out.method = c.method;
   out.residual_rms = c.residual_refined.rms;
   out.accel_noise_density = MeasuredAccelNoiseDensity(c);
+  out.gyro_noise_density = MeasuredGyroNoiseDensity(c);
   for (const PositionReport& p : c.positions) {
     const double t = p.position.temperature;
     if (!std::isfinite(t)) continue;
@@ -391,13 +502,13 @@ bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
   out.notes.push_back(
       "fit variance split between noise and pose scatter in proportion of their "
       "mean per-pose variances (noise share " +
-      Number(noise_share) + ")");
+      LimitNumber(noise_share) + ")");
   out.notes.push_back(c.effects.estimates.empty()
                           ? "temperature: not modelled by this calibration (no temperature term "
                             "fitted); not part of the budget"
                           : "temperature: the fitted effect terms are part of the fit variance");
-  out.notes.push_back("gravity " + Number(c.gravity) + " m/s^2 (" + c.gravity_source +
-                      "), standard uncertainty " + Number(out.gravity_std) + " m/s^2");
+  out.notes.push_back("gravity " + LimitNumber(c.gravity) + " m/s^2 (" + c.gravity_source +
+                      "), standard uncertainty " + LimitNumber(out.gravity_std) + " m/s^2");
   const NamedValues values = CollectValues(c);
   if (values.names.empty()) {
     *error = "no certificate: the calibration has no covariance (output_covariance: true)";
@@ -433,162 +544,6 @@ bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
   }
   *certificate = out;
   return true;
-}
-
-namespace {
-
-nlohmann::ordered_json ChecksJson(const AcceptanceResult& result) {
-  using Json = nlohmann::ordered_json;
-  using internal::JsonNumber;
-  Json checks = Json::array();
-  for (const LimitCheck& c : result.checks) {
-    checks.push_back({{"name", c.name},
-                      {"measured", JsonNumber<Json>(c.measured)},
-                      {"min", JsonNumber<Json>(c.min)},
-                      {"max", JsonNumber<Json>(c.max)},
-                      {"pass", c.pass},
-                      {"checked", c.checked},
-                      {"why", c.why}});
-  }
-  return checks;
-}
-
-}  // namespace
-
-std::string AcceptanceToJson(const AcceptanceResult& result) {
-  nlohmann::ordered_json j;
-  j["verdict"] = result.pass ? "pass" : "fail";
-  j["message"] = result.message;
-  j["limits"] = ChecksJson(result);
-  return j.dump(2) + "\n";
-}
-
-std::string CertificateToJson(const Certificate& cert) {
-  using Json = nlohmann::ordered_json;
-  using internal::JsonNumber;
-  Json j;
-  j["unit"] = cert.info.unit;
-  j["date"] = cert.info.date;
-  j["station"] = cert.info.station;
-  j["software"] = {{"name", "gravcal"},
-                   {"version", cert.info.software_version},
-                   {"hash", cert.info.software_hash}};
-  j["input"] = {{"file", cert.info.input_file}, {"hash", cert.info.input_hash}};
-  j["config"] = {{"file", cert.info.config_name}, {"text", cert.info.config_text}};
-  j["method"] = cert.method;
-  j["gravity"] = {{"value", cert.gravity},
-                  {"source", cert.gravity_source},
-                  {"standard_uncertainty", cert.gravity_std}};
-  j["residual_rms"] = JsonNumber<Json>(cert.residual_rms);
-  j["measured"] = {{"accel_noise_density",
-                    {JsonNumber<Json>(cert.accel_noise_density(0)),
-                     JsonNumber<Json>(cert.accel_noise_density(1)),
-                     JsonNumber<Json>(cert.accel_noise_density(2))}},
-                   {"temperature_min", JsonNumber<Json>(cert.temperature_min)},
-                   {"temperature_max", JsonNumber<Json>(cert.temperature_max)}};
-  j["coverage_factor"] = cert.info.coverage_factor;
-  Json parameters = Json::array();
-  for (const CertificateEntry& e : cert.parameters) {
-    Json p;
-    p["name"] = e.name;
-    p["unit"] = e.unit;
-    p["value"] = JsonNumber<Json>(e.value);
-    p["standard_uncertainty"] = JsonNumber<Json>(e.standard_uncertainty);
-    p["expanded_uncertainty"] = JsonNumber<Json>(e.expanded_uncertainty);
-    Json budget = Json::array();
-    for (const auto& [source, u] : e.budget) {
-      budget.push_back({{"source", source}, {"standard_uncertainty", JsonNumber<Json>(u)}});
-    }
-    p["budget"] = budget;
-    parameters.push_back(p);
-  }
-  j["parameters"] = parameters;
-  j["notes"] = cert.notes;
-  if (cert.has_limits) {
-    j["verdict"] = cert.acceptance.pass ? "pass" : "fail";
-    j["limits"] = ChecksJson(cert.acceptance);
-    j["verdict_message"] = cert.acceptance.message;
-  } else {
-    j["verdict"] = nullptr;
-    j["verdict_message"] = "no limits given";
-  }
-  return j.dump(2) + "\n";
-}
-
-std::string CertificateToHtml(const Certificate& cert) {
-  std::string h =
-      "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>Calibration certificate " +
-      internal::HtmlEscape(cert.info.unit) +
-      "</title><style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
-      "td,th{border:1px solid #999;padding:2px 8px;text-align:right}th{background:#eee}"
-      ".pass{color:#070}.fail{color:#b00}</style></head><body>\n";
-  h += "<h1>Calibration certificate</h1>\n<table id='identity'>\n";
-  const std::pair<const char*, std::string> rows[] = {
-      {"Unit", cert.info.unit},
-      {"Date (UTC)", cert.info.date},
-      {"Station", cert.info.station},
-      {"Software", "gravcal " + cert.info.software_version + " (" + cert.info.software_hash + ")"},
-      {"Input", cert.info.input_file + " (" + cert.info.input_hash + ")"},
-      {"Config", cert.info.config_name},
-      {"Method", cert.method},
-      {"Gravity", Number(cert.gravity) + " m/s^2 (" + cert.gravity_source +
-                      "), u = " + Number(cert.gravity_std) + " m/s^2"},
-      {"Residual |a| - g rms", Number(cert.residual_rms) + " m/s^2"},
-      {"Accelerometer noise density (holds)",
-       cert.accel_noise_density.allFinite()
-           ? Number(cert.accel_noise_density(0)) + ", " + Number(cert.accel_noise_density(1)) +
-                 ", " + Number(cert.accel_noise_density(2)) + " m/s^2/sqrt(Hz)"
-           : "not measured"},
-      {"Temperature (holds)",
-       std::isfinite(cert.temperature_min)
-           ? Number(cert.temperature_min) + " to " + Number(cert.temperature_max) + " degC"
-           : "not in the log"}};
-  for (const auto& [k, v] : rows)
-    h += "<tr><th>" + std::string(k) + "</th><td>" + internal::HtmlEscape(v) + "</td></tr>\n";
-  h += "</table>\n<h2>Parameters (expanded uncertainty, coverage factor k = " +
-       Number(cert.info.coverage_factor) +
-       ")</h2>\n<table id='parameters'>\n"
-       "<tr><th>parameter</th><th>unit</th><th>value</th><th>u (noise)</th><th>u (pose "
-       "scatter / placement)</th><th>u (gravity)</th><th>u_c</th><th>U = k u_c</th></tr>\n";
-  for (const CertificateEntry& e : cert.parameters) {
-    h += "<tr class='parameter'><td>" + internal::HtmlEscape(e.name) + "</td><td>" +
-         internal::HtmlEscape(e.unit) + "</td><td>" + Number(e.value) + "</td>";
-    if (!std::isfinite(e.standard_uncertainty)) {
-      h += "<td colspan='5'>not determined by this session</td></tr>\n";
-      continue;
-    }
-    std::string noise = "", scatter = "", gravity = "";
-    for (const auto& [source, u] : e.budget) {
-      (source == "noise" ? noise : source == "gravity" ? gravity : scatter) = Number(u);
-    }
-    h += "<td>" + noise + "</td><td>" + scatter + "</td><td>" + gravity + "</td><td>" +
-         Number(e.standard_uncertainty) + "</td><td>" + Number(e.expanded_uncertainty) +
-         "</td></tr>\n";
-  }
-  h += "</table>\n<ul>\n";
-  for (const std::string& n : cert.notes) h += "<li>" + internal::HtmlEscape(n) + "</li>\n";
-  h += "</ul>\n<h2>Verdict</h2>\n";
-  if (cert.has_limits) {
-    h += "<p id='verdict' class='" + std::string(cert.acceptance.pass ? "pass" : "fail") + "'>" +
-         (cert.acceptance.pass ? "PASS" : "FAIL") + ": " +
-         internal::HtmlEscape(cert.acceptance.message) +
-         "</p>\n<table id='limits'><tr><th>limit</th><th>measured</th><th>min</th><th>max</th>"
-         "<th>result</th></tr>\n";
-    for (const LimitCheck& c : cert.acceptance.checks) {
-      h += "<tr><td>" + internal::HtmlEscape(c.name) + "</td><td>" + Number(c.measured) +
-           "</td><td>" + Number(c.min) + "</td><td>" + Number(c.max) + "</td><td class='" +
-           (!c.checked ? "pass'>" + internal::HtmlEscape(c.why)
-            : c.pass   ? "pass'>pass"
-                       : "fail'>fail: " + internal::HtmlEscape(c.why)) +
-           "</td></tr>\n";
-    }
-    h += "</table>\n";
-  } else {
-    h += "<p id='verdict'>no limits given</p>\n";
-  }
-  h += "<h2>Configuration</h2>\n<pre>" + internal::HtmlEscape(cert.info.config_text) +
-       "</pre>\n</body></html>\n";
-  return h;
 }
 
 }  // namespace gravcal

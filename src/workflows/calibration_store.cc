@@ -291,8 +291,6 @@ bool ReadUnitHistory(const std::string& store, const std::string& unit, double l
       }
       h.dof = used - 1;
       h.p_value = internal::ChiSquareUpperTail(h.chi2, h.dof);
-      h.drifts = h.p_value < level;
-      drifting += h.drifts ? 1 : 0;
       const double det = sw * swxx - swx * swx;
       if (det > 0.0) {
         h.slope_per_day = (sw * swxy - swx * swy) / det;
@@ -301,6 +299,14 @@ bool ReadUnitHistory(const std::string& store, const std::string& unit, double l
       }
     }
     history->parameters.push_back(h);
+  }
+  // Bonferroni over the parameters tested: a unit that does not drift is
+  // said to in at most a fraction `level` of its histories.
+  int tested = 0;
+  for (const ParameterHistory& h : history->parameters) tested += h.dof > 0 ? 1 : 0;
+  for (ParameterHistory& h : history->parameters) {
+    h.drifts = h.dof > 0 && h.p_value < level / tested;
+    drifting += h.drifts ? 1 : 0;
   }
   history->message =
       std::to_string(n) + " calibration" + (n == 1 ? "" : "s") + " of '" + unit + "'; " +

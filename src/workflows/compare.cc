@@ -174,7 +174,36 @@ void ThermalCheckPoses(const ImuLog& log, const Calibration& stored,
   }
 }
 
+// The mean scale |det M|^(1/3) of a sensor matrix, per raw unit.
+double MeanScale(const Eigen::Matrix3d& m) { return std::cbrt(std::fabs(m.determinant())); }
+
+std::string ScaleText(double v) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.6g", v);
+  return text;
+}
+
+// False with *error when scales `a` and `b` differ by more than a factor 2.
+bool SameScale(const char* sensor, const char* unit, double a, double b, std::string* error) {
+  if (a > 0.0 && b > 0.0 && std::max(a, b) <= 2.0 * std::min(a, b)) return true;
+  *error = std::string("the calibrations map different raw units: ") + sensor + " scale " +
+           ScaleText(a) + " against " + ScaleText(b) + " " + unit +
+           " per raw unit; compare needs both made from logs in the same raw unit (the same "
+           "format, columns and nominal_scale)";
+  return false;
+}
+
 }  // namespace
+
+bool SameRawUnits(const Calibration& a, const Calibration& b, std::string* error) {
+  if (!SameScale("accelerometer", "m/s^2", MeanScale(a.accel.model.matrix()),
+                 MeanScale(b.accel.model.matrix()), error)) {
+    return false;
+  }
+  return !(a.gyro.estimated && b.gyro.estimated) ||
+         SameScale("gyroscope", "rad/s", MeanScale(a.gyro.model.matrix),
+                   MeanScale(b.gyro.model.matrix), error);
+}
 
 bool VerifyCheckLog(const ImuLog& log, const Calibration& stored, const CalibrationOptions& options,
                     const ComparisonOptions& comparison, CheckSessionResult* result,
@@ -188,6 +217,24 @@ bool VerifyCheckLog(const ImuLog& log, const Calibration& stored, const Calibrat
   }
   if (positions.empty()) {
     *error = internal::PrefixSource(log.source, "no static pose found in the check session");
+    return false;
+  }
+  // The check's raw unit against the calibration's: |a| of the poses
+  // through the stored model (median) near its gravity.
+  std::vector<double> magnitudes;
+  for (const Position& p : positions) {
+    magnitudes.push_back(stored.accel.model.Apply(p.raw_mean).norm());
+  }
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2,
+                   magnitudes.end());
+  const double magnitude = magnitudes[magnitudes.size() / 2];
+  if (!(magnitude > 0.5 * stored.gravity && magnitude < 2.0 * stored.gravity)) {
+    *error = internal::PrefixSource(
+        log.source, "its poses read |a| = " + ScaleText(magnitude) +
+                        " m/s^2 through the stored calibration, not about " +
+                        ScaleText(stored.gravity) +
+                        ": the check session's raw unit is not the calibration's (read it with "
+                        "the config the calibration was made with, --config)");
     return false;
   }
   std::vector<std::string> warnings;

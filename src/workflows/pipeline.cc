@@ -1,12 +1,14 @@
 #include "gravcal/workflows/pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/sensor_checks.h"
 #include "core/warnings.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/workflows/method_registry.h"
 #include "gravcal/workflows/rate_table_segments.h"
+#include "methods/static_positions.h"
 #include "util/source_prefix.h"
 
 namespace gravcal {
@@ -83,6 +85,12 @@ bool RunCalibration(const Config& config, const SessionFiles& files, Session* se
   }
   const bool ok = method.run(config, *session, calibration);
   calibration->method = method.name;
+  // Issue 36: the gyroscope's noise in each hold (the acceptance limits'
+  // gyro_noise_density); without a gyroscope model only a stated raw unit.
+  const bool scale_set = std::find(config.keys_set.begin(), config.keys_set.end(),
+                                   "gyro_nominal_scale") != config.keys_set.end();
+  internal::MeasureGyroHoldNoise(session->log, scale_set ? config.handheld.gyro_nominal_scale : NAN,
+                                 calibration);
   // Issue 33: a gyroscope whose axes disagree with the accelerometer's
   // convention (a flipped or swapped axis), named for every method.
   const std::string convention = internal::GyroAxisConventionWarning(session->log);

@@ -78,6 +78,13 @@ struct PositionReport {
   Position position;
   // sqrt of the diagonal of the sample covariance, raw units.
   Eigen::Vector3d raw_std = Eigen::Vector3d::Zero();
+  // The gyroscope's noise in the hold: the standard deviation of one sample
+  // per axis, rad/s, taken from the hold's raw gyroscope samples through the
+  // calibration's gyroscope model (sqrt diag(M_g C M_g^T), C their sample
+  // covariance) or, without one, the config's gyro_nominal_scale. NaN when
+  // the log has no gyroscope or its unit is not known (no gyroscope model
+  // and gyro_nominal_scale not set).
+  Eigen::Vector3d gyro_std = Eigen::Vector3d::Constant(NAN);
   int nominal_up = -1;
   double residual_before = 0.0;
   double residual_after = 0.0;

@@ -18,9 +18,10 @@ namespace gravcal {
 
 // Fills calibration->accel (model, bias_std, matrix_std, covariance and its
 // names), ->gyro (the same, estimated when the file has "gyro"), ->gravity,
-// ->method, ->provenance, ->residual_refined.rms (residual.after.rms, NaN
-// when absent) and ->positions (t_begin, t_end, raw_mean, samples, raw_std
-// and temperature; NaN where absent); `loaded` (may be null) receives what
+// ->method, ->provenance, ->thermal, ->residual_refined.rms
+// (residual.after.rms, NaN when absent) and ->positions (t_begin, t_end,
+// raw_mean, samples, raw_std, gyro_std and temperature; NaN where absent);
+// `loaded` (may be null) receives what
 // ReadCalibrationJson reads. Errors are one line naming the file and key.
 bool CalibrationUncertaintyFromJson(const std::string& text, const std::string& name,
                                     Calibration* calibration, LoadedCalibration* loaded,

@@ -10,6 +10,7 @@
 //   residual_rms: 0.005     # |a| - g rms after calibration, m/s^2
 //   gravity_std: 0.0001     # standard uncertainty of the gravity used, m/s^2
 //   accel_noise_density: 0.002   # m/s^2/sqrt(Hz), the largest axis, measured in the holds
+//   gyro_noise_density: {min: 5e-5, max: 5e-4}   # rad/s/sqrt(Hz), the same way
 //   temperature: {min: 15, max: 35}   # degC, every hold, where the log has temperature
 //   temperature_sensitivity: {accel_bias: 0.5, gyro_bias: 0.05}   # mg/K, deg/s/K
 //
@@ -29,6 +30,13 @@
 // N_i^2 = (M diag(raw_std^2) M^T)_ii / f_s with f_s = (samples - 1) / T.
 // The median over the holds per axis; the limit applies to the largest axis.
 // Hand tremor in a hold raises it: it is the noise the calibration saw.
+// The gyroscope's the same way, N_i = gyro_std_i / sqrt(f_s) in
+// rad/s/sqrt(Hz) (1 deg/s/sqrt(Hz) = 0.0174533 rad/s/sqrt(Hz)), from each
+// hold's gyro_std (core/calibration.h: through the gyroscope model, or the
+// config's gyro_nominal_scale when the calibration has none; without either
+// the raw unit is unknown and the limit fails as not measured). A noise
+// density limit is a number (the maximum) or a map {min, max}: a minimum
+// catches a stuck or disconnected sensor, whose holds show no noise.
 //
 // Temperature: every hold's mean temperature must lie in [min, max]. A log
 // without temperature leaves the limit not checked (listed as such, not
@@ -83,7 +91,11 @@ struct AcceptanceLimits {
   // <= 0: by the gravity's source (above).
   double gravity_std = 0.0;
   // m/s^2/sqrt(Hz), the largest axis of MeasuredAccelNoiseDensity.
+  double min_accel_noise_density = -std::numeric_limits<double>::infinity();
   double max_accel_noise_density = std::numeric_limits<double>::infinity();
+  // rad/s/sqrt(Hz), the largest axis of MeasuredGyroNoiseDensity.
+  double min_gyro_noise_density = -std::numeric_limits<double>::infinity();
+  double max_gyro_noise_density = std::numeric_limits<double>::infinity();
   // degC, every hold's mean temperature.
   double min_temperature = -std::numeric_limits<double>::infinity();
   double max_temperature = std::numeric_limits<double>::infinity();
@@ -102,6 +114,9 @@ double ThermalSensitivity(const Calibration& calibration, ThermalSensor sensor);
 // (above), m/s^2/sqrt(Hz); NaN where no hold has a sample count, a duration
 // and a raw standard deviation.
 Eigen::Vector3d MeasuredAccelNoiseDensity(const Calibration& calibration);
+// The gyroscope's, rad/s/sqrt(Hz), from the holds' gyro_std; NaN where no
+// hold has one.
+Eigen::Vector3d MeasuredGyroNoiseDensity(const Calibration& calibration);
 
 // Parses the limits YAML; `name` is used in messages. Errors are one line
 // naming the file and key ("limits.yaml: key 'parameters.accel.bias_z.min':
@@ -174,6 +189,8 @@ struct Certificate {
   // Measured in the holds: MeasuredAccelNoiseDensity, and the coldest and
   // hottest hold (NaN without temperature).
   Eigen::Vector3d accel_noise_density = Eigen::Vector3d::Constant(NAN);
+  // MeasuredGyroNoiseDensity, rad/s/sqrt(Hz).
+  Eigen::Vector3d gyro_noise_density = Eigen::Vector3d::Constant(NAN);
   double temperature_min = NAN;
   double temperature_max = NAN;
   std::vector<CertificateEntry> parameters;

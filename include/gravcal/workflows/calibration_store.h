@@ -6,8 +6,10 @@
 // The history of a unit: every parameter (compare's model names) over time
 // with its sigma, a weighted straight-line trend with its slope and sigma,
 // and a drift test: the chi-square of the values about their weighted mean
-// on n - 1 degrees of freedom (p < level: the parameter is not constant
-// within its sigmas), plus compare (estimation/calibration_comparison.h)
+// on n - 1 degrees of freedom (p < level / m, Bonferroni over the m
+// parameters tested: the parameter is not constant within its sigmas, and a
+// unit that does not drift is said to in at most a fraction `level` of its
+// histories), plus compare (estimation/calibration_comparison.h)
 // between each calibration and the one before.
 #ifndef GRAVCAL_WORKFLOWS_CALIBRATION_STORE_H_
 #define GRAVCAL_WORKFLOWS_CALIBRATION_STORE_H_

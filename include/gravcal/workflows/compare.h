@@ -35,10 +35,20 @@ OutputDifference CorrectedOutputDifference(const ImuCorrector& a, const ImuCorre
 // As a JSON section ("output_difference" of compare.json).
 std::string OutputDifferenceToJson(const OutputDifference& difference);
 
+// Whether two calibrations map the same raw unit: their accelerometer
+// matrices' mean scales |det M|^(1/3) (m/s^2 per raw unit), and the
+// gyroscopes' when both have one, within a factor 2. A unit's own scale
+// moves by percent; counts against m/s^2 or g against m/s^2 differ by a
+// factor 9.8 or more, which no test of "the same unit, unchanged" should
+// report as a change. False with a one-line message saying both scales.
+bool SameRawUnits(const Calibration& a, const Calibration& b, std::string* error);
+
 // The check session's static poses are found with options.detector and
 // their noise with options.pose_noise (the calibrate config's), then tested
 // against `stored` (VerifyCheckSession). False with a one-line message naming
-// the log when no pose is found or the log is invalid.
+// the log when no pose is found, the log is invalid, or its poses read
+// |a| through the stored calibration more than a factor 2 from its gravity
+// (the log's raw unit is not the calibration's).
 bool VerifyCheckLog(const ImuLog& log, const Calibration& stored, const CalibrationOptions& options,
                     const ComparisonOptions& comparison, CheckSessionResult* result,
                     std::string* error);

@@ -38,7 +38,8 @@ SectionOf<CalibrationConfig> AlignmentSection() {
                            "use the gyroscope in the alignment when the log has one"),
               GRAVCAL_KEY("gyro_nominal_scale",
                           "rad/s per raw gyroscope unit before calibration (1 = rad/s, 0.0174533 = "
-                          "deg/s), for the alignment and the handheld Kalman filter",
+                          "deg/s), for the alignment, the handheld Kalman filter and, without a "
+                          "gyroscope model, the holds' gyroscope noise (acceptance limits)",
                           ReadGyroNominalScale(n, c, e), DoubleText(c.handheld.gyro_nominal_scale)),
           }};
 }
