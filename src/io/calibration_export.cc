@@ -425,14 +425,10 @@ double PositionResidualRms(const ImuCorrector& corrector,
 ImuCorrector TruncatedCorrector(const ImuCorrector& full, ExportTarget target) {
   switch (target) {
     case ExportTarget::kRos:
+    case ExportTarget::kC:
+      // The C corrector is written from the effects' definitions and holds
+      // the thermal model with its lag: the whole model.
       return full;
-    case ExportTarget::kC: {
-      // The C functions take no temperature rate: no thermal lag; the
-      // effects they hold.
-      ImuCorrector t = full.WithEffects(internal::CCorrectorEffects());
-      t.thermal.lag_time_constant = 0.0;
-      return t;
-    }
     case ExportTarget::kKalibr:
     case ExportTarget::kOpenVins: {
       ImuCorrector t = full.WithEffects({Effect::kGyroGSensitivity});
