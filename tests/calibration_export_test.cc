@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "c_corrector_check.h"
 #include "cli_runner.h"
 #include "gravcal/core/calibration.h"
 #include "gravcal/core/thermal_rate.h"
@@ -648,47 +649,16 @@ TEST(Export, CCorrectorEqualsApply) {
       "apply --calibration " + calib + " --input " + raw + " --output " + (scratch / "applied.csv"),
       scratch);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  scratch.Write(
-      "c/main.c",
-      "#include <stdio.h>\n#include \"gravcal_correct.h\"\n"
-      "int main(void) {\n"
-      "  double t, v[3], u[3], temp, a[3], w[3];\n"
-      "  float vf[3], uf[3], af[3], wf[3];\n"
-      "  int i;\n"
-      "  while (scanf(\"%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf\", &t, &v[0], &v[1], &v[2], &u[0], &u[1], "
-      "&u[2], &temp) == 8) {\n"
-      "    gravcal_accel_correct(v, temp, t, a);\n"
-      "    gravcal_gyro_correct(u, a, temp, t, w);\n"
-      "    for (i = 0; i < 3; ++i) { vf[i] = (float)v[i]; uf[i] = (float)u[i]; }\n"
-      "    gravcal_accel_correct_f(vf, (float)temp, (float)t, af);\n"
-      "    gravcal_gyro_correct_f(uf, af, (float)temp, (float)t, wf);\n"
-      "    printf(\"%.17g %.17g %.17g %.17g %.17g %.17g %.9g %.9g %.9g %.9g %.9g %.9g\\n\", a[0], "
-      "a[1], "
-      "a[2], w[0], w[1], w[2], af[0], af[1], af[2], wf[0], wf[1], wf[2]);\n"
-      "  }\n  return 0;\n}\n");
-  const std::string dir = scratch / "c";
-  const std::string compile = "gcc -std=c99 -Wall -Wextra -Werror -pedantic -O2 -o " + dir +
-                              "/run " + dir + "/gravcal_correct.c " + dir + "/main.c -lm 2> " +
-                              dir + "/gcc.txt";
-  ASSERT_EQ(std::system(compile.c_str()), 0) << Slurp(dir + "/gcc.txt");
   // The raw rows without the header.
-  const std::string rows = "tail -n +2 " + raw + " | " + dir + "/run > " + dir + "/c_out.txt";
-  ASSERT_EQ(std::system(rows.c_str()), 0);
+  std::vector<testing_util::CCorrectedRow> c_rows;
+  std::string error;
+  ASSERT_TRUE(
+      testing_util::RunCCorrector(scratch / "c", "tail -n +2 " + raw, ",", false, &c_rows, &error))
+      << error;
   const ImuLog applied = ReadLog(scratch / "applied.csv");
-  std::ifstream c_out(dir + "/c_out.txt");
   double worst_double = 0.0, worst_float = 0.0;
-  size_t n = 0;
-  for (; n < applied.size(); ++n) {
-    Eigen::Vector3d a, w, af, wf;
-    if (!(c_out >> a(0) >> a(1) >> a(2) >> w(0) >> w(1) >> w(2) >> af(0) >> af(1) >> af(2) >>
-          wf(0) >> wf(1) >> wf(2))) {
-      break;
-    }
-    worst_double =
-        std::max({worst_double, Relative(a, applied.accel[n]), Relative(w, applied.gyro[n])});
-    worst_float =
-        std::max({worst_float, Relative(af, applied.accel[n]), Relative(wf, applied.gyro[n])});
-  }
+  testing_util::WorstRelative(c_rows, applied, &worst_double, &worst_float);
+  const size_t n = c_rows.size();
   EXPECT_EQ(n, applied.size());
   EXPECT_LT(worst_double, 1e-9);
   EXPECT_LT(worst_float, 1e-5);
@@ -698,34 +668,49 @@ TEST(Export, CCorrectorEqualsApply) {
 
 // Issue 32: the C corrector compiles warning-free (-std=c99 -Wall -Wextra
 // -Werror -pedantic), in both precisions, for every subset of the model's
-// optional terms: the four accelerometer effects, the gyroscope, and with
-// it its three effects (temperature and drift terms bring the reference
-// temperature and time). 16 + 16 * 8 = 144 models, compiled by gcc and by
-// clang (when installed) with -fsyntax-only, one compiler run each.
+// optional terms: the registry's accelerometer effects (every subset, each
+// once with and once without a gyroscope) and its gyroscope effects (every
+// subset, beside the accelerometer subsets in turn); the accelerometer's and
+// the gyroscope's functions read only their own terms. Temperature and
+// drift terms bring the reference temperature and time. Compiled by gcc and
+// by clang (when installed) with -fsyntax-only, one compiler run each.
 TEST(Export, CCorrectorCompilesWithoutWarningsForEveryModelSubset) {
-  const Effect kAccel[] = {Effect::kAccelQuadratic, Effect::kAccelTemperatureBias,
-                           Effect::kAccelTemperatureScale, Effect::kAccelBiasDrift};
-  const Effect kGyro[] = {Effect::kGyroGSensitivity, Effect::kGyroTemperatureBias,
-                          Effect::kGyroBiasDrift};
-  const Calibration full = FullCalibration(true);
+  std::vector<Effect> accel_effects, gyro_effects;
+  for (const EffectInfo& info : EffectCatalogue()) {
+    if (info.form == EffectForm::kInUpper) continue;
+    (info.sensor == EffectSensor::kGyroscope ? gyro_effects : accel_effects).push_back(info.effect);
+  }
+  Calibration full = FullCalibration(true);
+  // Every effect on (the catalogue's values 1e-5 .. for those FullCalibration
+  // does not set).
+  for (const EffectInfo& info : EffectCatalogue()) {
+    if (info.form == EffectForm::kInUpper) continue;
+    const bool set = std::any_of(full.effects.estimates.begin(), full.effects.estimates.end(),
+                                 [&](const EffectEstimate& e) { return e.effect == info.effect; });
+    if (!set) AddEffect(info.effect, std::vector<double>(info.num_parameters, 1e-5), &full);
+  }
+  const int accel_subsets = 1 << accel_effects.size(), gyro_subsets = 1 << gyro_effects.size();
   const ScratchDir scratch;
   int models = 0;
   for (int gyro = 0; gyro < 2; ++gyro) {
-    for (int accel_mask = 0; accel_mask < 16; ++accel_mask) {
-      for (int gyro_mask = 0; gyro_mask < (gyro ? 8 : 1); ++gyro_mask) {
+    for (int k = 0; k < std::max(accel_subsets, gyro ? gyro_subsets : 1); ++k) {
+      const int accel_mask = k % accel_subsets, gyro_mask = gyro ? k % gyro_subsets : 0;
+      {
         Calibration c = full;
         c.gyro.estimated = gyro == 1;
         if (!gyro) c.gyro = Calibration().gyro;
         c.effects.estimates.clear();
-        std::string name = gyro ? "g" : "a";
+        const std::string name =
+            (gyro ? "g_" : "a_") + std::to_string(accel_mask) + "_" + std::to_string(gyro_mask);
         for (const EffectEstimate& e : full.effects.estimates) {
           bool keep = false;
-          for (int b = 0; b < 4; ++b) keep |= (accel_mask >> b & 1) && e.effect == kAccel[b];
-          for (int b = 0; b < 3; ++b) keep |= (gyro_mask >> b & 1) && e.effect == kGyro[b];
-          if (keep) {
-            c.effects.estimates.push_back(e);
-            name += std::string("_") + ToString(e.effect);
+          for (size_t b = 0; b < accel_effects.size(); ++b) {
+            keep |= (accel_mask >> b & 1) && e.effect == accel_effects[b];
           }
+          for (size_t b = 0; b < gyro_effects.size(); ++b) {
+            keep |= (gyro_mask >> b & 1) && e.effect == gyro_effects[b];
+          }
+          if (keep) c.effects.estimates.push_back(e);
         }
         // Without a temperature term the log may have had no temperature
         // column: the reference is NaN, as calibrate writes it.
@@ -741,6 +726,7 @@ TEST(Export, CCorrectorCompilesWithoutWarningsForEveryModelSubset) {
         ASSERT_TRUE(ExportCalibration(Loaded(c), options, &result, &error))
             << name << ": " << error;
         ASSERT_EQ(result.files.size(), 2u) << name;
+        EXPECT_TRUE(result.dropped.empty()) << name << ": " << result.dropped.front();
         std::filesystem::create_directories(scratch / ("models/" + name));
         for (const ExportedFile& f : result.files) {
           scratch.Write("models/" + name + "/" + f.name, f.text);
@@ -749,7 +735,7 @@ TEST(Export, CCorrectorCompilesWithoutWarningsForEveryModelSubset) {
       }
     }
   }
-  EXPECT_EQ(models, 16 + 16 * 8);
+  EXPECT_EQ(models, accel_subsets + std::max(accel_subsets, gyro_subsets));
   int compilers = 0;
   for (const char* compiler : {"gcc", "clang"}) {
     if (std::system((std::string(compiler) + " --version > /dev/null 2>&1").c_str()) != 0) {

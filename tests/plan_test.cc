@@ -77,7 +77,7 @@ TEST(ExperimentDesign, JacobianIsTheAutodiffResidualAtTheNominalSensor) {
 TEST(ExperimentDesign, SixFacesLeaveTheNonOrthogonalityUndetermined) {
   DesignModel model;
   std::vector<Eigen::Vector3d> faces;
-  ASSERT_TRUE(CandidateDirections("faces", 0, &faces));
+  ASSERT_TRUE(CandidateDirections(PoseSet::kFaces, 0, &faces));
   std::vector<DesignPose> poses;
   for (const Eigen::Vector3d& u : faces) poses.push_back({u, 10.0});
   const Eigen::MatrixXd j = DesignJacobian(poses, model, WhiteDesignNoise(kDensity));
@@ -97,7 +97,7 @@ TEST(ExperimentDesign, SixFacesLeaveTheNonOrthogonalityUndetermined) {
 TEST(ExperimentDesign, MoreTimeLowersSigmaAsTheNoiseModelSays) {
   DesignModel model;
   std::vector<Eigen::Vector3d> twelve;
-  ASSERT_TRUE(CandidateDirections("faces+45", 0, &twelve));
+  ASSERT_TRUE(CandidateDirections(PoseSet::kFacesAnd45, 0, &twelve));
   auto sigma_at = [&](double hold, const DesignNoise& noise) {
     std::vector<DesignPose> poses;
     for (const Eigen::Vector3d& u : twelve) poses.push_back({u, hold});
@@ -213,7 +213,7 @@ SimulatedSession SimulateUps(const std::vector<Eigen::Vector3d>& ups, double hol
 
 TEST(Check, SixFacesNameTheNonOrthogonalityAndTheProposedPosesDetermineIt) {
   std::vector<Eigen::Vector3d> faces;
-  ASSERT_TRUE(CandidateDirections("faces", 0, &faces));
+  ASSERT_TRUE(CandidateDirections(PoseSet::kFaces, 0, &faces));
   const Config config = TwelveConfig();
   CoverageReport report;
   std::string error;
@@ -283,7 +283,7 @@ TEST(Check, BiasTradingWithAnUndeterminedScaleIsUndetermined) {
 // pose point along (1,1,1) and the unit 57 times too small.
 TEST(Check, AnOffsetSensorGivesTheSameSigmas) {
   std::vector<Eigen::Vector3d> faces;
-  ASSERT_TRUE(CandidateDirections("faces", 0, &faces));
+  ASSERT_TRUE(CandidateDirections(PoseSet::kFaces, 0, &faces));
   const Config config = TwelveConfig();
   SimulatedSession session = SimulateUps(faces, 10.0, 11);
   CoverageReport plain, offset;
@@ -306,7 +306,7 @@ TEST(Check, AnOffsetSensorGivesTheSameSigmas) {
 
 TEST(ExperimentDesign, CandidateTurnsTakeOneUpDirectionToTheOther) {
   std::vector<Eigen::Vector3d> ups;
-  ASSERT_TRUE(CandidateDirections("free", 40, &ups));
+  ASSERT_TRUE(CandidateDirections(PoseSet::kFree, 40, &ups));
   for (size_t a = 0; a < ups.size(); a += 3) {
     for (size_t b = 1; b < ups.size(); b += 5) {
       if ((ups[a] - ups[b]).norm() < 1e-6) continue;

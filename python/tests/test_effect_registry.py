@@ -20,7 +20,9 @@ def test_a_registered_effect_is_simulated_calibrated_applied_and_exported():
     exported = gravcal.export(cal, "c", name="unit")
     assert gravcal._gravcal._json_conversions() == before
     assert accel.shape == log.accel.shape and np.isfinite(accel).all()
-    assert any(NEW in line for line in exported["dropped"])
+    # The C corrector writes its term from its definition: nothing dropped.
+    assert not exported["dropped"]
+    assert any("D_ACCEL_TEMPERATURE_BIAS_QUADRATIC" in f["text"] for f in exported["files"])
     estimate = cal.to_dict()["effects"][NEW]
     assert estimate["parameters"] == ["kappa_x", "kappa_y", "kappa_z"]
     value, std = np.array(estimate["value"]), np.array(estimate["std"])

@@ -91,6 +91,13 @@ const EnumName<MotionProfile> kMotionProfiles[] = {
     {MotionProfile::kRateTable, "rate_table"},
 };
 
+const EnumName<PoseScheme> kPoseSchemes[] = {
+    {PoseScheme::kSix, "six"},
+    {PoseScheme::kTwelve, "twelve"},
+    {PoseScheme::kTen, "ten"},
+    {PoseScheme::kRandom, "random"},
+};
+
 const EnumName<BatchStatus> kBatchStatuses[] = {
     {BatchStatus::kOk, "ok"},
     {BatchStatus::kFailed, "failed"},
@@ -140,6 +147,16 @@ const EnumName<WarningCode> kWarningCodes[] = {
     {WarningCode::kSensorData, "sensor_data"},
 };
 
+// "a, b or c".
+template <typename E, std::size_t N>
+std::string NamesOf(const EnumName<E> (&table)[N]) {
+  std::string s;
+  for (std::size_t i = 0; i < N; ++i) {
+    s += std::string(i == 0 ? "" : i + 1 == N ? " or " : ", ") + table[i].name;
+  }
+  return s;
+}
+
 }  // namespace
 
 // Each enum's pair, from its table.
@@ -157,6 +174,7 @@ GRAVCAL_ENUM_STRINGS(LogFormat, kLogFormats)
 GRAVCAL_ENUM_STRINGS(Method, kMethods)
 GRAVCAL_ENUM_STRINGS(PoseSet, kPoseSets)
 GRAVCAL_ENUM_STRINGS(MotionProfile, kMotionProfiles)
+GRAVCAL_ENUM_STRINGS(PoseScheme, kPoseSchemes)
 GRAVCAL_ENUM_STRINGS(BatchStatus, kBatchStatuses)
 GRAVCAL_ENUM_STRINGS(Effect, kEffects)
 GRAVCAL_ENUM_STRINGS(EffectSensor, kEffectSensors)
@@ -165,5 +183,11 @@ GRAVCAL_ENUM_STRINGS(RejectionReason, kRejectionReasons)
 GRAVCAL_ENUM_STRINGS(WarningCode, kWarningCodes)
 
 #undef GRAVCAL_ENUM_STRINGS
+
+std::string AcceptedNames(Method) { return NamesOf(kMethods); }
+std::string AcceptedNames(PoseSet) { return NamesOf(kPoseSets); }
+std::string AcceptedNames(MotionProfile) { return NamesOf(kMotionProfiles); }
+// random takes its count.
+std::string AcceptedNames(PoseScheme) { return NamesOf(kPoseSchemes) + ":N"; }
 
 }  // namespace gravcal

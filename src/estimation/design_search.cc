@@ -302,7 +302,7 @@ bool DesignPoses(const std::vector<Eigen::Vector3d>& candidates, const DesignMod
     // The balanced designs (see the header): the six faces, as often as
     // max_poses allows.
     std::vector<Eigen::Vector3d> faces, repeated;
-    CandidateDirections("faces", 0, &faces);
+    CandidateDirections(PoseSet::kFaces, 0, &faces);
     while (true) {
       repeated.insert(repeated.end(), faces.begin(), faces.end());
       if (static_cast<int>(repeated.size()) > options.max_poses) break;

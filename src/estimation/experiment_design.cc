@@ -207,12 +207,11 @@ Eigen::VectorXd StdInRawUnits(const Eigen::VectorXd& scale_free_std, double nomi
   return out;
 }
 
-bool CandidateDirections(const std::string& pose_set, int count,
-                         std::vector<Eigen::Vector3d>* directions) {
+bool CandidateDirections(PoseSet pose_set, int count, std::vector<Eigen::Vector3d>* directions) {
   directions->clear();
-  if (pose_set == "free") {
+  if (pose_set == PoseSet::kFree) {
     if (count < 1) return false;
-    CandidateDirections("faces+45", 0, directions);
+    CandidateDirections(PoseSet::kFacesAnd45, 0, directions);
     // Fibonacci lattice: z evenly spaced, longitude by the golden angle.
     const double golden = M_PI * (3.0 - std::sqrt(5.0));
     for (int i = 0; i < count; ++i) {
@@ -222,13 +221,12 @@ bool CandidateDirections(const std::string& pose_set, int count,
     }
     return true;
   }
-  if (pose_set != "faces" && pose_set != "faces+45") return false;
   directions->clear();
   for (int a = 0; a < 3; ++a) {
     directions->push_back(Eigen::Vector3d::Unit(a));
     directions->push_back(-Eigen::Vector3d::Unit(a));
   }
-  if (pose_set != "faces") {
+  if (pose_set != PoseSet::kFaces) {
     for (int a = 0; a < 3; ++a) {
       for (int b = a + 1; b < 3; ++b) {
         for (double sa : {1.0, -1.0}) {

@@ -147,10 +147,56 @@ std::string CThermalRemoveScale(const ImuCorrector& c, const CPrecision& p, Ther
   return s.str();
 }
 
-std::string CThermalOffsetLine(const ImuCorrector& c, const CPrecision& p, ThermalSensor sensor) {
+std::string CThermalOffsetLine(const ImuCorrector& c, const CPrecision& p, ThermalSensor sensor,
+                               const std::string& temperature) {
   if (sensor == ThermalSensor::kGyro && !c.has_gyro) return "";
   if (!c.thermal.Sensor(sensor).active()) return "";
-  return "  const " + p.real + " x = gravcal_thermal_x" + p.suffix + "(temp_c);\n";
+  return "  const " + p.real + " x = gravcal_thermal_x" + p.suffix + "(" + temperature + ");\n";
+}
+
+std::string CLagFunctions(const ImuCorrector& c, const CPrecision& p) {
+  const std::string& r = p.real;
+  const std::string zero = CNumber(0.0, p.single);
+  const std::string state = "gravcal_lag_state" + p.suffix;
+  std::ostringstream s;
+  s << "void gravcal_lag_init" << p.suffix << "(" << state << "* lag) {\n"
+    << "  lag->started = 0;\n"
+    << "  lag->last_t = lag->last_temp_c = lag->element_c = lag->rate = " << zero << ";\n}\n\n";
+  const double tau = c.thermal.lag_time_constant;
+  if (!CThermalActive(c) || !(tau > 0.0)) {
+    s << "/* No thermal lag: the element is at the recorded temperature. */\n"
+      << "static " << r << " gravcal_lag_element" << p.suffix << "(" << state << "* lag, " << r
+      << " t_s, " << r << " temp_c) {\n"
+      << "  (void)lag;\n  (void)t_s;\n  return temp_c;\n}\n\n";
+    return s.str();
+  }
+  // ThermalElementRate::Add (core/thermal_rate.h) and
+  // ThermalModel::ElementTemperature, step for step.
+  const std::string tau_name = p.prefix + "THERMAL_LAG";
+  s << "static const " << r << " " << tau_name << " = " << CNumber(tau, p.single) << ";\n\n"
+    << "/* The sensing element's temperature T_e at this sample: tau dT_e/dt = T - T_e,\n"
+    << " * T_e = T at the first sample, T linear between samples (the step is exact);\n"
+    << " * a sample without a finite time or temperature keeps the last rate. */\n"
+    << "static " << r << " gravcal_lag_element" << p.suffix << "(" << state << "* lag, " << r
+    << " t_s, " << r << " temp_c) {\n"
+    << "  if (isfinite(temp_c) && isfinite(t_s)) {\n"
+    << "    if (!lag->started || !(t_s > lag->last_t)) {\n"
+    << "      if (!lag->started) lag->element_c = temp_c;\n"
+    << "      lag->started = 1;\n"
+    << "    } else {\n"
+    << "      const " << r << " dt = t_s - lag->last_t;\n"
+    << "      const " << r << " m = (temp_c - lag->last_temp_c) / dt;\n"
+    << "      const " << r << " a = " << (p.single ? "expf" : "exp") << "(-dt / " << tau_name
+    << ");\n"
+    << "      lag->element_c = temp_c - " << tau_name
+    << " * m + (lag->element_c - lag->last_temp_c + " << tau_name << " * m) * a;\n"
+    << "    }\n"
+    << "    lag->last_t = t_s;\n"
+    << "    lag->last_temp_c = temp_c;\n"
+    << "    lag->rate = (temp_c - lag->element_c) / " << tau_name << ";\n"
+    << "  }\n"
+    << "  return temp_c - " << tau_name << " * lag->rate;\n}\n\n";
+  return s.str();
 }
 
 }  // namespace internal

@@ -425,14 +425,10 @@ double PositionResidualRms(const ImuCorrector& corrector,
 ImuCorrector TruncatedCorrector(const ImuCorrector& full, ExportTarget target) {
   switch (target) {
     case ExportTarget::kRos:
+    case ExportTarget::kC:
+      // The C corrector is written from the effects' definitions and holds
+      // the thermal model with its lag: the whole model.
       return full;
-    case ExportTarget::kC: {
-      // The C functions take no temperature rate: no thermal lag; the
-      // effects they hold.
-      ImuCorrector t = full.WithEffects(internal::CCorrectorEffects());
-      t.thermal.lag_time_constant = 0.0;
-      return t;
-    }
     case ExportTarget::kKalibr:
     case ExportTarget::kOpenVins: {
       ImuCorrector t = full.WithEffects({Effect::kGyroGSensitivity});
@@ -503,8 +499,10 @@ bool ExportCalibration(const LoadedCalibration& calibration, const ExportOptions
       break;
     case ExportTarget::kC: {
       std::vector<std::string> comment = Provenance(calibration, options);
-      comment.push_back("Self-contained C99: no dynamic memory; <math.h> only with the quadratic");
-      comment.push_back("term. The equations: docs/workflows/export.md, target c.");
+      comment.push_back("Self-contained C99: no dynamic memory; <math.h> (link -lm with the");
+      comment.push_back("quadratic term or a thermal lag). The equations:");
+      comment.push_back("docs/workflows/export.md, target c; gravcal_correct_sample holds");
+      comment.push_back("the thermal lag, as gravcal apply does.");
       result->files = internal::CCorrectorFiles(calibration.corrector, comment);
       break;
     }

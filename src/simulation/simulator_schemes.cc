@@ -17,46 +17,35 @@ namespace {
 // Limit that keeps a typo from asking for gigabytes of poses.
 constexpr long kMaxRandomPoses = 100000;
 
-enum class SchemeKind { kSix, kTwelve, kTen, kRandom };
-
-// Parses "six", "twelve", "ten" or "random:N".
-bool ParseScheme(const std::string& scheme, SchemeKind* kind, long* count, std::string* error) {
+// Parses "six", "twelve", "ten" or "random:N" by the one table of
+// PoseScheme (core/types.h).
+bool ParseScheme(const std::string& scheme, PoseScheme* kind, long* count, std::string* error) {
   auto fail = [&](const std::string& what) {
     if (error) *error = what;
     return false;
   };
-  if (scheme == "six") {
-    *kind = SchemeKind::kSix;
-    *count = 6;
+  const size_t colon = scheme.find(':');
+  if (!FromString(scheme.substr(0, colon), kind) ||
+      (colon != std::string::npos) != (*kind == PoseScheme::kRandom)) {
+    return fail("unknown scheme '" + scheme + "' (expected " + AcceptedNames(PoseScheme()) + ")");
+  }
+  constexpr long kFixed[] = {6, 12, 10};
+  if (*kind != PoseScheme::kRandom) {
+    *count = kFixed[static_cast<int>(*kind)];
     return true;
   }
-  if (scheme == "twelve") {
-    *kind = SchemeKind::kTwelve;
-    *count = 12;
-    return true;
+  const std::string digits = scheme.substr(colon + 1);
+  bool ok = !digits.empty() && digits.size() <= 9;
+  for (char c : digits) ok = ok && c >= '0' && c <= '9';
+  const long n = ok ? std::stol(digits) : 0;
+  if (n < 1 || n > kMaxRandomPoses) {
+    std::ostringstream msg;
+    msg << "scheme '" << scheme << "': N in random:N must be an integer from 1 to "
+        << kMaxRandomPoses;
+    return fail(msg.str());
   }
-  if (scheme == "ten") {
-    *kind = SchemeKind::kTen;
-    *count = 10;
-    return true;
-  }
-  const std::string prefix = "random:";
-  if (scheme.compare(0, prefix.size(), prefix) == 0) {
-    const std::string digits = scheme.substr(prefix.size());
-    bool ok = !digits.empty() && digits.size() <= 9;
-    for (char c : digits) ok = ok && c >= '0' && c <= '9';
-    const long n = ok ? std::stol(digits) : 0;
-    if (n < 1 || n > kMaxRandomPoses) {
-      std::ostringstream msg;
-      msg << "scheme '" << scheme << "': N in random:N must be an integer from 1 to "
-          << kMaxRandomPoses;
-      return fail(msg.str());
-    }
-    *kind = SchemeKind::kRandom;
-    *count = n;
-    return true;
-  }
-  return fail("unknown scheme '" + scheme + "' (expected six, twelve, ten or random:N)");
+  *count = n;
+  return true;
 }
 
 // Body-to-navigation attitude from roll (about x) then pitch (about y), zero
@@ -84,7 +73,7 @@ Eigen::Quaterniond UniformRotation(std::mt19937_64* rng) {
 }  // namespace
 
 bool SchemePoseCount(const std::string& scheme, long* count, std::string* error) {
-  SchemeKind kind;
+  PoseScheme kind;
   return ParseScheme(scheme, &kind, count, error);
 }
 
@@ -136,7 +125,6 @@ bool MakeNominalPoses(const SimulatorOptions& options, uint64_t seed, NominalPos
 }  // namespace internal
 
 using internal::AxisAngle;
-using internal::SchemeKind;
 
 bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
                      std::vector<Eigen::Quaterniond>* attitudes, std::vector<int>* nominal_up,
@@ -145,7 +133,7 @@ bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
     if (error) *error = "SchemeAttitudes: null output";
     return false;
   }
-  SchemeKind kind;
+  PoseScheme kind;
   long count = 0;
   if (!internal::ParseScheme(scheme, &kind, &count, error)) return false;
   attitudes->clear();
@@ -154,8 +142,8 @@ bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
   const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
   const double h = M_PI / 2.0;
   switch (kind) {
-    case SchemeKind::kTwelve:
-    case SchemeKind::kSix:
+    case PoseScheme::kTwelve:
+    case PoseScheme::kSix:
       // +x, -x, +y, -y, +z, -z up (the body axis that points up).
       attitudes->push_back(AxisAngle(-h, y));
       attitudes->push_back(AxisAngle(h, y));
@@ -163,7 +151,7 @@ bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
       attitudes->push_back(AxisAngle(-h, x));
       attitudes->push_back(Eigen::Quaterniond::Identity());
       attitudes->push_back(AxisAngle(M_PI, x));
-      if (kind == SchemeKind::kTwelve) {
+      if (kind == PoseScheme::kTwelve) {
         // Chen 2012: the YZ, XZ and XY planes tilted to about 45 and 135
         // degrees. Up directions (body frame) are six of the twelve cube edge
         // midpoints, one from each opposite pair.
@@ -174,14 +162,14 @@ bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
         }
       }
       break;
-    case SchemeKind::kTen: {
+    case PoseScheme::kTen: {
       // CN101907638B: ten poses of differing roll and pitch (degrees).
       const double roll_pitch[10][2] = {{0, 0},   {180, 0}, {90, 0},   {-90, 0},  {0, 90},
                                         {0, -90}, {45, 45}, {-45, 45}, {45, -45}, {135, -45}};
       for (const auto& rp : roll_pitch) attitudes->push_back(internal::RollPitch(rp[0], rp[1]));
       break;
     }
-    case SchemeKind::kRandom: {
+    case PoseScheme::kRandom: {
       // A stream of its own, so the poses do not share numbers with the
       // simulator's other draws from the same seed.
       std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);

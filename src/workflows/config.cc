@@ -259,8 +259,8 @@ bool Config::IsValid(std::string* error) const {
   if (!CheckConsistency(*this, reads, error)) return false;
   if (chosen->validate && !chosen->validate(*this, error)) return false;
   MotionProfile profile;
-  if (!sim_motion.empty() && !FromString(sim_motion, &profile)) {
-    *error = "key 'sim_motion': must be empty, handheld, turntable, vertical or rate_table";
+  if (!sim_motion.empty() && !ParseName("sim_motion", sim_motion, &profile, error)) {
+    *error += " (or empty)";
     return false;
   }
   if (!motion.IsValid(error)) return false;

@@ -107,19 +107,13 @@ std::string Shortfalls(const std::vector<std::string>& names, const Eigen::Vecto
 // (the greedy search over thousands of directions can miss the balanced
 // 45-degree designs), keeping the better: meeting the targets in less time,
 // else the smaller worst ratio.
-// Whether the request's pose set is `free`.
-bool IsFree(const std::string& pose_set) {
-  PoseSet set;
-  return FromString(pose_set, &set) && set == PoseSet::kFree;
-}
-
-bool DesignOver(const std::string& pose_set, int free_candidates, const DesignModel& model,
+bool DesignOver(PoseSet pose_set, int free_candidates, const DesignModel& model,
                 const DesignNoise& noise, const DesignOptions& options, DesignResult* result) {
   std::vector<Eigen::Vector3d> candidates;
   CandidateDirections(pose_set, free_candidates, &candidates);
   if (!DesignPoses(candidates, model, noise, options, result)) return false;
-  if (!IsFree(pose_set)) return true;
-  CandidateDirections(ToString(PoseSet::kFacesAnd45), 0, &candidates);
+  if (pose_set != PoseSet::kFree) return true;
+  CandidateDirections(PoseSet::kFacesAnd45, 0, &candidates);
   DesignResult subset;
   if (!DesignPoses(candidates, model, noise, options, &subset)) return true;
   const bool better = subset.meets_targets && result->meets_targets
@@ -134,7 +128,7 @@ bool DesignOver(const std::string& pose_set, int free_candidates, const DesignMo
 // max_time_seconds, when positive): ranked by the largest sigma relative to
 // 1 mg, 100 ppm and 0.1 mrad, i.e. against targets far below reach, then
 // evaluated against options.targets.
-bool MostAccurateDesign(const std::string& pose_set, int free_candidates, const DesignModel& model,
+bool MostAccurateDesign(PoseSet pose_set, int free_candidates, const DesignModel& model,
                         const DesignNoise& noise, const DesignOptions& options,
                         const std::vector<std::string>& names, double max_time_seconds,
                         DesignResult* design) {
@@ -186,11 +180,11 @@ bool PlanRotations(const Config& config, const PlanRequest& request,
   for (const PlannedPose& p : out->poses) poses.push_back({p.up, p.hold_seconds});
   RotationDesignOptions rotation;
   rotation.targets = start.gyro_targets;
-  rotation.free_axes = IsFree(request.pose_set) ? 12 : 0;
+  rotation.free_axes = request.Set() == PoseSet::kFree ? 12 : 0;
   rotation.seconds_per_180 = request.turn_seconds;
   rotation.extra_hold_seconds = options.min_hold_seconds;
   rotation.max_extra_poses = std::max(0, options.max_poses - static_cast<int>(out->poses.size()));
-  CandidateDirections("faces+45", 0, &rotation.extra_candidates);
+  CandidateDirections(PoseSet::kFacesAnd45, 0, &rotation.extra_candidates);
   GyroDesignModel gyro_model = start.gyro_model;
   GyroDesignResult design;
   if (!DesignRotations(poses, model, gyro_model, noise, rotation, &design)) {
@@ -236,12 +230,15 @@ bool PlanRotations(const Config& config, const PlanRequest& request,
 
 }  // namespace
 
+PoseSet PlanRequest::Set() const {
+  PoseSet set = PoseSet::kFacesAnd45;
+  FromString(pose_set, &set);
+  return set;
+}
+
 bool PlanRequest::IsValid(std::string* error) const {
   PoseSet set;
-  if (!FromString(pose_set, &set)) {
-    *error = "pose_set '" + pose_set + "': expected faces, faces+45 or free";
-    return false;
-  }
+  if (!ParseName("pose_set", pose_set, &set, error)) return false;
   if (free_candidates < 1 || free_candidates > 100000) {
     *error = "candidates: 1 to 100000 free directions";
     return false;
@@ -469,10 +466,13 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   options.max_hold_seconds = std::max(request.max_hold_seconds, options.min_hold_seconds);
   options.max_poses =
       std::max(request.max_poses, static_cast<int>(names.size()) + options.redundancy);
+  const PoseSet pose_set = request.Set();
   std::vector<Eigen::Vector3d> candidates;
-  CandidateDirections(request.pose_set, request.free_candidates, &candidates);
+  CandidateDirections(pose_set, request.free_candidates, &candidates);
   const std::vector<std::pair<std::string, std::vector<Eigen::Vector3d>>> schemes = {
-      {"twelve", SchemeUps("twelve")}, {"six", SchemeUps("six")}, {"ten", SchemeUps("ten")}};
+      {ToString(PoseScheme::kTwelve), SchemeUps(ToString(PoseScheme::kTwelve))},
+      {ToString(PoseScheme::kSix), SchemeUps(ToString(PoseScheme::kSix))},
+      {ToString(PoseScheme::kTen), SchemeUps(ToString(PoseScheme::kTen))}};
   for (const auto& [name, ups] : schemes) {
     if (AllIn(ups, candidates)) options.reference_designs.push_back(ups);
   }
@@ -480,13 +480,13 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   DesignResult design;
   if (!any_stated) {
     // Best accuracy within max_time.
-    if (!MostAccurateDesign(request.pose_set, request.free_candidates, model, noise, options, names,
+    if (!MostAccurateDesign(pose_set, request.free_candidates, model, noise, options, names,
                             request.max_time_seconds, &design)) {
       *error = design.message;
       return false;
     }
   } else {
-    if (!DesignOver(request.pose_set, request.free_candidates, model, noise, options, &design)) {
+    if (!DesignOver(pose_set, request.free_candidates, model, noise, options, &design)) {
       *error = design.message;
       return false;
     }
@@ -499,7 +499,7 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
       std::ostringstream s;
       s.precision(4);
       s << "the targets cannot be met within --max_time " << request.max_time_seconds << " s";
-      if (DesignOver(request.pose_set, request.free_candidates, model, noise, within, &best) &&
+      if (DesignOver(pose_set, request.free_candidates, model, noise, within, &best) &&
           std::isfinite(best.worst_ratio)) {
         s << "; achievable within it (" << best.poses.size()
           << " poses): " << Shortfalls(names, best.predicted_std, targets);
@@ -523,7 +523,7 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
     DesignResult best = design;
     if (!(std::isfinite(best.worst_ratio) && best.predicted_std.size() > 0) &&
         !MostAccurateDesign(
-            request.pose_set, request.free_candidates, model, noise, options, names,
+            pose_set, request.free_candidates, model, noise, options, names,
             options.max_poses * (options.max_hold_seconds + options.overhead_seconds), &best)) {
       best = design;
     }

@@ -91,9 +91,10 @@ enum class Method {
   kThermal
 };
 // "twelve_position", "ten_position", "known_attitude", "handheld_kalman",
-// "rate_table".
+// "rate_table", "thermal".
 const char* ToString(Method method);
 bool FromString(const std::string& name, Method* method);
+std::string AcceptedNames(Method);
 
 // The candidate poses of a recording plan (`gravcal plan --pose_set`).
 enum class PoseSet {
@@ -107,12 +108,36 @@ enum class PoseSet {
 // "faces", "faces+45", "free".
 const char* ToString(PoseSet set);
 bool FromString(const std::string& name, PoseSet* set);
+std::string AcceptedNames(PoseSet);
 
 // The motion of a simulated handheld or rate-table recording.
 enum class MotionProfile { kHandheld, kTurntable, kVertical, kRateTable };
 // "handheld", "turntable", "vertical", "rate_table".
 const char* ToString(MotionProfile profile);
 bool FromString(const std::string& name, MotionProfile* profile);
+std::string AcceptedNames(MotionProfile);
+
+// The poses of a simulated multi-position session (the simulator's
+// sim_scheme: "six", "twelve", "ten" or "random:N", N uniformly drawn
+// attitudes; simulation/simulator.h).
+enum class PoseScheme { kSix, kTwelve, kTen, kRandom };
+// "six", "twelve", "ten", "random" (written random:N in a scheme).
+const char* ToString(PoseScheme scheme);
+bool FromString(const std::string& name, PoseScheme* scheme);
+std::string AcceptedNames(PoseScheme);
+
+// FromString for the value of a key (config key or flag): false with a
+// one-line `error` (may be null) naming the key, the value and the names
+// the enum's table accepts: "key 'pose_set': 'edges' is not one of faces,
+// faces+45 or free". For the enums with AcceptedNames.
+template <typename E>
+bool ParseName(const std::string& key, const std::string& name, E* value, std::string* error) {
+  if (FromString(name, value)) return true;
+  if (error != nullptr) {
+    *error = "key '" + key + "': '" + name + "' is not one of " + AcceptedNames(E());
+  }
+  return false;
+}
 
 // The outcome of one unit in a batch.
 enum class BatchStatus {

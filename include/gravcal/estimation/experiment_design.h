@@ -117,12 +117,11 @@ Eigen::VectorXd DeterminedStd(const Eigen::MatrixXd& fisher, const Eigen::Vector
 // at nominal scale s: bias / s, U entries * s.
 Eigen::VectorXd StdInRawUnits(const Eigen::VectorXd& scale_free_std, double nominal_scale);
 
-// Candidate up directions: "faces" (the six axis directions), "faces+45"
-// (plus the twelve 45-degree directions between two axes), "free" (those 18
+// Candidate up directions: faces (the six axis directions), faces+45
+// (plus the twelve 45-degree directions between two axes), free (those 18
 // and `count` directions spread evenly over the sphere, a Fibonacci
-// lattice). False for another name.
-bool CandidateDirections(const std::string& pose_set, int count,
-                         std::vector<Eigen::Vector3d>* directions);
+// lattice). False for free with count < 1.
+bool CandidateDirections(PoseSet pose_set, int count, std::vector<Eigen::Vector3d>* directions);
 
 struct DesignOptions {
   // Per parameter (scale-free units: m/s^2 for the bias, relative for U), in

@@ -36,7 +36,8 @@ struct PlanRequest {
   // (m_xx m_yy m_zz, or scale; ppm, %), gyro_misalignment (the other m_*;
   // mrad, urad, rad, deg), or gyro_<name> for one parameter (gyro_m_xy).
   std::string targets;
-  // faces, faces+45 or free (experiment_design.h).
+  // The candidate poses: a PoseSet's name, faces, faces+45 or free
+  // (core/types.h, experiment_design.h); IsValid parses it, Set() gives it.
   std::string pose_set = "faces+45";
   // Directions of the free set besides faces+45.
   int free_candidates = 500;
@@ -72,6 +73,9 @@ struct PlanRequest {
   int extra_poses = 2;
 
   bool IsValid(std::string* error) const;
+  // The pose set named by pose_set (faces+45 when it names none: IsValid
+  // refuses that).
+  PoseSet Set() const;
 };
 
 // Parses `text` (above) into scale-free targets per parameter of `model`

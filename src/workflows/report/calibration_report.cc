@@ -187,11 +187,17 @@ bool Contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
 }
 
+// Whether the result names `method` (its name parsed by Method's table).
+bool MadeBy(const Calibration& c, Method method) {
+  Method made;
+  return FromString(c.method, &made) && made == method;
+}
+
 // A parameter without a standard deviation: a recursive filter (the
 // handheld one) has no state for it, so it never estimated it; a batch fit
 // estimated it and the data did not determine it.
 std::string NotDeterminedOrNotEstimated(const Calibration& c) {
-  if (c.method == ToString(Method::kHandheldKalman)) {
+  if (MadeBy(c, Method::kHandheldKalman)) {
     return "not estimated (held at its nominal value: the filter has no state for it; "
            "hk_cross_axis: true estimates the cross-axis terms)";
   }
@@ -212,7 +218,7 @@ std::string AccelSource(const Calibration& c, const std::string& fit_name, doubl
   // Issue 33: a sigma that rests on holding undetermined terms says so.
   const std::string held = internal::Join(internal::ConditionalOn(c.refinement));
   const std::string given = held.empty() ? "" : " (sigma conditional on holding " + held + ")";
-  if (c.method == ToString(Method::kTwelvePosition)) return "magnitude fit" + given;
+  if (MadeBy(c, Method::kTwelvePosition)) return "magnitude fit" + given;
   return c.method + " fit" + given;
 }
 
@@ -372,7 +378,7 @@ std::string CalibrationReport(const Calibration& c, const ImuLog& log, const std
   h << "<h1>Calibration report</h1><p>" << HtmlEscape(source) << " &mdash; method "
     << HtmlEscape(c.method) << ", " << log.size() << " samples, ";
   // A filter on a moving log has no static poses to count.
-  if (c.method != ToString(Method::kHandheldKalman)) h << c.positions.size() << " static poses, ";
+  if (!MadeBy(c, Method::kHandheldKalman)) h << c.positions.size() << " static poses, ";
   h << "gravity " << FormatNumber(c.gravity, "%.6g") << " m/s^2 ("
     << HtmlEscape(c.gravity_source.empty() ? "not resolved" : c.gravity_source) << ")</p>\n";
 

@@ -25,6 +25,7 @@ struct AccelBiasDrift {
   static constexpr EffectSimulation kSimulation = {
       "sim_accel_bias_drift", "accel_bias_drift_std",
       "truth accelerometer bias drift spread, m/s^2/s"};
+  static constexpr const char* kC = "p[i] * dt";
 
   template <typename T>
   static void Add(const T* delta, int i, double /*dT*/, double dt, T* x) {

@@ -33,6 +33,7 @@ struct AccelQuadratic {
   static constexpr const char* kUnit = "1/(m/s^2)";
   static constexpr EffectSimulation kSimulation = {"sim_accel_quadratic", "accel_quadratic_std",
                                                    "truth k2 spread per axis, 1/(m/s^2)"};
+  static constexpr const char* kC = "2.0 * x / (1.0 + sqrt(1.0 + 4.0 * p[i] * x))";
 
   template <typename T>
   static void Add(const T* k2, int i, double /*dT*/, double /*dt*/, T* x) {

@@ -25,6 +25,7 @@ struct AccelTemperatureBias {
   static constexpr EffectSimulation kSimulation = {
       "sim_accel_temperature_bias", "accel_temperature_bias_std",
       "truth accelerometer bias tempco spread, m/s^2/degC"};
+  static constexpr const char* kC = "p[i] * dT";
 
   template <typename T>
   static void Add(const T* beta, int i, double dT, double /*dt*/, T* x) {

@@ -30,6 +30,7 @@ struct AccelTemperatureBiasQuadratic {
   static constexpr EffectSimulation kSimulation = {
       "sim_accel_temperature_bias_quadratic", "accel_temperature_bias_quadratic_std",
       "truth accelerometer bias curvature spread, m/s^2/degC^2"};
+  static constexpr const char* kC = "p[i] * (dT * dT)";
 
   template <typename T>
   static void Add(const T* kappa, int i, double dT, double /*dt*/, T* x) {

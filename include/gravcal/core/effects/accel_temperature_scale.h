@@ -30,6 +30,7 @@ struct AccelTemperatureScale {
   static constexpr EffectSimulation kSimulation = {
       "sim_accel_temperature_scale", "accel_temperature_scale_std",
       "truth accelerometer scale tempco spread, 1/degC", 0.01};
+  static constexpr const char* kC = "x / (1.0 + p[i] * dT)";
 
   template <typename T>
   static void Add(const T* c, int i, double dT, double /*dt*/, T* x) {

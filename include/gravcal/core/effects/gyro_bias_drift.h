@@ -23,6 +23,7 @@ struct GyroBiasDrift {
   static constexpr const char* kUnit = "raw gyro units/s";
   static constexpr EffectSimulation kSimulation = {"sim_gyro_bias_drift", "gyro_bias_drift_std",
                                                    "truth gyroscope bias drift spread, rad/s/s"};
+  static constexpr const char* kC = "p[i] * dt";
 
   template <typename T>
   static void Add(const T* eta, int i, const double* /*force*/, double /*dT*/, double dt, T* o) {

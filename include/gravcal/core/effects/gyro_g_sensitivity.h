@@ -32,6 +32,8 @@ struct GyroGSensitivity {
   static constexpr EffectSimulation kSimulation = {
       "sim_gyro_g_sensitivity", "gyro_g_sensitivity_std",
       "truth gyroscope g-sensitivity spread, rad/s per m/s^2"};
+  static constexpr const char* kC =
+      "p[3 * i] * force[0] + p[3 * i + 1] * force[1] + p[3 * i + 2] * force[2]";
 
   template <typename T>
   static void Add(const T* g, int i, const double* force, double /*dT*/, double /*dt*/, T* o) {

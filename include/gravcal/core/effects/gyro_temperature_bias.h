@@ -24,6 +24,7 @@ struct GyroTemperatureBias {
   static constexpr EffectSimulation kSimulation = {
       "sim_gyro_temperature_bias", "gyro_temperature_bias_std",
       "truth gyroscope bias tempco spread, rad/s/degC"};
+  static constexpr const char* kC = "p[i] * dT";
 
   template <typename T>
   static void Add(const T* gamma, int i, const double* /*force*/, double dT, double /*dt*/, T* o) {
