@@ -547,7 +547,7 @@ def extra_sections(r, binary, source_dir, rate, seeds, only):
     soaks = [-5.0, 10.0, 25.0, 40.0, 55.0]
     ramp = {'start': 0.0, 'end': 55.0, 'tau': 700.0, 'seconds': 3000.0}
     if 'gyro_scale' in only:
-        zs, dz, orders = [], [], []
+        zs, dz, orders, dz_frame = [], [], [], []
         for seed in range(200, 200 + seeds):
             truth = Truth(np.random.default_rng(seed), lag=(0.0, 30.0)[seed % 2])
             kind = ('soak', 'warmcool')[seed % 2]
@@ -559,13 +559,22 @@ def extra_sections(r, binary, source_dir, rate, seeds, only):
             lo, hi = cal['thermal']['valid_range']
             a, b = gyro_scale_z(cal, truth, np.linspace(lo + 2, hi - 2, 5))
             zs += a
-            dz += b
+            # M_g is in the accelerometer's frame: its diagonal is compared
+            # where the session determines that frame's non-orthogonality
+            # (else the calibration says so in a note).
+            us = cal['accel']['std']['matrix']
+            if all(us[i][j] is not None for i, j in ((0, 1), (0, 2), (1, 2))):
+                dz += b
+            else:
+                dz_frame.extend(b)
             orders.append(cal['thermal']['gyro'].get('scale', {}).get('order', 0))
         rms = float(np.sqrt(np.mean(np.square(zs)))) if zs else float('nan')
         rms_m = float(np.sqrt(np.mean(np.square(dz)))) if dz else float('nan')
+        rms_f = float(np.sqrt(np.mean(np.square(dz_frame)))) if dz_frame else float('nan')
         r.check('gyro_scale_honest', bool(zs) and 0.7 <= rms <= 1.4 and 0.6 <= rms_m <= 1.6,
                 {'rms_z_scale': rms, 'values': len(zs), 'rms_z_matrix_diag': rms_m,
-                 'orders': orders})
+                 'matrix_values': len(dz),
+                 'rms_z_matrix_diag_frame_undetermined': rms_f, 'orders': orders})
         # Turns at one temperature: scale(T) undetermined, said plainly.
         truth = Truth(np.random.default_rng(5))
         s = make_session(5, 'warmcool', truth, rate=rate,
