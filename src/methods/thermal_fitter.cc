@@ -352,7 +352,6 @@ void ThermalFitter::Covariance(const ThermalLayout& layout, const std::vector<do
   const Eigen::MatrixXd info = jf.transpose() * jf;
   Eigen::MatrixXd inv = info.ldlt().solve(Eigen::MatrixXd::Identity(info.rows(), info.cols()));
   const int dof = fit->residuals - fit->free;
-  const double factor = dof > 0 ? std::max(1.0, fit->chi2 / dof) : 1.0;
   // Quantised temperatures (thermal_calibration.h): the error e_g a group
   // of windows shares moves the solution by K_g e_g, K_g = (J^T J)^-1 J^T
   // a_g, a_g the whitened residuals' derivative in the group's
@@ -382,10 +381,15 @@ void ThermalFitter::Covariance(const ThermalLayout& layout, const std::vector<do
     }
     it->second.second = w.temperature_variance;
   }
+  // What those errors add to chi^2 on average, var_g |(I - J K) a_g|^2, is
+  // not taken as a sign of too small a noise (below).
+  double expected = 0.0;
   for (const auto& [key, g] : groups) {
     const Eigen::VectorXd gain = inv * (jf.transpose() * g.first);
     extra += g.second * gain * gain.transpose();
+    expected += g.second * (g.first - jf * gain).squaredNorm();
   }
+  const double factor = dof > 0 ? std::max(1.0, (fit->chi2 - expected) / dof) : 1.0;
   fit->covariance = Eigen::MatrixXd::Zero(layout.size, layout.size);
   for (size_t a = 0; a < free.size(); ++a) {
     for (size_t b = 0; b < free.size(); ++b) {
