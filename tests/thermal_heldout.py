@@ -571,7 +571,7 @@ def extra_sections(r, binary, source_dir, rate, seeds, only):
         rms = float(np.sqrt(np.mean(np.square(zs)))) if zs else float('nan')
         rms_m = float(np.sqrt(np.mean(np.square(dz)))) if dz else float('nan')
         rms_f = float(np.sqrt(np.mean(np.square(dz_frame)))) if dz_frame else float('nan')
-        r.check('gyro_scale_honest', bool(zs) and 0.7 <= rms <= 1.4 and 0.6 <= rms_m <= 1.6,
+        r.check('gyro_scale_honest', bool(zs) and 0.7 <= rms <= 1.4 and (not dz or 0.6 <= rms_m <= 1.6),
                 {'rms_z_scale': rms, 'values': len(zs), 'rms_z_matrix_diag': rms_m,
                  'matrix_values': len(dz),
                  'rms_z_matrix_diag_frame_undetermined': rms_f, 'orders': orders})
