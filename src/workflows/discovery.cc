@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <sstream>
 
 #include "core/warnings.h"
@@ -240,24 +239,12 @@ void CheckRotations(const std::vector<Effect>& baseline_effects,
     richest.push_back(e);
   }
   // Only where needed: when the magnitudes keep min_dof residual degrees
-  // of freedom under the deepest model discovery can reach, they test every
-  // candidate on their own, and the rotations (about a hundred times the
-  // CPU of the magnitudes: every fit integrates every turn) are left out.
-  // Discovery adds at most max_steps effects, so that model is the baseline
-  // with the max_steps largest candidates, not with all of them (a sixth
-  // accelerometer candidate in the catalogue must not switch on the turns
-  // of every 24-pose session). The choice follows from the design (poses
-  // and parameters), not from the data, so the tests stay honest.
-  std::vector<int> sizes;
-  for (size_t i = baseline_effects.size(); i < richest.size(); ++i) {
-    sizes.push_back(AccelModelParameterCount(ctx.parameterization, {richest[i]}) -
-                    AccelModelParameterCount(ctx.parameterization, {}));
-  }
-  std::sort(sizes.begin(), sizes.end(), std::greater<int>());
-  int parameters = AccelModelParameterCount(ctx.parameterization, baseline_effects);
-  for (size_t i = 0; i < sizes.size() && static_cast<int>(i) < options.max_steps; ++i) {
-    parameters += sizes[i];
-  }
+  // of freedom even under the richest model, they test every candidate on
+  // their own, and the rotations (about a hundred times the CPU of the
+  // magnitudes: every fit integrates every turn) are left out. The choice
+  // follows from the design (poses and parameters), not from the data, so
+  // the tests stay honest.
+  const int parameters = AccelModelParameterCount(ctx.parameterization, richest);
   if (static_cast<int>(ctx.observations->size()) - parameters >= options.min_dof) {
     ctx.use_rotations = false;
     return;

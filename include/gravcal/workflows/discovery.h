@@ -108,9 +108,8 @@ struct DiscoveryOptions {
   // use_between_pose_rotations), with the gyroscope's matrix and bias
   // estimated jointly. Used only where the magnitudes cannot test every
   // accelerometer candidate (fewer than min_dof residual degrees of freedom
-  // under the deepest model a run can reach: the baseline with the
-  // max_steps largest candidates), and left out, with a warning, when they
-  // exceed their noise under the richest model.
+  // under the richest model), and left out, with a warning, when they
+  // exceed their noise under that model.
   bool use_between_pose_rotations = true;
 
   bool IsValid(std::string* error) const;
