@@ -280,8 +280,8 @@ TEST(Config, KeyTheMethodDoesNotUseIsAnErrorNamingKeyAndMethod) {
                 "key 'window' is not used by method 'handheld_kalman'"},
            Case{"method: twelve_position\nhk_passes: 3\n",
                 "key 'hk_passes' is not used by method 'twelve_position'"},
-           Case{"method: twelve_position\ngyro_nominal_scale: 1\n",
-                "key 'gyro_nominal_scale' is not used by method 'twelve_position'"},
+           Case{"method: twelve_position\nthermal_gyro_scale_order: 1\n",
+                "key 'thermal_gyro_scale_order' is not used by method 'twelve_position'"},
            Case{"method: rate_table\ngravity: 9.81\n",
                 "key 'gravity' is not used by method 'rate_table'"},
        }) {
