@@ -11,6 +11,7 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "gravcal/io/log_reader.h"
@@ -139,6 +140,17 @@ TEST(LogReaderBlocks, GoodLogsGiveTheSameRows) {
   std::string no_end = kHeader + MixedRows(700);
   no_end.pop_back();  // The last line has no line end.
   EXPECT_EQ(ExpectSameAsLineByLine("no_end.csv", no_end), "");
+  // A column not used comes first: a comment or a blank line that looks like
+  // a row after it stays a comment; CR LF and lone CR around unused cells.
+  std::string unused = "seq,t,ax,ay,az,note\n";
+  for (int i = 0; i < 900; ++i) {
+    const std::string n = std::to_string(i);
+    unused += i % 7 == 3   ? "#" + n + "," + n + ",1,2,3,x\n"
+              : i % 7 == 4 ? "  #" + n + "," + n + ",1,2,3,x\n"
+              : i % 7 == 5 ? n + "," + n + ".5,1,2,3,a\r\n"
+                           : n + "," + n + ",4,-5," + n + ",\n";
+  }
+  EXPECT_EQ(ExpectSameAsLineByLine("unused.csv", unused), "");
   // No time column: t = row / sample_rate, counted across blocks.
   std::string untimed = "ax,ay,az\n";
   for (int i = 0; i < 900; ++i)
@@ -172,6 +184,7 @@ TEST(LogReaderBlocks, BadLogsGiveTheSameErrorAtTheSameLine) {
       "1e9,1,1e999,3,4,5,6,7",                         // out of range
       "0,1,2,3,4,5,6,7",                               // time goes back
       "1e9,1,2\r,3,4,5,6,7",                           // a carriage return inside a line
+      "1e9,1,2,3,4,5,6,7\r\r",                         // two before the line end
       std::string(70000, '7'),                         // longer than a log line
       "1e9,1,2,3,4,5,6,7," + std::string(65600, ' '),  // long, with its line end
   };
@@ -238,6 +251,73 @@ TEST(LogReaderBlocks, ALongFileReadOnTwoThreadsEqualsOneThread) {
   // Every entry, bit for bit.
   EXPECT_TRUE(two.t == one.t && two.accel == one.accel && two.gyro == one.gyro &&
               two.temperature == one.temperature);
+}
+
+// A log with a second gyroscope file, in bounded memory: both files in step
+// (io/log_pair.h), with the log or the error ReadImuLog gives; a longer pair
+// is held as the block means of the same rows in one file.
+TEST(LogReaderBlocks, GyroFileReadInStepInBoundedMemory) {
+  LogReaderOptions options;
+  options.format = LogFormat::kWhitespace;
+  options.columns = {"t", "ax", "ay", "az"};
+  const std::string main_path = WriteScratch("step_accel.txt", "");
+  options.gyro_path = WriteScratch("step_gyro.txt", "");
+  const std::string accel = "1.0 1 2 3\n1.1 4 5 6\n1.2 7 8 9\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {accel, "# gyro\n1.0 0.1 0.2 0.3\n1.1 0.4 0.5 0.6\n1.2 0.7 0.8 0.9\n"},
+      {accel, "1.0 0.1 0.2 0.3\n1.1 0.4 0.5 0.6\n1.25 0.7 0.8 0.9\n"},  // a time differs
+      {accel, "1.0 0.1 0.2 0.3\n1.1 x 0.5 0.6\n"},                      // bad, and short
+      {accel, "1.0 0.1 0.2 0.3\n1.1 0.4 0.5 0.6\n"},                    // fewer rows
+      {accel, "1.0 0 0 0\n1.1 0 0 0\n1.2 0 0 0\n1.3 0 0 0\n"},          // more rows
+      {"1.0 1 2 3\n1.1 4 5\n", "1.0 0 0 0\n1.3 0 0 0\n"},               // both bad
+      {"# nothing\n", "1.0 0 0 0\n"},                                   // no rows
+      {accel, ""}};
+  for (const auto& [main_text, gyro_text] : cases) {
+    WriteScratch("step_accel.txt", main_text);
+    WriteScratch("step_gyro.txt", gyro_text);
+    for (const bool missing : {false, true}) {
+      LogReaderOptions o = options;
+      if (missing) o.gyro_path += ".missing";
+      ImuLog whole, in_step;
+      std::string whole_error, step_error;
+      const bool whole_ok = ReadImuLog(main_path, o, &whole, &whole_error);
+      LongLogReading reading;
+      EXPECT_EQ(ReadImuLogBounded(main_path, o, &reading, &in_step, nullptr, &step_error), whole_ok)
+          << gyro_text;
+      EXPECT_EQ(step_error, whole_error);
+      EXPECT_TRUE(in_step.t == whole.t && in_step.accel == whole.accel &&
+                  in_step.gyro == whole.gyro);
+    }
+  }
+  // 100 rows held as means of 8 (at most 16 entries): those of one file.
+  std::string main_text, gyro_text, joined = "t,ax,ay,az,gx,gy,gz\n";
+  for (int i = 0; i < 100; ++i) {
+    const std::string t = std::to_string(i) + ".5 ";
+    const std::string a = std::to_string(i % 7) + " " + std::to_string(-i) + " 0.25";
+    const std::string g = std::to_string(3 * i) + " 0.125 " + std::to_string(i % 5);
+    main_text += t + a + "\n";
+    gyro_text += t + g + "\n";
+    std::string row = t + a + " " + g + "\n";
+    for (char& c : row) c = c == ' ' ? ',' : c;
+    joined += row;
+  }
+  WriteScratch("step_accel.txt", main_text);
+  WriteScratch("step_gyro.txt", gyro_text);
+  const std::string joined_path = WriteScratch("step_joined.csv", joined);
+  LongLogReading pair_reading, joined_reading;
+  pair_reading.max_samples = joined_reading.max_samples = 16;
+  ImuLog pair, one;
+  std::string error;
+  ASSERT_TRUE(ReadImuLogBounded(main_path, options, &pair_reading, &pair, nullptr, &error))
+      << error;
+  ASSERT_TRUE(ReadImuLogBounded(joined_path, {}, &joined_reading, &one, nullptr, &error)) << error;
+  EXPECT_EQ(pair_reading.samples_averaged, 8u);
+  EXPECT_EQ(pair_reading.rows_read, 100u);
+  EXPECT_EQ(pair.size(), 12u);
+  EXPECT_TRUE(pair.t == one.t && pair.accel == one.accel && pair.gyro == one.gyro);
+  for (const std::string& path : {main_path, options.gyro_path, joined_path}) {
+    std::remove(path.c_str());
+  }
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cstddef>
 
 #include "gravcal/core/imu_log.h"
+#include "io/log_text.h"
 
 namespace gravcal {
 namespace internal {
@@ -19,28 +20,31 @@ class BlockAverager {
  public:
   BlockAverager(size_t max, ImuLog* out) : max_(max - max % 2), out_(out) {}
 
-  void Add(double t, const Eigen::Vector3d& accel, const Eigen::Vector3d* gyro,
-           const double* temperature) {
+  // `count` rows of kNumSlots values (io/log_text.h), in order; with the
+  // gyroscope and the temperature when kGyro, kTemperature.
+  template <bool kGyro, bool kTemperature>
+  void AddRows(const double* rows, size_t count) {
     ImuLog& o = *out_;
-    // Full when a new block begins: halve first, so that a log of max_
-    // rows is kept as it is.
-    if (count_ == 0 && max_ > 0 && o.t.size() >= max_) Halve();
-    if (block_ == 1) {
-      o.t.push_back(t);
-      o.accel.push_back(accel);
-      if (gyro != nullptr) o.gyro.push_back(*gyro);
-      if (temperature != nullptr) o.temperature.push_back(*temperature);
-    } else {
-      t_ += t;
+    for (const double* v = rows; v < rows + count * kNumSlots; v += kNumSlots) {
+      if (count_ == 0 && max_ > 0 && o.t.size() >= max_) Halve();
+      const Eigen::Vector3d accel(v[kAx], v[kAy], v[kAz]);
+      if (block_ == 1) {
+        o.t.push_back(v[kT]);
+        o.accel.push_back(accel);
+        if (kGyro) o.gyro.emplace_back(v[kGx], v[kGy], v[kGz]);
+        if (kTemperature) o.temperature.push_back(v[kTemp]);
+        continue;
+      }
+      t_ += v[kT];
       accel_ += accel;
-      if (gyro != nullptr) gyro_ += *gyro;
-      if (temperature != nullptr) temperature_ += *temperature;
-      if (++count_ < block_) return;
+      if (kGyro) gyro_ += Eigen::Vector3d(v[kGx], v[kGy], v[kGz]);
+      if (kTemperature) temperature_ += v[kTemp];
+      if (++count_ < block_) continue;
       const double inv = 1.0 / static_cast<double>(block_);
       o.t.push_back(t_ * inv);
       o.accel.push_back(accel_ * inv);
-      if (gyro != nullptr) o.gyro.push_back(gyro_ * inv);
-      if (temperature != nullptr) o.temperature.push_back(temperature_ * inv);
+      if (kGyro) o.gyro.push_back(gyro_ * inv);
+      if (kTemperature) o.temperature.push_back(temperature_ * inv);
       t_ = 0.0;
       temperature_ = 0.0;
       accel_.setZero();

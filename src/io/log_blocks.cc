@@ -47,25 +47,31 @@ void ParseBlock(LogRowParser* rules, TextBlock* block) {
   const double time_scale = rules->options().time_scale;
   const char* p = block->text.data();
   const char* const end = p + block->size;
+  const char* const readable_end = block->text.data() + block->text.size();
   std::string why;
   double previous = 0.0;
   size_t count = 0, lines = 0;
   while (p < end) {
-    const char* newline = static_cast<const char*>(std::memchr(p, '\n', end - p));
-    const char* stop = newline != nullptr ? newline : end;
-    if (static_cast<size_t>(stop - p) > kMaxLogLineBytes) return;
-    if (newline != nullptr && stop > p && stop[-1] == '\r') --stop;
-    ++lines;
-    const char* s = p;
-    p = newline != nullptr ? newline + 1 : end;
-    while (s < stop && IsRowBlank(*s)) ++s;
-    if (s == stop || *s == '#') continue;
-    if (!rules->ParseFields(s, stop, 0, &why)) return;
     if ((count + 1) * kNumSlots > block->rows.size()) {
       block->rows.resize(2 * block->rows.size() + 4096 * kNumSlots);
     }
     double* row = block->rows.data() + count * kNumSlots;
-    std::memcpy(row, rules->values(), sizeof(double) * kNumSlots);
+    ++lines;
+    // Most lines are plain rows, read in one pass (the line and its cells).
+    if (const char* next = rules->ParsePlainCsvRow(p, end, readable_end, row)) {
+      p = next;
+    } else {
+      const char* newline = static_cast<const char*>(std::memchr(p, '\n', end - p));
+      const char* stop = newline != nullptr ? newline : end;
+      if (static_cast<size_t>(stop - p) > kMaxLogLineBytes) return;
+      if (newline != nullptr && stop > p && stop[-1] == '\r') --stop;
+      const char* s = p;
+      p = newline != nullptr ? newline + 1 : end;
+      while (s < stop && IsRowBlank(*s)) ++s;
+      if (s == stop || *s == '#') continue;
+      if (!rules->ParseFields(s, stop, 0, &why)) return;
+      std::memcpy(row, rules->values(), sizeof(double) * kNumSlots);
+    }
     if (timed) {
       const double t = row[kT] * time_scale;
       if (!std::isfinite(t) || (count > 0 && !(t > previous))) return;
@@ -92,7 +98,9 @@ class BlockPipeline {
     head_.assign(head.begin(), head.end());
     for (size_t i = 0; i < slots_; ++i) {
       blocks_.push_back(std::make_unique<TextBlock>());
-      blocks_.back()->text.resize(kMaxLogLineBytes + block_bytes_);
+      // (ParsePlainCsvRow may load bytes after the text.)
+      blocks_.back()->text.resize(kMaxLogLineBytes + block_bytes_ +
+                                  LogRowParser::kPlainRowReadAhead);
     }
     carry_.resize(std::max(kMaxLogLineBytes, block_bytes_));
     for (int w = 0; w < threads; ++w) rules_.push_back(std::make_unique<LogRowParser>(rules));

@@ -28,6 +28,7 @@
 #include "io/formats/file_format.h"
 #include "io/formats/message_log.h"
 #include "io/log_blocks.h"
+#include "io/log_pair.h"
 #include "io/log_text.h"
 #include "util/cancellation.h"
 #include "util/content_hash.h"
@@ -52,8 +53,7 @@ using internal::kTemp;
 using internal::LogWhere;
 using internal::SetError;
 
-// Two times agree when they differ by at most this, relative.
-constexpr double kRelativeTimeTolerance = 1e-9;
+using internal::kRelativeTimeTolerance;
 
 bool IsContractName(const std::string& name) {
   for (const char* contract : kLogSlotNames) {
@@ -114,11 +114,10 @@ bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std
   // Rows of kNumSlots values (LogRowParser::values) into the log.
   const internal::LogRowSink add_rows = [&](const double* rows, size_t count) {
     const bool gyro = parser.has(kGx), temperature = parser.has(kTemp);
-    for (const double* v = rows; v < rows + count * kNumSlots; v += kNumSlots) {
-      const Eigen::Vector3d accel(v[internal::kAx], v[internal::kAy], v[internal::kAz]);
-      const Eigen::Vector3d w = gyro ? Eigen::Vector3d(v[kGx], v[kGy], v[kGz]) : accel;
-      averager.Add(v[kT], accel, gyro ? &w : nullptr, temperature ? v + kTemp : nullptr);
-    }
+    if (gyro && temperature) averager.AddRows<true, true>(rows, count);
+    if (gyro && !temperature) averager.AddRows<true, false>(rows, count);
+    if (!gyro && temperature) averager.AddRows<false, true>(rows, count);
+    if (!gyro && !temperature) averager.AddRows<false, false>(rows, count);
   };
   const int threads = bounded != nullptr ? ReadingThreads(*bounded) : 1;
   std::string_view line;
@@ -204,6 +203,11 @@ bool ParseLog(internal::LogLines* source, uint64_t bytes, internal::FileFormat f
               LongLogReading* bounded, std::string* error) {
   const bool euroc = format == internal::FileFormat::kEuroc && internal::LayoutFromFile(options);
   const LogReaderOptions& layout = euroc ? internal::EurocOptions(options) : options;
+  if (bounded != nullptr && bounded->max_samples > 0 && !options.gyro_path.empty() && !euroc) {
+    // Both files in step, in bounded memory.
+    return internal::ParseLogPair(source, name, options, bounded->max_samples, log,
+                                  &bounded->samples_averaged, &bounded->rows_read, error);
+  }
   ImuLog parsed;
   size_t lines = 0;
   if (!ParseText(source, bytes, euroc, name, layout, nullptr, name, &parsed, &lines, bounded,
@@ -400,10 +404,10 @@ bool ReadLog(const std::string& path, const LogReaderOptions& options, ImuLog* l
       return ReadPipe(path, options, log, hash, bounded, error);
     }
     const uint64_t bytes = static_cast<uint64_t>(st.st_size);
-    // Read in bounded memory (max_samples) unless a second file is matched
-    // row for row.
-    const bool in_bounds =
-        bounded != nullptr && bounded->max_samples > 0 && options.gyro_path.empty();
+    // Read in bounded memory (max_samples); a second gyroscope file too,
+    // in step (io/log_pair.h), unless the main file is an EuRoC one.
+    const bool in_bounds = bounded != nullptr && bounded->max_samples > 0 &&
+                           (options.gyro_path.empty() || format != internal::FileFormat::kEuroc);
     if (!in_bounds &&
         !internal::CheckLogFitsInMemory(path, bytes, internal::AvailableMemoryBytes(), error)) {
       return false;

@@ -139,6 +139,22 @@ class LogRowParser {
     }
     return ok;
   }
+  // A reader's fast path (io/log_plain_rows.cc, used by io/log_blocks.cc):
+  // the CSV row that starts at `begin` (a line start, before `end`, the end
+  // of the text), when it is plain: every field in use a number that
+  // ParseNumber reads up to the next comma or, for the last field, the line
+  // end ("\n", "\r\n" or `end`), no blanks, at most kMaxLogLineBytes.
+  // Writes its values into row[kNumSlots] as ParseFields would leave
+  // value(slot) (0 for a slot not in the file; time as in the file) and
+  // returns where the next line starts. nullptr for anything else (a
+  // comment, a blank or header line, a bad cell, a whitespace log...): then
+  // LogLines and Line read that line, with the same values or the error they
+  // give. Bytes up to `readable_end` (>= end) may be loaded, not used.
+  const char* ParsePlainCsvRow(const char* begin, const char* end, const char* readable_end,
+                               double* row) const;
+  // The bytes after a line start that ParsePlainCsvRow loads when it may.
+  static constexpr ptrdiff_t kPlainRowReadAhead = 72;
+
   // Rows read and the last time, as if Line had read rows up to here (for a
   // reader that parsed some rows elsewhere).
   void Resume(size_t rows, double previous_t) {

@@ -8,8 +8,9 @@
 //   up, each two neighbours are replaced by their mean, and from then on
 //   every 2^k rows (t, accelerometer, gyroscope and temperature alike) enter
 //   as one mean; a last incomplete block (fewer than 2^k rows) is dropped.
-// No size refusal applies (memory is bounded). Bags, MCAP files and a log
-// with a second gyroscope file (gyro_path) are read whole, as by ReadImuLog;
+// No size refusal applies (memory is bounded). A log with a second
+// gyroscope file (gyro_path) is read so too, both files in step. Bags and
+// MCAP files are read whole, as by ReadImuLog;
 // a pipe or device is streamed from its start, unless a provenance is asked
 // (its hash needs the length first: then it is read whole).
 #ifndef GRAVCAL_IO_LONG_LOG_H_
