@@ -4,7 +4,8 @@
 // A row of up to 63 bytes is read whole: its commas and its line end are
 // found 16 bytes at a time (SSE2), so every cell's bounds are known before
 // any is read and the cells are independent work; a cell of at most 8
-// digits (raw counts) is added 8 bytes at a time. Any other cell goes to
+// digits (raw counts) or a short decimal ("-0.012345") is added 8 bytes at
+// a time. Any other cell goes to
 // ParseNumber, and any other row to the byte-by-byte loop below, which does
 // what ParseRow does for such a row.
 #include <cmath>
@@ -59,24 +60,46 @@ inline uint64_t DigitsValue(uint64_t w, unsigned n) {
   return v;
 }
 
+// The sign bit of a double set when `negative` (no branch: the signs of
+// readings change at random); exact, -0 included.
+inline double WithSign(double value, bool negative) {
+  uint64_t bits;
+  std::memcpy(&bits, &value, 8);
+  bits |= static_cast<uint64_t>(negative) << 63;
+  std::memcpy(&value, &bits, 8);
+  return value;
+}
+
 // The cell [s, e) as ParseNumber reads it, when that reads all of it and
-// the value is finite.
+// the value is finite. Integers of at most 8 digits and decimals of 1-7
+// digits, a point and 1-8 digits are added 8 bytes at a time: their
+// mantissa is below 2^53, so the value is the mantissa, or the mantissa
+// divided by 10^digits once (correctly rounded), as ParseNumber makes it.
 inline bool PlainCell(const char* s, const char* e, double* x) {
+  static constexpr double kPow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8};
+  static constexpr uint64_t kPow10Int[] = {1,      10,      100,      1000,     10000,
+                                           100000, 1000000, 10000000, 100000000};
   const bool negative = s < e && *s == '-';
   const char* digits = s + (negative ? 1 : 0);
   const size_t length = static_cast<size_t>(e - digits);
-  if (length >= 1 && length <= 8) {
+  if (length >= 1 && length <= 16) {
     uint64_t w;
     std::memcpy(&w, digits, 8);
-    if (LeadingDigits(w) >= length) {
-      // An integer of at most 8 digits: exact, as ParseNumber gives it; the
-      // sign set without a branch (signs of readings change at random).
-      const double value = static_cast<double>(DigitsValue(w, static_cast<unsigned>(length)));
-      uint64_t bits;
-      std::memcpy(&bits, &value, 8);
-      bits |= static_cast<uint64_t>(negative) << 63;
-      std::memcpy(x, &bits, 8);
+    const unsigned lead = LeadingDigits(w);
+    if (lead >= length) {  // An integer of at most 8 digits.
+      *x = WithSign(static_cast<double>(DigitsValue(w, static_cast<unsigned>(length))), negative);
       return true;
+    }
+    const size_t fraction = length - lead - 1;
+    if (lead >= 1 && lead <= 7 && digits[lead] == '.' && fraction >= 1 && fraction <= 8) {
+      uint64_t f;
+      std::memcpy(&f, digits + lead + 1, 8);
+      if (LeadingDigits(f) >= fraction) {
+        const uint64_t mantissa = DigitsValue(w, lead) * kPow10Int[fraction] +
+                                  DigitsValue(f, static_cast<unsigned>(fraction));
+        *x = WithSign(static_cast<double>(mantissa) / kPow10[fraction], negative);
+        return true;
+      }
     }
   }
   const std::from_chars_result result = ParseNumber(s, e, x);
@@ -95,7 +118,7 @@ const char* LogRowParser::ParsePlainCsvRow(const char* begin, const char* end,
   const int* const slot_of_field = slot_of_field_.data();
   for (int slot = 0; slot < kNumSlots; ++slot) row[slot] = 0.0;
 #ifdef GRAVCAL_PLAIN_ROWS_SSE2
-  // 64 bytes for the row, and 8 after a cell that opens at most at byte 63.
+  // 64 bytes for the row, and 17 after a cell that opens at most at byte 63.
   if (readable_end - begin >= kPlainRowReadAhead) {
     const size_t limit = static_cast<size_t>(end - begin);
     const uint64_t in_text = limit >= 64 ? ~uint64_t{0} : (uint64_t{1} << limit) - 1;

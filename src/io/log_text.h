@@ -153,7 +153,7 @@ class LogRowParser {
   const char* ParsePlainCsvRow(const char* begin, const char* end, const char* readable_end,
                                double* row) const;
   // The bytes after a line start that ParsePlainCsvRow loads when it may.
-  static constexpr ptrdiff_t kPlainRowReadAhead = 72;
+  static constexpr ptrdiff_t kPlainRowReadAhead = 96;
 
   // Rows read and the last time, as if Line had read rows up to here (for a
   // reader that parsed some rows elsewhere).
