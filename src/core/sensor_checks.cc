@@ -340,16 +340,30 @@ std::string GyroAxisConventionWarning(const ImuLog& log) {
   if (turning < 2.0 || d.size() < 20) return "";
   double total = 0.0;
   for (const Eigen::Vector3d& v : d) total += v.squaredNorm();
+  // For each mapping M, c_i = f_i x (M w_i), cd = sum c_i.d_i and
+  // cc = sum |c_i|^2, from sums over the samples taken once: with the
+  // triple product (f x v).d = v.(d x f) and |M w| = |w| (M is a signed
+  // permutation),
+  //   cd = sum_rc M_rc S_rc,                S = sum (d_i x f_i) w_i^T,
+  //   cc = sum |f_i|^2 |w_i|^2 - m^T Q m,   Q = sum p_i p_i^T,
+  // m and p_i the 9 entries of M and of f_i w_i^T.
+  Eigen::Matrix3d sum_s = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 9, 9> sum_q = Eigen::Matrix<double, 9, 9>::Zero();
+  double sum_norms = 0.0;
+  for (size_t i = 0; i < d.size(); ++i) {
+    sum_s += d[i].cross(fm[i]) * wm[i].transpose();
+    const Eigen::Matrix3d p = fm[i] * wm[i].transpose();
+    const Eigen::Map<const Eigen::Matrix<double, 9, 1>> pv(p.data());
+    sum_q.noalias() += pv * pv.transpose();
+    sum_norms += fm[i].squaredNorm() * wm[i].squaredNorm();
+  }
   double best = INFINITY, identity = INFINITY;
   int best_code = 0;
   for (int code = 0; code < 48; ++code) {
     const Eigen::Matrix3d m = SignedPermutation(code);
-    double cd = 0.0, cc = 0.0;
-    for (size_t i = 0; i < d.size(); ++i) {
-      const Eigen::Vector3d c = fm[i].cross(m * wm[i]);
-      cd += c.dot(d[i]);
-      cc += c.squaredNorm();
-    }
+    const Eigen::Map<const Eigen::Matrix<double, 9, 1>> mv(m.data());
+    const double cd = m.cwiseProduct(sum_s).sum();
+    const double cc = sum_norms - mv.dot(sum_q * mv);
     if (!(cc > 0.0)) continue;
     const double k = std::max(cd / cc, 0.0);
     const double residual = total - 2.0 * k * cd + k * k * cc;

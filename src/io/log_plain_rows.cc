@@ -60,14 +60,11 @@ inline uint64_t DigitsValue(uint64_t w, unsigned n) {
   return v;
 }
 
-// The sign bit of a double set when `negative` (no branch: the signs of
-// readings change at random); exact, -0 included.
+// -value when `negative`, without a branch (the signs of readings change
+// at random): a product with -1 or 1 is exact, -0 included.
 inline double WithSign(double value, bool negative) {
-  uint64_t bits;
-  std::memcpy(&bits, &value, 8);
-  bits |= static_cast<uint64_t>(negative) << 63;
-  std::memcpy(&value, &bits, 8);
-  return value;
+  static constexpr double kSign[2] = {1.0, -1.0};
+  return value * kSign[negative ? 1 : 0];
 }
 
 // The cell [s, e) as ParseNumber reads it, when that reads all of it and
