@@ -29,11 +29,11 @@ std::unique_ptr<PyRecorder> MakeRecorder(const Config& config, const std::string
   r->config = config;
   RecorderOptions options;
   options.request.targets = targets;
-  options.request.pose_set = pose_set;
+  std::string error;
+  Check(ParseName("pose_set", pose_set, &options.request.pose_set, &error), error);
   options.request.accel_noise_density = accel_noise_density;
   options.max_time_seconds = max_time;
   if (ReadNoise(noise_path, noise_text, &r->noise)) options.request.noise_model = &r->noise.model;
-  std::string error;
   Check(r->recorder.Start(r->config, options, &error), error);
   return r;
 }

@@ -166,7 +166,12 @@ void BindRecordings(py::module_& m) {
   py::class_<PlanRequest>(m, "PlanRequest", "The request of gravcal plan and gravcal check.")
       .def(py::init<>())
       .def_readwrite("targets", &PlanRequest::targets)
-      .def_readwrite("pose_set", &PlanRequest::pose_set)
+      .def_property(
+          "pose_set", [](const PlanRequest& r) { return std::string(ToString(r.pose_set)); },
+          [](PlanRequest& r, const std::string& name) {
+            std::string error;
+            Check(ParseName("pose_set", name, &r.pose_set, &error), error);
+          })
       .def_readwrite("free_candidates", &PlanRequest::free_candidates)
       .def_readwrite("max_time_seconds", &PlanRequest::max_time_seconds)
       .def_readwrite("overhead_seconds", &PlanRequest::overhead_seconds)

@@ -94,7 +94,7 @@ class BatchTest : public ::testing::Test {
     std::ofstream(*dir_ + "/u09.csv") << good;
     // Six poses cannot determine the nine scale_misalignment parameters.
     SimulatorOptions six = sim;
-    six.scheme = "random:6";
+    six.scheme = {PoseScheme::kRandom, 6};
     SimulatedSession s;
     ASSERT_TRUE(Simulate(six, 11, &s, &error)) << error;
     ASSERT_TRUE(WriteImuLogCsv(s.log, *dir_ + "/u11.csv", &error)) << error;

@@ -77,7 +77,7 @@ TEST(Calibration, SimulatedTwelvePositionCountsSigmaMatchesSpread) {
 TEST(Calibration, SimulatedSiUnitsRandomPosesNoInitialValue) {
   SimulatorOptions sim;
   sim.raw_counts = false;
-  sim.scheme = "random:15";
+  sim.scheme = {PoseScheme::kRandom, 15};
   CalibrationOptions options;
   const Outcome o = RunSeeds(sim, options, 150);
   ExpectCalibratedSigmas(o, options.refinement.parameterization);
@@ -120,7 +120,7 @@ TEST(Calibration, AffineRotationFromNominalAxesWithHonestSigma) {
 
 TEST(Calibration, TooFewPositionsSaysFoundAndNeeded) {
   SimulatorOptions sim;
-  sim.scheme = "six";
+  sim.scheme = {PoseScheme::kSix};
   SimulatedSession session;
   std::string error;
   ASSERT_TRUE(Simulate(sim, 3, &session, &error)) << error;

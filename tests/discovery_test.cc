@@ -218,7 +218,7 @@ TEST(Discovery, InvalidOptionsAndTooFewPositionsFailWithAMessage) {
   EXPECT_FALSE(DiscoverEffects(session.log, calibration, {}, options, &r));
   EXPECT_NE(r.message.find("discovery_significance"), std::string::npos) << r.message;
   SimulatorOptions six;
-  six.scheme = "six";
+  six.scheme = {PoseScheme::kSix};
   ASSERT_TRUE(Simulate(six, 1, &session, &error)) << error;
   EXPECT_FALSE(DiscoverEffects(session.log, calibration, {}, DiscoveryOptions(), &r));
   EXPECT_NE(r.message.find("needs at least 9"), std::string::npos) << r.message;
@@ -312,7 +312,7 @@ std::vector<StaticObservation> WithoutGyroscope(std::vector<StaticObservation> o
 
 TEST(Discovery, GyroscopeExcessDoesNotMaskAccelerometerEffect) {
   SimulatorOptions sim;
-  sim.scheme = "random:14";
+  sim.scheme = {PoseScheme::kRandom, 14};
   sim.hold_seconds = 10.0;
   sim.accel_misalignment_std = 1.5e-3;
   CalibrationOptions calibration;

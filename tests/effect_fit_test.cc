@@ -223,7 +223,7 @@ TEST(EffectFit, RobustLossResistsADisturbedPoseAsThePlainFitDoes) {
   // Twenty poses: with twelve for nine parameters every pose has a leverage
   // near 0.75, and no loss can tell a disturbed one from the rest.
   SimulatorOptions sim;
-  sim.scheme = "random:20";
+  sim.scheme = {PoseScheme::kRandom, 20};
   sim.hold_seconds = 30.0;  // long enough for the within-pose trends
   SimulatedSession clean;
   std::string error;

@@ -35,7 +35,7 @@ constexpr double kCandidateLevel = 0.01 / kNumEffects;
 // white noise (0.02 m/s^2 per sample at 100 Hz).
 inline SimulatorOptions TwelvePoseWarmUp() {
   SimulatorOptions o = WarmUpSession();
-  o.scheme = "twelve";
+  o.scheme = {PoseScheme::kTwelve};
   o.hold_seconds = 30.0;
   o.initial_still_seconds = 10.0;
   o.rotation_seconds = 3.0;

@@ -51,7 +51,7 @@ class KnownAttitudeTest : public ::testing::Test {
 
   static SimulatorOptions TenPositions() {
     SimulatorOptions sim;
-    sim.scheme = "ten";
+    sim.scheme = {PoseScheme::kTen};
     sim.hold_seconds = 8.0;
     sim.initial_still_seconds = 2.0;
     sim.rotation_seconds = 2.0;

@@ -2,8 +2,9 @@
 // every file under include/gravcal/<wing>/ and src/<wing>/ includes only
 // headers of its own wing or of lower wings, public headers include no
 // private header, no public header but the residuals (and their umbrella
-// gravcal/ceres.h) includes Ceres or glog, and every source file lives in a
-// known wing. A violation names the file, the line and the include.
+// gravcal/ceres.h) includes Ceres or glog, every source file lives in a
+// known wing, and no .cc is over 600 lines (a room holds one concept, issue
+// 34). A violation names the file, the line and the include.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -71,6 +72,9 @@ Include Classify(const std::string& path) {
   return inc;
 }
 
+// The longest a .cc may be.
+constexpr int kMaxSourceLines = 600;
+
 // Violations in the tree at `root` (which has include/gravcal and src).
 std::vector<std::string> CheckLayering(const fs::path& root) {
   std::vector<std::string> violations;
@@ -127,6 +131,10 @@ std::vector<std::string> CheckLayering(const fs::path& root) {
                                (target_rank == rank ? "a sibling" : "a higher wing") + ")");
         }
       }
+      if (ext == ".cc" && line_number > kMaxSourceLines) {
+        violations.push_back(shown + ": " + std::to_string(line_number) + " lines (at most " +
+                             std::to_string(kMaxSourceLines) + ": split it by concept)");
+      }
     }
   }
   return violations;
@@ -167,9 +175,12 @@ TEST(Layering, PlantedViolationsAreNamed) {
   write("include/gravcal/residuals/ok.h", "#include <ceres/ceres.h>\n");
   write("include/gravcal/gravcal.h", "#include <glog/logging.h>\n#include \"gravcal/core/a.h\"\n");
   write("include/gravcal/ceres.h", "#include \"gravcal/residuals/d.h\"\n");
+  write("src/core/long.cc", std::string(601, '\n'));
+  write("src/core/just.cc", std::string(600, '\n'));
   const std::vector<std::string> v = CheckLayering(root);
   const std::string all = Join(v);
-  EXPECT_EQ(v.size(), 8u) << all;
+  EXPECT_EQ(v.size(), 9u) << all;
+  EXPECT_NE(all.find("src/core/long.cc: 601 lines (at most 600"), std::string::npos) << all;
   EXPECT_NE(all.find("include/gravcal/core/a.h:1: wing 'core' includes \"gravcal/methods/b.h\""),
             std::string::npos)
       << all;

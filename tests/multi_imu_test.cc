@@ -22,7 +22,7 @@ namespace {
 PlateSimulatorOptions PlateOptions(int imus) {
   PlateSimulatorOptions o;
   o.imus = imus;
-  o.imu.scheme = "twelve";
+  o.imu.scheme = {PoseScheme::kTwelve};
   o.imu.hold_seconds = 4.0;
   o.imu.initial_still_seconds = 4.0;
   o.imu.rotation_seconds = 2.0;
@@ -215,7 +215,7 @@ TEST(MultiImu, DriftingClockIsNamed) {
 TEST(MultiImu, OneLevelPoseGivesOffsetsAlongGravityOnly) {
   PlateSimulatorOptions o = PlateOptions(4);
   o.mounting = "aligned";
-  o.imu.scheme = "random:1";
+  o.imu.scheme = {PoseScheme::kRandom, 1};
   o.imu.hold_seconds = 20.0;
   o.imu.initial_still_seconds = 20.0;
   SimulatedPlate plate;

@@ -126,7 +126,7 @@ TEST(Plan, MeetsTargetsAndNeverTakesLongerThanTheSeedsTwelvePositions) {
   };
   bool strictly_less = false;
   for (const char* target : targets) {
-    for (const char* set : {"faces+45", "free"}) {
+    for (const PoseSet set : {PoseSet::kFacesAnd45, PoseSet::kFree}) {
       PlanRequest request = Request(target);
       request.pose_set = set;
       // Long enough for the twelve positions to meet the last target.
@@ -143,10 +143,12 @@ TEST(Plan, MeetsTargetsAndNeverTakesLongerThanTheSeedsTwelvePositions) {
       const SchemeComparison& twelve = plan.schemes[0];
       ASSERT_EQ(twelve.name, "twelve");
       ASSERT_TRUE(twelve.meets_targets) << target;
-      EXPECT_LE(plan.total_seconds, twelve.total_seconds * (1 + 1e-9)) << target << " " << set;
+      EXPECT_LE(plan.total_seconds, twelve.total_seconds * (1 + 1e-9))
+          << target << " " << ToString(set);
       if (plan.total_seconds < 0.95 * twelve.total_seconds) strictly_less = true;
-      std::printf("%-70s %-9s plan %2zu poses %7.1f s | twelve hold %6.1f s %7.1f s\n", target, set,
-                  plan.poses.size(), plan.total_seconds, twelve.hold_seconds, twelve.total_seconds);
+      std::printf("%-70s %-9s plan %2zu poses %7.1f s | twelve hold %6.1f s %7.1f s\n", target,
+                  ToString(set), plan.poses.size(), plan.total_seconds, twelve.hold_seconds,
+                  twelve.total_seconds);
     }
   }
   EXPECT_TRUE(strictly_less);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gravcal/estimation/spectral_lines.h"
+#include "gravcal/workflows/config.h"
 #include "sigma_check.h"
 #include "test_util.h"
 
@@ -82,11 +83,15 @@ TEST(Simulator, DifferentSeedsDiffer) {
 TEST(Simulator, SchemesGiveTheirPoseCounts) {
   const std::vector<std::pair<std::string, size_t>> schemes = {
       {"six", 6}, {"twelve", 12}, {"ten", 10}, {"random:1", 1}, {"random:7", 7}};
-  for (const auto& [scheme, count] : schemes) {
+  for (const auto& [text, count] : schemes) {
+    const std::string& scheme = text;
+    SimulatorScheme parsed;
     std::vector<Eigen::Quaterniond> attitudes;
     std::vector<int> up;
     std::string error;
-    ASSERT_TRUE(SchemeAttitudes(scheme, 3, &attitudes, &up, &error)) << error;
+    ASSERT_TRUE(ParseSimulatorScheme(text, &parsed, &error)) << error;
+    EXPECT_EQ(ToString(parsed), text);
+    ASSERT_TRUE(SchemeAttitudes(parsed, 3, &attitudes, &up, &error)) << error;
     EXPECT_EQ(attitudes.size(), count) << scheme;
     ASSERT_EQ(up.size(), count) << scheme;
     for (size_t k = 0; k < count; ++k) {
@@ -98,7 +103,7 @@ TEST(Simulator, SchemesGiveTheirPoseCounts) {
       }
     }
     SimulatorOptions options;
-    options.scheme = scheme;
+    options.scheme = parsed;
     options.hold_seconds = 2.0;
     options.initial_still_seconds = 1.0;
     options.rotation_seconds = 1.0;
@@ -121,7 +126,7 @@ TEST(Simulator, SchemesGiveTheirPoseCounts) {
   // with no axis up, all well apart; ten has six axis-up poses.
   std::vector<Eigen::Quaterniond> attitudes;
   std::vector<int> up;
-  ASSERT_TRUE(SchemeAttitudes("twelve", 0, &attitudes, &up, nullptr));
+  ASSERT_TRUE(SchemeAttitudes({PoseScheme::kTwelve}, 0, &attitudes, &up, nullptr));
   for (int k = 0; k < 12; ++k) EXPECT_EQ(up[k], k < 6 ? k : -1);
   for (size_t a = 0; a < attitudes.size(); ++a) {
     for (size_t b = a + 1; b < attitudes.size(); ++b) {
@@ -130,7 +135,7 @@ TEST(Simulator, SchemesGiveTheirPoseCounts) {
       EXPECT_GT(AngleBetween(ua, ub), 40.0 * M_PI / 180.0) << a << " " << b;
     }
   }
-  ASSERT_TRUE(SchemeAttitudes("ten", 0, &attitudes, &up, nullptr));
+  ASSERT_TRUE(SchemeAttitudes({PoseScheme::kTen}, 0, &attitudes, &up, nullptr));
   int with_axis = 0;
   for (int u : up) with_axis += u >= 0;
   EXPECT_EQ(with_axis, 6);
@@ -179,7 +184,7 @@ TEST(Simulator, TremorStaysWithinItsRms) {
 
 TEST(Simulator, RawCountsAreIntegers) {
   SimulatorOptions options;
-  options.scheme = "six";
+  options.scheme = {PoseScheme::kSix};
   const SimulatedSession counts = MustSimulate(options, 11);
   EXPECT_NEAR(counts.accel_units_per_si, 16384.0 / 9.80665, 1e-9);
   EXPECT_NEAR(counts.gyro_units_per_si, 131.0 * 180.0 / M_PI, 1e-9);
@@ -315,7 +320,10 @@ TEST(Simulator, BiasRandomWalkMovesTheBias) {
 TEST(Simulator, RejectsInvalidOptions) {
   using Setter = void (*)(SimulatorOptions*);
   const std::vector<std::pair<std::string, Setter>> cases = {
-      {"scheme", [](SimulatorOptions* o) { o->scheme = "random:0"; }},
+      {"scheme",
+       [](SimulatorOptions* o) {
+         o->scheme = {PoseScheme::kRandom, 0};
+       }},
       {"hold_seconds", [](SimulatorOptions* o) { o->hold_seconds = 0.001; }},
       {"initial_still_seconds", [](SimulatorOptions* o) { o->initial_still_seconds = -1.0; }},
       {"rotation_seconds", [](SimulatorOptions* o) { o->rotation_seconds = 0.0; }},
@@ -356,7 +364,7 @@ TEST(Simulator, RejectsInvalidOptions) {
   }
   // A session of more than 1e8 samples is refused, not allocated.
   SimulatorOptions huge;
-  huge.scheme = "random:100000";
+  huge.scheme = {PoseScheme::kRandom, 100000};
   huge.sample_rate = 1000.0;
   EXPECT_FALSE(huge.IsValid(&error));
   EXPECT_NE(error.find("samples"), std::string::npos) << error;
@@ -372,23 +380,33 @@ TEST(Simulator, RejectsUnknownScheme) {
   std::vector<Eigen::Quaterniond> attitudes;
   std::vector<int> up;
   std::string error;
-  EXPECT_FALSE(SchemeAttitudes("seven", 0, &attitudes, &up, &error));
-  EXPECT_EQ(error, "unknown scheme 'seven' (expected six, twelve, ten or random:N)");
-  for (const std::string bad : {"random:", "random:x", "random:-3", "random:0", "Six", ""}) {
-    EXPECT_FALSE(SchemeAttitudes(bad, 0, &attitudes, &up, &error)) << bad;
+  SimulatorScheme scheme;
+  EXPECT_FALSE(ParseSimulatorScheme("seven", &scheme, &error));
+  EXPECT_EQ(error, "'seven' is not one of six, twelve, ten or random:N");
+  for (const std::string bad :
+       {"random:", "random:x", "random:-3", "random:0", "Six", "", "six:3"}) {
+    EXPECT_FALSE(ParseSimulatorScheme(bad, &scheme, &error)) << bad;
     EXPECT_NE(error.find("'" + bad + "'"), std::string::npos) << error;
   }
+  // The config key names itself and the accepted values.
+  Config config;
+  EXPECT_FALSE(SetConfigValue("sim_scheme", "bogus", &config, &error));
+  EXPECT_EQ(error, "key 'sim_scheme': 'bogus' is not one of six, twelve, ten or random:N");
+  ASSERT_TRUE(SetConfigValue("sim_scheme", "random:5", &config, &error)) << error;
+  EXPECT_EQ(ConfigValueText(config, "sim_scheme"), "random:5");
+  // A count out of range set in code is refused by the simulator.
   SimulatorOptions options;
-  options.scheme = "bogus";
+  options.scheme = {PoseScheme::kRandom, 0};
+  EXPECT_FALSE(SchemeAttitudes(options.scheme, 0, &attitudes, &up, &error));
   SimulatedSession session;
   EXPECT_FALSE(Simulate(options, 1, &session, &error));
-  EXPECT_NE(error.find("unknown scheme 'bogus'"), std::string::npos) << error;
+  EXPECT_NE(error.find("random:0"), std::string::npos) << error;
   EXPECT_FALSE(Simulate(SimulatorOptions(), 1, nullptr, &error));
 }
 
 TEST(Simulator, TruthJsonHoldsTheTruth) {
   SimulatorOptions options;
-  options.scheme = "ten";
+  options.scheme = {PoseScheme::kTen};
   const SimulatedSession session = MustSimulate(options, 17);
   const nlohmann::json j = nlohmann::json::parse(TruthToJson(session, options));
   EXPECT_EQ(j["seed"].get<uint64_t>(), 17u);
@@ -454,7 +472,7 @@ TEST(Simulator, TruthJsonHoldsTheTruth) {
 // number of the session changes (the tone draws nothing).
 TEST(Simulator, GyroToneIsALineOnOneAxisAndChangesNothingElse) {
   SimulatorOptions options;
-  options.scheme = "six";
+  options.scheme = {PoseScheme::kSix};
   options.raw_counts = false;
   options.initial_still_seconds = 60.0;
   const SimulatedSession plain = MustSimulate(options, 5);

@@ -65,7 +65,7 @@ testing_util::SigmaCheck RollPitchConsistency(const SimulatorOptions& sim,
 
 SimulatorOptions TenPoseSession() {
   SimulatorOptions sim;
-  sim.scheme = "ten";
+  sim.scheme = {PoseScheme::kTen};
   sim.hold_seconds = 8.0;
   sim.initial_still_seconds = 0.0;
   sim.rotation_seconds = 1.0;
@@ -136,7 +136,7 @@ TEST(StaticAlignment, ReportsSigmaOfTheBiasPrior) {
 StaticAlignmentResult NavigationGradeAlignment(double accel_bias, double hold_seconds, int seed,
                                                Eigen::Vector3d* truth) {
   SimulatorOptions sim = TenPoseSession();
-  sim.scheme = "six";
+  sim.scheme = {PoseScheme::kSix};
   sim.hold_seconds = hold_seconds;
   sim.raw_counts = false;
   sim.latitude_deg = 45.0;

@@ -22,7 +22,7 @@ namespace {
 
 SimulatorOptions TenPositions() {
   SimulatorOptions sim;
-  sim.scheme = "ten";
+  sim.scheme = {PoseScheme::kTen};
   sim.hold_seconds = 8.0;
   sim.initial_still_seconds = 2.0;
   sim.rotation_seconds = 2.0;
@@ -43,7 +43,7 @@ TEST(TenPosition, SchemeHasTenDifferentRollPitchPoses) {
   std::vector<Eigen::Quaterniond> attitudes;
   std::vector<int> up;
   std::string error;
-  ASSERT_TRUE(SchemeAttitudes("ten", 1, &attitudes, &up, &error)) << error;
+  ASSERT_TRUE(SchemeAttitudes({PoseScheme::kTen}, 1, &attitudes, &up, &error)) << error;
   ASSERT_EQ(attitudes.size(), 10u);
   // Ten different gravity directions in the body frame, not all in a plane.
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
@@ -147,7 +147,7 @@ TEST(TenPosition, RealMpu6050TenPoses) {
 
 TEST(TenPosition, RejectsTooFewPositions) {
   SimulatorOptions sim = TenPositions();
-  sim.scheme = "random:4";
+  sim.scheme = {PoseScheme::kRandom, 4};
   SimulatedSession s;
   std::string error;
   ASSERT_TRUE(Simulate(sim, 1, &s, &error)) << error;

@@ -191,7 +191,7 @@ inline int AllowedSuccesses(int n, double p, double alpha = kCountFailureProbabi
 // proportional: the session in which hidden effects are looked for.
 inline SimulatorOptions WarmUpSession() {
   SimulatorOptions o;
-  o.scheme = "random:24";
+  o.scheme = {PoseScheme::kRandom, 24};
   o.hold_seconds = 10.0;
   o.initial_still_seconds = 5.0;
   o.rotation_seconds = 2.0;

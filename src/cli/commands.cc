@@ -78,8 +78,9 @@ int RunDemo(const DemoArgs& args) {
   Calibration c;
   const bool ok = CalibrateAccelerometer(session.log, options, &c);
   std::printf("gravcal demo: simulated '%s' session, seed %llu, %zu samples at %.0f Hz, raw %s\n",
-              args.config.simulation.scheme.c_str(), static_cast<unsigned long long>(args.seed),
-              session.log.size(), args.config.simulation.sample_rate,
+              ToString(args.config.simulation.scheme).c_str(),
+              static_cast<unsigned long long>(args.seed), session.log.size(),
+              args.config.simulation.sample_rate,
               args.config.simulation.raw_counts ? "counts" : "m/s^2");
   std::printf("detected %zu static positions; %s\n\n", c.positions.size(), c.message.c_str());
   PrintWarnings(c);

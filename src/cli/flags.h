@@ -54,7 +54,7 @@
   X(string, target, "",                                                                          \
     "plan, check: targets, e.g. \"accel_bias=0.5mg accel_scale=50ppm "                           \
     "accel_misalignment=0.1mrad\" (or parameter names bias_x ... u_zz)")                         \
-  X(string, pose_set, gravcal::PlanRequest().pose_set,                                           \
+  X(string, pose_set, gravcal::ToString(gravcal::PlanRequest().pose_set),                        \
     "plan, check: candidate orientations: faces, faces+45 or free")                              \
   X(int32, candidates, gravcal::PlanRequest().free_candidates,                                   \
     "plan, check: directions of the free pose set (besides faces+45)")                           \
@@ -147,27 +147,43 @@ void ParseFlagText(const std::string& text, int* value);
 void ParseFlagText(const std::string& text, uint64_t* value);
 void ParseFlagText(const std::string& text, double* value);
 
+// Text to the value of flag `name`; an enum by its one string table
+// (core/types.h ParseName): false with a one-line error naming the flag and
+// the accepted names.
+template <typename T>
+bool SetFlagValue(const char* name, const std::string& text, T* value, std::string* error) {
+  if constexpr (std::is_enum_v<T>) {
+    return ParseName(name, text, value, error);
+  } else {
+    ParseFlagText(text, value);
+    return true;
+  }
+}
+
 // A command's use of one flag: its name, and where its value goes in the
-// command's args struct.
+// command's args struct (false with a one-line error on a bad value).
 template <typename Args>
 struct FlagBinding {
   const char* name;
-  std::function<void(const std::string& text, Args* args)> set;
+  std::function<bool(const std::string& text, Args* args, std::string* error)> set;
 };
 
 // The flag `name` into the field `field` of Args (or of its base).
 template <typename Args, typename Class, typename T>
 FlagBinding<Args> FlagField(const char* name, T Class::*field) {
   static_assert(std::is_base_of_v<Class, Args>, "the field is not one of the args struct");
-  return {name,
-          [field](const std::string& text, Args* args) { ParseFlagText(text, &(args->*field)); }};
+  return {name, [name, field](const std::string& text, Args* args, std::string* error) {
+            return SetFlagValue(name, text, &(args->*field), error);
+          }};
 }
 
 // The flag `name` into the field that `at` returns a pointer to (a field of
 // a nested struct: &args->request.targets).
 template <typename Args, typename At>
 FlagBinding<Args> FlagAt(const char* name, At at) {
-  return {name, [at](const std::string& text, Args* args) { ParseFlagText(text, at(args)); }};
+  return {name, [name, at](const std::string& text, Args* args, std::string* error) {
+            return SetFlagValue(name, text, at(args), error);
+          }};
 }
 
 }  // namespace cli

@@ -51,8 +51,10 @@ CommandInfo Command(const char* name, const char* summary, std::vector<FlagBindi
   info.run = [bindings, run](CommonArgs common) {
     Args args;
     static_cast<CommonArgs&>(args) = std::move(common);
-    for (const FlagBinding<Args>& b : bindings) b.set(FlagText(b.name), &args);
     std::string error;
+    for (const FlagBinding<Args>& b : bindings) {
+      if (!b.set(FlagText(b.name), &args, &error)) return Fail(error);
+    }
     if (!CheckCommandDestinations(args, &error)) return Fail(error);
     return run(args);
   };
@@ -72,13 +74,8 @@ FlagBinding<Args> StoredFlag(const char* name, T StoredCalibrationArgs::*field) 
 }
 
 // The flags of plan and check that fill the plan request.
-FlagBinding<PlanArgs> RequestFlag(const char* name, std::string gravcal::PlanRequest::*field) {
-  return FlagAt<PlanArgs>(name, [field](PlanArgs* a) { return &(a->request.*field); });
-}
-FlagBinding<PlanArgs> RequestFlag(const char* name, double gravcal::PlanRequest::*field) {
-  return FlagAt<PlanArgs>(name, [field](PlanArgs* a) { return &(a->request.*field); });
-}
-FlagBinding<PlanArgs> RequestFlag(const char* name, int gravcal::PlanRequest::*field) {
+template <typename T>
+FlagBinding<PlanArgs> RequestFlag(const char* name, T gravcal::PlanRequest::*field) {
   return FlagAt<PlanArgs>(name, [field](PlanArgs* a) { return &(a->request.*field); });
 }
 

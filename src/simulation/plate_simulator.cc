@@ -85,7 +85,7 @@ bool SimulatePlateImpl(const PlateSimulatorOptions& options, uint64_t seed, Simu
     truth.name = "imu" + std::to_string(i);
     // The sensor: the simulator's random truth of its own seed.
     SimulatorOptions small = options.imu;
-    small.scheme = ToString(PoseScheme::kSix);
+    small.scheme = {PoseScheme::kSix};
     small.planned_poses.clear();
     small.hold_seconds = small.initial_still_seconds = 1.0;
     small.rotation_seconds = 1.0;

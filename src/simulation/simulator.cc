@@ -385,8 +385,8 @@ bool SimulateImpl(const SimulatorOptions& options, uint64_t seed, SimulatedSessi
   if (!PlanTimeline(options, seed, nominal.hold_seconds, &plan, error)) return false;
 
   ImuLog& log = s.log;
-  log.source = "simulated " + (options.planned_poses.empty() ? options.scheme : "plan") + " seed " +
-               std::to_string(seed);
+  log.source = "simulated " + (options.planned_poses.empty() ? ToString(options.scheme) : "plan") +
+               " seed " + std::to_string(seed);
   log.t.resize(plan.total);
   log.accel.resize(plan.total);
   log.gyro.resize(plan.total);

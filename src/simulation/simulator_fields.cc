@@ -8,7 +8,7 @@ const std::vector<SimulatorField>& SimulatorFields() {
   // Never destroyed (Google style for static storage).
   static const std::vector<SimulatorField>& fields = *new std::vector<SimulatorField>([] {
     std::vector<SimulatorField> rows = {
-        {"sim_scheme", "scheme", "six, twelve, ten or random:N", &SimulatorOptions::scheme},
+        {"sim_scheme", "scheme", AcceptedNames(PoseScheme()), &SimulatorOptions::scheme},
         {"sim_hold", "hold_seconds", "hold per pose, s", &SimulatorOptions::hold_seconds},
         {"sim_initial_still", "initial_still_seconds", "initial still period, s",
          &SimulatorOptions::initial_still_seconds},

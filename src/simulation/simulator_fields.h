@@ -22,11 +22,11 @@ struct SimulatorField {
   const char* key;
   // The name in truth.json's "options", e.g. "hold_seconds" (the member's).
   const char* name;
-  const char* help;
+  std::string help;
   // The member, or the effect whose spread (SimulatorOptions::effect_std)
   // it is.
   std::variant<double SimulatorOptions::*, bool SimulatorOptions::*,
-               std::string SimulatorOptions::*, Effect>
+               std::string SimulatorOptions::*, SimulatorScheme SimulatorOptions::*, Effect>
       member;
 };
 

@@ -17,37 +17,6 @@ namespace {
 // Limit that keeps a typo from asking for gigabytes of poses.
 constexpr long kMaxRandomPoses = 100000;
 
-// Parses "six", "twelve", "ten" or "random:N" by the one table of
-// PoseScheme (core/types.h).
-bool ParseScheme(const std::string& scheme, PoseScheme* kind, long* count, std::string* error) {
-  auto fail = [&](const std::string& what) {
-    if (error) *error = what;
-    return false;
-  };
-  const size_t colon = scheme.find(':');
-  if (!FromString(scheme.substr(0, colon), kind) ||
-      (colon != std::string::npos) != (*kind == PoseScheme::kRandom)) {
-    return fail("unknown scheme '" + scheme + "' (expected " + AcceptedNames(PoseScheme()) + ")");
-  }
-  constexpr long kFixed[] = {6, 12, 10};
-  if (*kind != PoseScheme::kRandom) {
-    *count = kFixed[static_cast<int>(*kind)];
-    return true;
-  }
-  const std::string digits = scheme.substr(colon + 1);
-  bool ok = !digits.empty() && digits.size() <= 9;
-  for (char c : digits) ok = ok && c >= '0' && c <= '9';
-  const long n = ok ? std::stol(digits) : 0;
-  if (n < 1 || n > kMaxRandomPoses) {
-    std::ostringstream msg;
-    msg << "scheme '" << scheme << "': N in random:N must be an integer from 1 to "
-        << kMaxRandomPoses;
-    return fail(msg.str());
-  }
-  *count = n;
-  return true;
-}
-
 // Body-to-navigation attitude from roll (about x) then pitch (about y), zero
 // heading: C_bn = R_y(pitch) R_x(roll), so gravity in the body frame reads
 // g (-sin(pitch), sin(roll) cos(pitch), cos(roll) cos(pitch)).
@@ -71,11 +40,6 @@ Eigen::Quaterniond UniformRotation(std::mt19937_64* rng) {
 }
 
 }  // namespace
-
-bool SchemePoseCount(const std::string& scheme, long* count, std::string* error) {
-  PoseScheme kind;
-  return ParseScheme(scheme, &kind, count, error);
-}
 
 Eigen::Quaterniond UpToZenith(const Eigen::Vector3d& up) {
   const Eigen::Vector3d u = up.normalized();
@@ -126,16 +90,72 @@ bool MakeNominalPoses(const SimulatorOptions& options, uint64_t seed, NominalPos
 
 using internal::AxisAngle;
 
-bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
+bool SimulatorScheme::PoseCount(long* count, std::string* error) const {
+  constexpr long kFixed[] = {6, 12, 10};
+  switch (kind) {
+    case PoseScheme::kSix:
+    case PoseScheme::kTwelve:
+    case PoseScheme::kTen:
+      *count = kFixed[static_cast<int>(kind)];
+      return true;
+    case PoseScheme::kRandom:
+      if (random_poses < 1 || random_poses > internal::kMaxRandomPoses) {
+        if (error) {
+          *error = "random:" + std::to_string(random_poses) +
+                   ": N in random:N must be an integer from 1 to " +
+                   std::to_string(internal::kMaxRandomPoses);
+        }
+        return false;
+      }
+      *count = random_poses;
+      return true;
+  }
+  if (error) *error = "not one of " + AcceptedNames(PoseScheme());
+  return false;
+}
+
+std::string ToString(const SimulatorScheme& scheme) {
+  const std::string name = ToString(scheme.kind);
+  return scheme.kind == PoseScheme::kRandom ? name + ":" + std::to_string(scheme.random_poses)
+                                            : name;
+}
+
+bool ParseSimulatorScheme(const std::string& text, SimulatorScheme* scheme, std::string* error) {
+  const size_t colon = text.find(':');
+  SimulatorScheme parsed;
+  if (!FromString(text.substr(0, colon), &parsed.kind) ||
+      (colon != std::string::npos) != (parsed.kind == PoseScheme::kRandom)) {
+    if (error) *error = "'" + text + "' is not one of " + AcceptedNames(PoseScheme());
+    return false;
+  }
+  if (parsed.kind == PoseScheme::kRandom) {
+    const std::string digits = text.substr(colon + 1);
+    bool ok = !digits.empty() && digits.size() <= 9;
+    for (char c : digits) ok = ok && c >= '0' && c <= '9';
+    parsed.random_poses = ok ? std::stol(digits) : 0;
+  }
+  long count = 0;
+  if (!parsed.PoseCount(&count, nullptr)) {
+    if (error) {
+      *error = "'" + text + "': N in random:N must be an integer from 1 to " +
+               std::to_string(internal::kMaxRandomPoses);
+    }
+    return false;
+  }
+  *scheme = parsed;
+  return true;
+}
+
+bool SchemeAttitudes(const SimulatorScheme& scheme, uint64_t seed,
                      std::vector<Eigen::Quaterniond>* attitudes, std::vector<int>* nominal_up,
                      std::string* error) {
   if (attitudes == nullptr || nominal_up == nullptr) {
     if (error) *error = "SchemeAttitudes: null output";
     return false;
   }
-  PoseScheme kind;
   long count = 0;
-  if (!internal::ParseScheme(scheme, &kind, &count, error)) return false;
+  if (!scheme.PoseCount(&count, error)) return false;
+  const PoseScheme kind = scheme.kind;
   attitudes->clear();
   nominal_up->clear();
   const Eigen::Vector3d x = Eigen::Vector3d::UnitX();

@@ -17,10 +17,6 @@
 namespace gravcal {
 namespace internal {
 
-// The number of poses of `scheme`; false with `error` saying what a scheme
-// is when it is not one.
-bool SchemePoseCount(const std::string& scheme, long* count, std::string* error);
-
 // The smallest rotation taking the body direction `up` to navigation z (half
 // a turn about body x when up points straight down).
 Eigen::Quaterniond UpToZenith(const Eigen::Vector3d& up);

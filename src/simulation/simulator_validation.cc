@@ -66,7 +66,7 @@ class FieldCheck {
 // Scheme, rates, durations and units.
 bool CheckTiming(const SimulatorOptions& o, const FieldCheck& c, long* pose_count) {
   std::string scheme_error;
-  if (!internal::SchemePoseCount(o.scheme, pose_count, &scheme_error)) {
+  if (!o.scheme.PoseCount(pose_count, &scheme_error)) {
     c.Say("SimulatorOptions.scheme: " + scheme_error);
     return false;
   }

@@ -28,7 +28,10 @@ ConfigSection Lift(const SectionOf<Part>& section) {
     whole.keys.push_back(
         {h.name, h.help,
          [set = h.set](const YAML::Node& n, Config* c, std::string* e) { return set(n, c, e); },
-         [get = h.get](const Config& c) { return get(c); }});
+         [get = h.get](const Config& c) { return get(c); },
+         [fields = h.fields](const Config& c) {
+           return fields ? fields(c) : std::vector<const void*>();
+         }});
   }
   return whole;
 }
@@ -60,13 +63,7 @@ const std::vector<ConfigSection>& ConfigSections() {
   return sections;
 }
 
-}  // namespace internal
-
 namespace {
-
-using internal::ConfigKeyHandler;
-using internal::ConfigSection;
-using internal::ConfigSections;
 
 const ConfigKeyHandler* FindHandler(const std::string& name) {
   for (const ConfigSection& section : ConfigSections()) {
@@ -76,6 +73,22 @@ const ConfigKeyHandler* FindHandler(const std::string& name) {
   }
   return nullptr;
 }
+
+}  // namespace
+
+std::vector<const void*> ConfigKeyFields(const Config& config, const std::string& name) {
+  const ConfigKeyHandler* h = FindHandler(name);
+  return h == nullptr ? std::vector<const void*>() : h->fields(config);
+}
+
+}  // namespace internal
+
+namespace {
+
+using internal::ConfigKeyHandler;
+using internal::ConfigSection;
+using internal::ConfigSections;
+using internal::FindHandler;
 
 bool SetNode(const std::string& key, const YAML::Node& node, Config* config, std::string* error) {
   const ConfigKeyHandler* h = FindHandler(key);
@@ -258,11 +271,6 @@ bool Config::IsValid(std::string* error) const {
   };
   if (!CheckConsistency(*this, reads, error)) return false;
   if (chosen->validate && !chosen->validate(*this, error)) return false;
-  MotionProfile profile;
-  if (!sim_motion.empty() && !ParseName("sim_motion", sim_motion, &profile, error)) {
-    *error += " (or empty)";
-    return false;
-  }
   if (!motion.IsValid(error)) return false;
   std::string what;
   if (!input.IsValid(&what)) {

@@ -77,10 +77,10 @@ bool RunCalibration(const Config& config, const SessionFiles& files, Session* se
     calibration->message = error;
     return false;
   }
-  // Detected once here; the method, the report and the check read it. A
-  // failed detection is the method's to report, at its own step.
-  const std::vector<std::string>& sections = method.sections;
-  if (std::find(sections.begin(), sections.end(), "detector") != sections.end()) {
+  // Detected once here (for a method whose options embed the detector); the
+  // method, the report and the check read it. A failed detection is the
+  // method's to report, at its own step.
+  if (method.reads(config, &config.calibration.detector)) {
     DetectSessionPoses(config.calibration.detector, session);
   }
   const bool ok = method.run(config, *session, calibration);

@@ -68,7 +68,8 @@ std::vector<int> TargetColumns(const std::string& name, const std::vector<std::s
 using internal::Join;
 
 // The sensor-frame up direction of each pose of a seed scheme.
-std::vector<Eigen::Vector3d> SchemeUps(const std::string& scheme) {
+std::vector<Eigen::Vector3d> SchemeUps(PoseScheme kind) {
+  const SimulatorScheme scheme{kind};
   std::vector<Eigen::Quaterniond> attitudes;
   std::vector<int> nominal_up;
   std::string error;
@@ -180,7 +181,7 @@ bool PlanRotations(const Config& config, const PlanRequest& request,
   for (const PlannedPose& p : out->poses) poses.push_back({p.up, p.hold_seconds});
   RotationDesignOptions rotation;
   rotation.targets = start.gyro_targets;
-  rotation.free_axes = request.Set() == PoseSet::kFree ? 12 : 0;
+  rotation.free_axes = request.pose_set == PoseSet::kFree ? 12 : 0;
   rotation.seconds_per_180 = request.turn_seconds;
   rotation.extra_hold_seconds = options.min_hold_seconds;
   rotation.max_extra_poses = std::max(0, options.max_poses - static_cast<int>(out->poses.size()));
@@ -230,15 +231,7 @@ bool PlanRotations(const Config& config, const PlanRequest& request,
 
 }  // namespace
 
-PoseSet PlanRequest::Set() const {
-  PoseSet set = PoseSet::kFacesAnd45;
-  FromString(pose_set, &set);
-  return set;
-}
-
 bool PlanRequest::IsValid(std::string* error) const {
-  PoseSet set;
-  if (!ParseName("pose_set", pose_set, &set, error)) return false;
   if (free_candidates < 1 || free_candidates > 100000) {
     *error = "candidates: 1 to 100000 free directions";
     return false;
@@ -466,13 +459,13 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   options.max_hold_seconds = std::max(request.max_hold_seconds, options.min_hold_seconds);
   options.max_poses =
       std::max(request.max_poses, static_cast<int>(names.size()) + options.redundancy);
-  const PoseSet pose_set = request.Set();
+  const PoseSet pose_set = request.pose_set;
   std::vector<Eigen::Vector3d> candidates;
   CandidateDirections(pose_set, request.free_candidates, &candidates);
   const std::vector<std::pair<std::string, std::vector<Eigen::Vector3d>>> schemes = {
-      {ToString(PoseScheme::kTwelve), SchemeUps(ToString(PoseScheme::kTwelve))},
-      {ToString(PoseScheme::kSix), SchemeUps(ToString(PoseScheme::kSix))},
-      {ToString(PoseScheme::kTen), SchemeUps(ToString(PoseScheme::kTen))}};
+      {ToString(PoseScheme::kTwelve), SchemeUps(PoseScheme::kTwelve)},
+      {ToString(PoseScheme::kSix), SchemeUps(PoseScheme::kSix)},
+      {ToString(PoseScheme::kTen), SchemeUps(PoseScheme::kTen)}};
   for (const auto& [name, ups] : schemes) {
     if (AllIn(ups, candidates)) options.reference_designs.push_back(ups);
   }
@@ -547,7 +540,7 @@ bool MakeRecordingPlan(const Config& config, const PlanRequest& request, Recordi
   out.overhead_seconds = request.overhead_seconds;
   out.total_seconds = design.total_seconds;
   out.meets_targets = design.meets_targets;
-  out.pose_set = request.pose_set;
+  out.pose_set = ToString(request.pose_set);
   out.criterion =
       "target-weighted A-optimal: minimise sum_i (sigma_i / target_i)^2 over the candidate "
       "orientations (greedy + Fedorov exchange), least total time (holds + overhead) with "

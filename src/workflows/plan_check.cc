@@ -154,7 +154,7 @@ bool CheckRecording(const Session& session, const Config& config, const PlanRequ
   }
   const double hold = std::max(Median(holds) + model.trimmed_seconds, request.min_hold_seconds);
   std::vector<Eigen::Vector3d> candidates;
-  CandidateDirections(request.Set(), request.free_candidates, &candidates);
+  CandidateDirections(request.pose_set, request.free_candidates, &candidates);
   std::vector<DesignPose> candidate_poses;
   for (const Eigen::Vector3d& c : candidates) candidate_poses.push_back({c, hold});
   const Eigen::MatrixXd rows = DesignJacobian(candidate_poses, model, noise);

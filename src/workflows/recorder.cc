@@ -117,9 +117,7 @@ bool Recorder::Start(const Config& config, const RecorderOptions& options, std::
     if (!PlanDesignNoise(options.request, &s.noise, &source, error)) return false;
   }
   s.noise.pose_disturbance = options.request.pose_disturbance;
-  PoseSet pose_set;
-  if (!ParseName("pose_set", options.request.pose_set, &pose_set, error)) return false;
-  CandidateDirections(pose_set, options.request.free_candidates, &s.candidates);
+  CandidateDirections(options.request.pose_set, options.request.free_candidates, &s.candidates);
   s.p = static_cast<Eigen::Index>(s.start.names.size());
   s.weight = s.start.targets.cwiseInverse().cwiseAbs2();
   s.prior = (s.weight / (options.prior_factor * options.prior_factor)).asDiagonal();

@@ -60,9 +60,9 @@ bool SimulateFromConfig(const Config& config, const SimulationRequest& request,
     files->segments_csv.clear();
     return true;
   }
-  if (!config.sim_motion.empty()) {
+  if (config.sim_motion) {
     MotionOptions motion = config.motion;
-    FromString(config.sim_motion, &motion.profile);
+    motion.profile = *config.sim_motion;
     MotionSession moving;
     if (!SimulateMotion(sim, motion, request.seed, &moving, error)) return false;
     files->segments = std::move(moving.segments);

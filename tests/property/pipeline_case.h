@@ -44,12 +44,9 @@ inline Config ShippedConfig(const std::string& file,
 // the multi-position one otherwise.
 inline bool SimulateAsCli(const Config& config, uint64_t seed, SimulatedInput* input,
                           std::string* error) {
-  if (config.sim_motion.empty()) return Simulate(config.simulation, seed, &input->session, error);
+  if (!config.sim_motion) return Simulate(config.simulation, seed, &input->session, error);
   MotionOptions motion = config.motion;
-  if (!FromString(config.sim_motion, &motion.profile)) {
-    *error = "unknown sim_motion " + config.sim_motion;
-    return false;
-  }
+  motion.profile = *config.sim_motion;
   MotionSession moving;
   if (!SimulateMotion(config.simulation, motion, seed, &moving, error)) return false;
   input->session = std::move(moving.sensor);

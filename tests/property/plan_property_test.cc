@@ -104,7 +104,7 @@ void CheckPlanSpread(const std::string& target, const std::string& pose_set) {
   config.calibration.nominal_scale = kStandardGravity / config.simulation.accel_counts_per_g;
   PlanRequest request;
   request.targets = target;
-  request.pose_set = pose_set;
+  ASSERT_TRUE(FromString(pose_set, &request.pose_set)) << pose_set;
   // The simulator's white noise: sim_accel_noise per sample at sim_sample_rate.
   request.accel_noise_density =
       config.simulation.accel_noise / std::sqrt(config.simulation.sample_rate);
@@ -148,7 +148,7 @@ void CheckGyroPlanSpread(const std::string& target, const std::string& pose_set)
   config.ten_position.gyro_nominal_scale = M_PI / 180.0 / config.simulation.gyro_counts_per_dps;
   PlanRequest request;
   request.targets = target;
-  request.pose_set = pose_set;
+  ASSERT_TRUE(FromString(pose_set, &request.pose_set)) << pose_set;
   request.accel_noise_density =
       config.simulation.accel_noise / std::sqrt(config.simulation.sample_rate);
   request.gyro_noise_density =

@@ -56,10 +56,29 @@ struct EffectSpreads {
   double operator[](Effect e) const { return values[static_cast<int>(e)]; }
 };
 
+// The poses of a simulated multi-position session: six, twelve (the seed's
+// six faces plus six 45-degree poses), ten (ten poses of differing roll and
+// pitch), or random with random_poses uniformly drawn attitudes (1 to
+// 100000). Written as PoseScheme's name from its one table, with ":N" for
+// random ("twelve", "random:24"): the value of sim_scheme and of
+// truth.json's "scheme".
+struct SimulatorScheme {
+  PoseScheme kind = PoseScheme::kTwelve;
+  // kRandom only.
+  long random_poses = 0;
+
+  // The number of poses; false with `error` saying what is wrong (a random
+  // count out of range, a kind outside the enum).
+  bool PoseCount(long* count, std::string* error) const;
+};
+// "six", "twelve", "ten", "random:N".
+std::string ToString(const SimulatorScheme& scheme);
+// Parses that text; false with a one-line `error` giving the text and the
+// accepted forms ("'x' is not one of six, twelve, ten or random:N").
+bool ParseSimulatorScheme(const std::string& text, SimulatorScheme* scheme, std::string* error);
+
 struct SimulatorOptions {
-  // "six", "twelve" (the seed's six faces plus six 45-degree poses), "ten"
-  // (ten poses of differing roll and pitch), or "random:N".
-  std::string scheme = "twelve";
+  SimulatorScheme scheme;
   // Issue 15: when not empty, these poses in this order, each held its own
   // time, replace `scheme` and `hold_seconds`.
   std::vector<PlannedHold> planned_poses;
@@ -207,8 +226,9 @@ struct SimulatedSession {
 };
 
 // Nominal orientations (body-to-navigation) of a scheme, and the nominal up
-// axis of each (-1 where none points up). Returns false for an unknown scheme.
-bool SchemeAttitudes(const std::string& scheme, uint64_t seed,
+// axis of each (-1 where none points up). Returns false for a scheme whose
+// PoseCount fails.
+bool SchemeAttitudes(const SimulatorScheme& scheme, uint64_t seed,
                      std::vector<Eigen::Quaterniond>* attitudes, std::vector<int>* nominal_up,
                      std::string* error);
 

@@ -1,12 +1,16 @@
 // gravcal/workflows/method_registry.h: the one list of calibration methods a
 // config's `method:` can name.
 //
-// Each entry gives the method's name, a one-line help, the config sections
-// and single keys it reads (beyond the general and input sections every
-// method reads), the side input it needs, and its run function. The help of
-// the `method` key, Config::IsValid and RunCalibration all come from this
-// list, so a new method is its own file(s) in src/methods, its options
-// section in src/workflows/config/, and one entry in method_registry.cc.
+// Each entry gives the method's name, a one-line help, the side input it
+// needs, and where each part of its options struct is copied from in the
+// Config. That one list fills the options the method runs with and says
+// which keys it reads (beyond the general and input sections every method
+// reads): a key is read when a field it sets is copied into the options, so
+// a key the method's options do not embed is refused, and no list of key
+// names is kept by hand. The help of the `method` key, Config::IsValid and
+// RunCalibration all come from this list, so a new method is its own
+// file(s) in src/methods, its options section in src/workflows/config/, and
+// one entry in method_registry.cc.
 //
 // Run functions take data already read and parsed (Session), never a path:
 // the pipeline (pipeline.h) reads the files.
@@ -38,10 +42,10 @@ struct CalibrationMethod {
   // ToString(id): the value of `method:`.
   std::string name;
   std::string help;
-  // Config sections (config.h, ConfigSectionUse::kSomeMethods) whose every
-  // key the method reads, and single keys of other sections it reads.
-  std::vector<std::string> sections;
-  std::vector<std::string> keys;
+  // Whether the method's options are filled from the field at `field` of
+  // `config` (derived from the parts of the config its options are copied
+  // from); MethodReadsKey asks it of the fields a key sets.
+  std::function<bool(const Config& config, const void* field)> reads;
   MethodSideInput side_input = MethodSideInput::kNone;
   // Checks the options the method reads (beyond the shared ones);
   // nullptr = nothing more to check.
@@ -68,8 +72,9 @@ const CalibrationMethod* FindCalibrationMethod(Method method);
 std::string CalibrationMethodNames();
 // "twelve_position (one-line help), ten_position (...), ..." for help text.
 std::string CalibrationMethodsHelp();
-// Whether `method` reads `key`: every kAllMethods key, the keys of its
-// sections and its single keys; never a kCommand key.
+// Whether `method` reads `key`: every kAllMethods key, and a kSomeMethods
+// key when a field the key sets is copied into the method's options; never
+// a kCommand key.
 bool MethodReadsKey(const CalibrationMethod& method, const ConfigKey& key);
 
 }  // namespace gravcal

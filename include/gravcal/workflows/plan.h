@@ -36,9 +36,9 @@ struct PlanRequest {
   // (m_xx m_yy m_zz, or scale; ppm, %), gyro_misalignment (the other m_*;
   // mrad, urad, rad, deg), or gyro_<name> for one parameter (gyro_m_xy).
   std::string targets;
-  // The candidate poses: a PoseSet's name, faces, faces+45 or free
-  // (core/types.h, experiment_design.h); IsValid parses it, Set() gives it.
-  std::string pose_set = "faces+45";
+  // The candidate poses (core/types.h, experiment_design.h); written
+  // faces, faces+45 or free in flags, Python and plan.json.
+  PoseSet pose_set = PoseSet::kFacesAnd45;
   // Directions of the free set besides faces+45.
   int free_candidates = 500;
   // > 0: the total time may not exceed this, seconds.
@@ -73,9 +73,6 @@ struct PlanRequest {
   int extra_poses = 2;
 
   bool IsValid(std::string* error) const;
-  // The pose set named by pose_set (faces+45 when it names none: IsValid
-  // refuses that).
-  PoseSet Set() const;
 };
 
 // Parses `text` (above) into scale-free targets per parameter of `model`

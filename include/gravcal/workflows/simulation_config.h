@@ -6,8 +6,10 @@
 #ifndef GRAVCAL_WORKFLOWS_SIMULATION_CONFIG_H_
 #define GRAVCAL_WORKFLOWS_SIMULATION_CONFIG_H_
 
+#include <optional>
 #include <string>
 
+#include "gravcal/core/types.h"
 #include "gravcal/simulation/handheld_simulator.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/simulation/thermal_simulator.h"
@@ -18,10 +20,10 @@ struct SimulationConfig {
   // The multi-position simulator (sim_scheme and the other sim_* keys).
   SimulatorOptions simulation;
   // Issue 4: the motion simulator used when sim_motion names a profile
-  // (handheld, turntable, vertical, rate_table; empty = the multi-position
-  // scheme).
+  // (handheld, turntable, vertical, rate_table; none, written empty = the
+  // multi-position scheme). It replaces motion.profile.
   MotionOptions motion;
-  std::string sim_motion;
+  std::optional<MotionProfile> sim_motion;
   // Issue 35: the thermal simulator (thermal_simulator.h), used when
   // sim_thermal names a profile (soak_steps, warm_up, cool_down,
   // warm_up_poses, warm_cool_poses; empty = off).

@@ -96,9 +96,10 @@ SectionOf<CalibrationConfig> ModelSection() {
                        "scale (6), scale_misalignment (9, gauge-free) or affine (12)"),
           GRAVCAL_DOUBLE("axis_tolerance", calibration.coarse.axis_tolerance_deg,
                          "a position within this many degrees of an axis counts as axis-aligned"),
-          GRAVCAL_KEY("nominal_up",
-                      "up axis of each detected position, e.g. [+z, -z, +x, ?]; empty = automatic",
-                      ReadNominalUp(n, c, e), NominalUpText(c)),
+          GRAVCAL_KEY_AT("nominal_up",
+                         "up axis of each detected position, e.g. [+z, -z, +x, ?]; empty = "
+                         "automatic",
+                         ReadNominalUp(n, c, e), NominalUpText(c), &c.calibration.nominal_up),
           GRAVCAL_BOOL(
               "allow_undetermined", calibration.allow_undetermined,
               "write parameters the positions do not determine as null instead of failing"),

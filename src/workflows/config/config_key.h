@@ -18,14 +18,18 @@ namespace gravcal {
 namespace internal {
 
 // One key of a part of Config (Part: CalibrationConfig, SimulationConfig or
-// DiscoveryConfig, or the whole Config): how to set it from a YAML node and
-// how to print it as YAML.
+// DiscoveryConfig, or the whole Config): how to set it from a YAML node, how
+// to print it as YAML, and where in the part it is kept (the fields `set`
+// writes). A method reads a key when its options are filled from one of
+// those fields (method_registry.cc), so the fields are what ties a key to
+// the methods that read it; every key of a kSomeMethods section has them.
 template <typename Part>
 struct KeyHandlerOf {
   std::string name;
   std::string help;
   std::function<bool(const YAML::Node&, Part*, std::string*)> set;
   std::function<std::string(const Part&)> get;
+  std::function<std::vector<const void*>(const Part&)> fields;
 };
 
 // A group of keys, owned by one part: its handlers reach that part's
@@ -43,6 +47,10 @@ using ConfigSection = SectionOf<Config>;
 
 // The sections, in the order `gravcal help` lists them (config.cc).
 const std::vector<ConfigSection>& ConfigSections();
+
+// The fields of `config` that key `name` sets (KeyHandlerOf::fields); empty
+// for an unknown key or one that names none.
+std::vector<const void*> ConfigKeyFields(const Config& config, const std::string& name);
 
 // One function per section, in its file, by the part that owns it.
 // calibration (general_keys.cc, accelerometer_keys.cc, gyro_keys.cc,
@@ -99,10 +107,15 @@ inline bool ReadValue(const YAML::Node& n, bool* v, std::string* e) { return Rea
 inline bool ReadValue(const YAML::Node& n, std::string* v, std::string* e) {
   return ReadString(n, v, e);
 }
+inline bool ReadValue(const YAML::Node& n, SimulatorScheme* v, std::string* e) {
+  std::string text;
+  return ReadString(n, &text, e) && ParseSimulatorScheme(text, v, e);
+}
 inline std::string ValueText(double v) { return DoubleText(v); }
 inline std::string ValueText(int v) { return std::to_string(v); }
 inline std::string ValueText(bool v) { return v ? "true" : "false"; }
 inline std::string ValueText(const std::string& v) { return v.empty() ? "\"\"" : v; }
+inline std::string ValueText(const SimulatorScheme& v) { return ToString(v); }
 
 }  // namespace internal
 }  // namespace gravcal
@@ -110,21 +123,31 @@ inline std::string ValueText(const std::string& v) { return v.empty() ? "\"\"" :
 // Binders from a key name to a (nested) field of the section's part, e.g.
 // GRAVCAL_DOUBLE("window", calibration.detector.window_seconds, "help"); in
 // `read` and `print`, c is the part (a pointer in read), n the YAML node
-// and e the error.
+// and e the error. GRAVCAL_KEY_AT's last arguments are the addresses of the
+// fields `read` sets (&c.field, ...); GRAVCAL_KEY names none (for the keys of
+// commands, which no method reads).
+#define GRAVCAL_KEY_AT(name, help, read, print, ...)                               \
+  {                                                                                \
+    name, help, [](const YAML::Node& n, auto* c, std::string* e) { return read; }, \
+        [](const auto& c) { return print; },                                       \
+        [](const auto& c) { return std::vector<const void*>{__VA_ARGS__}; }        \
+  }
 #define GRAVCAL_KEY(name, help, read, print)                                       \
   {                                                                                \
     name, help, [](const YAML::Node& n, auto* c, std::string* e) { return read; }, \
-        [](const auto& c) { return print; }                                        \
+        [](const auto& c) { return print; },                                       \
+        [](const auto&) { return std::vector<const void*>(); }                     \
   }
 #define GRAVCAL_DOUBLE(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadDouble(n, &c->field, e), ValueText(c.field))
+  GRAVCAL_KEY_AT(name, help, ReadDouble(n, &c->field, e), ValueText(c.field), &c.field)
 #define GRAVCAL_INT(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadInt(n, &c->field, e), ValueText(c.field))
+  GRAVCAL_KEY_AT(name, help, ReadInt(n, &c->field, e), ValueText(c.field), &c.field)
 #define GRAVCAL_BOOL(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadBool(n, &c->field, e), ValueText(c.field))
+  GRAVCAL_KEY_AT(name, help, ReadBool(n, &c->field, e), ValueText(c.field), &c.field)
 #define GRAVCAL_STRING(name, field, help) \
-  GRAVCAL_KEY(name, help, ReadString(n, &c->field, e), ValueText(c.field))
-#define GRAVCAL_ENUM(name, field, choices, help) \
-  GRAVCAL_KEY(name, help, ReadEnum(n, &c->field, choices, e), std::string(ToString(c.field)))
+  GRAVCAL_KEY_AT(name, help, ReadString(n, &c->field, e), ValueText(c.field), &c.field)
+#define GRAVCAL_ENUM(name, field, choices, help)                                                 \
+  GRAVCAL_KEY_AT(name, help, ReadEnum(n, &c->field, choices, e), std::string(ToString(c.field)), \
+                 &c.field)
 
 #endif  // GRAVCAL_SRC_WORKFLOWS_CONFIG_CONFIG_KEY_H_

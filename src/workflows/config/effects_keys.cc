@@ -19,11 +19,11 @@ SectionOf<CalibrationConfig> EffectsSection() {
   return {"effects",
           ConfigSectionUse::kSomeMethods,
           {
-              GRAVCAL_KEY(
+              GRAVCAL_KEY_AT(
                   "effects",
                   "effects added to the model by name (catalogue: docs/methods.md section 6), e.g. "
                   "[accel_temperature_bias]",
-                  ReadEffects(n, &c->effects, e), ListText(EffectNames(c.effects))),
+                  ReadEffects(n, &c->effects, e), ListText(EffectNames(c.effects)), &c.effects),
           }};
 }
 

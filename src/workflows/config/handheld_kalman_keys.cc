@@ -51,11 +51,12 @@ SectionOf<CalibrationConfig> HandheldKalmanSection() {
           GRAVCAL_DOUBLE("hk_gyro_bias_std", handheld.gyro_bias_std, "prior gyroscope bias, rad/s"),
           GRAVCAL_DOUBLE("hk_gyro_scale_std", handheld.gyro_scale_std,
                          "prior gyroscope scale-factor error (fraction)"),
-          GRAVCAL_KEY(
+          GRAVCAL_KEY_AT(
               "hk_cross_axis",
               "also estimate cross-axis terms (accelerometer upper-triangular, gyroscope full)",
               ReadCrossAxis(n, c, e),
-              std::string(c.handheld.gyro_terms.matrix_entries.size() > 3 ? "true" : "false")),
+              std::string(c.handheld.gyro_terms.matrix_entries.size() > 3 ? "true" : "false"),
+              &c.handheld.accel_terms, &c.handheld.gyro_terms),
           GRAVCAL_DOUBLE("hk_cross_axis_std", handheld.cross_axis_std,
                          "prior cross-axis term (with hk_cross_axis), rad"),
           GRAVCAL_BOOL("hk_lever_arm", handheld.estimate_lever_arm,

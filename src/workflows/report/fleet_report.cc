@@ -12,7 +12,6 @@ namespace {
 
 using internal::FormatNumber;
 using internal::HtmlEscape;
-using internal::Plot;
 using internal::Rule;
 using internal::Series;
 using internal::SeriesStyle;
@@ -62,7 +61,7 @@ std::string Histogram(const ParameterStatistics& p, const std::vector<SummaryRow
                               static_cast<size_t>(std::max(0.0, std::floor((v - t.lo) / t.step))));
     if (!bars.y.empty()) bars.y[b] += 1;
   }
-  Plot plot;
+  internal::Plot plot;
   plot.title = p.name;
   plot.x.label = p.name + ", " + ColumnUnit(p.name);
   plot.y.label = "units";
