@@ -63,19 +63,26 @@ AllanFloor ReadAllanFloor(const AllanDeviation& curve, const std::vector<size_t>
       falls = falls || above(k, adev0);
       stops = stops || below(k, white);
     }
-    if (k > lowest) {
-      stops = stops || above(k, white);
-      floor.rises = floor.rises || above(k, adev0);
-    }
+    if (k > lowest) stops = stops || above(k, white);
+  }
+  // The curve rises when a later point, however few its clusters (a
+  // random walk's rise is steepest at the longest tau), lies significantly
+  // above the white-noise line through the lowest point: white noise alone
+  // keeps falling.
+  for (size_t k = lowest + 1; k < used.size(); ++k) {
+    floor.rises = floor.rises || above(k, adev0 * std::sqrt(tau0 / curve.points[used[k]].tau));
   }
   floor.lowest_tau = tau0;
   if (!falls || !stops) {
     why << "the curve shows no floor: its lowest point (tau " << tau0 << " s, Allan deviation "
-        << adev0 << ") "
-        << (!falls ? "is where it starts: it does not fall to it"
-                   : "is not followed by a rise or a flat part above the white-noise slope (the "
-                     "log is too short): the bias instability is at most ")
-        << (!falls ? std::string() : std::to_string(adev0 / std::sqrt(kFlickerAllanFactor)));
+        << adev0 << ") ";
+    if (!falls) {
+      why << "is where it starts: it does not fall to it";
+    } else {
+      why << "is not followed by a rise or a flat part above the white-noise slope (the log is "
+             "too short): the bias instability is at most "
+          << adev0 / std::sqrt(kFlickerAllanFactor);
+    }
     floor.reason = why.str();
     return floor;
   }

@@ -24,8 +24,9 @@ double ReadingDof(const AllanDeviation& curve, size_t i);
 // where it lies, or why the curve does not show one.
 struct AllanFloor {
   bool seen = false;
-  // Whether a point after the lowest lies significantly above it (the
-  // curve shows a rise, floor or not), and the lowest point's tau.
+  // Whether a point after the lowest (any, however few its clusters) lies
+  // significantly above the white-noise line through it (the curve shows a
+  // rise, floor or not), and the lowest point's tau.
   bool rises = false;
   double lowest_tau = 0.0;
   double adev = 0.0;

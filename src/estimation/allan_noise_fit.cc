@@ -348,7 +348,7 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
       if (j == 3 && !floor.rises) {
         term->reason = floor.lowest_tau > 0.0
                            ? "random walk (tau^+1/2): the curve does not rise significantly "
-                             "above its lowest point (tau " +
+                             "above the white-noise line through its lowest point (tau " +
                                  TauText(floor.lowest_tau) + ")"
                            : "random walk (tau^+1/2): " + floor.reason;
         continue;

@@ -187,8 +187,9 @@ struct NoiseFit {
 //      when that is it), clear of spectral lines (the overload below);
 //      random walk likewise on the +1/2 rise, and only where the rise's
 //      slope is near +1/2 (within 0.3; a slope of +1 is a drift), the
-//      curve rises significantly above its lowest point, and the rise does
-//      not turn over (a slow line's bump); NaN when its sd exceeds it;
+//      curve rises significantly above the white-noise line through its
+//      lowest point, and the rise does not turn over (a slow line's bump);
+//      NaN when its sd exceeds it;
 //      bias instability at the curve's floor whether or not the flicker
 //      term dominates it, the conventional reading B = sigma_floor / 0.664
 //      (IEEE Std 952; what datasheets state): the floor is the vertex of a
