@@ -126,6 +126,18 @@ TEST(AllanReplicates, OneUnitsReplicatesAgreeWithinTheirSigmas) {
   }
 }
 
+// The model read from a log of `o` (no flicker): N within 10 % of the
+// truth, B undetermined with a reason that contains `why`.
+AxisNoiseModel ReadWithoutFlicker(const NoiseProcessOptions& o, uint64_t seed, double seconds,
+                                  const std::string& why) {
+  const AxisNoiseModel m = ReadReplicate(o, seed, seconds).model;
+  EXPECT_TRUE(m.white_noise.visible()) << seed << ": " << m.white_noise.reason;
+  EXPECT_NEAR(m.white_noise.value / o.white_noise, 1.0, 0.1) << seed;
+  EXPECT_FALSE(m.bias_instability.visible()) << seed << ": " << m.bias_instability.value;
+  EXPECT_NE(m.bias_instability.reason.find(why), std::string::npos) << m.bias_instability.reason;
+  return m;
+}
+
 // Ten minutes of white noise and a tone: the curve never leaves the -1/2
 // slope, so neither a floor nor a rise is shown. B and K are undetermined
 // with the reason (B's names its upper bound), N is read.
@@ -135,16 +147,40 @@ TEST(AllanReplicates, ShortWhiteLogShowsNoFloorNorRise) {
   o.white_noise = 1e-4;
   o.tones = {{17.0, 1e-3}};
   for (uint64_t seed = 0; seed < 3; ++seed) {
-    const ReplicateReading r = ReadReplicate(o, 40 + seed, 600.0);
-    const AxisNoiseModel& m = r.model;
-    ASSERT_TRUE(m.white_noise.visible()) << m.white_noise.reason;
-    EXPECT_NEAR(m.white_noise.value / o.white_noise, 1.0, 0.1) << seed;
-    EXPECT_FALSE(m.bias_instability.visible()) << seed << ": " << m.bias_instability.value;
-    EXPECT_NE(m.bias_instability.reason.find("no floor"), std::string::npos)
-        << m.bias_instability.reason;
+    const AxisNoiseModel m = ReadWithoutFlicker(o, 40 + seed, 600.0, "no floor");
     EXPECT_FALSE(m.random_walk.visible()) << seed << ": " << m.random_walk.value;
     EXPECT_FALSE(m.random_walk.reason.empty());
   }
+}
+
+// White noise and a random walk, no flicker: the curve's floor is where
+// the two slopes meet. B is not determined there (else a model holding N,
+// K and B counts the floor twice, and `plan` finds no design): NaN, with
+// the floor read as B as its upper bound and the reason. N and K are read.
+// With flicker, the model's Allan variance at B's tau is the floor itself
+// (B's share of the other terms taken off), not floor plus N and K again.
+TEST(AllanReplicates, WhiteAndRandomWalkShowNoBiasInstability) {
+  NoiseProcessOptions o;
+  o.rate_hz = 50.0;
+  o.white_noise = 1e-4;
+  o.random_walk = std::sqrt(3.0) * o.white_noise / 100.0;  // they meet at tau 100 s
+  for (uint64_t seed = 0; seed < 2; ++seed) {
+    const AxisNoiseModel m = ReadWithoutFlicker(o, 70 + seed, 7200.0, "meet");
+    ASSERT_TRUE(m.random_walk.visible()) << seed << ": " << m.random_walk.reason;
+    EXPECT_NEAR(m.random_walk.value / o.random_walk, 1.0, 0.5) << seed;
+    const double meeting = std::sqrt(2.0) * o.white_noise / std::sqrt(100.0);  // adev there
+    EXPECT_GT(m.bias_instability.upper_bound * std::sqrt(kFlickerAllanFactor), 0.7 * meeting);
+    EXPECT_LT(m.bias_instability.upper_bound * std::sqrt(kFlickerAllanFactor), 1.5 * meeting);
+  }
+  AxisNoiseModel with_flicker;
+  with_flicker.white_noise.value = 1e-4;
+  with_flicker.random_walk.value = 1e-6;
+  with_flicker.bias_instability.value = 1e-4;
+  with_flicker.bias_instability.tau = 20.0;
+  EXPECT_NEAR(with_flicker.AllanVariance(20.0), kFlickerAllanFactor * 1e-8, 1e-15);
+  with_flicker.bias_instability.tau = NAN;  // a datasheet's B: all flicker
+  EXPECT_NEAR(with_flicker.AllanVariance(20.0),
+              kFlickerAllanFactor * 1e-8 + 1e-8 / 20.0 + 1e-12 * 20.0 / 3.0, 1e-15);
 }
 
 }  // namespace

@@ -73,6 +73,7 @@ AllanFloor ReadAllanFloor(const AllanDeviation& curve, const std::vector<size_t>
     floor.rises = floor.rises || above(k, adev0 * std::sqrt(tau0 / curve.points[used[k]].tau));
   }
   floor.lowest_tau = tau0;
+  floor.bound = adev0 / std::sqrt(kFlickerAllanFactor);
   if (!falls || !stops) {
     why << "the curve shows no floor: its lowest point (tau " << tau0 << " s, Allan deviation "
         << adev0 << ") ";
@@ -81,7 +82,7 @@ AllanFloor ReadAllanFloor(const AllanDeviation& curve, const std::vector<size_t>
     } else {
       why << "is not followed by a rise or a flat part above the white-noise slope (the log is "
              "too short): the bias instability is at most "
-          << adev0 / std::sqrt(kFlickerAllanFactor);
+          << floor.bound;
     }
     floor.reason = why.str();
     return floor;

@@ -34,6 +34,9 @@ struct AllanFloor {
   double tau = 0.0;
   double tau_min = 0.0;
   double tau_max = 0.0;
+  // The bias instability the lowest point bounds, its adev / 0.664 (the
+  // flicker's Allan deviation lies at or below the curve everywhere).
+  double bound = 0.0;
   std::string reason;
 };
 

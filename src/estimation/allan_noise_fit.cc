@@ -261,13 +261,27 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
         next_variance[j] = std::pow((flicker ? 2.0 * floor.relative : 1.0) * next[j], 2);
         if (!floor.seen) {
           term->reason = "bias instability: " + floor.reason;
+          if (floor.lowest_tau > 0.0) term->upper_bound = floor.bound;
+          continue;
+        }
+        term->tau = floor.tau;
+        term->tau_min = floor.tau_min;
+        term->tau_max = floor.tau_max;
+        if (!flicker) {
+          // A floor that white noise, random walk and quantisation explain
+          // is where their slopes meet: B is not shown, only bounded (a
+          // model that added B to N and K would count the floor twice).
+          term->upper_bound = floor.adev / std::sqrt(kFlickerAllanFactor);
+          std::ostringstream r;
+          r.precision(3);
+          r << "bias instability: the curve's floor (tau " << floor.tau << " s, Allan deviation "
+            << floor.adev << ") is where white noise and random walk meet, not above them: no "
+            << "flicker shows; B is at most " << term->upper_bound;
+          term->reason = r.str();
           continue;
         }
         term->value = floor.adev / std::sqrt(kFlickerAllanFactor);
         term->std = floor.relative * term->value;
-        term->tau = floor.tau;
-        term->tau_min = floor.tau_min;
-        term->tau_max = floor.tau_max;
         continue;
       }
       std::vector<size_t> dominated;

@@ -196,8 +196,13 @@ struct NoiseFit {
 //      parabola through the points within an octave of the lowest one, and
 //      is seen only when the curve falls to it and leaves the white-noise
 //      slope there (estimation/allan_floor.h), else B is NaN with its upper
-//      bound; where white noise and random walk also add at the floor, B
-//      holds them too;
+//      bound; B is determined only when the floor shows flicker, lying
+//      above the fitted white noise, random walk and quantisation there by
+//      half at least and four of its relative sigmas: a floor they explain
+//      is where their slopes meet, and B is NaN with the floor as its
+//      upper_bound (a model holding N, K and that B would count the floor
+//      twice); a determined B holds the other terms' share of the floor
+//      too, which AxisNoiseModel::AllanVariance takes off;
 //      quantisation at its smallest dominated tau;
 //    its variance is that of the Allan variance at that point, 2 sigma^4 /
 //    dof with dof the point's edf but at most its independent clusters less
