@@ -438,10 +438,16 @@ void ExpectSameTerm(const NoiseTerm& a, const NoiseTerm& b) {
   EXPECT_TRUE(same(a.tau_min, b.tau_min));
   EXPECT_TRUE(same(a.tau_max, b.tau_max));
   EXPECT_EQ(a.reason, b.reason);
+  EXPECT_TRUE(same(a.upper_bound, b.upper_bound));
 }
 
 TEST(NoiseIo, JsonRoundTrip) {
-  const ImuNoise noise = SmallResult();
+  ImuNoise noise = SmallResult();
+  // A bounded term (a floor where white noise and random walk meet).
+  NoiseTerm& bounded = noise.model.gyro[2].bias_instability;
+  bounded = NoiseTerm();
+  bounded.upper_bound = 3e-5;
+  bounded.reason = "bias instability: no flicker shows; B is at most 3e-05";
   const std::string text = NoiseToJson(noise);
   ImuNoise back;
   std::string error;
@@ -462,8 +468,10 @@ TEST(NoiseIo, JsonRoundTrip) {
   }
   EXPECT_EQ(back.temperature_curve.points.size(), noise.temperature_curve.points.size());
   EXPECT_EQ(NoiseToJson(back), text);
-  // Terms the 10-minute log cannot show are null with a reason.
+  // Terms the 10-minute log cannot show are null with a reason, a bounded
+  // one with its bound.
   EXPECT_NE(text.find("\"value\": null"), std::string::npos);
+  EXPECT_EQ(back.model.gyro[2].bias_instability.upper_bound, 3e-5);
   EXPECT_FALSE(NoiseFromJson("{\"rate_hz\": 1}", "bad.json", &back, &error));
   EXPECT_NE(error.find("bad.json: not a noise.json"), std::string::npos) << error;
 }

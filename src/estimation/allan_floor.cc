@@ -72,12 +72,26 @@ AllanFloor ReadAllanFloor(const AllanDeviation& curve, const std::vector<size_t>
   for (size_t k = lowest + 1; k < used.size(); ++k) {
     floor.rises = floor.rises || above(k, adev0 * std::sqrt(tau0 / curve.points[used[k]].tau));
   }
+  // A later point, however few its clusters, significantly below the
+  // lowest shows the curve falling on: the flat part there is the shoulder
+  // of a slow line's bump, and the floor lies beyond the points of 10 or
+  // more degrees of freedom (a part of a log reads it where the whole log
+  // reads it lower).
+  size_t deeper = 0;
+  for (size_t k = lowest + 1; k < used.size() && deeper == 0; ++k) {
+    if (avar[k] > 0.0 && below(k, adev0)) deeper = k;
+  }
   floor.lowest_tau = tau0;
   floor.bound = adev0 / std::sqrt(kFlickerAllanFactor);
-  if (!falls || !stops) {
+  if (!falls || !stops || deeper > 0) {
     why << "the curve shows no floor: its lowest point (tau " << tau0 << " s, Allan deviation "
         << adev0 << ") ";
-    if (!falls) {
+    if (deeper > 0) {
+      why << "is not its floor: the curve falls on, to " << std::sqrt(avar[deeper]) << " at tau "
+          << curve.points[used[deeper]].tau
+          << " s (too few clusters there to read it): the bias instability is at most "
+          << floor.bound;
+    } else if (!falls) {
       why << "is where it starts: it does not fall to it";
     } else {
       why << "is not followed by a rise or a flat part above the white-noise slope (the log is "

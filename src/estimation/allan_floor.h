@@ -47,8 +47,10 @@ struct AllanFloor {
 // it is seen only when the curve falls to it (a point before it lies
 // significantly above) and has left the white-noise slope there (a point
 // after it lies significantly above the line tau^-1/2 through it, or one
-// before it significantly below), so a log too short to leave the
-// white-noise slope gets no floor. Its value
+// before it significantly below), and no later point (however few its
+// clusters) lies significantly below it (else the curve falls on past a
+// slow line's bump), so a log too short to leave the white-noise slope
+// gets no floor. Its value
 // is the vertex of a weighted parabola in log adev over log tau through the
 // points within an octave of the lowest (the lowest point alone is biased
 // low: the least of several noisy points); its relative standard deviation
