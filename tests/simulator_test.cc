@@ -509,5 +509,58 @@ TEST(Simulator, GyroToneIsALineOnOneAxisAndChangesNothingElse) {
   EXPECT_NE(error.find("tone_frequency"), std::string::npos) << error;
 }
 
+// Tones on several axes ("xz") and the slow line: on a still gyroscope
+// (no bias, no white noise, SI output) each axis is exactly the tone where
+// named plus amplitude sin(2 pi t / period + phase_i), phases differing
+// between axes; the accelerometer and the truth are unchanged.
+TEST(Simulator, ToneOnSeveralAxesAndSlowLine) {
+  SimulatorOptions options;
+  options.scheme = "random:1";
+  options.raw_counts = false;
+  options.initial_still_seconds = 0.0;
+  options.hold_seconds = 400.0;
+  options.gyro_noise = 0.0;
+  options.gyro_bias_std = 0.0;
+  options.gyro_scale_std = 0.0;
+  options.gyro_misalignment_std = 0.0;
+  const SimulatedSession plain = MustSimulate(options, 8);
+  options.gyro_tone = 0.01;
+  options.tone_axis = "xz";
+  options.gyro_slow_line = 2e-4;
+  options.slow_line_period = 100.0;
+  const SimulatedSession lined = MustSimulate(options, 8);
+  ASSERT_EQ(plain.log.size(), lined.log.size());
+  std::vector<double> phase;
+  for (int a = 0; a < 3; ++a) {
+    // The slow line's phase from the first sample (the tone is zero there).
+    const double s0 = (lined.log.gyro[0](a) - plain.log.gyro[0](a)) / 2e-4;
+    const double s1 = (lined.log.gyro[25](a) - plain.log.gyro[25](a) -
+                       (a != 1 ? 0.01 * std::sin(2.0 * M_PI * 17.0 * 0.25) : 0.0)) /
+                      2e-4;
+    phase.push_back(std::atan2(
+        s0, (s1 - s0 * std::cos(2.0 * M_PI * 0.25 / 100.0)) / std::sin(2.0 * M_PI * 0.25 / 100.0)));
+    for (size_t i = 0; i < lined.log.size(); i += 37) {
+      const double t = lined.log.t[i];
+      const double expected = (a != 1 ? 0.01 * std::sin(2.0 * M_PI * 17.0 * t) : 0.0) +
+                              2e-4 * std::sin(2.0 * M_PI * t / 100.0 + phase[a]);
+      EXPECT_NEAR(lined.log.gyro[i](a) - plain.log.gyro[i](a), expected, 1e-9) << a << " " << i;
+    }
+  }
+  EXPECT_GT(std::abs(std::remainder(phase[0] - phase[1], 2.0 * M_PI)), 1e-3);
+  EXPECT_GT(std::abs(std::remainder(phase[1] - phase[2], 2.0 * M_PI)), 1e-3);
+  for (size_t i = 0; i < plain.log.size(); i += 101) {
+    EXPECT_EQ(plain.log.accel[i], lined.log.accel[i]) << i;
+  }
+  options.tone_axis = "xw";
+  SimulatedSession session;
+  std::string error;
+  EXPECT_FALSE(Simulate(options, 8, &session, &error));
+  EXPECT_NE(error.find("tone_axis"), std::string::npos) << error;
+  options.tone_axis = "x";
+  options.slow_line_period = 0.0;
+  EXPECT_FALSE(Simulate(options, 8, &session, &error));
+  EXPECT_NE(error.find("slow_line_period"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace gravcal

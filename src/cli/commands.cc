@@ -177,8 +177,11 @@ int RunCalibrate(const CalibrateArgs& args) {
     if (!HistoryToCsv(c, &outputs.back().contents, &error))
       return Fail(args.history + ": " + error);
   }
+  const VarianceComponent& scatter = c.accel.pose_variance;
   const std::string json =
-      CalibrationToJson(c, args.config.output_covariance, CalibrationCheckSections(args, session));
+      CalibrationToJson(c, args.config.output_covariance,
+                        CalibrationCheckSections(
+                            args, session, scatter.absorbed ? std::sqrt(scatter.variance) : 0.0));
   if (args.output != "-") outputs.push_back({args.output, json});
   if (!WriteFilesAtomically(outputs, &error) ||
       (args.output == "-" && !WriteOutput(args.output, json, &error))) {

@@ -247,8 +247,11 @@ int RunCheck(const PlanArgs& args);
 // Issue 15: calibrate's "check" section (what the session lacks, as gravcal
 // check says it) with --check, for the methods of the magnitude model;
 // prints the text on stderr. Empty without --check, when the method has
-// none or when the check cannot be made.
-JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session);
+// none or when the check cannot be made. pose_disturbance: the per-pose
+// scatter the calibration estimated and carried in its sigmas (m/s^2; 0 =
+// none), so that the check predicts the sigmas the calibration reports.
+JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session,
+                                      double pose_disturbance);
 
 // destinations.cc: the command's destinations checked against the
 // destination contract (io/files.h) before it runs: false with a one-line

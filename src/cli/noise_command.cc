@@ -1,5 +1,6 @@
 // gravcal noise: the noise model of a still log (issue 14): noise.json, and
 // optionally Kalibr's imu.yaml and the handheld filter's hk_* keys.
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -13,8 +14,13 @@ namespace cli {
 namespace {
 
 std::string TermText(const NoiseTerm& term, const std::string& unit) {
-  if (!term.visible()) return "not shown";
   char text[64];
+  if (!term.visible()) {
+    if (!std::isfinite(term.upper_bound)) return "not shown";
+    std::snprintf(text, sizeof(text), "not shown (at most %.3g %s)", term.upper_bound,
+                  unit.c_str());
+    return text;
+  }
   std::snprintf(text, sizeof(text), "%.3g %s", term.value, unit.c_str());
   return text;
 }

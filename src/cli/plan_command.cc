@@ -64,7 +64,8 @@ int RunCheck(const PlanArgs& args) {
   return 0;
 }
 
-JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session) {
+JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& session,
+                                      double pose_disturbance) {
   // Issue 35: the thermal method's check adds what the temperature span
   // allows (CoverageReport::temperature).
   if (!args.check ||
@@ -74,6 +75,7 @@ JsonSections CalibrationCheckSections(const CalibrateArgs& args, const Session& 
   // The session's noise model (read with the log), its poses (detected once).
   PlanRequest request;
   request.noise_model = session.noise_model();
+  request.pose_disturbance = pose_disturbance;
   CoverageReport report;
   std::string error;
   if (!CheckRecording(session, args.config, request, &report, &error)) return {};

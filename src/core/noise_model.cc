@@ -1,17 +1,33 @@
 #include "gravcal/core/noise_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gravcal {
 
-double AxisNoiseModel::AllanVariance(double tau) const {
+namespace {
+
+// The Allan variance at tau of every term but the bias instability.
+double OtherTermsVariance(const AxisNoiseModel& m, double tau) {
   double v = 0.0;
-  if (quantisation.visible()) v += 3.0 * quantisation.value * quantisation.value / (tau * tau);
-  if (white_noise.visible()) v += white_noise.value * white_noise.value / tau;
+  if (m.quantisation.visible())
+    v += 3.0 * m.quantisation.value * m.quantisation.value / (tau * tau);
+  if (m.white_noise.visible()) v += m.white_noise.value * m.white_noise.value / tau;
+  if (m.random_walk.visible()) v += m.random_walk.value * m.random_walk.value * tau / 3.0;
+  return v;
+}
+
+}  // namespace
+
+double AxisNoiseModel::AllanVariance(double tau) const {
+  double v = OtherTermsVariance(*this, tau);
   if (bias_instability.visible()) {
-    v += kFlickerAllanFactor * bias_instability.value * bias_instability.value;
+    double flicker = kFlickerAllanFactor * bias_instability.value * bias_instability.value;
+    const double at = bias_instability.tau;
+    if (at > 0.0 && std::isfinite(at))
+      flicker = std::max(0.0, flicker - OtherTermsVariance(*this, at));
+    v += flicker;
   }
-  if (random_walk.visible()) v += random_walk.value * random_walk.value * tau / 3.0;
   return v;
 }
 

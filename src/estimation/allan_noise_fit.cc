@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "estimation/allan_floor.h"
 #include "gravcal/estimation/allan_deviation.h"
 
 namespace gravcal {
@@ -199,24 +200,12 @@ Reading ReadAt(int j, size_t k, const Coefficients& value, const Coefficients& v
     rest += value[o] * go;
     rest_variance += variance[o] * go * go;
   }
-  const double edf = curve.points[p.used[k]].edf;
+  const double edf = ReadingDof(curve, p.used[k]);
   Reading r;
   r.value = (p.avar[k] - rest) / g;
   r.statistical = (2.0 / edf * model[k] * model[k] + p.extra[k]) / (g * g);
   r.variance = r.statistical + rest_variance / (g * g);
   return r;
-}
-
-// The index of the curve's measured floor: the smallest deviation among
-// points with at least 5 equivalent degrees of freedom (fewer scatter too
-// far to mark a floor), -1 if none.
-int FloorPoint(const FitPoints& p, const AllanDeviation& curve) {
-  int floor = -1;
-  for (size_t k = 0; k < p.used.size(); ++k) {
-    if (curve.points[p.used[k]].edf < 5.0) continue;
-    if (floor < 0 || p.avar[k] < p.avar[static_cast<size_t>(floor)]) floor = static_cast<int>(k);
-  }
-  return floor;
 }
 
 // Step 2: each term read where the curve shows it, the others subtracted;
@@ -225,9 +214,11 @@ int FloorPoint(const FitPoints& p, const AllanDeviation& curve) {
 //     (share >= dominance), the one with the smallest predicted
 //     uncertainty; the random walk only where the rising end has a slope
 //     near +1/2 (a steeper one is a drift or a slow line);
-//   bias instability: at the curve's measured floor, if it dominates there
-//     (not at the model's largest share, which a rising end can put at the
-//     longest tau);
+//   bias instability: at the curve's floor (ReadAllanFloor, allan_floor.h),
+//     the conventional reading B = sigma_floor / 0.664 (IEEE Std 952), with
+//     nothing subtracted: where white noise and random walk also add at the
+//     floor it is their meeting level, which is what a datasheet's "bias
+//     instability" states; undetermined when the curve shows no floor;
 //   quantisation: its smallest dominated tau.
 // The variance is the reading's; when the readings over the term's whole
 // dominated range scatter more than their own variances say (chi-square per
@@ -244,7 +235,7 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
       if (c[j] * Shape(j, p.tau[k]) >= dominance * model[k]) value[j] = c[j];
     }
   }
-  const int floor = FloorPoint(p, fit->curve);
+  const AllanFloor floor = ReadAllanFloor(fit->curve, p.used, p.avar);
   Coefficients variance{0.0, 0.0, 0.0, 0.0};
   for (int pass = 0; pass < 2; ++pass) {
     Coefficients next{0.0, 0.0, 0.0, 0.0};
@@ -252,6 +243,47 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
     for (int j = 0; j < kTerms; ++j) {
       NoiseTerm* term = TermOf(j, &fit->model);
       *term = NoiseTerm();
+      if (j == 2) {
+        // The other readings subtract the fitted flicker coefficient (not
+        // the floor, which holds the other terms too), as uncertain as the
+        // floor, when the floor shows flicker: it lies significantly above
+        // the fitted white noise, random walk and quantisation there, and
+        // by half at least (else it is where they meet, and the fit's
+        // flicker is the curvature of a V). Without that, only a flicker the fit
+        // finds dominant somewhere is subtracted, with its whole size as
+        // its standard deviation: the curve does not say it is there.
+        Coefficients others = c;
+        others[2] = 0.0;
+        const bool flicker =
+            floor.seen && floor.adev * floor.adev > std::max(1.5, 1.0 + 4.0 * floor.relative) *
+                                                        ModelVariance(others, floor.tau);
+        next[j] = flicker ? c[j] : value[j];
+        next_variance[j] = std::pow((flicker ? 2.0 * floor.relative : 1.0) * next[j], 2);
+        if (!floor.seen) {
+          term->reason = "bias instability: " + floor.reason;
+          if (floor.lowest_tau > 0.0) term->upper_bound = floor.bound;
+          continue;
+        }
+        term->tau = floor.tau;
+        term->tau_min = floor.tau_min;
+        term->tau_max = floor.tau_max;
+        if (!flicker) {
+          // A floor that white noise, random walk and quantisation explain
+          // is where their slopes meet: B is not shown, only bounded (a
+          // model that added B to N and K would count the floor twice).
+          term->upper_bound = floor.adev / std::sqrt(kFlickerAllanFactor);
+          std::ostringstream r;
+          r.precision(3);
+          r << "bias instability: the curve's floor (tau " << floor.tau << " s, Allan deviation "
+            << floor.adev << ") is where white noise and random walk meet, not above them: no "
+            << "flicker shows; B is at most " << term->upper_bound;
+          term->reason = r.str();
+          continue;
+        }
+        term->value = floor.adev / std::sqrt(kFlickerAllanFactor);
+        term->std = floor.relative * term->value;
+        continue;
+      }
       std::vector<size_t> dominated;
       double best_share = 0.0, best_tau = 0.0;
       for (size_t k = 0; k < n; ++k) {
@@ -275,17 +307,7 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
         continue;
       }
       int chosen = -1;
-      if (j == 2) {
-        if (floor >= 0 && std::find(dominated.begin(), dominated.end(),
-                                    static_cast<size_t>(floor)) != dominated.end()) {
-          chosen = floor;
-        } else {
-          term->reason = std::string(kTermNames[j]) + " does not dominate at the curve's floor" +
-                         (floor >= 0 ? " (tau " + TauText(p.tau[static_cast<size_t>(floor)]) + ")"
-                                     : std::string());
-          continue;
-        }
-      } else if (j == 0) {
+      if (j == 0) {
         chosen = static_cast<int>(dominated.front());
       } else {
         double best = std::numeric_limits<double>::infinity();
@@ -306,14 +328,14 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
         // (a drift rises at +1).
         double sw = 0.0, sx = 0.0, sy = 0.0;
         for (size_t k : dominated) {
-          const double w = 2.0 * fit->curve.points[p.used[k]].edf;
+          const double w = 2.0 * ReadingDof(fit->curve, p.used[k]);
           sw += w;
           sx += w * std::log(p.tau[k]);
           sy += w * 0.5 * std::log(p.avar[k]);
         }
         double sxx = 0.0, sxy = 0.0;
         for (size_t k : dominated) {
-          const double w = 2.0 * fit->curve.points[p.used[k]].edf;
+          const double w = 2.0 * ReadingDof(fit->curve, p.used[k]);
           const double dx = std::log(p.tau[k]) - sx / sw;
           sxx += w * dx * dx;
           sxy += w * dx * (0.5 * std::log(p.avar[k]) - sy / sw);
@@ -337,6 +359,21 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
           continue;
         }
       }
+      if (j == 3 && !floor.rises) {
+        term->reason = floor.lowest_tau > 0.0
+                           ? "random walk (tau^+1/2): the curve does not rise significantly "
+                             "above the white-noise line through its lowest point (tau " +
+                                 TauText(floor.lowest_tau) + ")"
+                           : "random walk (tau^+1/2): " + floor.reason;
+        continue;
+      }
+      if (j == 3) {
+        // The rise starts at the floor (or where the walk dominates, if
+        // earlier or without a floor).
+        size_t from = dominated.front();
+        while (floor.seen && from > 0 && p.tau[from - 1] >= floor.tau) --from;
+        if (RiseTurnsOver(fit->curve, p.used, p.avar, from, &term->reason)) continue;
+      }
       const size_t k = static_cast<size_t>(chosen);
       const Reading reading = ReadAt(j, k, value, variance, p, model, fit->curve);
       term->tau = p.tau[k];
@@ -346,19 +383,35 @@ void ReadTerms(const Coefficients& c, const FitPoints& p, const std::vector<doub
         next[j] = 0.0;
         continue;
       }
-      // The scatter of the readings over the dominated range.
-      double chi2 = 0.0;
+      // Where on its range the term is read is a choice: the readings over
+      // the dominated range scatter beyond their own variances where the
+      // curve departs from the term's slope. That scatter (the between-
+      // reading variance of a random-effects mean, DerSimonian-Laird, about
+      // the chosen reading) is added as the model's error.
+      double q = 0.0, sw = 0.0, sww = 0.0;
       for (size_t o : dominated) {
         const Reading r = ReadAt(j, o, value, variance, p, model, fit->curve);
-        chi2 += (r.value - reading.value) * (r.value - reading.value) / r.statistical;
+        const double w = 1.0 / r.statistical;
+        q += w * (r.value - reading.value) * (r.value - reading.value);
+        sw += w;
+        sww += w * w;
       }
-      const double inflation = dominated.size() >= 3
-                                   ? std::max(1.0, chi2 / static_cast<double>(dominated.size() - 1))
-                                   : 1.0;
+      const double model_error =
+          dominated.size() >= 3
+              ? std::max(0.0, (q - static_cast<double>(dominated.size() - 1)) / (sw - sww / sw))
+              : 0.0;
       next[j] = reading.value;
-      next_variance[j] = reading.variance * inflation;
+      next_variance[j] = reading.variance + model_error;
       term->value = std::sqrt(reading.value);
       term->std = std::sqrt(next_variance[j]) / (2.0 * term->value);
+      if (j == 3 && !(term->std < term->value)) {
+        std::ostringstream r;
+        r.precision(3);
+        r << "random walk (tau^+1/2) read at tau " << p.tau[k] << " s is " << term->value << " +- "
+          << term->std << ": the uncertainty exceeds the value";
+        *term = NoiseTerm();
+        term->reason = r.str();
+      }
     }
     value = next;
     variance = next_variance;

@@ -92,6 +92,7 @@ json TermJson(const NoiseTerm& t) {
             {"tau", Number(t.tau)},
             {"tau_range", json::array({Number(t.tau_min), Number(t.tau_max)})}};
   if (!t.reason.empty()) j["reason"] = t.reason;
+  if (std::isfinite(t.upper_bound)) j["upper_bound"] = t.upper_bound;
   return j;
 }
 
@@ -110,6 +111,7 @@ NoiseTerm TermFromJson(const json& j, const std::string& where) {
   t.tau_max = NumberAt(range.at(1), where + ".tau_range[1]", Range::kPositive);
   if (t.tau_max < t.tau_min) throw std::runtime_error(where + ".tau_range: max is below min");
   if (j.contains("reason")) t.reason = j.at("reason").get<std::string>();
+  t.upper_bound = NumberOr(j, "upper_bound", where, Range::kPositive);
   return t;
 }
 

@@ -29,6 +29,8 @@ bool NoiseProcessOptions::IsValid(std::string* error) const {
     *error = "noise process rate_hz must be > 0";
   } else if (!(white_noise >= 0.0) || !(random_walk >= 0.0) || !(bias_instability >= 0.0)) {
     *error = "noise process densities must be >= 0";
+  } else if (!std::isfinite(ramp)) {
+    *error = "noise process ramp must be finite";
   } else if (bias_instability > 0.0 &&
              !(bias_tau_low >= 10.0 / rate_hz && bias_tau_high > bias_tau_low)) {
     *error = "noise process bias tau range must satisfy 10 / rate_hz <= tau_low < tau_high";
@@ -89,6 +91,7 @@ double NoiseProcess::Next() {
     const NoiseProcessOptions::Tone& tone = options_.tones[i];
     v += tone.amplitude * std::sin(2.0 * M_PI * tone.frequency_hz * t + tone_phase_[i]);
   }
+  if (options_.ramp != 0.0) v += options_.ramp * t;
   return v;
 }
 
@@ -109,7 +112,7 @@ double NoiseProcess::ModelAllanVariance(double tau) const {
     const double s = std::sin(x);
     v += tone.amplitude * tone.amplitude * s * s * s * s / (x * x);
   }
-  return v;
+  return v + 0.5 * options_.ramp * options_.ramp * tau * tau;
 }
 
 }  // namespace gravcal

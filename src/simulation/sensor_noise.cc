@@ -1,6 +1,8 @@
 #include "simulation/sensor_noise.h"
 
 #include <cmath>
+#include <random>
+#include <string>
 
 namespace gravcal {
 namespace internal {
@@ -19,6 +21,29 @@ BiasInstability::BiasInstability(double bias_instability, double tau_low, double
   }
 }
 
+namespace {
+
+// 1 on each axis tone_axis names ("x", "xz", ...).
+Eigen::Vector3d ToneAxes(const std::string& axes) {
+  Eigen::Vector3d on = Eigen::Vector3d::Zero();
+  for (int a = 0; a < 3; ++a) {
+    if (axes.find("xyz"[a]) != std::string::npos) on(a) = 1.0;
+  }
+  return on;
+}
+
+// The slow line's phase on each axis, uniform in [0, 2 pi), from a stream
+// of its own.
+Eigen::Vector3d SlowLinePhases(uint64_t seed) {
+  std::mt19937_64 rng(seed ^ 0x3c6ef372fe94f82bULL);
+  std::uniform_real_distribution<double> turn(0.0, 2.0 * M_PI);
+  Eigen::Vector3d phase;
+  for (int a = 0; a < 3; ++a) phase(a) = turn(rng);
+  return phase;
+}
+
+}  // namespace
+
 Eigen::Vector3d BiasInstability::Next() {
   if (axes_.empty()) return Eigen::Vector3d::Zero();
   return Eigen::Vector3d(axes_[0]->Next(), axes_[1]->Next(), axes_[2]->Next());
@@ -36,9 +61,11 @@ SensorNoise::SensorNoise(const SimulatorOptions& o, double accel_units_per_si,
       accel_tone_(o.accel_tone * accel_units_per_si),
       gyro_tone_(o.gyro_tone * gyro_units_per_si),
       tone_step_(2.0 * M_PI * o.tone_frequency / o.sample_rate),
-      tone_axis_(o.tone_axis == "y"   ? 1
-                 : o.tone_axis == "z" ? 2
-                                      : 0),
+      tone_axes_(ToneAxes(o.tone_axis)),
+      accel_slow_(o.accel_slow_line * accel_units_per_si),
+      gyro_slow_(o.gyro_slow_line * gyro_units_per_si),
+      slow_step_(2.0 * M_PI / (o.slow_line_period * o.sample_rate)),
+      slow_phase_(SlowLinePhases(seed)),
       accel_instability_(o.accel_bias_instability, o.bias_instability_tau_low,
                          o.bias_instability_tau_high, o.sample_rate, seed, 1),
       gyro_instability_(o.gyro_bias_instability, o.bias_instability_tau_low,

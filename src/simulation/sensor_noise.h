@@ -7,8 +7,10 @@
 //                      noise_process.h) with only its bias instability
 //                      term, from a stream of its own, so that switching it
 //                      on changes no other number of a session;
-//   tones              amplitude sin(2 pi f k / rate) on one raw axis (no
-//                      random draw);
+//   tones              amplitude sin(2 pi f k / rate) on the raw axes named
+//                      (no random draw);
+//   slow line          amplitude sin(2 pi k / (period rate) + phase_i) on
+//                      every axis i, the phases from a stream of their own;
 // then quantisation to counts when the output is in counts. The white and
 // random-walk draws come from the caller's stream (`normal3`, three N(0, 1)),
 // in the order the simulators have always drawn them.
@@ -69,8 +71,16 @@ class SensorNoise {
     if (gyro_instability_.on()) *u += gyro_units_per_si_ * gyro_instability_.Next();
     if (accel_tone_ > 0.0 || gyro_tone_ > 0.0) {
       const double wave = std::sin(tone_step_ * static_cast<double>(sample_));
-      (*v)(tone_axis_) += accel_tone_ * wave;
-      (*u)(tone_axis_) += gyro_tone_ * wave;
+      *v += accel_tone_ * wave * tone_axes_;
+      *u += gyro_tone_ * wave * tone_axes_;
+    }
+    if (accel_slow_ > 0.0 || gyro_slow_ > 0.0) {
+      const double phase = slow_step_ * static_cast<double>(sample_);
+      for (int a = 0; a < 3; ++a) {
+        const double wave = std::sin(phase + slow_phase_(a));
+        (*v)(a) += accel_slow_ * wave;
+        (*u)(a) += gyro_slow_ * wave;
+      }
     }
     ++sample_;
     if (raw_counts_) {
@@ -87,11 +97,16 @@ class SensorNoise {
   double gyro_noise_;
   double accel_walk_;
   double gyro_walk_;
-  // Raw units, the phase step per sample (rad) and the axis.
+  // Raw units, the phase step per sample (rad) and the axes (1 where on).
   double accel_tone_;
   double gyro_tone_;
   double tone_step_;
-  int tone_axis_;
+  Eigen::Vector3d tone_axes_;
+  // The slow line: raw units, phase step per sample and each axis's phase.
+  double accel_slow_;
+  double gyro_slow_;
+  double slow_step_;
+  Eigen::Vector3d slow_phase_;
   uint64_t sample_ = 0;
   BiasInstability accel_instability_;
   BiasInstability gyro_instability_;

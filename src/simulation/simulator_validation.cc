@@ -135,8 +135,19 @@ bool CheckNoise(const SimulatorOptions& o, const FieldCheck& c) {
     return c.Fail("tone_frequency", o.tone_frequency,
                   "must be positive and below half the sample rate");
   }
-  if (o.tone_axis != "x" && o.tone_axis != "y" && o.tone_axis != "z") {
-    return c.Fail("tone_axis", NAN, "must be x, y or z (not '" + o.tone_axis + "')");
+  if (o.tone_axis.empty() || o.tone_axis.size() > 3 ||
+      o.tone_axis.find_first_not_of("xyz") != std::string::npos) {
+    return c.Fail("tone_axis", NAN,
+                  "must be x, y, z or several of them (not '" + o.tone_axis + "')");
+  }
+  if (!c.NonNegative("accel_slow_line", o.accel_slow_line) ||
+      !c.NonNegative("gyro_slow_line", o.gyro_slow_line)) {
+    return false;
+  }
+  if ((o.accel_slow_line > 0.0 || o.gyro_slow_line > 0.0) &&
+      !(o.slow_line_period > 2.0 / o.sample_rate && std::isfinite(o.slow_line_period))) {
+    return c.Fail("slow_line_period", o.slow_line_period,
+                  "must be finite and longer than two sample periods");
   }
   return true;
 }

@@ -95,7 +95,11 @@ void CheckSpread(const Config& config, size_t poses, const std::string& label,
   }
 }
 
-void CheckPlanSpread(const std::string& target, const std::string& pose_set) {
+// `by_hand`: the shipped session's pose scatter (sim_pose_disturbance,
+// poses placed by hand) is simulated and stated to the plan, as a user
+// states it with --pose_disturbance; else the session is on a table (no
+// scatter, none stated).
+void CheckPlanSpread(const std::string& target, const std::string& pose_set, bool by_hand) {
   Config config;
   std::string error;
   ASSERT_TRUE(LoadConfigFile(SourceDir() + "/configs/twelve_position.yaml", &config, &error))
@@ -108,6 +112,9 @@ void CheckPlanSpread(const std::string& target, const std::string& pose_set) {
   // The simulator's white noise: sim_accel_noise per sample at sim_sample_rate.
   request.accel_noise_density =
       config.simulation.accel_noise / std::sqrt(config.simulation.sample_rate);
+  if (!by_hand) config.simulation.pose_disturbance = 0.0;
+  request.pose_disturbance = config.simulation.pose_disturbance;
+  EXPECT_EQ(request.pose_disturbance > 0.0, by_hand);
   RecordingPlan plan;
   ASSERT_TRUE(MakeRecordingPlan(config, request, &plan, &error)) << error;
   config.simulation.initial_still_seconds = 0.0;
@@ -130,7 +137,8 @@ void CheckPlanSpread(const std::string& target, const std::string& pose_set) {
                         for (int i = 0; i < 9; ++i) errors[i] = estimate[i] - truth[i];
                         return errors;
                       }};
-  CheckSpread(config, plan.poses.size(), "plan " + target + " (" + pose_set + ")", p);
+  CheckSpread(config, plan.poses.size(),
+              "plan " + target + " (" + pose_set + (by_hand ? ", by hand" : "") + ")", p);
 }
 
 // The gyroscope half: the plan's turns (and any extra poses) simulated with
@@ -256,12 +264,15 @@ TEST(PlanProperty, KnownAttitudeSpreadMatchesPrediction) {
   CheckKnownAttitudePlanSpread("accel_bias=0.2mg accel_scale=100ppm accel_misalignment=0.5mrad");
 }
 
-TEST(PlanProperty, SpreadMatchesPredictionFacesPlus45) {
-  CheckPlanSpread("accel_bias=0.05mg accel_scale=20ppm accel_misalignment=0.02mrad", "faces+45");
+// Placed by hand: the scatter limits the scale to about 50 ppm in a
+// session of 18 poses (20 ppm is out of reach within 40 poses).
+TEST(PlanProperty, SpreadMatchesPredictionFacesPlus45ByHand) {
+  CheckPlanSpread("accel_bias=0.05mg accel_scale=50ppm accel_misalignment=0.1mrad", "faces+45",
+                  /*by_hand=*/true);
 }
 
 TEST(PlanProperty, SpreadMatchesPredictionFree) {
-  CheckPlanSpread("accel_bias=0.05mg accel_scale=20ppm", "free");
+  CheckPlanSpread("accel_bias=0.05mg accel_scale=20ppm", "free", /*by_hand=*/false);
 }
 
 }  // namespace

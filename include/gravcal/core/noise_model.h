@@ -46,6 +46,10 @@ struct NoiseTerm {
   double tau_max = std::numeric_limits<double>::quiet_NaN();
   // Why value is NaN; empty when it is not.
   std::string reason;
+  // When value is NaN but the curve bounds the coefficient (bias
+  // instability: the curve's floor, or its lowest point, read as B), the
+  // bound; NaN otherwise.
+  double upper_bound = std::numeric_limits<double>::quiet_NaN();
 
   bool visible() const { return value == value; }
 };
@@ -58,7 +62,11 @@ struct AxisNoiseModel {
   NoiseTerm random_walk;
 
   // The model's Allan variance at tau (seconds): the sum of the visible
-  // terms' formulas above.
+  // terms' formulas above, the bias instability's as its flicker part: B
+  // read at the floor (tau = bias_instability.tau, the datasheet
+  // convention sigma_floor = 0.664 B) holds the other terms' variance
+  // there too, which is taken off it (down to 0) so that it is not counted
+  // twice; a B without tau (a datasheet's) is taken as all flicker.
   double AllanVariance(double tau) const;
 };
 

@@ -186,17 +186,31 @@ struct NoiseFit {
 //      smallest predicted uncertainty (the classic reading at tau = 1 s
 //      when that is it), clear of spectral lines (the overload below);
 //      random walk likewise on the +1/2 rise, and only where the rise's
-//      slope is near +1/2 (within 0.3; a slope of +1 is a drift);
-//      bias instability at the curve's measured floor, its smallest
-//      deviation among points with 5 or more degrees of freedom (B =
-//      sigma_min / 0.664 when nothing else contributes there), if it
-//      dominates there; not at the model's largest share, which a rising
-//      end can put at the longest tau;
+//      slope is near +1/2 (within 0.3; a slope of +1 is a drift), the
+//      curve rises significantly above the white-noise line through its
+//      lowest point, and the rise does not turn over (a slow line's bump);
+//      NaN when its sd exceeds it;
+//      bias instability at the curve's floor whether or not the flicker
+//      term dominates it, the conventional reading B = sigma_floor / 0.664
+//      (IEEE Std 952; what datasheets state): the floor is the vertex of a
+//      parabola through the points within an octave of the lowest one, and
+//      is seen only when the curve falls to it and leaves the white-noise
+//      slope there (estimation/allan_floor.h), else B is NaN with its upper
+//      bound; B is determined only when the floor shows flicker, lying
+//      above the fitted white noise, random walk and quantisation there by
+//      half at least and four of its relative sigmas: a floor they explain
+//      is where their slopes meet, and B is NaN with the floor as its
+//      upper_bound (a model holding N, K and that B would count the floor
+//      twice); a determined B holds the other terms' share of the floor
+//      too, which AxisNoiseModel::AllanVariance takes off;
 //      quantisation at its smallest dominated tau;
-//    its variance is that of the Allan variance at that point,
-//    2 sigma^4 / edf, plus the other terms' subtracted variances, times the
-//    readings' chi-square per degree of freedom over the term's dominated
-//    range when above 1 (the curve departs from the term's slope).
+//    its variance is that of the Allan variance at that point, 2 sigma^4 /
+//    dof with dof the point's edf but at most its independent clusters less
+//    one (n / m - 1), plus the other terms' subtracted variances, plus the
+//    model's error: the between-reading variance (DerSimonian-Laird) of the
+//    term's readings over its dominated range (the curve departs from the
+//    term's slope); B's is the floor's: the lowest point's and the
+//    distance between it and the vertex.
 // A term that never dominates is NaN with the reason. Returns false only on
 // invalid options or an empty curve.
 bool FitNoiseTerms(const AllanDeviation& curve, const NoiseFitOptions& options, NoiseFit* fit);

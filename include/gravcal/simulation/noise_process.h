@@ -21,7 +21,10 @@
 //   falls like a random walk, above tau_high like white noise;
 // - tones (lines in the spectrum: a fan's 17 Hz, a heater's slow cycle):
 //   A sin(2 pi f t + phase), the phase drawn from the seed, Allan variance
-//   A^2 sin^4(pi f tau) / (pi f tau)^2.
+//   A^2 sin^4(pi f tau) / (pi f tau)^2;
+// - a ramp R t (a drift, as a warming sensor shows: the rising long-tau end
+//   of real curves, steeper than a random walk), Allan variance
+//   R^2 tau^2 / 2.
 #ifndef GRAVCAL_SIMULATION_NOISE_PROCESS_H_
 #define GRAVCAL_SIMULATION_NOISE_PROCESS_H_
 
@@ -49,6 +52,8 @@ struct NoiseProcessOptions {
     double amplitude = 0.0;
   };
   std::vector<Tone> tones;
+  // Ramp R, units/s (the sign is the drift's direction); 0 = none.
+  double ramp = 0.0;
 
   bool IsValid(std::string* error) const;
 };

@@ -128,10 +128,20 @@ struct SimulatorOptions {
   // ("x", "y" or "z") of each sensor: amplitude in m/s^2 (accelerometer) and
   // rad/s (gyroscope) at tone_frequency Hz (below half the sample rate).
   // Deterministic (no random draw), so it changes no other number. 0 = off.
+  // tone_axis may name several axes ("xz": the same tone on x and z).
   double accel_tone = 0.0;
   double gyro_tone = 0.0;
   double tone_frequency = 17.0;
   std::string tone_axis = "x";
+  // A low-frequency line on every axis (a heater's or an air conditioner's
+  // cycle: the bump real Allan curves show at tens to hundreds of seconds):
+  // amplitude in m/s^2 (accelerometer) and rad/s (gyroscope), period in
+  // seconds, each axis's phase drawn from a stream of its own (so it
+  // changes no other number). Its Allan deviation peaks at 0.72 times the
+  // amplitude near tau = 0.37 period. 0 = off.
+  double accel_slow_line = 0.0;
+  double gyro_slow_line = 0.0;
+  double slow_line_period = 600.0;
 
   // Placement error of each pose, degrees (standard deviation per axis).
   double placement_error_deg = 2.0;
