@@ -365,10 +365,16 @@ inline void GyroTurnBackwardPass(const GyroRotationData& data, const double* bia
   }
 }
 
+// The forward pass buffer of this thread, for the turns no cache keeps.
+inline GyroTurnForward& GyroTurnScratch() {
+  thread_local GyroTurnForward forward;
+  return forward;
+}
+
 inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const double* bias,
                                           const double* matrix, const double* g_sensitivity,
                                           double* dq, Eigen::Matrix<double, 4, 21>* jacobian) {
-  thread_local GyroTurnForward forward;
+  GyroTurnForward& forward = GyroTurnScratch();
   GyroTurnForwardPass(data, bias, matrix, g_sensitivity, &forward);
   for (int j = 0; j < 4; ++j) dq[j] = forward.dq[j];
   GyroTurnBackwardPass(data, bias, matrix, g_sensitivity, forward, jacobian);
@@ -384,10 +390,15 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
 // scratch, bit for bit. One cache serves one turn's data (t, gyro, force);
 // residuals of several problems on the same turn may share it (the
 // accelerometer effect fit's gyroscope-alone start and its joint solve).
-// Safe when one rotation is evaluated from several threads (they take
-// turns).
+// The forward pass takes 120 bytes per sample: it is kept only for turns of
+// at most kMaxSamples samples (about 1 MB; 8 s at 1 kHz), so that a long
+// log's turns do not hold their whole length in memory; a longer turn
+// keeps dq and the Jacobian only. Safe when one rotation is evaluated from
+// several threads (they take turns).
 class GyroTurnCache {
  public:
+  static constexpr size_t kMaxSamples = 8192;
+
   // dq at key (21 values: b_g, M_g, G; G is used when with_g), with
   // jacobian not null its Jacobian (IntegrateGyroRotationJacobian's
   // columns), and with path not null the attitude at every sample
@@ -396,31 +407,42 @@ class GyroTurnCache {
                 Eigen::Matrix<double, 4, 21>* jacobian, double* path = nullptr) {
     std::lock_guard<std::mutex> lock(mutex_);
     const double* g = with_g ? key + 12 : nullptr;
-    if (!forward_valid_ || std::memcmp(key, key_, sizeof(key_)) != 0) {
-      GyroTurnForwardPass(data, key, key + 3, g, &forward_);
+    if (!valid_ || std::memcmp(key, key_, sizeof(key_)) != 0) {
       std::memcpy(key_, key, sizeof(key_));
-      forward_valid_ = true;
-      jacobian_valid_ = false;
+      valid_ = forward_kept_ = jacobian_valid_ = false;
     }
-    if (path != nullptr) {
-      for (size_t i = 0; i < data.t.size(); ++i) {
-        for (int j = 0; j < 4; ++j) path[4 * i + j] = forward_.path[i](j);
-      }
+    const bool need_jacobian = jacobian != nullptr && !jacobian_valid_;
+    const GyroTurnForward* f = &forward_;
+    if (!forward_kept_ && (!valid_ || need_jacobian || path != nullptr)) {
+      const bool keep = data.t.size() <= kMaxSamples;
+      GyroTurnForward* target = keep ? &forward_ : &GyroTurnScratch();
+      GyroTurnForwardPass(data, key, key + 3, g, target);
+      std::memcpy(dq_, target->dq, sizeof(dq_));
+      valid_ = true;
+      forward_kept_ = keep;
+      f = target;
     }
-    std::memcpy(dq, forward_.dq, sizeof(forward_.dq));
-    if (jacobian == nullptr) return;
-    if (!jacobian_valid_) {
-      GyroTurnBackwardPass(data, key, key + 3, g, forward_, &jacobian_);
+    if (need_jacobian) {
+      GyroTurnBackwardPass(data, key, key + 3, g, *f, &jacobian_);
       jacobian_valid_ = true;
     }
-    *jacobian = jacobian_;
+    std::memcpy(dq, dq_, sizeof(dq_));
+    if (jacobian != nullptr) *jacobian = jacobian_;
+    if (path != nullptr) {
+      for (size_t i = 0; i < data.t.size(); ++i) {
+        for (int j = 0; j < 4; ++j) path[4 * i + j] = f->path[i](j);
+      }
+    }
   }
 
  private:
   std::mutex mutex_;
-  bool forward_valid_ = false;
+  // key_ and dq_ hold; forward_ is kept for key_; jacobian_ is key_'s.
+  bool valid_ = false;
+  bool forward_kept_ = false;
   bool jacobian_valid_ = false;
   double key_[21] = {};
+  double dq_[4] = {1.0, 0.0, 0.0, 0.0};
   GyroTurnForward forward_;
   Eigen::Matrix<double, 4, 21> jacobian_;
 };
