@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
+#include <vector>
 
 namespace gravcal {
 namespace {
@@ -106,6 +108,46 @@ TEST(GyroTurnJacobian, ResidualJacobianIsTheDualNumbersOne) {
           << "r" << r << " parameter " << j;
     }
   }
+}
+
+// A turn's cache (what the residuals evaluate through) gives the bits of an
+// evaluation from scratch in any order of requests: a plain evaluation, the
+// Jacobian at the same parameters (the backward pass alone), the Jacobian at
+// new parameters, the path, and a return to earlier parameters; for a turn
+// whose forward pass the cache keeps and for one too long to keep.
+TEST(GyroTurnCache, GivesTheBitsOfAnEvaluationFromScratch) {
+  std::mt19937_64 rng(13);
+  for (size_t n : {size_t{300}, GyroTurnCache::kMaxSamples + 1})
+    for (bool with_g : {false, true}) {
+      const GyroRotationData turn = Turn(n, 2.0, &rng);
+      double key[2][21];
+      for (double* k : key) Parameters(&rng, k, k + 3, k + 12);
+      GyroTurnCache cache;
+      // {parameters, Jacobian asked, path asked}.
+      const int order[][3] = {{0, 0, 1}, {0, 1, 0}, {0, 1, 0}, {1, 1, 1},
+                              {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, 1, 1}};
+      for (const auto& request : order) {
+        const double* k = key[request[0]];
+        const double* g = with_g ? k + 12 : nullptr;
+        const bool jacobian = request[1] == 1;
+        double q[4], expected_q[4];
+        std::vector<double> path(4 * turn.t.size()), expected_path(path.size());
+        Eigen::Matrix<double, 4, 21> j, expected_j;
+        const bool with_path = request[2] == 1;
+        cache.Evaluate(turn, k, with_g, q, jacobian ? &j : nullptr,
+                       with_path ? path.data() : nullptr);
+        IntegrateGyroRotation<double>(turn, k, k + 3, g, expected_q, expected_path.data());
+        EXPECT_EQ(std::memcmp(q, expected_q, sizeof(q)), 0) << "n " << n << " G " << with_g;
+        if (with_path) {
+          EXPECT_EQ(std::memcmp(path.data(), expected_path.data(), path.size() * sizeof(double)),
+                    0);
+        }
+        if (!jacobian) continue;
+        IntegrateGyroRotationJacobian(turn, k, k + 3, g, expected_q, &expected_j);
+        EXPECT_EQ(std::memcmp(j.data(), expected_j.data(), sizeof(double) * 84), 0)
+            << "n " << n << " G " << with_g;
+      }
+    }
 }
 
 }  // namespace

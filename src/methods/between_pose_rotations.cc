@@ -155,8 +155,9 @@ bool WeighRows(const std::vector<StaticObservation>& observations, const Normali
     const size_t n = turn.t.size();
     std::vector<double> path(4 * n);
     double dq[4];
-    IntegrateGyroRotation<double>(turn, rows->gyro_bias, rows->gyro_matrix, nullptr, dq,
-                                  path.data());
+    double key[21];
+    GyroTurnKey<double>(rows->gyro_bias, rows->gyro_matrix, nullptr, key);
+    d.turn_cache->Evaluate(turn, key, false, dq, nullptr, path.data());
     const Eigen::Matrix3d rn = RotationOf(dq);
     Eigen::Matrix3d white = Eigen::Matrix3d::Zero();
     Eigen::Matrix3d shared = Eigen::Matrix3d::Zero();
@@ -274,6 +275,7 @@ bool PrepareRotationRows(const std::vector<StaticObservation>& observations,
     const StaticObservation& to = observations[pair.second];
     AccelRotationData d;
     d.turn.t = to.turn_t;
+    d.turn_cache = std::make_shared<GyroTurnCache>();
     // The turn's rate about the local level at rest, the mean of the two
     // poses' static means (rows->gyro_bias is a common correction to it).
     const Eigen::Vector3d level = 0.5 * (from.gyro_mean + to.gyro_mean);

@@ -48,6 +48,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <memory>
 #include <utility>
 
 #include "gravcal/core/imu_model.h"
@@ -71,10 +72,17 @@ struct AccelRotationData {
   Eigen::Matrix<double, 2, 3> tangent = Eigen::Matrix<double, 2, 3>::Zero();
   // W: square-root information of E (R(dq)^T d_s - d_e).
   Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();
+  // The turn's integration at the gyroscope parameters it was last
+  // evaluated at (gyro_rotation_residual.h), shared by every residual made
+  // from this data and its copies; null: each residual keeps its own. Set
+  // it only while `turn` stays as it is.
+  std::shared_ptr<GyroTurnCache> turn_cache;
 };
 
 struct AccelRotationResidual {
-  explicit AccelRotationResidual(AccelRotationData data) : data_(std::move(data)) {}
+  explicit AccelRotationResidual(AccelRotationData data)
+      : data_(std::move(data)),
+        cache_(data_.turn_cache ? data_.turn_cache : std::make_shared<GyroTurnCache>()) {}
 
   template <typename T>
   bool operator()(const T* const bias, const T* const upper, const T* const effects,
@@ -89,7 +97,7 @@ struct AccelRotationResidual {
     }
     T dq[4];
     IntegrateGyroTurn(data_.turn, gyro_bias, gyro_matrix, static_cast<const T*>(nullptr), dq,
-                      &cache_);
+                      cache_.get());
     WhitenedTurnError<T>(dq, start, end, data_.tangent, data_.sqrt_information, residual);
     return true;
   }
@@ -101,7 +109,7 @@ struct AccelRotationResidual {
 
  private:
   const AccelRotationData data_;
-  mutable GyroTurnCache cache_;
+  const std::shared_ptr<GyroTurnCache> cache_;
 };
 
 }  // namespace gravcal

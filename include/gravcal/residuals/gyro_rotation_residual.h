@@ -79,13 +79,23 @@ struct GyroRotationData {
   Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();
 };
 
+// The per-sample helpers below are forced inline into the integrators'
+// loops: GCC left them as calls, and the two were a tenth of discovery's
+// profile. Inlining keeps every operation and its order, so the bits.
+#if defined(__GNUC__)
+#define GRAVCAL_TURN_INLINE __attribute__((always_inline)) inline
+#else
+#define GRAVCAL_TURN_INLINE inline
+#endif
+
 // Weights of w_{i-1}, w_i, w_{i+1}, w_{i+2} in the first Magnus term of step
 // i (0 <= i < n - 1) of the scheme above: the integral over [t_i, t_{i+1}]
 // of the cubic through the four samples, h (-1, 13, 13, -1) / 24, and the
 // trapezoid h (0, 1, 1, 0) / 2 at the first and last step. Summed over the
 // steps every inner sample weighs h, as in the trapezoid rule, so the
 // correction costs no noise.
-inline void GyroStepWeights(const std::vector<double>& t, size_t i, double weights[4]) {
+GRAVCAL_TURN_INLINE void GyroStepWeights(const std::vector<double>& t, size_t i,
+                                         double weights[4]) {
   const size_t n = t.size();
   const double h = t[i + 1] - t[i];
   const bool inner = i >= 1 && i + 2 < n;
@@ -98,8 +108,8 @@ inline void GyroStepWeights(const std::vector<double>& t, size_t i, double weigh
 
 // w = M_g (u_i - b_g) - G f_i of sample i (G = 0 when g_sensitivity is null).
 template <typename T>
-void CalibratedGyroRate(const GyroRotationData& data, size_t i, const T* bias, const T* matrix,
-                        const T* g_sensitivity, T* w) {
+GRAVCAL_TURN_INLINE void CalibratedGyroRate(const GyroRotationData& data, size_t i, const T* bias,
+                                            const T* matrix, const T* g_sensitivity, T* w) {
   GyroBlocks<T> gyro;
   gyro.bias = bias;
   gyro.matrix = matrix;
@@ -111,8 +121,8 @@ void CalibratedGyroRate(const GyroRotationData& data, size_t i, const T* bias, c
 // phi_i of step i (the scheme above) from the rates of samples i - 1 .. i + 2
 // (before and after are read only at inner steps).
 template <typename T>
-void GyroStepRotation(const std::vector<double>& t, size_t i, const T* before, const T* a,
-                      const T* b, const T* after, T* phi) {
+GRAVCAL_TURN_INLINE void GyroStepRotation(const std::vector<double>& t, size_t i, const T* before,
+                                          const T* a, const T* b, const T* after, T* phi) {
   const double h = t[i + 1] - t[i];
   double c[4];
   GyroStepWeights(t, i, c);
@@ -196,8 +206,9 @@ void IntegrateGyroRotation(const GyroRotationData& data, const T* bias, const T*
 // Each step costs one sincos(t / 2) (the step's quaternion; 1 - cos t is
 // 2 sin^2(t / 2) from the same value) and, only for steps above 0.01 rad,
 // one sin(t): sin t = 2 sin(t / 2) cos(t / 2) would round differently and
-// change the bits of the fit. The buffers are kept per thread, so a call
-// allocates nothing once a turn that long has been seen.
+// change the bits of the fit. The buffers are kept per thread (or per
+// GyroTurnCache), so a call allocates nothing once a turn that long has been
+// seen.
 inline void SinCos(double x, double* sine, double* cosine) {
 #if defined(__GLIBC__)
   ::sincos(x, sine, cosine);
@@ -207,63 +218,70 @@ inline void SinCos(double x, double* sine, double* cosine) {
 #endif
 }
 
-struct GyroTurnWorkspace {
+// The forward pass of a turn at one set of parameters: the rates w_k, the
+// steps phi_i, their quaternions and sin(|phi_i| / 2), and the turn dq. The
+// backward pass (the Jacobian) needs all of them; a plain evaluation makes
+// them on its way to dq, so a residual that keeps them (GyroTurnCache)
+// spends only the backward pass when the solver then asks for the Jacobian
+// at the same parameters (it does after every accepted step).
+struct GyroTurnForward {
   std::vector<Eigen::Vector3d> w;
+  // The attitude at every sample relative to the first (path[0] = 1).
+  std::vector<Eigen::Vector4d> path;
   std::vector<Eigen::Vector3d> phi;
   std::vector<Eigen::Vector4d> steps;
-  // sin(|phi_i| / 2) of each step, from the forward pass.
+  // sin(|phi_i| / 2) of each step.
   std::vector<double> half_sin;
-  std::vector<Eigen::Matrix3d> h_k;
+  double dq[4] = {1.0, 0.0, 0.0, 0.0};
 };
 
-inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const double* bias,
-                                          const double* matrix, const double* g_sensitivity,
-                                          double* dq, Eigen::Matrix<double, 4, 21>* jacobian) {
-  jacobian->setZero();
+// Fills *f at (bias, matrix, g_sensitivity): the same values, in the same
+// order of operations, as IntegrateGyroRotation<double> (f->dq and f->path
+// have its bits).
+inline void GyroTurnForwardPass(const GyroRotationData& data, const double* bias,
+                                const double* matrix, const double* g_sensitivity,
+                                GyroTurnForward* f) {
+  double* dq = f->dq;
   dq[0] = 1.0;
   dq[1] = dq[2] = dq[3] = 0.0;
   const size_t n = data.t.size();
+  f->path.resize(n);
+  if (n > 0) f->path[0] = Eigen::Vector4d(dq[0], dq[1], dq[2], dq[3]);
   if (n < 2) return;
-  thread_local GyroTurnWorkspace space;
-  if (space.w.size() < n) {
-    space.w.resize(n);
-    space.phi.resize(n);
-    space.steps.resize(n);
-    space.half_sin.resize(n);
-    space.h_k.resize(n);
+  if (f->w.size() < n) {
+    f->w.resize(n);
+    f->phi.resize(n);
+    f->steps.resize(n);
+    f->half_sin.resize(n);
   }
-  std::vector<Eigen::Vector3d>& w = space.w;
-  std::vector<Eigen::Vector3d>& phi = space.phi;
-  std::vector<Eigen::Vector4d>& steps = space.steps;
-  std::vector<double>& half_sin = space.half_sin;
-  std::vector<Eigen::Matrix3d>& h_k = space.h_k;
-  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(matrix);
+  std::vector<Eigen::Vector3d>& w = f->w;
   // The rates w_k, as IntegrateGyroRotation<double> computes them.
   for (size_t k = 0; k < n; ++k) {
     CalibratedGyroRate<double>(data, k, bias, matrix, g_sensitivity, w[k].data());
   }
-  // Forward: the steps phi_i and the turn. The step's quaternion is
+  // The steps phi_i and the turn. The step's quaternion is
   // ceres::AngleAxisToQuaternion's, operation for operation.
   for (size_t i = 0; i + 1 < n; ++i) {
     // Samples i - 1 and i + 2 exist (and are read) only at inner steps.
     const double* before = w[i > 0 ? i - 1 : i].data();
     const double* after = w[i + 2 < n ? i + 2 : i + 1].data();
-    GyroStepRotation<double>(data.t, i, before, w[i].data(), w[i + 1].data(), after, phi[i].data());
-    const double* a = phi[i].data();
+    GyroStepRotation<double>(data.t, i, before, w[i].data(), w[i + 1].data(), after,
+                             f->phi[i].data());
+    const double* a = f->phi[i].data();
     const double theta_squared = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    double* q = steps[i].data();
+    double* q = f->steps[i].data();
     if (theta_squared > 0.0) {
       const double theta = std::sqrt(theta_squared);
       double sine, cosine;
       SinCos(theta * 0.5, &sine, &cosine);
       const double k = sine / theta;
-      half_sin[i] = sine;
+      f->half_sin[i] = sine;
       q[0] = cosine;
       q[1] = a[0] * k;
       q[2] = a[1] * k;
       q[3] = a[2] * k;
     } else {
-      half_sin[i] = 0.0;
+      f->half_sin[i] = 0.0;
       q[0] = 1.0;
       q[1] = a[0] * 0.5;
       q[2] = a[1] * 0.5;
@@ -272,8 +290,24 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
     double next[4];
     ceres::QuaternionProduct(dq, q, next);
     for (int j = 0; j < 4; ++j) dq[j] = next[j];
+    f->path[i + 1] = Eigen::Vector4d(dq[0], dq[1], dq[2], dq[3]);
   }
-  // Backward: S_i and H_k.
+}
+
+// The Jacobian of f.dq (columns as IntegrateGyroRotationJacobian's) from
+// the forward pass *f made at the same parameters.
+inline void GyroTurnBackwardPass(const GyroRotationData& data, const double* bias,
+                                 const double* matrix, const double* g_sensitivity,
+                                 const GyroTurnForward& f, Eigen::Matrix<double, 4, 21>* jacobian) {
+  jacobian->setZero();
+  const size_t n = data.t.size();
+  if (n < 2) return;
+  thread_local std::vector<Eigen::Matrix3d> h_k;
+  if (h_k.size() < n) h_k.resize(n);
+  const std::vector<Eigen::Vector3d>& w = f.w;
+  const std::vector<Eigen::Vector3d>& phi = f.phi;
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(matrix);
+  // S_i and H_k.
   for (size_t k = 0; k < n; ++k) h_k[k].setZero();
   double s[4] = {1.0, 0.0, 0.0, 0.0};
   for (size_t i = n - 1; i-- > 0;) {
@@ -284,7 +318,7 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
       beta = 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0;
     } else {
       const double t = std::sqrt(t2);
-      const double half = half_sin[i];
+      const double half = f.half_sin[i];
       alpha = 2.0 * half * half / t2;
       beta = (t - std::sin(t)) / (t2 * t);
     }
@@ -304,7 +338,7 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
       h_k[i + 2] += c[3] * g;
     }
     double next[4];
-    ceres::QuaternionProduct(steps[i].data(), s, next);
+    ceres::QuaternionProduct(f.steps[i].data(), s, next);
     for (int j = 0; j < 4; ++j) s[j] = next[j];
   }
   // e = E dp, then d dq = dq * (0, e / 2).
@@ -322,6 +356,7 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
     }
   }
   e.leftCols<3>() = -h_sum * m;
+  const double* dq = f.dq;
   const Eigen::Vector3d v(dq[1], dq[2], dq[3]);
   for (int j = 0; j < 21; ++j) {
     const Eigen::Vector3d half = 0.5 * e.col(j);
@@ -330,37 +365,104 @@ inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const do
   }
 }
 
-// The last turn and Jacobian of one rotation, with the parameters they were
-// computed at. A residual is evaluated again at the same parameters (the
-// solver's last step, then the check of the free columns and the
-// covariance): the cache answers those with a comparison. Safe when one
-// rotation is evaluated from several threads.
+// The forward pass buffer of this thread, for the turns no cache keeps.
+inline GyroTurnForward& GyroTurnScratch() {
+  thread_local GyroTurnForward forward;
+  return forward;
+}
+
+inline void IntegrateGyroRotationJacobian(const GyroRotationData& data, const double* bias,
+                                          const double* matrix, const double* g_sensitivity,
+                                          double* dq, Eigen::Matrix<double, 4, 21>* jacobian) {
+  GyroTurnForward& forward = GyroTurnScratch();
+  GyroTurnForwardPass(data, bias, matrix, g_sensitivity, &forward);
+  for (int j = 0; j < 4; ++j) dq[j] = forward.dq[j];
+  GyroTurnBackwardPass(data, bias, matrix, g_sensitivity, forward, jacobian);
+}
+
+// The turn of one rotation at the parameters it was last evaluated at: its
+// forward pass, and its Jacobian once asked for. The solver evaluates a
+// residual at plain values (a trial step) and, when it takes the step, with
+// its Jacobian at the same parameters; then again at the same parameters
+// (the check of the free columns and the covariance). The cache answers
+// those with a comparison, and the Jacobian after a plain evaluation with
+// the backward pass alone; the values are those of an evaluation from
+// scratch, bit for bit. One cache serves one turn's data (t, gyro, force);
+// residuals of several problems on the same turn may share it (the
+// accelerometer effect fit's gyroscope-alone start and its joint solve).
+// The forward pass takes 120 bytes per sample: it is kept only for turns of
+// at most kMaxSamples samples (about 1 MB; 8 s at 1 kHz), so that a long
+// log's turns do not hold their whole length in memory; a longer turn
+// keeps dq and the Jacobian only. Safe when one rotation is evaluated from
+// several threads (they take turns).
 class GyroTurnCache {
  public:
-  // True, with dq and *jacobian set, when key (21 values: b_g, M_g, G) is
-  // the key of the last Store.
-  bool Find(const double* key, double* dq, Eigen::Matrix<double, 4, 21>* jacobian) const {
+  static constexpr size_t kMaxSamples = 8192;
+
+  // dq at key (21 values: b_g, M_g, G; G is used when with_g), with
+  // jacobian not null its Jacobian (IntegrateGyroRotationJacobian's
+  // columns), and with path not null the attitude at every sample
+  // (IntegrateGyroRotation's path, 4 values per sample).
+  void Evaluate(const GyroRotationData& data, const double* key, bool with_g, double* dq,
+                Eigen::Matrix<double, 4, 21>* jacobian, double* path = nullptr) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!valid_ || std::memcmp(key, key_, sizeof(key_)) != 0) return false;
+    const double* g = with_g ? key + 12 : nullptr;
+    if (!valid_ || std::memcmp(key, key_, sizeof(key_)) != 0) {
+      std::memcpy(key_, key, sizeof(key_));
+      valid_ = forward_kept_ = jacobian_valid_ = false;
+    }
+    const bool need_jacobian = jacobian != nullptr && !jacobian_valid_;
+    const GyroTurnForward* f = &forward_;
+    if (!forward_kept_ && (!valid_ || need_jacobian || path != nullptr)) {
+      const bool keep = data.t.size() <= kMaxSamples;
+      GyroTurnForward* target = keep ? &forward_ : &GyroTurnScratch();
+      GyroTurnForwardPass(data, key, key + 3, g, target);
+      std::memcpy(dq_, target->dq, sizeof(dq_));
+      valid_ = true;
+      forward_kept_ = keep;
+      f = target;
+    }
+    if (need_jacobian) {
+      GyroTurnBackwardPass(data, key, key + 3, g, *f, &jacobian_);
+      jacobian_valid_ = true;
+    }
     std::memcpy(dq, dq_, sizeof(dq_));
-    *jacobian = jacobian_;
-    return true;
-  }
-  void Store(const double* key, const double* dq, const Eigen::Matrix<double, 4, 21>& jacobian) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    std::memcpy(key_, key, sizeof(key_));
-    std::memcpy(dq_, dq, sizeof(dq_));
-    jacobian_ = jacobian;
-    valid_ = true;
+    if (jacobian != nullptr) *jacobian = jacobian_;
+    if (path != nullptr) {
+      for (size_t i = 0; i < data.t.size(); ++i) {
+        for (int j = 0; j < 4; ++j) path[4 * i + j] = f->path[i](j);
+      }
+    }
   }
 
  private:
-  mutable std::mutex mutex_;
+  std::mutex mutex_;
+  // key_ and dq_ hold; forward_ is kept for key_; jacobian_ is key_'s.
   bool valid_ = false;
+  bool forward_kept_ = false;
+  bool jacobian_valid_ = false;
   double key_[21] = {};
-  double dq_[4] = {};
+  double dq_[4] = {1.0, 0.0, 0.0, 0.0};
+  GyroTurnForward forward_;
   Eigen::Matrix<double, 4, 21> jacobian_;
 };
+
+// The value part of a parameter (a plain value, or a Jet's).
+inline double TurnScalar(double x) { return x; }
+template <int N>
+double TurnScalar(const ceres::Jet<double, N>& x) {
+  return x.a;
+}
+
+// The key of a turn's cache: (b_g, M_g, G), G = 0 when not estimated.
+template <typename T>
+void GyroTurnKey(const T* bias, const T* matrix, const T* g_sensitivity, double* key) {
+  for (int i = 0; i < 3; ++i) key[i] = TurnScalar(bias[i]);
+  for (int i = 0; i < 9; ++i) {
+    key[3 + i] = TurnScalar(matrix[i]);
+    key[12 + i] = g_sensitivity != nullptr ? TurnScalar(g_sensitivity[i]) : 0.0;
+  }
+}
 
 // IntegrateGyroRotation for Ceres: at plain values, or for automatic
 // differentiation with the derivatives of dq chained from
@@ -368,27 +470,29 @@ class GyroTurnCache {
 // (through `cache` when not null).
 inline void IntegrateGyroTurn(const GyroRotationData& data, const double* bias,
                               const double* matrix, const double* g_sensitivity, double* dq,
-                              GyroTurnCache* /*cache*/ = nullptr) {
-  IntegrateGyroRotation<double>(data, bias, matrix, g_sensitivity, dq);
+                              GyroTurnCache* cache = nullptr) {
+  if (cache == nullptr) {
+    IntegrateGyroRotation<double>(data, bias, matrix, g_sensitivity, dq);
+    return;
+  }
+  double key[21];
+  GyroTurnKey(bias, matrix, g_sensitivity, key);
+  cache->Evaluate(data, key, g_sensitivity != nullptr, dq, nullptr);
 }
 template <int N>
 void IntegrateGyroTurn(const GyroRotationData& data, const ceres::Jet<double, N>* bias,
                        const ceres::Jet<double, N>* matrix,
                        const ceres::Jet<double, N>* g_sensitivity, ceres::Jet<double, N>* dq,
                        GyroTurnCache* cache = nullptr) {
-  // key = (b_g, M_g, G), G = 0 when not estimated.
   double key[21];
-  for (int i = 0; i < 3; ++i) key[i] = bias[i].a;
-  for (int i = 0; i < 9; ++i) {
-    key[3 + i] = matrix[i].a;
-    key[12 + i] = g_sensitivity != nullptr ? g_sensitivity[i].a : 0.0;
-  }
+  GyroTurnKey(bias, matrix, g_sensitivity, key);
   double q[4];
   Eigen::Matrix<double, 4, 21> jacobian;
-  if (cache == nullptr || !cache->Find(key, q, &jacobian)) {
+  if (cache == nullptr) {
     IntegrateGyroRotationJacobian(data, key, key + 3, g_sensitivity != nullptr ? key + 12 : nullptr,
                                   q, &jacobian);
-    if (cache != nullptr) cache->Store(key, q, jacobian);
+  } else {
+    cache->Evaluate(data, key, g_sensitivity != nullptr, q, &jacobian);
   }
   for (int k = 0; k < 4; ++k) {
     dq[k].a = q[k];
