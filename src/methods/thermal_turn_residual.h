@@ -1,12 +1,14 @@
 // methods/thermal_turn_residual.h (private): the residual of one turn
-// between two static poses of a thermal session and the layout of the turn
-// fit's parameters (the equations are in thermal_turns.h).
+// between two static poses of a thermal session, the layout of the turn
+// fit's parameters (the equations are in thermal_turns.h) and the dense
+// Jacobian and covariance helpers of that fit.
 #ifndef GRAVCAL_METHODS_THERMAL_TURN_RESIDUAL_H_
 #define GRAVCAL_METHODS_THERMAL_TURN_RESIDUAL_H_
 
+#include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
-#include <Eigen/Core>
+#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -114,6 +116,37 @@ class TurnResidual final {
   const double inv_sigma_;
   Eigen::Matrix<double, 2, 3> basis_;
 };
+
+// The Jacobian of `problem`'s residuals at its parameters, dense.
+inline Eigen::MatrixXd TurnDenseJacobian(ceres::Problem* problem) {
+  ceres::CRSMatrix crs;
+  problem->Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &crs);
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int at = crs.rows[row]; at < crs.rows[row + 1]; ++at) {
+      j(row, crs.cols[at]) = crs.values[at];
+    }
+  }
+  return j;
+}
+
+// (J^T J)^-1 with column scaling; a direction J leaves open gets an
+// infinite (1e30) variance.
+inline Eigen::MatrixXd TurnScaledInverse(Eigen::MatrixXd j) {
+  Eigen::VectorXd d = j.colwise().norm().transpose();
+  for (int c = 0; c < d.size(); ++c) {
+    if (!(d(c) > 0.0)) d(c) = 1.0;
+    j.col(c) /= d(c);
+  }
+  const Eigen::MatrixXd info = j.transpose() * j;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(info, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(sv.size());
+  for (int i = 0; i < sv.size(); ++i) inv(i) = sv(i) > 1e-12 * sv(0) ? 1.0 / sv(i) : 1e30;
+  return d.cwiseInverse().asDiagonal() *
+         (svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose()) *
+         d.cwiseInverse().asDiagonal();
+}
 
 }  // namespace internal
 }  // namespace gravcal

@@ -41,6 +41,7 @@ constexpr const char* kFrameNames[3] = {"xy", "xz", "yz"};
 // The bound on each fitted entry of N (rad); a fit that reaches half of it
 // does not determine N.
 constexpr double kFrameBound = 0.05;
+constexpr int kFrameIterations = 15;
 
 // The calibrated specific force of a window and the tangent variance of its
 // direction per component (rad^2).
@@ -65,40 +66,10 @@ struct TurnSolve {
   bool ok = false;
   std::vector<double> theta;
   double chi2 = NAN;
+  bool converged = false;
   int residuals = 0;
   Eigen::MatrixXd covariance;
 };
-
-// The Jacobian of `problem`'s residuals at its parameters, dense.
-Eigen::MatrixXd DenseJacobian(ceres::Problem* problem) {
-  ceres::CRSMatrix crs;
-  problem->Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &crs);
-  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
-  for (int row = 0; row < crs.num_rows; ++row) {
-    for (int at = crs.rows[row]; at < crs.rows[row + 1]; ++at) {
-      j(row, crs.cols[at]) = crs.values[at];
-    }
-  }
-  return j;
-}
-
-// (J^T J)^-1 with column scaling; a direction J leaves open gets an
-// infinite (1e30) variance.
-Eigen::MatrixXd ScaledInverse(Eigen::MatrixXd j) {
-  Eigen::VectorXd d = j.colwise().norm().transpose();
-  for (int c = 0; c < d.size(); ++c) {
-    if (!(d(c) > 0.0)) d(c) = 1.0;
-    j.col(c) /= d(c);
-  }
-  const Eigen::MatrixXd info = j.transpose() * j;
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(info, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::VectorXd sv = svd.singularValues();
-  Eigen::VectorXd inv = Eigen::VectorXd::Zero(sv.size());
-  for (int i = 0; i < sv.size(); ++i) inv(i) = sv(i) > 1e-12 * sv(0) ? 1.0 / sv(i) : 1e30;
-  return d.cwiseInverse().asDiagonal() *
-         (svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose()) *
-         d.cwiseInverse().asDiagonal();
-}
 
 // Solves the turn fit of `layout` from `start` (layout.size() values).
 TurnSolve SolveTurns(const std::vector<ThermalTurn>& turns, const std::vector<double>& sigmas,
@@ -131,9 +102,10 @@ TurnSolve SolveTurns(const std::vector<ThermalTurn>& turns, const std::vector<do
   out.chi2 = 2.0 * summary.final_cost;
   out.residuals = problem.NumResiduals();
   out.ok = summary.IsSolutionUsable() && std::isfinite(out.chi2);
+  out.converged = summary.termination_type == ceres::CONVERGENCE;
   for (double v : out.theta) out.ok = out.ok && std::isfinite(v);
   if (!out.ok) return out;
-  const Eigen::MatrixXd inverse = ScaledInverse(DenseJacobian(&problem));
+  const Eigen::MatrixXd inverse = TurnScaledInverse(TurnDenseJacobian(&problem));
   const int dof = out.residuals - size;
   const double factor = dof > 0 ? std::max(1.0, out.chi2 / dof) : 1.0;
   out.covariance = factor * inverse;
@@ -152,7 +124,7 @@ Eigen::MatrixXd TurnJacobian(const std::vector<ThermalTurn>& turns,
     f->SetNumResiduals(2);
     problem.AddResidualBlock(f, nullptr, theta.data());
   }
-  return DenseJacobian(&problem);
+  return TurnDenseJacobian(&problem);
 }
 
 // `theta` of `layout` carried into `wider` (the same orders, more of N's
@@ -354,8 +326,8 @@ void FitThermalTurns(const std::vector<ThermalTurn>& turns, double gyro_noise_va
     if (s.ok && (frame[0] || frame[1] || frame[2])) {
       TurnLayout open;
       open.frame = frame;
-      const Eigen::MatrixXd c =
-          ScaledInverse(TurnJacobian(turns, sigmas, open, WidenTurnTheta(layout, s.theta, open)));
+      const Eigen::MatrixXd c = TurnScaledInverse(
+          TurnJacobian(turns, sigmas, open, WidenTurnTheta(layout, s.theta, open)));
       for (int k = 0, at = open.frame_at(); k < 3; ++k) {
         if (!frame[k]) continue;
         layout.frame[k] = std::sqrt(c(at, at)) < kFrameStdLimit;
@@ -366,9 +338,10 @@ void FitThermalTurns(const std::vector<ThermalTurn>& turns, double gyro_noise_va
     // of N must stay well inside its bound (the entries that do not are
     // considered instead; twice, then none is fitted).
     for (int pass = 0; pass < 3 && layout.frames() > 0; ++pass) {
-      TurnSolve t =
-          SolveTurns(turns, sigmas, layout, TurnStart(layout, from, {}), options.max_iterations);
-      if (!t.ok || pass == 2) {
+      // A determined N converges in a few iterations from the fit without it.
+      TurnSolve t = SolveTurns(turns, sigmas, layout, TurnStart(layout, from, {}),
+                               std::min(options.max_iterations, kFrameIterations));
+      if (!t.ok || !t.converged || pass == 2) {
         layout.frame = {false, false, false};
         break;
       }
@@ -421,8 +394,12 @@ void FitThermalTurns(const std::vector<ThermalTurn>& turns, double gyro_noise_va
     if (options.gyro_misalignment_order > 0) best_score = INFINITY;
     for (int order = 1; order <= misalignment_limit; ++order) {
       layout.misalignment = order;
-      TurnSolve s = SolveTurns(turns, sigmas, layout, TurnStart(layout, from, n_from),
-                               options.max_iterations);
+      // From the chosen scale fit, the misalignment coefficients at 0.
+      const TurnSolve& base = best;
+      std::vector<double> theta(base.theta.begin(), base.theta.begin() + layout.misalignment_at());
+      theta.resize(layout.frame_at(), 0.0);
+      theta.insert(theta.end(), base.theta.begin() + best_layout.frame_at(), base.theta.end());
+      TurnSolve s = SolveTurns(turns, sigmas, layout, theta, options.max_iterations);
       if (!s.ok) break;
       if (options.gyro_misalignment_order >= 0 && order != options.gyro_misalignment_order) {
         continue;
@@ -464,7 +441,7 @@ void FitThermalTurns(const std::vector<ThermalTurn>& turns, double gyro_noise_va
     Eigen::MatrixXd jf(j.rows(), fitted.size()), jc(j.rows(), held.size());
     for (size_t c = 0; c < fitted.size(); ++c) jf.col(c) = j.col(fitted[c]);
     for (size_t c = 0; c < held.size(); ++c) jc.col(c) = j.col(held[c]);
-    const Eigen::MatrixXd k = ScaledInverse(jf) * (jf.transpose() * jc);
+    const Eigen::MatrixXd k = TurnScaledInverse(jf) * (jf.transpose() * jc);
     covariance += kFrameSpread * kFrameSpread * k * k.transpose();
   }
   const double scale = std::cbrt(
