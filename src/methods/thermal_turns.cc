@@ -478,7 +478,7 @@ void FitThermalTurns(const std::vector<ThermalTurn>& turns, double gyro_noise_va
       best, covariance, layout.misalignment_at(), 6, layout.misalignment, max_misalignment,
       how(options.gyro_misalignment_order), half, kMaxScaleChangeStd, &fit->misalignment);
   if (fit->span < ThermalMinimumSpan(1)) {
-    fit->notes.push_back("gyro scale and misalignment against temperature undetermined: the " +
+    fit->notes.push_back("gyro scale against temperature undetermined (and misalignment): the " +
                          std::to_string(fit->turns) + " turns span only " + Num(fit->span, 2) +
                          " degC (a linear term needs " + Num(ThermalMinimumSpan(1), 2) +
                          "); turn the unit between poses at several temperatures");
@@ -533,25 +533,18 @@ void AddThermalTurns(const ImuLog& log, const std::vector<StaticInterval>& inter
     model.gyro.scale = fit.scale;
     model.gyro.misalignment = fit.misalignment;
     if (fit.frame_fitted[0] || fit.frame_fitted[1] || fit.frame_fitted[2]) {
-      // U <- N U (N upper triangular with a unit diagonal keeps U's form;
-      // the static poses' magnitudes do not change to first order), so that
-      // U and M_g share one frame.
-      Eigen::Matrix3d n = Eigen::Matrix3d::Identity();
-      n(0, 1) = fit.frame(0);
-      n(0, 2) = fit.frame(1);
-      n(1, 2) = fit.frame(2);
-      AccelModel& accel = out->accel.model;
-      accel.upper = n * accel.upper;
-      const int row[3] = {0, 0, 1}, col[3] = {1, 2, 2};
+      // M_g is in the frame N U gives. U keeps the static fit's entries
+      // (held at 0, null): verify tests U against check sessions, whose
+      // own fit of those entries does not agree with the turns' N yet
+      // (issue 35 leftover).
       std::ostringstream note;
       note.precision(3);
       note << "accelerometer non-orthogonality, which the static poses leave open, from the turns:";
       for (int k = 0; k < 3; ++k) {
         if (!fit.frame_fitted[k]) continue;
-        out->accel.matrix_std(row[k], col[k]) = fit.frame_std(k) * accel.upper(col[k], col[k]);
         note << " n_" << kFrameNames[k] << " " << fit.frame(k) << " +- " << fit.frame_std(k);
       }
-      note << " rad (in U; M_g is in that frame)";
+      note << " rad (M_g is in the frame N U; U keeps 0 there)";
       fit.notes.push_back(note.str());
     }
     if (fit.frame_considered[0] || fit.frame_considered[1] || fit.frame_considered[2]) {

@@ -20,7 +20,8 @@
 //   e = E (R^T d_s' - d_e') / sigma,   E: 2 x 3 basis orthogonal to d_e
 //   d' = N d / |N d|,   N = [1 n01 n02; 0 1 n12; 0 0 1]
 //
-// N: the accelerometer's non-orthogonality (U's off-diagonal, U <- N U) where
+// N: the accelerometer's non-orthogonality (U's off-diagonal; M_g is in the
+// frame N U, U itself keeps the static fit's 0 there for now) where
 // the static poses leave it open (six faces do: a pose along one axis does
 // not see it, to first order); the turns' angles between the faces measure
 // it (Tedaldi et al. 2014 calibrate the two sensors' frames jointly). An
@@ -130,9 +131,8 @@ void FitThermalTurns(const std::vector<ThermalTurn>& turns, double gyro_noise_va
 // The turns' step of CalibrateThermal: with the static fit in `out`
 // (accelerometer, gyroscope bias and their thermal terms), fits the turns
 // of `log` and, when they determine it, sets out->gyro's matrix and its
-// standard deviations, the gyroscope's scale and misalignment terms and
-// the accelerometer's open non-orthogonality (U <- N U, with its std);
-// adds the notes.
+// standard deviations and the gyroscope's scale and misalignment terms;
+// adds the notes (N among them).
 void AddThermalTurns(const ImuLog& log, const std::vector<StaticInterval>& intervals,
                      const std::vector<ThermalWindow>& windows,
                      const ThermalCalibrationOptions& options, Calibration* out);
