@@ -56,7 +56,8 @@ bool ThermalCalibrationOptions::IsValid(std::string* error) const {
       {"thermal_accel_scale_max_order", accel_scale_max_order},
       {"thermal_accel_misalignment_max_order", accel_misalignment_max_order},
       {"thermal_gyro_bias_max_order", gyro_bias_max_order},
-      {"thermal_gyro_scale_max_order", gyro_scale_max_order}};
+      {"thermal_gyro_scale_max_order", gyro_scale_max_order},
+      {"thermal_gyro_misalignment_max_order", gyro_misalignment_max_order}};
   for (const auto& [key, v] : maxima) {
     if (v < 0 || v > kMaxThermalOrder) {
       return fail(std::string(key) + " must be between 0 and " + std::to_string(kMaxThermalOrder));
@@ -67,7 +68,8 @@ bool ThermalCalibrationOptions::IsValid(std::string* error) const {
       {"thermal_accel_scale_order", accel_scale_order},
       {"thermal_accel_misalignment_order", accel_misalignment_order},
       {"thermal_gyro_bias_order", gyro_bias_order},
-      {"thermal_gyro_scale_order", gyro_scale_order}};
+      {"thermal_gyro_scale_order", gyro_scale_order},
+      {"thermal_gyro_misalignment_order", gyro_misalignment_order}};
   for (const auto& [key, v] : fixed) {
     if (v < -1 || v > kMaxThermalOrder) {
       return fail(std::string(key) + " must be -1 (chosen from the data) or between 0 and " +
@@ -168,7 +170,8 @@ std::vector<std::string> ThermalSpanMessages(double span, const ThermalCalibrati
                                                {"accel scale", o.accel_scale_order},
                                                {"accel misalignment", o.accel_misalignment_order},
                                                {"gyro bias", o.gyro_bias_order},
-                                               {"gyro scale", o.gyro_scale_order}};
+                                               {"gyro scale", o.gyro_scale_order},
+                                               {"gyro misalignment", o.gyro_misalignment_order}};
   for (const auto& [name, order] : fixed) {
     if (order <= supported) continue;
     out.push_back("your session spans " + Degrees(span) + "; the " + OrderName(order) + " " + name +
@@ -494,10 +497,6 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
   }
   if (has_gyro && (options.gyro_scale_max_order > 0 || options.gyro_scale_order > 0)) {
     internal::AddThermalTurns(log, detection.intervals, windows, options, &out);
-  }
-  if (has_gyro) {
-    model.notes.push_back(
-        "gyro misalignment against temperature is not estimated (the turns fit the scale only)");
   }
   if (model.lag_estimated) {
     std::ostringstream s;

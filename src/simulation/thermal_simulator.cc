@@ -57,7 +57,7 @@ bool ThermalSimulatorOptions::IsValid(std::string* error) const {
   }
   for (const std::vector<double>* v :
        {&accel_bias_tempco, &accel_scale_tempco, &accel_misalignment_tempco, &gyro_bias_tempco,
-        &gyro_scale_tempco}) {
+        &gyro_scale_tempco, &gyro_misalignment_tempco}) {
     if (static_cast<int>(v->size()) > kMaxThermalOrder) {
       return fail("thermal simulator: at most " + std::to_string(kMaxThermalOrder) +
                   " temperature coefficients per term");
@@ -137,6 +137,8 @@ bool SimulateThermal(const ThermalSimulatorOptions& o, uint64_t seed,
            &truth.gyro.bias);
   DrawTerm(ThermalSensor::kGyro, ThermalQuantity::kScale, o.gyro_scale_tempco, 1.0, &rng,
            &truth.gyro.scale);
+  DrawTerm(ThermalSensor::kGyro, ThermalQuantity::kMisalignment, o.gyro_misalignment_tempco, 1.0,
+           &rng, &truth.gyro.misalignment);
 
   // The attitude schedule and the recorded temperature against time.
   const std::vector<Eigen::Vector3d> up = PoseDirections(o.poses);

@@ -20,6 +20,10 @@ ThermalDiscovery DiscoverThermal(const ImuLog& log, const ThermalCalibrationOpti
   // the misalignment search is left to calibrate (it keeps the search short).
   options.accel_scale_max_order = std::min(options.accel_scale_max_order, 1);
   options.accel_misalignment_max_order = 0;
+  // Nor does it ask about the gyroscope's scale: no turn fit (its cost is
+  // the turns' integration, several times the static fit's).
+  options.gyro_scale_max_order = 0;
+  options.gyro_scale_order = -1;
   Session session;
   session.log = log;
   Calibration c;

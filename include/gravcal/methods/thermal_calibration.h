@@ -81,11 +81,14 @@ struct ThermalCalibrationOptions {
   // (methods/thermal_turns.h); 0 = off (the gyroscope matrix is then not
   // estimated either).
   int gyro_scale_max_order = 2;
+  // The gyroscope's misalignment(T), from the turns too (with the scale).
+  int gyro_misalignment_max_order = 1;
   int accel_bias_order = -1;
   int accel_scale_order = -1;
   int accel_misalignment_order = -1;
   int gyro_bias_order = -1;
   int gyro_scale_order = -1;
+  int gyro_misalignment_order = -1;
   // Try the first-order lag tau as one more term.
   bool fit_lag = true;
   ThermalOrderSelection selection = ThermalOrderSelection::kBic;

@@ -111,6 +111,9 @@ struct ThermalSimulatorOptions {
   std::vector<double> gyro_bias_tempco = {0.015 * 0.017453292519943295, 3e-4 * 0.017453292519943295,
                                           1e-5 * 0.017453292519943295};
   std::vector<double> gyro_scale_tempco = {3e-4};
+  // The gyroscope's misalignment(T), rad per degC^k (6 components); off by
+  // default.
+  std::vector<double> gyro_misalignment_tempco;
   // The element's lag behind the recorded temperature, s (0 = none).
   double lag_time_constant = 0.0;
 
