@@ -37,7 +37,7 @@ const std::vector<BatchUnit>& Units() {
   static const SessionFiles files{[] {
     std::vector<BatchUnit> out;
     SimulatorOptions sim;
-    sim.scheme = "twelve";
+    sim.scheme = {PoseScheme::kTwelve};
     sim.hold_seconds = 30.0;
     sim.sample_rate = 100.0;
     const std::string prefix =

@@ -95,7 +95,7 @@ void CompareMethods(double misalignment, int seeds) {
     motion.seconds_per_axis = 60.0;
     if (!SimulateMotion(sensor, motion, seed, &rates, &error)) return;
     SimulatorOptions six_sensor = sensor;
-    six_sensor.scheme = "six";
+    six_sensor.scheme = {PoseScheme::kSix};
     six_sensor.hold_seconds = 60.0;
     SimulatedSession faces;
     if (!Simulate(six_sensor, seed, &faces, &error)) return;

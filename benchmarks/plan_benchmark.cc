@@ -15,7 +15,7 @@ namespace {
 void BM_PlanFree(benchmark::State& state) {
   Config config;
   PlanRequest request;
-  request.pose_set = "free";
+  request.pose_set = PoseSet::kFree;
   request.free_candidates = static_cast<int>(state.range(0));
   request.accel_noise_density = 0.002;
   request.targets = state.range(1) == 0

@@ -14,7 +14,7 @@ namespace {
 
 SimulatorOptions Session(double hold_seconds) {
   SimulatorOptions sim;
-  sim.scheme = "ten";
+  sim.scheme = {PoseScheme::kTen};
   sim.hold_seconds = hold_seconds;
   return sim;
 }

@@ -515,7 +515,7 @@ TEST(Simulator, GyroToneIsALineOnOneAxisAndChangesNothingElse) {
 // between axes; the accelerometer and the truth are unchanged.
 TEST(Simulator, ToneOnSeveralAxesAndSlowLine) {
   SimulatorOptions options;
-  options.scheme = "random:1";
+  options.scheme = {PoseScheme::kRandom, 1};
   options.raw_counts = false;
   options.initial_still_seconds = 0.0;
   options.hold_seconds = 400.0;
