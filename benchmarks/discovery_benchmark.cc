@@ -48,7 +48,7 @@ std::vector<Session> MakeSessions(const SimulatorOptions& sim, AccelParameteriza
   return out;
 }
 
-SimulatorOptions WarmUp(const std::string& scheme) {
+SimulatorOptions WarmUp(const SimulatorScheme& scheme) {
   SimulatorOptions o;
   o.scheme = scheme;
   o.temperature_start = 20.0;
@@ -79,7 +79,7 @@ void Run(benchmark::State& state, const std::vector<Session>& sessions) {
 
 void BM_DiscoveryTwelveScaleBaseline(benchmark::State& state) {
   static const std::vector<Session> sessions =
-      MakeSessions(WarmUp("twelve"), AccelParameterization::kScale);
+      MakeSessions(WarmUp({PoseScheme::kTwelve}), AccelParameterization::kScale);
   // The scale baseline misses the truth's non-orthogonality: the first step
   // names accel_misalignment, as it should.
   Run(state, sessions);
@@ -87,7 +87,7 @@ void BM_DiscoveryTwelveScaleBaseline(benchmark::State& state) {
 BENCHMARK(BM_DiscoveryTwelveScaleBaseline)->Unit(benchmark::kMillisecond);
 
 void BM_DiscoveryTwelveNoMisalignmentScaleBaseline(benchmark::State& state) {
-  SimulatorOptions sim = WarmUp("twelve");
+  SimulatorOptions sim = WarmUp({PoseScheme::kTwelve});
   sim.accel_misalignment_std = 0.0;
   static const std::vector<Session> sessions = MakeSessions(sim, AccelParameterization::kScale);
   Run(state, sessions);
@@ -96,13 +96,13 @@ BENCHMARK(BM_DiscoveryTwelveNoMisalignmentScaleBaseline)->Unit(benchmark::kMilli
 
 void BM_DiscoveryTwelveScaleMisalignmentBaseline(benchmark::State& state) {
   static const std::vector<Session> sessions =
-      MakeSessions(WarmUp("twelve"), AccelParameterization::kScaleMisalignment);
+      MakeSessions(WarmUp({PoseScheme::kTwelve}), AccelParameterization::kScaleMisalignment);
   Run(state, sessions);
 }
 BENCHMARK(BM_DiscoveryTwelveScaleMisalignmentBaseline)->Unit(benchmark::kMillisecond);
 
 void BM_DiscoveryRandom24HiddenTemperatureBias(benchmark::State& state) {
-  SimulatorOptions sim = WarmUp("random:24");
+  SimulatorOptions sim = WarmUp({PoseScheme::kRandom, 24});
   sim.effect_std[Effect::kAccelTemperatureBias] = 0.005;
   static const std::vector<Session> sessions =
       MakeSessions(sim, AccelParameterization::kScaleMisalignment);

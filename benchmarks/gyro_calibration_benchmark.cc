@@ -26,7 +26,7 @@ struct Prepared {
   std::vector<StaticInterval> intervals;
 };
 
-Prepared Prepare(const std::string& scheme, uint64_t seed) {
+Prepared Prepare(const SimulatorScheme& scheme, uint64_t seed) {
   SimulatorOptions sim;
   sim.scheme = scheme;
   sim.rotation_profile = "hand";
@@ -52,7 +52,8 @@ void BM_GyroCalibration(benchmark::State& state) {
   const std::atomic<bool> never(false);
   std::optional<internal::ScopedCancelFlag> one_thread;
   if (state.range(2) == 1) one_thread.emplace(&never);
-  const std::string scheme = state.range(0) == 12 ? "twelve" : "random:40";
+  const SimulatorScheme scheme = state.range(0) == 12 ? SimulatorScheme{PoseScheme::kTwelve}
+                                                      : SimulatorScheme{PoseScheme::kRandom, 40};
   std::vector<Prepared> sessions;
   for (uint64_t seed = 1; seed <= 4; ++seed) sessions.push_back(Prepare(scheme, seed));
   GyroCalibrationOptions options;

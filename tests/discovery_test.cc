@@ -233,8 +233,8 @@ TEST(Discovery, InvalidOptionsAndTooFewPositionsFailWithAMessage) {
 // 60 s) so that temperature and time are not alike: with the 120 s of the
 // other tests, the quadratic's residual sometimes tips a bias drift in time
 // ahead of the bias tempco, which that session can barely tell apart.
-constexpr AccelParameterization kMisalignment = AccelParameterization::kScaleMisalignment;
-const DiscoveryOptions kBaselineOnly = [] {
+constexpr AccelParameterization kTwoEffectsModel = AccelParameterization::kScaleMisalignment;
+const DiscoveryOptions kTwoEffectsBaselineOnly = [] {
   DiscoveryOptions o;
   o.max_steps = 0;
   return o;
@@ -254,8 +254,10 @@ TEST(Discovery, FindsTwoHiddenEffectsLargerFirst) {
     const std::vector<Effect> named = run.result.named();
     // The gaps are the baseline's alone: no step is taken (max_steps 0), the
     // same baseline fit and assessment at a fraction of the search's cost.
-    const double gap_a = Discover(a, seed, kMisalignment, kBaselineOnly).result.baseline.gap.accel;
-    const double gap_b = Discover(b, seed, kMisalignment, kBaselineOnly).result.baseline.gap.accel;
+    const double gap_a =
+        Discover(a, seed, kTwoEffectsModel, kTwoEffectsBaselineOnly).result.baseline.gap.accel;
+    const double gap_b =
+        Discover(b, seed, kTwoEffectsModel, kTwoEffectsBaselineOnly).result.baseline.gap.accel;
     const Effect larger = gap_a > gap_b ? Effect::kAccelTemperatureBias : Effect::kAccelQuadratic;
     const bool has_both =
         Contains(named, Effect::kAccelTemperatureBias) && Contains(named, Effect::kAccelQuadratic);
