@@ -51,6 +51,16 @@ ceres::Solver::Options SolverOptions(const SolverTolerances& tolerances,
   return options;
 }
 
+SolverTolerances CeresDefaultTolerances(int max_iterations) {
+  const ceres::Solver::Options defaults;
+  SolverTolerances t;
+  t.max_iterations = max_iterations;
+  t.function_tolerance = defaults.function_tolerance;
+  t.gradient_tolerance = defaults.gradient_tolerance;
+  t.parameter_tolerance = defaults.parameter_tolerance;
+  return t;
+}
+
 int SingleCalibrationThreads() {
   if (ThreadCancelFlag() != nullptr) return 1;
   const unsigned cores = std::thread::hardware_concurrency();

@@ -16,6 +16,11 @@ namespace internal {
 ceres::Solver::Options SolverOptions(const SolverTolerances& tolerances,
                                      ceres::LinearSolverType linear_solver);
 
+// Ceres' own default stopping rules (read from ceres::Solver::Options) with
+// `max_iterations`: for fits whose options give only an iteration limit
+// (the thermal fits, the multi-IMU joint fit).
+SolverTolerances CeresDefaultTolerances(int max_iterations);
+
 // Threads for the solver of a single calibration: the machine's (at most 4)
 // when called from a thread of its own, 1 inside a batch worker (a thread
 // with a cancellation flag, util/cancellation.h), which already runs one

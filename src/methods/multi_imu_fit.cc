@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 
+#include "estimation/solver_settings.h"
 #include "gravcal/core/imu_model.h"
 #include "methods/multi_imu_internal.h"
 
@@ -178,11 +179,8 @@ bool Fit(const std::vector<PlateImuData>& data, const std::vector<int>& members,
       row_turns[m].push_back(&turn);
     }
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = max_iterations;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options options =
+      internal::SolverOptions(internal::CeresDefaultTolerances(max_iterations), ceres::DENSE_QR);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   if (!summary.IsSolutionUsable()) {

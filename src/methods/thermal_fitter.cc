@@ -9,6 +9,8 @@
 #include <map>
 #include <sstream>
 
+#include "estimation/solver_settings.h"
+
 namespace gravcal {
 namespace internal {
 namespace {
@@ -318,11 +320,8 @@ bool ThermalFitter::Solve(const ThermalLayout& layout, const std::vector<double>
     fit->theta[layout.lag] = std::max(0.0, fit->theta[layout.lag]);
     problem.SetParameterLowerBound(fit->theta.data(), layout.lag, 0.0);
   }
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = o_.max_iterations;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
+  const ceres::Solver::Options so =
+      internal::SolverOptions(internal::CeresDefaultTolerances(o_.max_iterations), ceres::DENSE_QR);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
   fit->residuals = static_cast<int>(problem.NumResiduals());

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "estimation/solver_settings.h"
 #include "methods/thermal_turn_residual.h"
 
 namespace gravcal {
@@ -92,11 +93,8 @@ TurnSolve SolveTurns(const std::vector<ThermalTurn>& turns, const std::vector<do
     problem.SetParameterLowerBound(out.theta.data(), layout.frame_at() + k, -kFrameBound);
     problem.SetParameterUpperBound(out.theta.data(), layout.frame_at() + k, kFrameBound);
   }
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = max_iterations;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
+  const ceres::Solver::Options so =
+      internal::SolverOptions(internal::CeresDefaultTolerances(max_iterations), ceres::DENSE_QR);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
   out.chi2 = 2.0 * summary.final_cost;
