@@ -11,17 +11,13 @@
 #include <sstream>
 
 #include "estimation/solver_settings.h"
+#include "gravcal/methods/gyro_calibration.h"
 #include "methods/thermal_turn_residual.h"
 
 namespace gravcal {
 namespace internal {
 namespace {
 
-// A static interval's edge included in the turns, s (as the rotations
-// gyroscope calibration's edge_seconds).
-constexpr double kTurnEdgeSeconds = 0.5;
-// A gap longer than this between two poses is not a turn, s.
-constexpr double kLongestTurnSeconds = 60.0;
 // Turns needed at least: two rows each beside M_g's 9 entries.
 constexpr int kMinTurns = 6;
 // A parameter whose standard deviation exceeds this share of the scale
@@ -151,6 +147,10 @@ std::vector<ThermalTurn> ThermalTurns(const ImuLog& log,
   if (!log.has_gyro() || !log.has_temperature() || log.size() < 2) return turns;
   const double h = (log.t.back() - log.t.front()) / static_cast<double>(log.size() - 1);
   const ThermalBlocks<double> gyro = model.Blocks(ThermalSensor::kGyro);
+  // A static interval's edge included in a turn, and the longest gap
+  // between two poses that is a turn: the rotations gyroscope calibration's
+  // defaults (edge_seconds, max_rotation_seconds).
+  const GyroCalibrationOptions turn_defaults;
   for (size_t k = 0; k + 1 < intervals.size(); ++k) {
     const ThermalWindow* before = nullptr;
     const ThermalWindow* after = nullptr;
@@ -161,10 +161,12 @@ std::vector<ThermalTurn> ThermalTurns(const ImuLog& log,
     if (before == nullptr || after == nullptr) continue;
     const StaticInterval& s = intervals[k];
     const StaticInterval& e = intervals[k + 1];
-    const size_t edge = static_cast<size_t>(std::round(kTurnEdgeSeconds / std::max(h, 1e-9)));
+    const size_t edge =
+        static_cast<size_t>(std::round(turn_defaults.edge_seconds / std::max(h, 1e-9)));
     const size_t a = s.end - std::min(edge, s.count() / 4) - 1;
     const size_t b = e.begin + std::min(edge, e.count() / 4);
-    if (b <= a + 1 || b >= log.size() || log.t[b] - log.t[a] > kLongestTurnSeconds) continue;
+    if (b <= a + 1 || b >= log.size() || log.t[b] - log.t[a] > turn_defaults.max_rotation_seconds)
+      continue;
     ThermalTurn turn;
     double vs = 0.0, ve = 0.0;
     turn.from = WindowDirection(*before, accel, model, &vs);
