@@ -319,7 +319,8 @@ void FitThermalTurns(const std::vector<ThermalTurn>& turns, double gyro_noise_va
   // considered in the covariance below.
   {
     TurnSolve s =
-        SolveTurns(turns, sigmas, layout, TurnStart(layout, from, {}), options.max_iterations);
+        SolveTurns(turns, sigmas, layout, TurnStart(layout, from, Eigen::Vector3d::Zero()),
+                   options.max_iterations);
     if (s.ok) {
       for (int i = 0; i < 9; ++i) from(i / 3, i % 3) = s.theta[i];
     }
@@ -339,8 +340,9 @@ void FitThermalTurns(const std::vector<ThermalTurn>& turns, double gyro_noise_va
     // considered instead; twice, then none is fitted).
     for (int pass = 0; pass < 3 && layout.frames() > 0; ++pass) {
       // A determined N converges in a few iterations from the fit without it.
-      TurnSolve t = SolveTurns(turns, sigmas, layout, TurnStart(layout, from, {}),
-                               std::min(options.max_iterations, kFrameIterations));
+      TurnSolve t =
+          SolveTurns(turns, sigmas, layout, TurnStart(layout, from, Eigen::Vector3d::Zero()),
+                     std::min(options.max_iterations, kFrameIterations));
       if (!t.ok || !t.converged || pass == 2) {
         layout.frame = {false, false, false};
         break;

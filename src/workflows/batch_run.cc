@@ -22,8 +22,11 @@ double Seconds(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
 }
 
-// One unit's place in the run.
-struct Slot {
+}  // namespace
+
+// One unit's place in the run (outside the anonymous namespace: State,
+// declared in the header, holds these).
+struct BatchSlot {
   // Held while a callback of the caller runs for this unit, and to abandon
   // it: an abandoned unit gets no callback after that.
   std::mutex callback;
@@ -35,8 +38,6 @@ struct Slot {
   size_t worker = 0;
   std::atomic<bool> cancel{false};
 };
-
-}  // namespace
 
 struct BatchRun::State {
   State(const std::vector<BatchUnit>& u, const Config& b, const BatchOptions& o,
@@ -53,7 +54,7 @@ struct BatchRun::State {
 
   std::mutex mutex;
   std::condition_variable changed;
-  std::vector<Slot> slots;
+  std::vector<BatchSlot> slots;
   size_t next = 0;
   // Workers that have not exited and are not abandoned.
   size_t active = 0;
@@ -118,13 +119,13 @@ void Worker(std::shared_ptr<State> state, size_t worker) {
         return;
       }
       i = state->next++;
-      Slot& slot = state->slots[i];
+      BatchSlot& slot = state->slots[i];
       slot.started = true;
       slot.start = Clock::now();
       slot.worker = worker;
       unit = state->units[i];  // A copy: the caller's may be gone when we are late.
     }
-    Slot& slot = state->slots[i];
+    BatchSlot& slot = state->slots[i];
     const std::shared_ptr<const Config> base = state->base;
     BatchResult r;
     // The caller's skip, unless the unit has been abandoned meanwhile.
@@ -180,7 +181,7 @@ namespace {
 // worker is inside a callback for it (try again later).
 bool Abandon(const std::shared_ptr<State>& state, size_t i, bool timed_out, double running) {
   State& s = *state;
-  Slot& slot = s.slots[i];
+  BatchSlot& slot = s.slots[i];
   std::unique_lock<std::mutex> callback(slot.callback, std::try_to_lock);
   if (!callback.owns_lock()) return false;
   slot.abandoned = true;
@@ -239,7 +240,7 @@ void BatchRun::Run(int threads) {
     }
     const bool grace_over = stopping && Seconds(stop_time, now) > options.stop_grace_seconds;
     for (size_t i = 0; i < s.slots.size(); ++i) {
-      const Slot& slot = s.slots[i];
+      const BatchSlot& slot = s.slots[i];
       if (!slot.started || slot.finished) continue;
       const double running = Seconds(slot.start, now);
       const bool timed_out =
