@@ -72,6 +72,21 @@ TEST(Config, SetsValuesFromText) {
   EXPECT_DOUBLE_EQ(config.calibration.gravity.gravity, 9.81);
 }
 
+// A list typed as on a command line (--columns t,ax,ay,az) is the list of
+// its names; an empty name is refused with where it is.
+TEST(Config, ANameListTakesCommasAsOnACommandLine) {
+  Config config;
+  std::string error;
+  ASSERT_TRUE(SetConfigValue("columns", "t, ax,ay ,az", &config, &error)) << error;
+  EXPECT_EQ(config.input.columns, (std::vector<std::string>{"t", "ax", "ay", "az"}));
+  ASSERT_TRUE(SetConfigValue("columns", "[t, ax, ay, az]", &config, &error)) << error;
+  EXPECT_EQ(config.input.columns.size(), 4u);
+  EXPECT_FALSE(SetConfigValue("columns", "t,,ax", &config, &error));
+  EXPECT_NE(error.find("empty name at character 3"), std::string::npos) << error;
+  EXPECT_FALSE(SetConfigValue("columns", "t,ax,", &config, &error));
+  EXPECT_EQ(config.input.columns.size(), 4u) << "left unchanged";
+}
+
 TEST(Config, UnknownKeyNamesFileLineAndKey) {
   Config config;
   std::string error;

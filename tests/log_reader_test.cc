@@ -322,6 +322,14 @@ TEST(LogReader, BadInputNamesFileLineAndColumn) {
        {"mem.csv:1:", "'gz'", "gx, gy"}},
       {"no time", "ax,ay,az\n1,2,3\n", {}, {"mem.csv:1:", "no column 't'", "sample_rate"}},
       {"duplicate column", "t,ax,ay,az,ax\n0,1,2,3,4\n", {}, {"mem.csv:1:", "'ax'", "twice"}},
+      {"no header row",
+       "0,1,2,3\n1,1,2,3\n",
+       {},
+       {"mem.csv:1:", "no column 'ax'", "no header row", "4 columns"}},
+      {"no header row, space separated",
+       "# t ax ay az\n0 1.5 -2e-3 3\n1 1 2 3\n",
+       {},
+       {"mem.csv:2:", "no header row", "4 columns", "--format whitespace"}},
       {"whitespace field count",
        "0 1 2 3\n1 1 2\n",
        WhitespaceOptions({"t", "ax", "ay", "az"}),
@@ -353,6 +361,21 @@ TEST(LogReader, BadInputNamesFileLineAndColumn) {
     EXPECT_EQ(log.source, "untouched") << c.label;
     ExpectSameBits(before, log);
   }
+}
+
+// With `columns` given, a CSV file's first line is its header row and is
+// skipped, unless it is numbers: then it is the first sample, not lost.
+TEST(LogReader, ColumnsGivenKeepAFirstLineOfNumbers) {
+  LogReaderOptions options;
+  options.columns = {"t", "ax", "ay", "az"};
+  ImuLog log;
+  std::string error;
+  ASSERT_TRUE(Parse("0,1,2,3\n0.1,4,5,6\n", options, &log, &error)) << error;
+  ASSERT_EQ(log.size(), 2u);
+  EXPECT_EQ(log.accel[0].x(), 1.0);
+  ASSERT_TRUE(Parse("time,a,b,c\n0,1,2,3\n0.1,4,5,6\n", options, &log, &error)) << error;
+  ASSERT_EQ(log.size(), 2u) << "a header row of names is still skipped";
+  EXPECT_EQ(log.accel[0].x(), 1.0);
 }
 
 TEST(LogReader, UnreadableFileNamesTheFile) {

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <system_error>
 #include <utility>
@@ -233,6 +234,28 @@ bool LogLines::Next(std::string_view* line, std::string* error) {
 
 // --- LogRowParser ------------------------------------------------------------
 
+namespace {
+
+// Whether every comma-separated cell of [begin, end) is a number: a first
+// line that a CSV file with `columns` given holds as data, not as a header.
+bool CellsAreNumbers(const char* begin, const char* end) {
+  while (begin <= end) {
+    const char* comma = std::find(begin, end, ',');
+    std::string cell(begin, comma);
+    const size_t first = cell.find_first_not_of(" \t\r");
+    const size_t last = cell.find_last_not_of(" \t\r");
+    if (first == std::string::npos) return false;
+    cell = cell.substr(first, last - first + 1);
+    char* stop = nullptr;
+    std::strtod(cell.c_str(), &stop);
+    if (stop != cell.c_str() + cell.size()) return false;
+    begin = comma + 1;
+  }
+  return true;
+}
+
+}  // namespace
+
 LogRowParser::LogRowParser(std::string name, const LogReaderOptions& options, bool gyro_file)
     : name_(std::move(name)),
       options_(options),
@@ -254,9 +277,10 @@ bool LogRowParser::Line(std::string_view text, size_t line, bool* row, std::stri
   if (!have_layout_) {
     if (!BuildLayout(s, end, line, error)) return false;
     have_layout_ = true;
-    // A CSV file always has a header row; with `columns` given it is
-    // skipped and `columns` names the fields instead.
-    if (csv) return true;
+    // A CSV file has a header row; with `columns` given it is skipped and
+    // `columns` names the fields instead, unless that first line is numbers:
+    // then the file has no header row and the line is the first sample.
+    if (csv && (columns_.empty() || !CellsAreNumbers(s, end))) return true;
   }
   const bool ok = ParseFields(s, end, line, error);
   if (!ok || !CheckTime(line, error)) return false;
@@ -311,7 +335,33 @@ bool LogRowParser::BuildLayout(const char* begin, const char* end, size_t line,
                                std::to_string(names.size()) + " columns; a log has at most " +
                                std::to_string(kMaxLogColumns));
   }
-  const std::string listing = std::string(source) + ": " + JoinNames(names);
+  std::string listing = std::string(source) + ": " + JoinNames(names);
+  // A first line of numbers is a log without a header row: say so, with
+  // the way to name its columns (and its separator, when the numbers are
+  // apart by spaces in a comma-separated read).
+  if (columns_.empty()) {
+    size_t numbers = 0;
+    bool spaced = false, only_numbers = !names.empty();
+    for (const std::string& name : names) {
+      size_t from = name.find_first_not_of(" \t");
+      if (from == std::string::npos) only_numbers = false;
+      while (only_numbers && from != std::string::npos) {
+        const size_t to = std::min(name.find_first_of(" \t", from), name.size());
+        const std::string token = name.substr(from, to - from);
+        char* stop = nullptr;
+        std::strtod(token.c_str(), &stop);
+        if (stop != token.c_str() + token.size()) only_numbers = false;
+        ++numbers;
+        from = name.find_first_not_of(" \t", to);
+        spaced = spaced || from != std::string::npos;
+      }
+    }
+    if (only_numbers) {
+      listing += " (numbers, not names: the log has no header row; name its " +
+                 std::to_string(numbers) + " columns with the columns key, e.g. --columns " +
+                 "t,ax,ay,az,..." + (spaced ? ", and give --format whitespace" : "") + ")";
+    }
+  }
   const std::string where = LogWhere(name_, line);
 
   slot_of_field_.assign(names.size(), -1);

@@ -1,4 +1,5 @@
 // YAML value readers and printers shared by the config sections.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -76,11 +77,33 @@ bool ReadStringList(const YAML::Node& n, std::vector<std::string>* v, std::strin
     v->clear();
     return true;
   }
+  std::vector<std::string> out;
+  // A scalar with commas is the list written as on a command line
+  // (--columns t,ax,ay,az): its names, split at the commas.
+  if (n.IsScalar() && n.Scalar().find(',') != std::string::npos) {
+    const std::string& text = n.Scalar();
+    for (size_t from = 0;;) {
+      const size_t comma = std::min(text.find(',', from), text.size());
+      const size_t first = text.find_first_not_of(" \t", from);
+      const size_t last = text.find_last_not_of(" \t", comma == 0 ? 0 : comma - 1);
+      if (first >= comma || last == std::string::npos || last < first) {
+        *error =
+            "must be a list of names, e.g. [t, ax, ay, az] or t,ax,ay,az (an empty name at "
+            "character " +
+            std::to_string(from + 1) + ")";
+        return false;
+      }
+      out.push_back(text.substr(first, last - first + 1));
+      if (comma == text.size()) break;
+      from = comma + 1;
+    }
+    *v = out;
+    return true;
+  }
   if (!n.IsSequence()) {
-    *error = "must be a list, e.g. [t, ax, ay, az]";
+    *error = "must be a list, e.g. [t, ax, ay, az] (or t,ax,ay,az)";
     return false;
   }
-  std::vector<std::string> out;
   for (const YAML::Node& e : n) {
     if (!e.IsScalar()) {
       *error = "must be a list of names";
