@@ -4,8 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <random>
 
@@ -30,6 +33,34 @@ using testing_util::kTemperatureScale;
 constexpr double kGSensitivity = 9e-5;
 constexpr double kGyroTemperatureBias = 1.7e-4;
 constexpr double kGyroDrift = 1e-5;
+
+// The session the hidden effects are looked for in: the warm-up of
+// test_util.h with 26 random poses. 26, not 24: the richest accelerometer
+// model of the catalogue (the baseline's 9 parameters and five 3-parameter
+// effects) has 24 parameters, so 26 poses keep the magnitudes the
+// min_dof (2) residual degrees of freedom that let them test every
+// candidate on their own, and discovery leaves the rotations between poses
+// out of these fits (discovery.cc, CheckRotations); with 24 poses every fit
+// integrated every turn, 5-15 times the CPU, for decisions the magnitudes
+// and trends make. The rotations' decisions are the twelve-pose tests'
+// (discovery_twelve_poses_test.cc), where the magnitudes cannot make them.
+SimulatorOptions DiscoverySession() {
+  SimulatorOptions o = testing_util::WarmUpSession();
+  o.scheme.random_poses = 26;
+  return o;
+}
+
+// The seeds a test runs: 1..count, or GRAVCAL_DISCOVERY_SEEDS="F:N" (seeds
+// F..F+N-1; the rates recorded beside the thresholds were measured with
+// 1001:200).
+void DiscoverySeeds(int count, int* first, int* n) {
+  *first = 1;
+  *n = count;
+  const char* value = std::getenv("GRAVCAL_DISCOVERY_SEEDS");
+  if (value == nullptr || std::strchr(value, ':') == nullptr) return;
+  *first = std::atoi(value);
+  *n = std::max(1, std::atoi(std::strchr(value, ':') + 1));
+}
 
 struct Outcome {
   DiscoveryResult result;
@@ -63,7 +94,9 @@ struct Tally {
 Tally RunSeeds(const SimulatorOptions& sim, int seeds, Effect expected,
                AccelParameterization p = AccelParameterization::kScaleMisalignment) {
   Tally t;
-  for (int seed = 1; seed <= seeds; ++seed) {
+  int first = 1;
+  DiscoverySeeds(seeds, &first, &seeds);
+  for (int seed = first; seed < first + seeds; ++seed) {
     const Outcome run = Discover(sim, seed, p);
     ++t.seeds;
     const std::vector<Effect> named = run.result.named();
@@ -93,8 +126,11 @@ Tally RunSeeds(const SimulatorOptions& sim, int seeds, Effect expected,
 // (testing_util::RequiredSuccesses): an honest workflow fails a test with
 // probability below 0.001. The per-seed probabilities are stated per test:
 // the one-sided 99.9 % lower confidence bound of the rate measured on seeds
-// 1001-1200 (not the test's), recorded next to each.
+// 1001-1200 (not the test's; GRAVCAL_DISCOVERY_SEEDS=1001:200), recorded
+// next to each. Measured 2026-11-28 on DiscoverySession's 26 poses; the
+// rates of the 24-pose session before are in brackets where they differ.
 void ExpectFound(const Tally& t, double p_named_first, double p_cv_halved) {
+  std::printf("named first %d, cv halved %d of %d\n", t.named_first, t.cv_halved, t.seeds);
   EXPECT_GE(t.named_first, testing_util::RequiredSuccesses(t.seeds, p_named_first))
       << t.named_first << " of " << t.seeds;
   EXPECT_GE(t.cv_halved, testing_util::RequiredSuccesses(t.seeds, p_cv_halved))
@@ -104,69 +140,77 @@ void ExpectFound(const Tally& t, double p_named_first, double p_cv_halved) {
 constexpr int kSeeds = 20;
 
 TEST(Discovery, FindsAccelQuadraticNonlinearity) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.effect_std[Effect::kAccelQuadratic] = kQuadratic;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelQuadratic),
-              /*197 of 200*/ 0.92, /*188 of 200*/ 0.86);
+              /*198 (197) of 200*/ 0.92, /*187 (188) of 200*/ 0.86);
 }
 
 TEST(Discovery, FindsAccelTemperatureBias) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.effect_std[Effect::kAccelTemperatureBias] = kTemperatureBias;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelTemperatureBias),
-              /*199 of 200*/ 0.94, /*198 of 200*/ 0.93);
+              /*200 (199) of 200*/ 0.94, /*200 (198) of 200*/ 0.93);
 }
 
 TEST(Discovery, FindsAccelTemperatureScale) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.effect_std[Effect::kAccelTemperatureScale] = kTemperatureScale;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelTemperatureScale),
-              /*190 of 200*/ 0.87, /*174 of 200*/ 0.77);
+              /*192 (190) of 200*/ 0.87, /*169 (174) of 200*/ 0.75);
 }
 
 TEST(Discovery, FindsAccelBiasDrift) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.effect_std[Effect::kAccelBiasDrift] = kBiasDrift;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelBiasDrift),
-              /*194 of 200*/ 0.90, /*193 of 200*/ 0.89);
+              /*199 (194) of 200*/ 0.90, /*197 (193) of 200*/ 0.89);
 }
 
 TEST(Discovery, FindsAccelMisalignmentMissingFromScaleBaseline) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kAccelMisalignment, AccelParameterization::kScale),
               /*200 of 200*/ 0.95, /*200 of 200*/ 0.95);
 }
 
 TEST(Discovery, FindsGyroGSensitivity) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.effect_std[Effect::kGyroGSensitivity] = kGSensitivity;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroGSensitivity),
-              /*200 of 200*/ 0.95, /*199 of 200*/ 0.94);
+              /*200 of 200*/ 0.95, /*200 (199) of 200*/ 0.94);
 }
 
 TEST(Discovery, FindsGyroTemperatureBias) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.effect_std[Effect::kGyroTemperatureBias] = kGyroTemperatureBias;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroTemperatureBias),
-              /*200 of 200*/ 0.95, /*199 of 200*/ 0.94);
+              /*200 of 200*/ 0.95, /*200 (199) of 200*/ 0.94);
 }
 
 TEST(Discovery, FindsGyroBiasDrift) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.effect_std[Effect::kGyroBiasDrift] = kGyroDrift;
   ExpectFound(RunSeeds(sim, kSeeds, Effect::kGyroBiasDrift),
-              /*200 of 200*/ 0.95, /*198 of 200*/ 0.93);
+              /*200 of 200*/ 0.95, /*199 (198) of 200*/ 0.93);
 }
 
 TEST(Discovery, NamesNothingWithoutHiddenEffect) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   Tally t;
-  for (int seed = 1; seed <= kSeeds; ++seed) {
+  int first = 1, seeds = kSeeds;
+  DiscoverySeeds(kSeeds, &first, &seeds);
+  for (int seed = first; seed < first + seeds; ++seed) {
     const Outcome run = Discover(sim, seed);
     ++t.seeds;
     if (run.result.named().empty()) {
       ++t.named_nothing;
-      EXPECT_EQ(run.result.verdict, "no significant missing effect");
+      // The verdict may go on to say that a sensor's static means exceed
+      // their noise (a test at 1e-3 per sensor: seed 9 of these 20 sessions,
+      // none of seeds 1001-1200), but it names nothing.
+      if (run.result.verdict != "no significant missing effect")
+        std::printf("seed %d: %s\n", seed, run.result.verdict.c_str());
+      EXPECT_EQ(run.result.verdict.rfind("no significant missing effect", 0), 0u)
+          << "seed " << seed << ": " << run.result.verdict;
     } else {
       std::printf("seed %d: false discovery %s\n", seed, ToString(run.result.named().front()));
     }
@@ -174,6 +218,7 @@ TEST(Discovery, NamesNothingWithoutHiddenEffect) {
   // Each step names an effect only below a family-wise significance of
   // 0.01 (and a BIC gain): a session without a hidden effect names nothing
   // with probability at least 0.99 (measured: 200 of 200 on seeds 1001-1200).
+  std::printf("named nothing %d of %d\n", t.named_nothing, t.seeds);
   EXPECT_GE(t.named_nothing, testing_util::RequiredSuccesses(t.seeds, 0.99))
       << t.named_nothing << " of " << t.seeds;
 }
@@ -181,7 +226,7 @@ TEST(Discovery, NamesNothingWithoutHiddenEffect) {
 // A log with neither gyroscope nor temperature: the effects that need them
 // are not tried, with a warning naming why, and the rest still work.
 TEST(Discovery, SaysWhatALogWithoutGyroscopeOrTemperatureCannotTest) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.effect_std[Effect::kAccelQuadratic] = kQuadratic;
   SimulatedSession session;
   std::string error;
@@ -241,15 +286,17 @@ const DiscoveryOptions kTwoEffectsBaselineOnly = [] {
 }();
 
 TEST(Discovery, FindsTwoHiddenEffectsLargerFirst) {
-  SimulatorOptions a = testing_util::WarmUpSession();
+  SimulatorOptions a = DiscoverySession();
   a.temperature_tau = 60.0;
   a.effect_std[Effect::kAccelTemperatureBias] = 3.0 * kTemperatureBias;
-  SimulatorOptions b = testing_util::WarmUpSession();
+  SimulatorOptions b = DiscoverySession();
   b.effect_std[Effect::kAccelQuadratic] = 1.5 * kQuadratic;
   SimulatorOptions both = a;
   both.effect_std[Effect::kAccelQuadratic] = b.effect_std[Effect::kAccelQuadratic];
   int found = 0, in_order = 0;
-  for (int seed = 1; seed <= kSeeds; ++seed) {
+  int first = 1, seeds = kSeeds;
+  DiscoverySeeds(kSeeds, &first, &seeds);
+  for (int seed = first; seed < first + seeds; ++seed) {
     const Outcome run = Discover(both, seed);
     const std::vector<Effect> named = run.result.named();
     // The gaps are the baseline's alone: no step is taken (max_steps 0), the
@@ -268,11 +315,12 @@ TEST(Discovery, FindsTwoHiddenEffectsLargerFirst) {
                   run.result.verdict.c_str());
     }
   }
-  // Measured on seeds 1001-1200: both named in 199, in order in 186 of 200
-  // (lower 99.9 % bounds 0.94 and 0.85).
-  EXPECT_GE(found, testing_util::RequiredSuccesses(kSeeds, 0.94)) << found << " of " << kSeeds;
-  EXPECT_GE(in_order, testing_util::RequiredSuccesses(kSeeds, 0.85))
-      << in_order << " of " << kSeeds;
+  // Measured on seeds 1001-1200: both named in 199, in order in 183 (186
+  // with 24 poses) of 200 (lower 99.9 % bounds 0.94 and 0.83; 11 of 20 in
+  // order either way).
+  std::printf("both named %d, in order %d of %d\n", found, in_order, seeds);
+  EXPECT_GE(found, testing_util::RequiredSuccesses(seeds, 0.94)) << found << " of " << seeds;
+  EXPECT_GE(in_order, testing_util::RequiredSuccesses(seeds, 0.83)) << in_order << " of " << seeds;
 }
 
 // A slow, monotonic warm-up (time constant 3000 s over a 5-minute session):
@@ -280,12 +328,13 @@ TEST(Discovery, FindsTwoHiddenEffectsLargerFirst) {
 // temperature and one linear in time fit the data equally. The report must
 // say so, with advice, instead of silently picking one.
 TEST(Discovery, ReportsTemperatureVersusTimeAmbiguityInMonotonicWarmUp) {
-  SimulatorOptions sim = testing_util::WarmUpSession();
+  SimulatorOptions sim = DiscoverySession();
   sim.temperature_tau = 3000.0;
   sim.effect_std[Effect::kAccelTemperatureBias] = 5.0 * kTemperatureBias;
   int reported = 0;
-  const int seeds = 10;
-  for (int seed = 1; seed <= seeds; ++seed) {
+  int first = 1, seeds = 10;
+  DiscoverySeeds(10, &first, &seeds);
+  for (int seed = first; seed < first + seeds; ++seed) {
     const Outcome run = Discover(sim, seed);
     bool found = false;
     for (const Ambiguity& a : run.result.ambiguous) {
@@ -299,8 +348,9 @@ TEST(Discovery, ReportsTemperatureVersusTimeAmbiguityInMonotonicWarmUp) {
       EXPECT_NE(run.result.verdict.find("cannot tell them apart"), std::string::npos);
     }
   }
-  // Measured on seeds 1001-1200: reported in 197 of 200 (lower 99.9 % bound
-  // 0.92).
+  // Measured on seeds 1001-1200: reported in 199 (197 with 24 poses) of 200
+  // (lower 99.9 % bound 0.92).
+  std::printf("reported %d of %d\n", reported, seeds);
   EXPECT_GE(reported, testing_util::RequiredSuccesses(seeds, 0.92)) << reported << " of " << seeds;
 }
 
