@@ -98,6 +98,12 @@ bool RunCalibration(const Config& config, const SessionFiles& files, Session* se
     internal::AddWarning(WarningCode::kSensorData,
                          internal::PrefixSource(session->log.source, convention),
                          &calibration->warnings, &calibration->warning_codes);
+    // A filter that ran away on such a log did so for that reason first.
+    if (!ok && calibration->not_converged) {
+      calibration->message +=
+          "; first fix the gyroscope's axis convention (the warning above names it): "
+          "integrated with the wrong signs, the turns diverge";
+    }
   }
   return ok;
 }
