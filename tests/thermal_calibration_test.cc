@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 #include "gravcal/simulation/thermal_simulator.h"
 #include "gravcal/workflows/acceptance.h"
@@ -181,10 +182,14 @@ TEST(ThermalCalibration, LagIsFoundWhereHeatingAndCoolingDisagree) {
   EXPECT_FALSE(c.thermal.lag_estimated) << c.message;
 }
 
-// The uncontrolled warm-up: turned through the poses while it heats. The
-// bias is right within its sigma at three temperatures of the range.
+// The uncontrolled warm-up: turned through the poses while it heats, in a
+// new order each cycle as a hand does. The bias is right within its sigma
+// at three temperatures of the range, and the varied turns determine all
+// three of the accelerometer's non-orthogonality entries that six faces
+// leave open (the same order every cycle leaves two of them open).
 TEST(ThermalCalibration, UncontrolledWarmUpWithPoses) {
   ThermalSimulatorOptions sim;
+  sim.shuffle_poses = true;
   sim.profile = ThermalProfile::kWarmUpPoses;
   sim.ramp_seconds = 1500.0;
   sim.ramp_time_constant = 500.0;
@@ -195,6 +200,13 @@ TEST(ThermalCalibration, UncontrolledWarmUpWithPoses) {
   const ThermalModel& m = c.thermal;
   EXPECT_GE(m.accel.bias.order, 1) << c.message;
   EXPECT_GT(m.max_temperature - m.min_temperature, 30.0);
+  std::string frame;
+  for (const std::string& n : m.notes) {
+    if (n.find("non-orthogonality") != std::string::npos) frame += n + "; ";
+  }
+  EXPECT_NE(frame.find("from the turns: n_xy"), std::string::npos) << frame;
+  EXPECT_NE(frame.find("n_yz"), std::string::npos) << frame;
+  EXPECT_EQ(frame.find("undetermined"), std::string::npos) << frame;
   for (double temperature : {20.0, 35.0, 50.0}) {
     const double x = temperature - m.reference_temperature;
     for (ThermalSensor s : {ThermalSensor::kAccel, ThermalSensor::kGyro}) {

@@ -45,6 +45,36 @@ TEST(ThermalInputs, QuantisedAndImplausibleTemperaturesAreNamed) {
   EXPECT_EQ(c.distinct, 11u);
   ASSERT_EQ(c.warnings.size(), 1u);
   EXPECT_NE(c.warnings[0].find("quantised"), std::string::npos) << c.warnings[0];
+  // Across the steady ramp the whole-degree readings are interpolated
+  // between the dated rounding boundaries: far closer to the temperature
+  // than a reading (rounding error rms 1 / sqrt(12) = 0.29 degC), with a
+  // stated deviation that covers the error; the first and last levels keep
+  // their readings (-1).
+  {
+    const ImuLog log = TemperatureLog(whole);
+    std::vector<double> v = log.temperature, sd;
+    DequantiseTemperature(log.t, 1.0, &v, &sd);
+    double sum2 = 0.0, z2 = 0.0;
+    int n = 0;
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (sd[i] < 0.0) {
+        EXPECT_EQ(v[i], whole[i]);
+        continue;
+      }
+      const double truth = 20.0 + 10.0 * static_cast<double>(i) / 4000.0;
+      sum2 += (v[i] - truth) * (v[i] - truth);
+      z2 += (v[i] - truth) * (v[i] - truth) / (sd[i] * sd[i]);
+      ++n;
+    }
+    ASSERT_GT(n, 2000);
+    EXPECT_LT(std::sqrt(sum2 / n), 0.03);
+    EXPECT_LT(std::sqrt(z2 / n), 1.5);
+    // A plateau (one reading, then back) is not interpolated.
+    std::vector<double> flat(4000, 21.0), fsd;
+    for (int i = 1000; i < 1400; ++i) flat[i] = 22.0;
+    DequantiseTemperature(log.t, 1.0, &flat, &fsd);
+    for (double d : fsd) EXPECT_LT(d, 0.0);
+  }
   c = InspectTemperatureColumn(TemperatureLog(lsb));
   EXPECT_NEAR(c.step, 0.125, 1e-12);
   c = InspectTemperatureColumn(TemperatureLog(counts));

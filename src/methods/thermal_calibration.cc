@@ -200,7 +200,9 @@ std::map<std::string, double> Named(const ThermalOrders& orders, bool has_gyro,
                                     const ThermalFit& fit) {
   const ThermalLayout layout(orders, has_gyro);
   std::map<std::string, double> out;
-  for (int j = 0; j < layout.size; ++j) out[layout.names[j]] = fit.theta[j];
+  for (int j = 0; j < layout.size; ++j) {
+    if (!fit.fixed[j]) out[layout.names[j]] = fit.theta[j];
+  }
   return out;
 }
 
@@ -300,8 +302,17 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
   if (!DetectStaticIntervals(log, options.detector, &detection)) return fail(detection.message);
   const TemperatureColumn column = InspectTemperatureColumn(log);
   if (column.implausible) return fail(log.source + ": " + column.warnings.front());
-  std::vector<ThermalWindow> windows = ThermalWindows(log, detection.intervals, options);
-  SetTemperatureQuantisation(log, column.step, &windows);
+  // Quantised readings: the fit reads the temperature interpolated across
+  // the rounding boundaries of steady ramps (DequantiseTemperature).
+  ImuLog dequantised;
+  std::vector<double> interpolation_std;
+  if (column.step > 0.0) {
+    dequantised = log;
+    DequantiseTemperature(log.t, column.step, &dequantised.temperature, &interpolation_std);
+  }
+  const ImuLog& fit_log = column.step > 0.0 ? dequantised : log;
+  std::vector<ThermalWindow> windows = ThermalWindows(fit_log, detection.intervals, options);
+  SetTemperatureQuantisation(log, column.step, interpolation_std, &windows);
   if (windows.size() < 3) {
     return fail(log.source + ": " + std::to_string(windows.size()) +
                 " static windows; the thermal calibration needs at least 3");
@@ -318,7 +329,7 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
   const bool has_gyro = log.has_gyro();
   // The element temperature's grid: 1 s, or the sample period when longer.
   const internal::ThermalElementSeries element(
-      log, std::max(1.0, (log.t.back() - log.t.front()) / std::max<size_t>(1, log.size() - 1)));
+      fit_log, std::max(1.0, (log.t.back() - log.t.front()) / std::max<size_t>(1, log.size() - 1)));
   ThermalFitter fitter(windows, element, options, has_gyro, reference, span);
   const int poses = DistinctPoses(windows);
   // A pose within 10 degrees of a face counts as that face (as check does).
@@ -360,8 +371,9 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
     std::string chosen_name;
     auto consider = [&](const ThermalOrders& candidate, const std::string& name) {
       ThermalFit f = fitter.Run(candidate, Named(orders, has_gyro, best));
-      // A step whose new coefficients are all undetermined adds nothing.
-      if (!f.ok || f.free <= best.free) return;
+      // A step whose new coefficients are all undetermined adds nothing; an
+      // unconverged fit's criterion says nothing.
+      if (!f.ok || !f.converged || f.free <= best.free) return;
       const double s = fitter.Score(f);
       if (s < chosen_score) {
         chosen_score = s;
@@ -496,7 +508,7 @@ bool CalibrateThermal(const Session& session, const ThermalCalibrationOptions& o
     }
   }
   if (has_gyro && (options.gyro_scale_max_order > 0 || options.gyro_scale_order > 0)) {
-    internal::AddThermalTurns(log, detection.intervals, windows, options, &out);
+    internal::AddThermalTurns(fit_log, detection.intervals, windows, options, &out);
   }
   if (model.lag_estimated) {
     std::ostringstream s;

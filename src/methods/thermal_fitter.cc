@@ -93,9 +93,15 @@ ThermalFit ThermalFitter::Run(const ThermalOrders& orders,
     const auto it = start.find(layout.names[j]);
     if (it != start.end()) initial[j] = it->second;
   }
-  // U's off-diagonal starts (and, when undetermined, stays) at 0, not at
-  // a previous step's value.
-  for (int k : {1, 2, 4}) initial[layout.upper + k] = 0.0;
+  // U's off-diagonal starts (and, when undetermined, stays) at 0, unless
+  // `start` gives it (a previous step that determined it, thermal_calibration.cc
+  // Named): a next order started with U moved back to 0, the other
+  // parameters where that U had put them, begins at a cost a thousand
+  // times its solution's and took the solver past its iteration limit on
+  // some held-out sessions (a bias order then chosen from an unconverged fit).
+  for (int k : {1, 2, 4}) {
+    if (start.count(layout.names[layout.upper + k]) == 0) initial[layout.upper + k] = 0.0;
+  }
   // What is determined depends on where the Jacobian is taken (a bias far
   // from its value tilts the poses' directions and lends the
   // non-orthogonality information it does not have), so the test is
@@ -328,6 +334,7 @@ bool ThermalFitter::Solve(const ThermalLayout& layout, const std::vector<double>
   fit->free = layout.size - static_cast<int>(held.size());
   fit->chi2 = 2.0 * summary.final_cost;
   fit->ok = summary.IsSolutionUsable() && std::isfinite(fit->chi2);
+  fit->converged = summary.termination_type == ceres::CONVERGENCE;
   for (double v : fit->theta) fit->ok = fit->ok && std::isfinite(v);
   fit->message = summary.BriefReport();
   return fit->ok;

@@ -28,6 +28,8 @@ struct ThermalFit {
   int residuals = 0;
   Eigen::MatrixXd covariance;  // layout.size square, zero rows for held ones
   std::string message;
+  // The solver met its tolerances (not stopped by the iteration limit).
+  bool converged = false;
 };
 
 class ThermalFitter {

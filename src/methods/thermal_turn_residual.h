@@ -64,21 +64,54 @@ class TurnResidual final {
       blocks.RemoveScale(turn_.x, c);
       for (int i = 0; i < 3; ++i) a[3 * i + j] = c[i];
     }
-    T r[9] = {T(1.0), T(0.0), T(0.0), T(0.0), T(1.0), T(0.0), T(0.0), T(0.0), T(1.0)};
+    // R = prod_k exp([A u_k]^) in doubles at A's value A0, and its first
+    // order change with A, R(A0 + dA) = R exp([G vec(dA)]^) (vec row-major):
+    // G accumulates over the increments as G <- E_k^T G + J_r(theta_k) U_k,
+    // E_k = exp([theta_k]^), theta_k = A0 u_k, U_k = d theta_k / d vec(A)
+    // and J_r the right Jacobian of exp, J_r(th) = I - (1 - cos t) / t^2
+    // [th]^ + (t - sin t) / t^3 [th]^2, t = |th|. The value is the one a
+    // product of Jets gives; the derivative is exact (first order is all
+    // a Jet carries), at a 16th of the Jet product's cost.
+    double a0[9];
+    for (int k = 0; k < 9; ++k) a0[k] = ValueOf(a[k]);
+    double r0[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+    Eigen::Matrix<double, 3, 9> g = Eigen::Matrix<double, 3, 9>::Zero();
     for (const Eigen::Vector3d& u : turn_.increments) {
-      T angle[3];
+      double angle[3];
       for (int i = 0; i < 3; ++i) {
-        angle[i] = a[3 * i] * u.x() + a[3 * i + 1] * u.y() + a[3 * i + 2] * u.z();
+        angle[i] = a0[3 * i] * u.x() + a0[3 * i + 1] * u.y() + a0[3 * i + 2] * u.z();
       }
-      T e[9];
+      double e[9];
       ceres::AngleAxisToRotationMatrix(angle, ceres::RowMajorAdapter3x3(e));
-      T n[9];
+      double n[9];
       for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
-          n[3 * i + j] = r[3 * i] * e[j] + r[3 * i + 1] * e[3 + j] + r[3 * i + 2] * e[6 + j];
+          n[3 * i + j] = r0[3 * i] * e[j] + r0[3 * i + 1] * e[3 + j] + r0[3 * i + 2] * e[6 + j];
         }
       }
-      std::copy(n, n + 9, r);
+      std::copy(n, n + 9, r0);
+      const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> em(e);
+      const Eigen::Map<const Eigen::Vector3d> th(angle);
+      const Eigen::Matrix3d jr = RightJacobian(th);
+      Eigen::Matrix<double, 3, 9> next = em.transpose() * g;
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) next.col(3 * i + j) += jr.col(i) * u(j);
+      }
+      g = next;
+    }
+    T phi[3];
+    for (int i = 0; i < 3; ++i) {
+      phi[i] = T(0.0);
+      for (int k = 0; k < 9; ++k) phi[i] += g(i, k) * (a[k] - T(a0[k]));
+    }
+    // R (I + [phi]^), [phi]^ = [[0, -p2, p1], [p2, 0, -p0], [-p1, p0, 0]].
+    const T hat[9] = {T(0.0), -phi[2], phi[1], phi[2], T(0.0), -phi[0], -phi[1], phi[0], T(0.0)};
+    T r[9];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        r[3 * i + j] = T(r0[3 * i + j]) + r0[3 * i] * hat[j] + r0[3 * i + 1] * hat[3 + j] +
+                       r0[3 * i + 2] * hat[6 + j];
+      }
     }
     // N = I + the fitted strictly upper entries (n01, n02, n12).
     T n[3] = {T(0.0), T(0.0), T(0.0)};
@@ -100,6 +133,23 @@ class TurnResidual final {
   }
 
  private:
+  static double ValueOf(double v) { return v; }
+  template <int N>
+  static double ValueOf(const ceres::Jet<double, N>& v) {
+    return v.a;
+  }
+
+  // J_r(th) (above); its series below t = 1e-4.
+  static Eigen::Matrix3d RightJacobian(const Eigen::Vector3d& th) {
+    const double t2 = th.squaredNorm();
+    const double t = std::sqrt(t2);
+    const double c1 = t < 1e-4 ? 0.5 - t2 / 24.0 : (1.0 - std::cos(t)) / t2;
+    const double c2 = t < 1e-4 ? 1.0 / 6.0 - t2 / 120.0 : (t - std::sin(t)) / (t2 * t);
+    Eigen::Matrix3d k;
+    k << 0.0, -th.z(), th.y(), th.z(), 0.0, -th.x(), -th.y(), th.x(), 0.0;
+    return Eigen::Matrix3d::Identity() - c1 * k + c2 * k * k;
+  }
+
   // out = N d / |N d|.
   template <typename T>
   static void Frame(const Eigen::Vector3d& d, const T* n, T* out) {

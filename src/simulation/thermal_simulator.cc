@@ -1,6 +1,7 @@
 #include "gravcal/simulation/thermal_simulator.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <Eigen/LU>
 #include <cmath>
 #include <random>
@@ -162,12 +163,27 @@ bool SimulateThermal(const ThermalSimulatorOptions& o, uint64_t seed,
     now += o.rotation_seconds;
     current = next;
   };
+  // The pose orders (shuffle_poses) come from a generator of their own, so
+  // the truth and the noise of a seed do not depend on the option.
+  std::mt19937_64 order_rng(seed ^ 0x9e3779b97f4a7c15ULL);
+  int at = 0;  // the pose the unit is in
   auto all_poses = [&]() {
-    for (int p = 0; p < o.poses; ++p) {
-      if (p > 0) turn_to(p);
+    if (!o.shuffle_poses) {
+      for (int p = 0; p < o.poses; ++p) {
+        if (p > 0) turn_to(p);
+        hold(o.hold_seconds);
+      }
+      turn_to(0);
+      return;
+    }
+    std::vector<int> order(o.poses);
+    for (int p = 0; p < o.poses; ++p) order[p] = p;
+    std::shuffle(order.begin(), order.end(), order_rng);
+    for (int p : order) {
+      if (p != at) turn_to(p);
+      at = p;
       hold(o.hold_seconds);
     }
-    turn_to(0);
   };
   std::vector<double> soak_begin;  // kSoakSteps: when each soak's poses begin
   switch (o.profile) {

@@ -174,8 +174,31 @@ TemperatureColumn InspectTemperatureColumn(const ImuLog& log);
 // step^2 / 12), shared by the consecutive windows of that value; a window
 // whose readings cross n steps averages it down to step^2 / (12 (n+1)^2),
 // its own. The fit's covariance then carries these errors (thermal_fitter.h).
+//
+// `interpolation_std` (DequantiseTemperature; empty = none): samples with a
+// value >= 0 carry an interpolated temperature of that standard deviation
+// instead of a reading; a window made of them gets the mean of those
+// deviations (its own error, no group), a window that mixes both kinds the
+// two errors weighted by the fractions of its samples.
 void SetTemperatureQuantisation(const ImuLog& log, double step,
+                                const std::vector<double>& interpolation_std,
                                 std::vector<ThermalWindow>* windows);
+
+// Quantised readings (step > 0) on a steady ramp: the reading changes when
+// the temperature crosses a rounding boundary (half-way between two
+// readings), so a change of one step dates that boundary. Readings that
+// flicker across one boundary (the sensor's noise) date it at the middle
+// of the flicker. In a monotone pass whose level crossings come at regular
+// intervals (each within a factor 2 of its neighbours'), the temperature is
+// interpolated linearly between the dated boundaries; elsewhere (plateaus,
+// turning points, the first and last levels, jumps of several steps) the
+// readings stay. `temperature` is rewritten in place; `interpolation_std`
+// gets, per sample, the interpolated value's standard deviation (the
+// dating's spread times the slope, and the curvature the neighbouring
+// intervals show, h^2 |T''| / 8 at mid-interval), or -1 for a kept reading.
+void DequantiseTemperature(const std::vector<double>& t, double step,
+                           std::vector<double>* temperature,
+                           std::vector<double>* interpolation_std);
 
 // What a session's temperature span allows, in sentences for check and
 // plan: for each fixed order above ThermalMaxOrderForSpan ("your session

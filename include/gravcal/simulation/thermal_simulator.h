@@ -66,7 +66,7 @@ struct ThermalSimulatorOptions {
   ThermalProfile profile = ThermalProfile::kSoakSteps;
   // kSoakSteps: the soak temperatures, degrees C, and the time spent
   // settling at each before the poses (the temperature moves linearly to
-  // the next soak over transition_seconds, the unit resting in pose 0).
+  // the next soak over transition_seconds, the unit resting in the pose it is in).
   std::vector<double> soak_temperatures = {-10.0, 5.0, 20.0, 35.0, 50.0};
   double transition_seconds = 60.0;
   // Ramps: T_s(t) = T_end - (T_end - T_start) exp(-t / ramp_time_constant)
@@ -80,6 +80,12 @@ struct ThermalSimulatorOptions {
   // The poses: the six faces, then 45-degree poses between them, up to
   // `poses` (6..12).
   int poses = 6;
+  // The order of the poses in each pass (a soak, a cycle of the ramps):
+  // the same every pass (false: 0, 1, ..., then back to 0), or a new
+  // random order each pass, from the pose the unit is in (true: as a hand
+  // turns it; the turns then differ from pass to pass, which is what lets
+  // the turns determine the accelerometer's non-orthogonality).
+  bool shuffle_poses = false;
   double hold_seconds = 20.0;
   double rotation_seconds = 2.0;
   double sample_rate = 100.0;

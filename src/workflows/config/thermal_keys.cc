@@ -118,6 +118,8 @@ SectionOf<SimulationConfig> ThermalSimulatorSection() {
                           "poses per cycle: the six faces, then 45-degree poses (6..12)"),
               GRAVCAL_DOUBLE("sim_thermal_hold", thermal_simulation.hold_seconds,
                              "seconds each pose is held"),
+              GRAVCAL_BOOL("sim_thermal_shuffle", thermal_simulation.shuffle_poses,
+                           "a new random pose order each pass (true), or the same (false)"),
               GRAVCAL_DOUBLE("sim_thermal_rate", thermal_simulation.sample_rate, "sample rate, Hz"),
           }};
 }
