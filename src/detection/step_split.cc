@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -34,31 +35,48 @@ struct WindowLines {
 
   WindowLines(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end, size_t w) {
     const size_t n = end - begin;
-    std::vector<Eigen::Vector3d> s0(n + 1, Eigen::Vector3d::Zero());
-    std::vector<Eigen::Vector3d> s1 = s0, s2 = s0;
-    const Eigen::Vector3d r = x[begin];
+    // Per sample j the prefix sums s0, s1, s2 (3 axes each), at 9 j. Axis
+    // by axis, the same operations as on Eigen vectors: the same bits.
+    std::unique_ptr<double[]> prefix(new double[9 * (n + 1)]);
+    double* const ps = prefix.get();
+    std::fill(ps, ps + 9, 0.0);
+    const double* const xs = x[begin].data();  // contiguous: 3 doubles per sample
+    const double r[3] = {xs[0], xs[1], xs[2]};
     for (size_t j = 0; j < n; ++j) {
-      const Eigen::Vector3d d = x[begin + j] - r;
-      s0[j + 1] = s0[j] + d;
-      s1[j + 1] = s1[j] + static_cast<double>(j) * d;
-      s2[j + 1] = s2[j] + d.cwiseProduct(d);
+      const double* const q = ps + 9 * j;
+      double* const o = ps + 9 * (j + 1);
+      const double jd = static_cast<double>(j);
+      for (int c = 0; c < 3; ++c) {
+        const double d = xs[3 * j + c] - r[c];
+        o[c] = q[c] + d;
+        o[3 + c] = q[3 + c] + jd * d;
+        o[6 + c] = q[6 + c] + d * d;
+      }
     }
     const double len = static_cast<double>(w);
     mean_j = 0.5 * (len - 1.0);
     const double sjj = len * (len * len - 1.0) / 12.0;
+    const double residual_dof = std::max(len - 2.0, 1.0);
+    const double variance_dof = std::max(len - 1.0, 1.0);
     lines.resize(n - w + 1);
     for (size_t a = 0; a + w <= n; ++a) {
-      const Eigen::Vector3d sx = s0[a + w] - s0[a];
-      const Eigen::Vector3d sjx = s1[a + w] - s1[a] - static_cast<double>(a) * sx;
-      const Eigen::Vector3d sxx = s2[a + w] - s2[a];
+      const double* const lo = ps + 9 * a;
+      const double* const hi = ps + 9 * (a + w);
+      const double ad = static_cast<double>(a);
       Line& line = lines[a];
-      line.slope = (sjx - mean_j * sx) / sjj;
-      line.mean = sx / len;
-      const double rss =
-          (sxx - sx.cwiseProduct(sx) / len - line.slope.cwiseProduct(line.slope) * sjj).sum();
-      line.residual = std::max(rss, 0.0) / std::max(len - 2.0, 1.0);
-      line.variance =
-          std::max((sxx - sx.cwiseProduct(sx) / len).sum(), 0.0) / std::max(len - 1.0, 1.0);
+      double rss[3], spread[3];
+      for (int c = 0; c < 3; ++c) {
+        const double sx = hi[c] - lo[c];
+        const double sjx = hi[3 + c] - lo[3 + c] - ad * sx;
+        const double sxx = hi[6 + c] - lo[6 + c];
+        const double slope = (sjx - mean_j * sx) / sjj;
+        line.slope[c] = slope;
+        line.mean[c] = sx / len;
+        spread[c] = sxx - sx * sx / len;
+        rss[c] = spread[c] - slope * slope * sjj;
+      }
+      line.residual = std::max(rss[0] + rss[1] + rss[2], 0.0) / residual_dof;
+      line.variance = std::max(spread[0] + spread[1] + spread[2], 0.0) / variance_dof;
     }
   }
   // The line of window a at local position t (0 = its first sample).
