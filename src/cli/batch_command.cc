@@ -3,6 +3,9 @@
 // are the library's (workflows/batch_folder.h).
 #include <signal.h>
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <cstdio>
 #include <string>
@@ -157,8 +160,24 @@ void PrintHiddenNote(const std::string& folder, const std::vector<std::string>& 
 
 }  // namespace
 
+namespace {
+
+// A unit's file and samples (a few MB each) taken from memory the process
+// keeps, not mapped fresh from the kernel and zeroed for every unit
+// (glibc's default for blocks of 128 kB or more: 1-2 ms of a 1.6 MB unit's
+// 10 went to page faults). What is freed is still given back above 256 MB.
+void KeepUnitMemory() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
+}
+
+}  // namespace
+
 int RunBatch(const BatchArgs& args) {
   if (IsMultiImuConfigFile(args.config_path)) return RunPlateBatch(args);
+  KeepUnitMemory();
   BatchSource source;
   BatchFolderOptions options;
   std::string shard_source;

@@ -92,11 +92,38 @@ void CheckSensor(const std::string& sensor, const std::vector<Eigen::Vector3d>& 
     extremes[axis][1].value = lo[axis];
     extremes[axis][0].band = extremes[axis][1].band = band;
   }
-  for (size_t i = 0; i < x.size(); ++i) {
-    for (int axis = 0; axis < 3; ++axis) {
-      if (!checked[axis]) continue;
-      extremes[axis][0].Add(x[i][axis], i);
-      extremes[axis][1].Add(x[i][axis], i);
+  // A block of samples none of which is near an extreme (the distance Add
+  // computes above twice the band, so never near nor at it) only ends the
+  // runs at its first sample, as Add would.
+  double reach[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    reach[axis] =
+        checked[axis] ? 2.0 * extremes[axis][0].band : -std::numeric_limits<double>::infinity();
+  }
+  constexpr size_t kBlock = 16;
+  const double* const p = x[0].data();  // contiguous: 3 doubles per sample
+  for (size_t b = 0; b < x.size(); b += kBlock) {
+    const size_t e = std::min(x.size(), b + kBlock);
+    bool near = false;
+    for (size_t i = b; i < e; ++i) {
+      for (int axis = 0; axis < 3; ++axis) {
+        const double v = p[3 * i + axis];
+        near |= (hi[axis] - v <= reach[axis]) | (v - lo[axis] <= reach[axis]);
+      }
+    }
+    if (!near) {
+      for (int axis = 0; axis < 3; ++axis) {
+        extremes[axis][0].End(b);
+        extremes[axis][1].End(b);
+      }
+      continue;
+    }
+    for (size_t i = b; i < e; ++i) {
+      for (int axis = 0; axis < 3; ++axis) {
+        if (!checked[axis]) continue;
+        extremes[axis][0].Add(x[i][axis], i);
+        extremes[axis][1].Add(x[i][axis], i);
+      }
     }
   }
   for (int axis = 0; axis < 3; ++axis) {

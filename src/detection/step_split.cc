@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,50 +21,85 @@ namespace {
 // j (x - r) and |x - r|^2 per axis, j the sample's index in the run and r
 // its first sample (small magnitudes: no cancellation with raw counts).
 // SplitRunAtSteps compares the windows either side of each sample, at every
-// level of its recursion: each window is fitted once, here.
+// level of its recursion: each window's mean and variance are computed once,
+// here, and its line (Fit) only where the means differ enough to matter.
+// Axis by axis, the same operations as on Eigen vectors: the same bits.
 struct WindowLines {
-  struct Line {
-    // The window's mean and the line's slope per sample; the residual
-    // variance about the line and the variance about the mean, summed over
-    // the axes.
-    Eigen::Vector3d mean, slope;
-    double residual, variance;
+  struct Window {
+    // The window's mean; the variance about it, summed over the axes.
+    Eigen::Vector3d mean;
+    double variance;
   };
-  std::vector<Line> lines;
+  struct Line {
+    // The line's slope per sample; the residual variance about the line,
+    // summed over the axes.
+    Eigen::Vector3d slope;
+    double residual;
+  };
+  std::vector<Window> windows;
   double mean_j;  // the window's mean local position
+  double len, sjj;
+  // Per sample j the prefix sums s0, s1, s2 (3 axes each), at 9 j.
+  std::unique_ptr<double[]> prefix;
 
   WindowLines(const std::vector<Eigen::Vector3d>& x, size_t begin, size_t end, size_t w) {
     const size_t n = end - begin;
-    std::vector<Eigen::Vector3d> s0(n + 1, Eigen::Vector3d::Zero());
-    std::vector<Eigen::Vector3d> s1 = s0, s2 = s0;
-    const Eigen::Vector3d r = x[begin];
+    prefix.reset(new double[9 * (n + 1)]);
+    double* const ps = prefix.get();
+    std::fill(ps, ps + 9, 0.0);
+    const double* const xs = x[begin].data();  // contiguous: 3 doubles per sample
+    const double r[3] = {xs[0], xs[1], xs[2]};
     for (size_t j = 0; j < n; ++j) {
-      const Eigen::Vector3d d = x[begin + j] - r;
-      s0[j + 1] = s0[j] + d;
-      s1[j + 1] = s1[j] + static_cast<double>(j) * d;
-      s2[j + 1] = s2[j] + d.cwiseProduct(d);
+      const double* const q = ps + 9 * j;
+      double* const o = ps + 9 * (j + 1);
+      const double jd = static_cast<double>(j);
+      for (int c = 0; c < 3; ++c) {
+        const double d = xs[3 * j + c] - r[c];
+        o[c] = q[c] + d;
+        o[3 + c] = q[3 + c] + jd * d;
+        o[6 + c] = q[6 + c] + d * d;
+      }
     }
-    const double len = static_cast<double>(w);
+    len = static_cast<double>(w);
     mean_j = 0.5 * (len - 1.0);
-    const double sjj = len * (len * len - 1.0) / 12.0;
-    lines.resize(n - w + 1);
+    sjj = len * (len * len - 1.0) / 12.0;
+    const double variance_dof = std::max(len - 1.0, 1.0);
+    windows.resize(n - w + 1);
     for (size_t a = 0; a + w <= n; ++a) {
-      const Eigen::Vector3d sx = s0[a + w] - s0[a];
-      const Eigen::Vector3d sjx = s1[a + w] - s1[a] - static_cast<double>(a) * sx;
-      const Eigen::Vector3d sxx = s2[a + w] - s2[a];
-      Line& line = lines[a];
-      line.slope = (sjx - mean_j * sx) / sjj;
-      line.mean = sx / len;
-      const double rss =
-          (sxx - sx.cwiseProduct(sx) / len - line.slope.cwiseProduct(line.slope) * sjj).sum();
-      line.residual = std::max(rss, 0.0) / std::max(len - 2.0, 1.0);
-      line.variance =
-          std::max((sxx - sx.cwiseProduct(sx) / len).sum(), 0.0) / std::max(len - 1.0, 1.0);
+      const double* const lo = ps + 9 * a;
+      const double* const hi = ps + 9 * (a + w);
+      Window& window = windows[a];
+      double spread[3];
+      for (int c = 0; c < 3; ++c) {
+        const double sx = hi[c] - lo[c];
+        window.mean[c] = sx / len;
+        spread[c] = hi[6 + c] - lo[6 + c] - sx * sx / len;
+      }
+      window.variance = std::max(spread[0] + spread[1] + spread[2], 0.0) / variance_dof;
     }
   }
+  // The line of window a.
+  Line Fit(size_t a) const {
+    const size_t w = static_cast<size_t>(len);
+    const double* const lo = prefix.get() + 9 * a;
+    const double* const hi = prefix.get() + 9 * (a + w);
+    const double ad = static_cast<double>(a);
+    Line line;
+    double rss[3];
+    for (int c = 0; c < 3; ++c) {
+      const double sx = hi[c] - lo[c];
+      const double sjx = hi[3 + c] - lo[3 + c] - ad * sx;
+      const double sxx = hi[6 + c] - lo[6 + c];
+      const double slope = (sjx - mean_j * sx) / sjj;
+      line.slope[c] = slope;
+      rss[c] = sxx - sx * sx / len - slope * slope * sjj;
+    }
+    line.residual = std::max(rss[0] + rss[1] + rss[2], 0.0) / std::max(len - 2.0, 1.0);
+    return line;
+  }
   // The line of window a at local position t (0 = its first sample).
-  Eigen::Vector3d Value(const Line& line, double t) const {
-    return line.mean + line.slope * (t - mean_j);
+  Eigen::Vector3d Value(size_t a, const Line& line, double t) const {
+    return windows[a].mean + line.slope * (t - mean_j);
   }
 };
 
@@ -89,15 +125,21 @@ void SplitRunAtSteps(const std::vector<Eigen::Vector3d>& x, const WindowLines& f
   double best = options.step_factor;
   size_t split = 0;
   for (size_t s = begin + w; s + w <= end; ++s) {
-    const WindowLines::Line& before = fits.lines[s - w - base];
-    const WindowLines::Line& after = fits.lines[s - base];
-    const Eigen::Vector3d left = fits.Value(before, len - 0.5);
-    const Eigen::Vector3d right = fits.Value(after, -0.5);
-    const double t_line =
-        (right - left).squaredNorm() /
-        (c * (std::max(before.residual, floor) + std::max(after.residual, floor)));
+    const size_t a_before = s - w - base, a_after = s - base;
+    const WindowLines::Window& before = fits.windows[a_before];
+    const WindowLines::Window& after = fits.windows[a_after];
     const double t_mean = (after.mean - before.mean).squaredNorm() * len /
                           (std::max(before.variance, floor) + std::max(after.variance, floor));
+    // t = min(t_line, t_mean) <= t_mean: not above best (and t_mean not
+    // NaN, which std::min would pass over), no need of the lines.
+    if (t_mean <= best) continue;
+    const WindowLines::Line line_before = fits.Fit(a_before);
+    const WindowLines::Line line_after = fits.Fit(a_after);
+    const Eigen::Vector3d left = fits.Value(a_before, line_before, len - 0.5);
+    const Eigen::Vector3d right = fits.Value(a_after, line_after, -0.5);
+    const double t_line =
+        (right - left).squaredNorm() /
+        (c * (std::max(line_before.residual, floor) + std::max(line_after.residual, floor)));
     const double t = std::min(t_line, t_mean);
     if (!(t > best)) continue;
     const Eigen::Vector3d a = left + r, b = right + r;

@@ -94,6 +94,61 @@ int ReadingThreads(const LongLogReading& reading) {
   return static_cast<int>(std::min<unsigned>(cores, internal::kMaxLogBlocksInFlight - 2));
 }
 
+// The plain CSV rows that follow the last line `source` gave
+// (LogRowParser::ParsePlainCsvRow), into `sink` in batches, without the line
+// reader: its buffered whole lines for a file, the rest of text in memory.
+// Stops before the first line that is not a plain row, whose time Line
+// would refuse, or on which Line would check for cancellation: Line reads
+// that one, with the same value or message. False when the first line was
+// not a plain row.
+bool ReadPlainRows(internal::LogLines* source, internal::LogRowParser* parser,
+                   const internal::LogRowSink& sink) {
+  using internal::kNumSlots;
+  using internal::kT;
+  std::string_view text = source->rest();
+  const char* const readable_end = text.data() + text.size();
+  if (source->is_file()) {  // Only whole lines: the rest is read again.
+    const size_t last = text.rfind('\n');
+    text = text.substr(0, last == std::string_view::npos ? 0 : last + 1);
+  }
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  const bool timed = parser->has(kT);
+  const double time_scale = parser->options().time_scale;
+  const double sample_rate = parser->options().sample_rate;
+  size_t rows = parser->rows();
+  double previous_t = parser->previous_t();
+  size_t number = source->number();
+  constexpr size_t kBatch = 256;
+  double batch[kBatch * kNumSlots];
+  size_t count = 0;
+  bool plain = true;
+  while (p < end && ((number + 1) & 0xffff) != 0) {
+    double* row = batch + count * kNumSlots;
+    const char* next = parser->ParsePlainCsvRow(p, end, readable_end, row);
+    if (next == nullptr) {
+      plain = number > source->number();
+      break;
+    }
+    // As LogRowParser::CheckTime.
+    const double t = timed ? row[kT] * time_scale : static_cast<double>(rows) / sample_rate;
+    if (!std::isfinite(t) || (rows > 0 && !(t > previous_t))) break;
+    row[kT] = t;
+    previous_t = t;
+    ++rows;
+    ++number;
+    p = next;
+    if (++count == kBatch) {
+      sink(batch, count);
+      count = 0;
+    }
+  }
+  if (count > 0) sink(batch, count);
+  parser->Resume(rows, previous_t);
+  source->Skip(static_cast<size_t>(p - text.data()), number - source->number());
+  return plain;
+}
+
 // Parses the lines of one text log (io/log_text.h; text in memory or a file
 // read block by block, `bytes` long, 0 for text in memory): the main log, or
 // (`reference` not null) the second file holding the gyroscope, whose times
@@ -123,6 +178,8 @@ bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std
   std::string_view line;
   std::string why;
   bool reserved = false;
+  constexpr int kMaxPlainMisses = 16;
+  int plain_misses = 0;
   while (source->Next(&line, &why)) {
     if (euroc && source->number() == 1 && !line.empty() && line[0] == '#') line.remove_prefix(1);
     bool row = false;
@@ -164,6 +221,12 @@ bool ParseText(internal::LogLines* source, uint64_t bytes, bool euroc, const std
       reserved = true;
     }
     add_rows(parser.values(), 1);
+    // The plain rows that follow, without the line reader; after a few
+    // tries that read none (a whitespace log), no more.
+    if (plain_misses < kMaxPlainMisses && source->newline_ends() && reference == nullptr &&
+        !ReadPlainRows(source, &parser, add_rows)) {
+      ++plain_misses;
+    }
     // The rest of a long file on several threads (io/log_blocks.h): the
     // same rows and errors. Not a pipe (bytes 0): its reader thread could
     // wait on the writer after an error.

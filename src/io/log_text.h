@@ -87,6 +87,11 @@ class LogLines {
   std::string_view TakeBuffered();
   size_t ReadRaw(char* out, size_t size, std::string* error);
   void set_number(size_t number) { number_ = number; }
+  // The first `bytes` of rest(), `lines` whole lines, were read elsewhere.
+  void Skip(size_t bytes, size_t lines) {
+    begin_ += bytes;
+    number_ += lines;
+  }
   // Text in memory that continues a newline-ended text after its line
   // `number` (the next line is number + 1).
   void ContinueNewlineText(size_t number) {
