@@ -159,6 +159,9 @@ TEST(ThermalCalibration, LagIsFoundWhereHeatingAndCoolingDisagree) {
   sim.ramp_time_constant = 900.0;
   sim.hold_seconds = 10.0;
   sim.lag_time_constant = 60.0;
+  // 50 Hz: the lag and the discovery depend on the windows, not on the
+  // rate (half the samples of the default 100 Hz, half the test's time).
+  sim.sample_rate = 50.0;
   ThermalSimulatedSession truth;
   Calibration c;
   ASSERT_TRUE(Calibrate(sim, 41, nullptr, &truth, &c));

@@ -32,6 +32,7 @@ exit 0 when every check passes, 1 otherwise, 77 when numpy is missing.
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 
@@ -626,6 +627,7 @@ def extra_sections(r, binary, source_dir, rate, seeds, only):
         # (held at 0, its spread considered): cautious by design, so only
         # checked for not being overconfident.
         zm_held = []
+        zn, n_sessions = [], set()  # N from the turns' note, and the sessions with it
         for seed in range(600, 600 + seeds):
             truth = Truth(np.random.default_rng(seed), lag=(0.0, 30.0)[seed % 2],
                           gyro_misalign_t=True)
@@ -659,6 +661,14 @@ def extra_sections(r, binary, source_dir, rate, seeds, only):
                     # n_ij = U_ij / U_jj, compared as such.
                     zu.append((u[i][j] / u[j][j] - upper[i, j] / upper[j, j]) /
                               (us[i][j] / u[j][j]))
+            # The entries the turns fit (U keeps 0 there): from the note.
+            for note in th.get('notes', []):
+                if 'from the turns: n_' not in note:
+                    continue
+                for name, v, sd in re.findall(r'(n_[xyz]{2}) (-?[0-9.e+-]+) \+- ([0-9.e+-]+)', note):
+                    i, j = 'xyz'.index(name[2]), 'xyz'.index(name[3])
+                    zn.append((float(v) - upper[i, j] / upper[j, j]) / float(sd))
+                    n_sessions.add(seed)
             term = th.get('gyro', {}).get('misalignment', {})
             orders.append(term.get('order', 0))
             lo, hi = th['valid_range']
@@ -681,6 +691,8 @@ def extra_sections(r, binary, source_dir, rate, seeds, only):
         detail = {'rms_z_matrix_diag': rms(zm_diag), 'rms_z_matrix_off': rms(zm_off),
                   'rms_z_matrix_frame_held': rms(zm_held), 'matrix_values': len(zm_diag),
                   'rms_z_accel_nonorthogonality': rms(zu), 'accel_entries_from_turns': frames,
+                  'rms_z_nonorthogonality_from_turns_note': rms(zn), 'note_values': len(zn),
+                  'sessions_with_n_from_turns': len(n_sessions),
                   'rms_z_gyro_misalignment_t': rms(zmis), 'misalignment_values': len(zmis),
                   'misalignment_orders': orders,
                   'max_abs_z_matrix': float(np.abs(zm_diag + zm_off + zm_held).max())
@@ -688,6 +700,7 @@ def extra_sections(r, binary, source_dir, rate, seeds, only):
         ok = bool(zm_diag) and 0.6 <= rms(zm_diag) <= 1.6 and (not zm_off or rms(zm_off) <= 1.6)
         ok = ok and (not zm_held or rms(zm_held) <= 1.4)
         ok = ok and (not zu or rms(zu) <= 1.6) and (not zmis or 0.6 <= rms(zmis) <= 1.6)
+        ok = ok and (not zn or 0.6 <= rms(zn) <= 1.6)
         r.check('six_face_gyro_matrix', ok, detail)
     if 'quantised' in only:
         zs = {'accel': [], 'gyro': []}
