@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/noise_flicker.h"
 #include "gravcal/core/noise_model.h"
 #include "gravcal/estimation/allan_deviation.h"
 #include "gravcal/estimation/spectral_lines.h"
@@ -178,7 +179,10 @@ TEST(AllanReplicates, WhiteAndRandomWalkShowNoBiasInstability) {
   with_flicker.bias_instability.value = 1e-4;
   with_flicker.bias_instability.tau = 20.0;
   EXPECT_NEAR(with_flicker.AllanVariance(20.0), kFlickerAllanFactor * 1e-8, 1e-15);
+  EXPECT_NEAR(internal::FlickerAllanVariance(with_flicker),
+              kFlickerAllanFactor * 1e-8 - 1e-8 / 20.0 - 1e-12 * 20.0 / 3.0, 1e-15);
   with_flicker.bias_instability.tau = NAN;  // a datasheet's B: all flicker
+  EXPECT_NEAR(internal::FlickerAllanVariance(with_flicker), kFlickerAllanFactor * 1e-8, 1e-15);
   EXPECT_NEAR(with_flicker.AllanVariance(20.0),
               kFlickerAllanFactor * 1e-8 + 1e-8 / 20.0 + 1e-12 * 20.0 / 3.0, 1e-15);
 }

@@ -6,10 +6,13 @@
 // records it as a known failure); the calibration must say so with a
 // kNoiseModel warning, not stay silent. With the sensor's noise model
 // (--noise) the wander is sized and there is nothing to say.
+#include "methods/gyro_bias_wander.h"
+
 #include <gtest/gtest.h>
 
 #include <string>
 
+#include "gravcal/core/noise_model.h"
 #include "gravcal/simulation/simulator.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/pipeline.h"
@@ -90,6 +93,35 @@ TEST(GyroBiasWander, SilentWithoutPoseVariance) {
   Calibration c;
   ASSERT_TRUE(CalibrateSeed(config, 1, false, &c)) << c.message;
   EXPECT_FALSE(WarnsWhiteNoise(c));
+}
+
+// W from a noise model: a B read at the Allan curve's floor (with its tau)
+// holds the white noise's and the random walk's variance there; W counts
+// only its flicker part, then K^2 T / 3 once. A datasheet's B (no tau) is
+// all flicker. (Before: W = B^2 + K^2 T / 3 with the floor's whole B.)
+TEST(GyroBiasWander, MeasuredBiasInstabilityCountsItsFlickerOnly) {
+  AxisNoiseModel axis;
+  axis.white_noise.value = 1e-4;
+  axis.random_walk.value = 1e-6;
+  axis.bias_instability.value = 1e-4;
+  axis.bias_instability.tau = 20.0;
+  ImuNoiseModel model;
+  model.gyro = {axis, axis, axis};
+  GyroCalibrationOptions options;
+  options.noise_model = &model;
+  internal::GyroPrepared prep;
+  prep.session_seconds = 100.0;
+  Eigen::Matrix3d wander;
+  std::string note;
+  ASSERT_TRUE(
+      internal::SessionBiasWander(prep, options, Eigen::Matrix3d::Identity(), &wander, &note));
+  const double at_floor = 1e-8 / 20.0 + 1e-12 * 20.0 / 3.0;  // N^2 / tau + K^2 tau / 3
+  const double walk = 1e-12 * 100.0 / 3.0;
+  EXPECT_NEAR(wander(0, 0), 1e-8 - at_floor / kFlickerAllanFactor + walk, 1e-15) << note;
+  for (AxisNoiseModel& a : model.gyro) a.bias_instability.tau = NAN;
+  ASSERT_TRUE(
+      internal::SessionBiasWander(prep, options, Eigen::Matrix3d::Identity(), &wander, &note));
+  EXPECT_NEAR(wander(2, 2), 1e-8 + walk, 1e-15) << note;
 }
 
 }  // namespace

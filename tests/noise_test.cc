@@ -19,6 +19,7 @@
 #include "gravcal/io/log_reader.h"
 #include "gravcal/io/noise_io.h"
 #include "gravcal/simulation/noise_process.h"
+#include "gravcal/workflows/noise_workflow.h"
 #include "sigma_check.h"
 #include "still_log.h"
 #include "test_util.h"
@@ -333,6 +334,38 @@ TEST(StillMeanVariance, TermByTerm) {
   EXPECT_TRUE(std::isnan(StillMeanVariance(AxisNoiseModel(), 4.0)));
 }
 
+// N against a datasheet density: white noise up to Nyquist (flatness about
+// 1) three times the datasheet's is named as possible aliasing; the same
+// noise through a [1 2 1] / 4 low-pass (zero at Nyquist) is not. Within 1.3
+// times the datasheet's nothing is claimed.
+TEST(CharacteriseNoise, DatasheetGapNamesAliasingOnlyWhenFlatToNyquist) {
+  ImuLog log = StillLog(ThreeTerms(2e-3), ThreeTerms(1e-4), 1.0, 1, 120.0);
+  NoiseOptions options;
+  options.find_still = false;
+  ImuNoise noise;
+  ASSERT_TRUE(CharacteriseNoise(log, options, &noise)) << noise.message;
+  NoiseDatasheetCheck check;
+  CheckNoiseAgainstDatasheet(log, LongLogReading(), noise, 2e-3, 1e-4 / 3.0, &check);
+  ASSERT_EQ(check.notes.size(), 6u);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(check.gyro_flatness[a], 1.0, 0.15) << a;
+    EXPECT_NE(check.notes[a].find("within its scatter"), std::string::npos) << check.notes[a];
+    EXPECT_NE(check.notes[3 + a].find("possibly aliasing"), std::string::npos)
+        << check.notes[3 + a];
+  }
+  const std::vector<Eigen::Vector3d> white = log.gyro;
+  for (size_t i = 1; i + 1 < white.size(); ++i) {
+    log.gyro[i] = 0.25 * (white[i - 1] + 2.0 * white[i] + white[i + 1]);
+  }
+  ASSERT_TRUE(CharacteriseNoise(log, options, &noise)) << noise.message;
+  CheckNoiseAgainstDatasheet(log, LongLogReading(), noise, 0.0, 1e-4 / 3.0, &check);
+  ASSERT_EQ(check.notes.size(), 3u);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_LT(check.gyro_flatness[a], 0.5) << a;
+    EXPECT_NE(check.notes[a].find("no aliasing shows"), std::string::npos) << check.notes[a];
+  }
+}
+
 // Bad input: a one-line message naming the problem.
 
 TEST(CharacteriseNoise, RefusesTooShortForTauAsked) {
@@ -600,6 +633,20 @@ TEST(CharacteriseNoiseRealData, SunsidedStillLogNearTheDatasheet) {
   ImuNoise noise;
   ASSERT_TRUE(CharacteriseNoise(log, options, &noise)) << noise.message;
   std::cout << noise.message << "\n";
+  NoiseDatasheetCheck check;
+  CheckNoiseAgainstDatasheet(log, LongLogReading(), noise, 400.0 * ug, 0.005 * dps, &check);
+  for (const std::string& note : check.notes) std::cout << note << "\n";
+  // Every axis's spectrum is flat to Nyquist (measured 0.98-1.02: the
+  // MPU-6050's filter reaches past the 50 Hz the host reads at), so the
+  // gyroscope's 1.8-2.5 times the datasheet is named as possible aliasing
+  // (its default 256 Hz filter would give sqrt(256 / 49.6) = 2.3).
+  ASSERT_EQ(check.notes.size(), 6u);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_GT(check.accel_flatness[a], 0.9) << a;
+    EXPECT_GT(check.gyro_flatness[a], 0.9) << a;
+    EXPECT_NE(check.notes[3 + a].find("possibly aliasing"), std::string::npos)
+        << check.notes[3 + a];
+  }
   EXPECT_NE(noise.timing.rate_source.find("least squares"), std::string::npos);
   EXPECT_NEAR(noise.model.rate_hz, 99.3, 0.5);
   for (int sensor = 0; sensor < 2; ++sensor) {

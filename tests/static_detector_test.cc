@@ -600,7 +600,9 @@ TEST(StaticDetector, TimeInOtherUnitsIsNamed) {
     const char* time_scale;
   } cases[] = {{1e3, "milliseconds", "time_scale: 0.001"},
                {1e6, "microseconds", "time_scale: 1e-06"},
-               {1e9, "nanoseconds", "time_scale: 1e-09"}};
+               {1e9, "nanoseconds", "time_scale: 1e-09"},
+               // A 4 kHz log in ms reads as 4 Hz: four samples per window.
+               {1e3 / 40.0, "milliseconds", "time_scale: 0.001"}};
   for (const auto& c : cases) {
     ImuLog scaled = log;
     for (double& t : scaled.t) t *= c.scale;

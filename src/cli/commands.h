@@ -139,6 +139,9 @@ struct LogReportArgs : CommonArgs {
   // noise: Kalibr's imu.yaml and the handheld filter's keys.
   std::string kalibr;
   std::string handheld;
+  // noise: the datasheet's white-noise densities to compare with (0 = none).
+  double accel_noise_density = 0.0;
+  double gyro_noise_density = 0.0;
 };
 
 struct InspectArgs : CommonArgs {

@@ -65,14 +65,14 @@
   X(double, max_hold, gravcal::PlanRequest().max_hold_seconds, "plan: longest hold, s")          \
   X(double, accel_noise_density, 0.0,                                                            \
     "plan, check: accelerometer white noise N, m/s^2/sqrt(Hz) (datasheet; instead of "           \
-    "--noise)")                                                                                  \
+    "--noise); noise: the datasheet's, to compare with")                                         \
   X(double, accel_bias_instability, 0.0, "plan, check: accelerometer bias instability B, m/s^2") \
   X(double, accel_random_walk, 0.0, "plan, check: accelerometer random walk K, m/s^3/sqrt(Hz)")  \
   X(double, pose_disturbance, 0.0,                                                               \
     "plan, check: per-pose disturbance of |a|, m/s^2 rms (0 = none)")                            \
   X(double, gyro_noise_density, 0.0,                                                             \
     "plan: gyroscope white noise N, rad/s/sqrt(Hz) (datasheet; instead of --noise): "            \
-    "plans the turns between poses for the gyroscope")                                           \
+    "plans the turns between poses for the gyroscope; noise: the datasheet's, to compare with") \
   X(double, attitude_std, 0.0,                                                                   \
     "plan (method known_attitude): the fixture's roll and pitch standard deviation, "            \
     "degrees")                                                                                   \

@@ -228,7 +228,9 @@ const std::vector<CommandInfo>& Commands() {
            FlagField<LogReportArgs>("output", &LogReportArgs::output),
            FlagField<LogReportArgs>("kalibr", &LogReportArgs::kalibr),
            FlagField<LogReportArgs>("handheld", &LogReportArgs::handheld),
-           FlagField<LogReportArgs>("report", &LogReportArgs::report)},
+           FlagField<LogReportArgs>("report", &LogReportArgs::report),
+           FlagField<LogReportArgs>("accel_noise_density", &LogReportArgs::accel_noise_density),
+           FlagField<LogReportArgs>("gyro_noise_density", &LogReportArgs::gyro_noise_density)},
           RunNoise),
       Command<InspectArgs>(
           "inspect",

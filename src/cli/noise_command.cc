@@ -42,6 +42,11 @@ int RunNoise(const LogReportArgs& args) {
   std::string error;
   NoiseOptions options;
   if (!NoiseOptionsFromConfig(args.config, &options, &error)) return Fail(error);
+  for (double density : {args.accel_noise_density, args.gyro_noise_density}) {
+    if (!(density >= 0.0) || !std::isfinite(density)) {
+      return Fail("noise: --accel-noise-density and --gyro-noise-density must be finite and >= 0");
+    }
+  }
   // In bounded memory: a long log is read as block means (io/long_log.h).
   ImuLog log;
   LongLogReading reading;
@@ -51,9 +56,16 @@ int RunNoise(const LogReportArgs& args) {
   }
   ImuNoise noise;
   if (!CharacteriseLongLogNoise(log, reading, options, &noise, &error)) return Fail(error);
+  // Against the datasheet's densities, when given (noise_workflow.h).
+  NoiseDatasheetCheck datasheet;
+  const bool compared = args.accel_noise_density > 0.0 || args.gyro_noise_density > 0.0;
+  if (compared) {
+    CheckNoiseAgainstDatasheet(log, reading, noise, args.accel_noise_density,
+                               args.gyro_noise_density, &datasheet);
+  }
   std::vector<std::string> written;
   if (!WriteNoiseFiles(noise, args.input, {args.output, args.kalibr, args.handheld, args.report},
-                       &written, &error)) {
+                       &written, &error, compared ? &datasheet : nullptr)) {
     return Fail(error);
   }
   const char* axes = "xyz";
@@ -62,6 +74,9 @@ int RunNoise(const LogReportArgs& args) {
   }
   for (int a = 0; a < 3 && log.has_gyro(); ++a) {
     PrintAxis("gyro", axes[a], noise.model.gyro[a], "rad/s", "rad/s^2");
+  }
+  for (const std::string& note : datasheet.notes) {
+    std::fprintf(stderr, "gravcal: %s\n", note.c_str());
   }
   std::string files;
   for (const std::string& w : written) files += (files.empty() ? "" : ", ") + w;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/noise_flicker.h"
+
 namespace gravcal {
 
 namespace {
@@ -19,16 +21,22 @@ double OtherTermsVariance(const AxisNoiseModel& m, double tau) {
 
 }  // namespace
 
+namespace internal {
+
+double FlickerAllanVariance(const AxisNoiseModel& axis) {
+  if (!axis.bias_instability.visible()) return 0.0;
+  const double b = axis.bias_instability.value;
+  double flicker = kFlickerAllanFactor * b * b;
+  const double at = axis.bias_instability.tau;
+  if (at > 0.0 && std::isfinite(at))
+    flicker = std::max(0.0, flicker - OtherTermsVariance(axis, at));
+  return flicker;
+}
+
+}  // namespace internal
+
 double AxisNoiseModel::AllanVariance(double tau) const {
-  double v = OtherTermsVariance(*this, tau);
-  if (bias_instability.visible()) {
-    double flicker = kFlickerAllanFactor * bias_instability.value * bias_instability.value;
-    const double at = bias_instability.tau;
-    if (at > 0.0 && std::isfinite(at))
-      flicker = std::max(0.0, flicker - OtherTermsVariance(*this, at));
-    v += flicker;
-  }
-  return v;
+  return OtherTermsVariance(*this, tau) + internal::FlickerAllanVariance(*this);
 }
 
 double StillMeanVariance(const AxisNoiseModel& axis, double seconds) {

@@ -435,11 +435,23 @@ void NearlyStillStretches(const ImuLog& log, const SensorWindows& accel, const S
   }
 }
 
-// A time step so long that a window holds fewer than two samples is most
-// likely a time column in another unit; the message names the likely one.
+// A window holds at least this many samples: fewer give no usable
+// variance or level (the detector's statistics), and a time column in ms
+// read as seconds shows as a rate 1000 times too low (a 4 kHz log as 4 Hz:
+// four samples per 1 s window, which made 1064 "positions" of a 12-pose
+// session before this check).
+constexpr double kMinWindowSamples = 8.0;
+
+// A time step so long that a window holds fewer than kMinWindowSamples is
+// most likely a time column in another unit; the message names the likely
+// one, or the window a slow log needs.
 std::string TimeUnitMessage(const std::string& name, double dt, double window_seconds) {
   std::string message = name + ": the median time step is " + Num(dt) + " s (" + Num(1.0 / dt) +
-                        " Hz), too long for the " + Num(window_seconds) + " s window";
+                        " Hz), too long for the " + Num(window_seconds) +
+                        " s window (it would hold " + Num(std::floor(window_seconds / dt)) +
+                        " samples, fewer than " + Num(kMinWindowSamples) + ")";
+  const std::string slow = "; or, for a log this slow, give window_seconds: " +
+                           Num(std::ceil(kMinWindowSamples * dt * 10.0) / 10.0) + " or more";
   const struct {
     double scale;
     const char* unit;
@@ -448,10 +460,10 @@ std::string TimeUnitMessage(const std::string& name, double dt, double window_se
     const double rate = 1.0 / (dt * u.scale);
     if (rate >= 5.0 && rate <= 1e5) {
       return message + ": the time column looks like " + u.unit + " (" + Num(rate) +
-             " Hz if so); set time_scale: " + Num(u.scale);
+             " Hz if so); set time_scale: " + Num(u.scale) + slow;
     }
   }
-  return message + ": check the time column's unit (time_scale) or give a longer window";
+  return message + ": check the time column's unit (time_scale)" + slow;
 }
 
 }  // namespace
@@ -476,7 +488,7 @@ bool DetectStaticIntervals(const ImuLog& log, const StaticDetectorOptions& given
     const double samples = seconds / dt;
     return samples < static_cast<double>(n) ? static_cast<size_t>(std::llround(samples)) : n + 1;
   };
-  if (options.window_seconds < 1.5 * dt) {
+  if (options.window_seconds < kMinWindowSamples * dt) {
     return Fail(detection, TimeUnitMessage(name, dt, options.window_seconds));
   }
   const size_t w = std::max<size_t>(2, to_samples(options.window_seconds));

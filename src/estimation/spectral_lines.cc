@@ -4,8 +4,10 @@
 #include <cmath>
 #include <complex>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
+#include "estimation/nyquist_flatness.h"
 #include "util/statistics.h"
 
 namespace gravcal {
@@ -155,6 +157,32 @@ std::vector<SpectralLine> FindSpectralLines(const std::vector<double>& x, size_t
   if (lines.size() > max_lines) lines.resize(max_lines);
   return lines;
 }
+
+namespace internal {
+
+double NyquistFlatness(const std::vector<double>& x, size_t begin, size_t end, double rate_hz) {
+  constexpr size_t kLength = 256;
+  if (!(end > begin) || end > x.size() || end - begin < 8 * kLength || !(rate_hz > 0.0)) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  size_t segments = 0;
+  const std::vector<double> psd = internal::WelchPsd(x, begin, end, rate_hz, kLength, &segments);
+  // Bin k is at k / (kLength / 2) of Nyquist.
+  auto band = [&psd](double from, double to) {
+    const double half = static_cast<double>(kLength / 2);
+    std::vector<double> bins;
+    for (size_t k = static_cast<size_t>(std::ceil(from * half));
+         k <= static_cast<size_t>(std::floor(to * half)) && k < psd.size(); ++k) {
+      bins.push_back(psd[k]);
+    }
+    return internal::Median(bins);
+  };
+  const double middle = band(0.2, 0.4);
+  if (!(middle > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return std::sqrt(band(0.8, 0.97) / middle);
+}
+
+}  // namespace internal
 
 double LineAllanVariance(const SpectralLine& line, double tau, double rate_hz) {
   const double m = tau * rate_hz;

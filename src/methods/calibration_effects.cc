@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/noise_flicker.h"
 #include "core/warnings.h"
 #include "gravcal/methods/effect_fit.h"
 #include "util/statistics.h"
@@ -131,7 +132,9 @@ void SetEffectResiduals(const EffectFitResult& fit, Calibration* calibration) {
 
 // The variance of the gyroscope's bias about its session value from the
 // noise model, (rad/s)^2: B^2 + K^2 T / 6 (the random walk's mean square
-// about its mean over T s), the largest over the axes; 0 without a model.
+// about its mean over T s; B^2 the flicker's alone, as in
+// methods/gyro_bias_wander.cc), the largest over the axes; 0 without a
+// model.
 double GyroBiasWanderVariance(const ImuNoiseModel* model,
                               const std::vector<StaticObservation>& observations) {
   if (model == nullptr || observations.empty()) return 0.0;
@@ -139,8 +142,7 @@ double GyroBiasWanderVariance(const ImuNoiseModel* model,
   double largest = 0.0;
   for (const AxisNoiseModel& axis : model->gyro) {
     double v = 0.0;
-    if (axis.bias_instability.visible())
-      v += axis.bias_instability.value * axis.bias_instability.value;
+    v += internal::FlickerAllanVariance(axis) / kFlickerAllanFactor;
     if (axis.random_walk.visible()) {
       v += axis.random_walk.value * axis.random_walk.value * std::max(0.0, seconds) / 6.0;
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/noise_flicker.h"
 #include "core/warnings.h"
 #include "gravcal/core/noise_model.h"
 
@@ -12,12 +13,16 @@ namespace internal {
 namespace {
 
 // B^2 + K^2 T / 3 of one axis, (rad/s)^2 (gyro_bias_wander.h); NaN when the
-// axis shows neither term.
+// axis shows neither term. B^2 is the flicker's alone: a B read at the Allan
+// curve's floor (with a tau) still holds the white noise's and the random
+// walk's share there, which internal::FlickerAllanVariance (core/noise_flicker.h) takes off,
+// as the model's Allan variance does; otherwise the random walk would be
+// counted twice (once in B, once in K^2 T / 3).
 double ModelWander(const AxisNoiseModel& axis, double seconds) {
   double v = 0.0;
   bool shown = false;
   if (axis.bias_instability.visible()) {
-    v += axis.bias_instability.value * axis.bias_instability.value;
+    v += FlickerAllanVariance(axis) / kFlickerAllanFactor;
     shown = true;
   }
   if (axis.random_walk.visible()) {

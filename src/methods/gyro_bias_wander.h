@@ -28,7 +28,11 @@
 //   over 1-100 s, Gauss-Markov terms up to 1000 s) the variance of a
 //   117-s session's mean is 1.18 B^2 (computed from its terms), and the
 //   measured error / sigma rms of the bias is 0.98-1.05 with B^2 against
-//   1.16-1.26 with 0.44 B^2 (tests/property/hand_placed_test.cc).
+//   1.16-1.26 with 0.44 B^2 (tests/property/hand_placed_test.cc). A B
+//   read at the Allan curve's floor (noise.json, with its tau) still holds
+//   the white noise's and the random walk's variance there; that share is
+//   taken off (AxisNoiseModel::FlickerAllanVariance) so that K is not
+//   counted twice. A B without a tau (a datasheet's) is all flicker.
 // - Otherwise, from the poses' own scatter s^2 (REML, when
 //   estimate_static_variance finds one), by the random walk's ratio: a
 //   random walk over T scatters the poses about their mean by K^2 T / 6 and

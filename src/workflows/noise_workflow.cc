@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <utility>
 
+#include "estimation/nyquist_flatness.h"
 #include "gravcal/core/gravity.h"
 #include "gravcal/io/files.h"
 #include "gravcal/io/noise_io.h"
@@ -108,8 +111,87 @@ bool CharacteriseLongLogNoise(const ImuLog& log, const LongLogReading& reading,
   return true;
 }
 
+namespace {
+
+// One axis's note (noise_workflow.h, CheckNoiseAgainstDatasheet).
+std::string DatasheetNote(const std::string& name, const AxisNoiseModel& axis, double datasheet,
+                          double flatness, double rate_hz, bool block_means) {
+  // Datasheet figures are typical values; parts scatter by tens of percent.
+  constexpr double kTypical = 1.3;
+  // A white spectrum's top band holds at least this share of its middle's
+  // amplitude (Welch medians over about 20 bins: a few percent of scatter);
+  // a filter at Nyquist would take off about 30 %.
+  constexpr double kFlat = 0.85;
+  std::ostringstream s;
+  s.precision(3);
+  if (!axis.white_noise.visible()) {
+    s << name << ": N not determined, not compared with the datasheet's " << datasheet;
+    return s.str();
+  }
+  const double ratio = axis.white_noise.value / datasheet;
+  s << name << ": N is " << ratio << " times the datasheet's " << datasheet;
+  if (ratio <= kTypical && ratio >= 1.0 / kTypical) return s.str() + " (within its scatter)";
+  const double nyquist = 0.5 * rate_hz;
+  if (ratio < 1.0 / kTypical) {
+    s << ": a quieter part than typical, or a low-pass filter below the datasheet's bandwidth";
+    if (std::isfinite(flatness)) {
+      s << " (the spectrum at Nyquist is " << flatness << " of its mid level)";
+    }
+  } else if (block_means) {
+    s << "; a log read as block means keeps no spectrum up to the rows' Nyquist, so aliasing "
+         "is not judged";
+  } else if (!std::isfinite(flatness)) {
+    s << "; the still interval is too short for the spectrum to tell aliasing";
+  } else if (flatness >= kFlat) {
+    s << "; the spectrum is flat up to Nyquist (" << nyquist << " Hz: " << flatness
+      << " of its level at 0.2-0.4 of Nyquist), so the sensor's bandwidth reaches past it: "
+         "possibly aliasing, noise above Nyquist folded in by sampling at "
+      << rate_hz << " Hz (a bandwidth B reads sqrt(2 B / " << rate_hz
+      << ") times the part's own density), or a part that noisy. N is the density the "
+         "sampled data hold, the one a filter at this rate must use; a lower one needs the "
+         "sensor's low-pass filter below "
+      << nyquist << " Hz";
+  } else {
+    s << "; the spectrum falls toward Nyquist (" << flatness
+      << " of its mid level), so no aliasing shows: the part or its mounting is that noisy";
+  }
+  return s.str();
+}
+
+}  // namespace
+
+void CheckNoiseAgainstDatasheet(const ImuLog& log, const LongLogReading& reading,
+                                const ImuNoise& noise, double accel_density, double gyro_density,
+                                NoiseDatasheetCheck* check) {
+  *check = NoiseDatasheetCheck();
+  const ImuNoiseModel& m = noise.model;
+  const bool block_means = reading.samples_averaged > 1;
+  const char* axes = "xyz";
+  for (int sensor = 0; sensor < 2; ++sensor) {
+    const bool gyro = sensor == 1;
+    if (gyro && !log.has_gyro()) break;
+    const std::vector<Eigen::Vector3d>& x = gyro ? log.gyro : log.accel;
+    const double scale = gyro ? noise.gyro_scale : noise.accel_scale;
+    const double density = gyro ? gyro_density : accel_density;
+    for (int a = 0; a < 3; ++a) {
+      double& flatness = gyro ? check->gyro_flatness[a] : check->accel_flatness[a];
+      if (!block_means && m.still_end <= x.size()) {
+        std::vector<double> samples;
+        samples.reserve(m.still_end - m.still_begin);
+        for (size_t i = m.still_begin; i < m.still_end; ++i) samples.push_back(scale * x[i](a));
+        flatness = internal::NyquistFlatness(samples, 0, samples.size(), m.rate_hz);
+      }
+      if (!(density > 0.0)) continue;
+      check->notes.push_back(DatasheetNote(std::string(gyro ? "gyro " : "accel ") + axes[a],
+                                           gyro ? m.gyro[a] : m.accel[a], density, flatness,
+                                           m.rate_hz, block_means));
+    }
+  }
+}
+
 bool WriteNoiseFiles(const ImuNoise& noise, const std::string& source, const NoiseFiles& files,
-                     std::vector<std::string>* written, std::string* error) {
+                     std::vector<std::string>* written, std::string* error,
+                     const NoiseDatasheetCheck* datasheet) {
   if (!CheckDestinations({{files.json, "noise.json"},
                           {files.kalibr, "kalibr"},
                           {files.handheld, "handheld"},
@@ -118,7 +200,25 @@ bool WriteNoiseFiles(const ImuNoise& noise, const std::string& source, const Noi
     return false;
   }
   std::vector<FileContents> texts;
-  if (!files.json.empty()) texts.push_back({files.json, NoiseToJson(noise)});
+  if (!files.json.empty()) {
+    std::string text = NoiseToJson(noise);
+    if (datasheet != nullptr) {
+      // How far each axis's spectrum reaches toward Nyquist, and N against
+      // the datasheet's (CheckNoiseAgainstDatasheet).
+      nlohmann::json out = nlohmann::json::parse(text);
+      auto flatness = [](const std::array<double, 3>& f) {
+        nlohmann::json axes = nlohmann::json::array();
+        for (double v : f) axes.push_back(std::isfinite(v) ? nlohmann::json(v) : nullptr);
+        return axes;
+      };
+      out["choices"]["spectrum"] = {{"nyquist_flatness",
+                                     {{"accel", flatness(datasheet->accel_flatness)},
+                                      {"gyro", flatness(datasheet->gyro_flatness)}}},
+                                    {"datasheet", datasheet->notes}};
+      text = out.dump(2) + "\n";
+    }
+    texts.push_back({files.json, text});
+  }
   if (!files.kalibr.empty()) {
     std::string yaml;
     if (!NoiseToKalibrYaml(noise.model, &yaml, error)) {

@@ -63,8 +63,9 @@
 // still pose. Neighbours are merged only when their means agree within
 // trend_factor times the noise of a window's mean.
 // Time units are checked too: a median time step so long that a window holds
-// fewer than two samples is refused, naming the unit (ms, us, ns) the time
-// column is likely in and the time_scale that fixes it.
+// fewer than 8 samples is refused, naming the unit (ms, us, ns) the time
+// column is likely in and the time_scale that fixes it (a 4 kHz log in ms
+// reads as 4 Hz), or the window_seconds a log that slow needs.
 #ifndef GRAVCAL_DETECTION_STATIC_DETECTOR_H_
 #define GRAVCAL_DETECTION_STATIC_DETECTOR_H_
 

@@ -10,6 +10,8 @@
 #ifndef GRAVCAL_WORKFLOWS_NOISE_WORKFLOW_H_
 #define GRAVCAL_WORKFLOWS_NOISE_WORKFLOW_H_
 
+#include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -46,6 +48,27 @@ bool CharacteriseLogNoise(const ImuLog& log, const NoiseOptions& options, ImuNoi
 bool CharacteriseLongLogNoise(const ImuLog& log, const LongLogReading& reading,
                               const NoiseOptions& options, ImuNoise* noise, std::string* error);
 
+// N against the datasheet's white-noise density (`noise
+// --accel-noise-density/--gyro-noise-density`, SI units; 0 = none): one
+// note per axis, and how far each axis's spectrum reaches toward Nyquist
+// (the square root of its level at 0.8-0.97 of Nyquist over that at 0.2-0.4
+// of it; NaN when the still interval is too short or the log was read as
+// block means). An N more than 1.3 times the datasheet's over a spectrum flat
+// to Nyquist (0.85 or more) is named as possible aliasing: a sensor whose
+// bandwidth B reaches past Nyquist folds the noise above it in, reading
+// sqrt(2 B / rate) times its own density (an MPU-6050's default 256 Hz
+// filter read at 100 Hz: 2.3); the same spectrum is what a part that noisy
+// shows, so the note says "possibly", and N stays the density the sampled
+// data hold. A spectrum that falls toward Nyquist rules aliasing out.
+struct NoiseDatasheetCheck {
+  std::array<double, 3> accel_flatness{NAN, NAN, NAN};
+  std::array<double, 3> gyro_flatness{NAN, NAN, NAN};
+  std::vector<std::string> notes;
+};
+void CheckNoiseAgainstDatasheet(const ImuLog& log, const LongLogReading& reading,
+                                const ImuNoise& noise, double accel_density, double gyro_density,
+                                NoiseDatasheetCheck* check);
+
 // The files of `gravcal noise`; an empty path is not written.
 struct NoiseFiles {
   // noise.json (io/noise_io.h).
@@ -62,8 +85,11 @@ struct NoiseFiles {
 // in the order above; on a failure the files already written are removed,
 // so none is left. *written (may be null): the paths written, in order.
 // False with a one-line *error (naming the file).
+// With `datasheet` (may be null), noise.json also holds its flatness and
+// notes (choices.spectrum).
 bool WriteNoiseFiles(const ImuNoise& noise, const std::string& source, const NoiseFiles& files,
-                     std::vector<std::string>* written, std::string* error);
+                     std::vector<std::string>* written, std::string* error,
+                     const NoiseDatasheetCheck* datasheet = nullptr);
 
 }  // namespace gravcal
 
