@@ -29,7 +29,7 @@ struct Prepared {
 Prepared Prepare(const SimulatorScheme& scheme, uint64_t seed) {
   SimulatorOptions sim;
   sim.scheme = scheme;
-  sim.rotation_profile = "hand";
+  sim.rotation_profile = RotationProfile::kHand;
   sim.hold_seconds = 6.0;
   Prepared p;
   std::string error;

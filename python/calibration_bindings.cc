@@ -208,13 +208,12 @@ py::dict Export(const PyCalibration& c, const std::string& to, const std::string
   options.accel_device_id = static_cast<int64_t>(accel_device_id);
   options.gyro_device_id = static_cast<int64_t>(gyro_device_id);
   options.drop_thermal = drop_thermal;
-  Check(FromString(to, &options.target),
-        "to: expected one of " + ExportTargetNames() + ", not '" + to + "'");
+  std::string error;
+  Check(ParseName("to", to, &options.target, &error), error);
   ImuNoise noise;
   if (ReadNoise(noise_path, noise_text, &noise)) options.noise = &noise.model;
   options.calibration_name = name.empty() ? c.name : name;
   ExportResult result;
-  std::string error;
   Check(ExportCalibration(c.Models(), options, &result, &error), error);
   py::list files;
   for (const ExportedFile& f : result.files) {

@@ -20,11 +20,11 @@ void BindMultiImu(py::module_& m) {
         o.max_clock_offset = max_clock_offset;
         o.clock_drift_std = clock_drift_std;
         o.slip_imu = slip_imu;
-        o.mounting = mounting;
+        std::string error;
+        Check(ParseName("mounting", mounting, &o.mounting, &error), error);
         o.imu.hold_seconds = hold_seconds;
         o.imu.initial_still_seconds = hold_seconds;
         SimulatedPlate plate;
-        std::string error;
         bool ok = false;
         {
           py::gil_scoped_release release;

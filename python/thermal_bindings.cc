@@ -9,16 +9,20 @@ namespace gravcal {
 namespace python {
 namespace {
 
-ThermalSensor SensorNamed(const std::string& name) {
-  ThermalSensor s;
-  Check(FromString(name, &s), "sensor: expected accel or gyro, not '" + name + "'");
-  return s;
+// An enum from its name (its one table); the error names the argument and
+// the accepted names.
+template <typename E>
+E Named(const char* argument, const std::string& name) {
+  E value{};
+  std::string error;
+  Check(ParseName(argument, name, &value, &error), error);
+  return value;
 }
 
+ThermalSensor SensorNamed(const std::string& name) { return Named<ThermalSensor>("sensor", name); }
+
 ThermalQuantity QuantityNamed(const std::string& name) {
-  ThermalQuantity q;
-  Check(FromString(name, &q), "quantity: expected bias, scale or misalignment, not '" + name + "'");
-  return q;
+  return Named<ThermalQuantity>("quantity", name);
 }
 
 py::dict TermDict(const ThermalPolynomial& p, ThermalSensor s, ThermalQuantity q) {

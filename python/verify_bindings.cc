@@ -44,11 +44,11 @@ std::string Compare(const PyCalibration& a, const PyCalibration& b, double level
                     const std::string& space_name) {
   const ComparisonOptions options = Options(level);
   ComparisonSpace space;
-  Check(FromString(space_name, &space), "space: '" + space_name + "' is not model or intrinsic");
+  std::string error;
+  Check(ParseName("space", space_name, &space, &error), error);
   ParameterVector p[2];
   const Calibration c[2] = {WithUncertainty(a), WithUncertainty(b)};
   const std::string names[2] = {a.name, b.name};
-  std::string error;
   Check(SameRawUnits(c[0], c[1], &error), names[0] + ", " + names[1] + ": " + error);
   for (int i = 0; i < 2; ++i) {
     Check(CalibrationParameters(c[i], space, &p[i], &error),

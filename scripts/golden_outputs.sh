@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Writes the calibration JSON of the demo, of the three real recordings (when
+# Writes the calibration JSON of the demo, of the real recordings (when
 # ../shared/data/real exists) and of one simulated run of every method into
 # OUT_DIR, with wall-clock fields removed, so that two builds can be compared
 # with `diff -r`. Usage: scripts/golden_outputs.sh BUILD_DIR OUT_DIR
@@ -46,6 +46,15 @@ run_sim known_attitude configs/known_attitude.yaml
 run_sim handheld_kalman configs/handheld_kalman.yaml \
   --nominal_scale 0.00059855 --gyro_nominal_scale 0.000133231 --gravity 9.80665
 run_sim discovery_effects configs/discovery.yaml
+run_sim thermal configs/thermal.yaml
+# rate_table: the simulator's rate-table motion (configs/handheld_kalman.yaml
+# holds its keys) and the segments it writes.
+"$g" simulate --config configs/handheld_kalman.yaml --sim_motion rate_table --seed 3 \
+  --output-dir "$tmp/rate_table" > /dev/null 2>&1
+"$g" calibrate --input "$tmp/rate_table/raw.csv" --config configs/rate_table.yaml \
+  --segments "$tmp/rate_table/segments.csv" --output "$tmp/rate_table.json" > /dev/null 2>&1 ||
+  echo "calibrate rate_table failed" >&2
+strip "$tmp/rate_table.json" "$out/rate_table.json"
 
 real="$root/../shared/data/real"
 if [ -d "$real" ]; then

@@ -11,6 +11,8 @@
 #include <string>
 
 #include "cli_runner.h"
+#include "gravcal/core/types.h"
+#include "gravcal/io/calibration_export.h"
 #include "sigma_check.h"
 #include "test_util.h"
 
@@ -213,6 +215,16 @@ TEST_F(CliTest, HelpListsCommandsAndKeys) {
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.out.find("--parameterization"), std::string::npos);
   EXPECT_NE(r.out.find("--latitude"), std::string::npos);
+  // An enum key's or flag's help ends in the names its table accepts.
+  EXPECT_NE(r.out.find("robust loss on the residuals: " + AcceptedNames(LossType())),
+            std::string::npos)
+      << r.out;
+  r = Run("export --help");
+  EXPECT_NE(r.out.find("export: the target: " + AcceptedNames(ExportTarget())), std::string::npos)
+      << r.out;
+  r = Run("export --to matlab");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--to: 'matlab' is not one of kalibr"), std::string::npos) << r.err;
 }
 
 // Issue 5: the gyroscope from the rotations between poses, end to end.

@@ -442,6 +442,8 @@ TEST(Config, SimulatorTruthHoldsEverySimulatorKey) {
       value = std::to_string(std::stod(text) + 0.375);
     } else if (key.name == "sim_scheme") {
       value = "random:7";  // a SimulatorScheme
+    } else if (key.name == "sim_rotation_profile") {
+      value = "hand";  // a RotationProfile
     }
     Config one;
     std::string error;

@@ -34,7 +34,7 @@ namespace {
 // The simulated IMU of these tests: the twelve poses, hand-like rotations.
 SimulatorOptions HandSession() {
   SimulatorOptions sim;
-  sim.rotation_profile = "hand";
+  sim.rotation_profile = RotationProfile::kHand;
   sim.hold_seconds = 6.0;
   sim.initial_still_seconds = 4.0;
   return sim;

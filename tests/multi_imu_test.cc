@@ -214,7 +214,7 @@ TEST(MultiImu, DriftingClockIsNamed) {
 
 TEST(MultiImu, OneLevelPoseGivesOffsetsAlongGravityOnly) {
   PlateSimulatorOptions o = PlateOptions(4);
-  o.mounting = "aligned";
+  o.mounting = PlateMounting::kAligned;
   o.imu.scheme = {PoseScheme::kRandom, 1};
   o.imu.hold_seconds = 20.0;
   o.imu.initial_still_seconds = 20.0;
@@ -280,7 +280,7 @@ TEST(MultiImu, HandTurnsAndSiUnitsStayHonest) {
     for (uint64_t seed = 1; seed <= 4; ++seed) {
       PlateSimulatorOptions o = PlateOptions(3);
       o.permuted_imu = 2;
-      if (mode == 0) o.imu.rotation_profile = "hand";
+      if (mode == 0) o.imu.rotation_profile = RotationProfile::kHand;
       if (mode == 1) o.imu.raw_counts = false;
       SimulatedPlate plate;
       std::string error;

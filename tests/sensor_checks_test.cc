@@ -47,7 +47,7 @@ struct GyroSession {
 
 GyroSession MakeGyroSession() {
   GyroSession g;
-  g.config.simulation.rotation_profile = "hand";
+  g.config.simulation.rotation_profile = RotationProfile::kHand;
   g.config.simulation.hold_seconds = 6.0;
   g.config.simulation.initial_still_seconds = 4.0;
   std::string error;

@@ -394,6 +394,13 @@ TEST(Simulator, RejectsUnknownScheme) {
   EXPECT_EQ(error, "key 'sim_scheme': 'bogus' is not one of six, twelve, ten or random:N");
   ASSERT_TRUE(SetConfigValue("sim_scheme", "random:5", &config, &error)) << error;
   EXPECT_EQ(ConfigValueText(config, "sim_scheme"), "random:5");
+  // So is every other enum key, from the enum's one table.
+  EXPECT_FALSE(SetConfigValue("sim_rotation_profile", "jerky", &config, &error));
+  EXPECT_EQ(error, "key 'sim_rotation_profile': 'jerky' is not one of smooth or hand");
+  ASSERT_TRUE(SetConfigValue("sim_rotation_profile", "hand", &config, &error)) << error;
+  EXPECT_EQ(config.simulation.rotation_profile, RotationProfile::kHand);
+  EXPECT_FALSE(SetConfigValue("loss", "l2", &config, &error));
+  EXPECT_EQ(error, "key 'loss': 'l2' is not one of none, huber, cauchy, soft_l1, arctan or tukey");
   // A count out of range set in code is refused by the simulator.
   SimulatorOptions options;
   options.scheme = {PoseScheme::kRandom, 0};

@@ -132,7 +132,7 @@ def test_export_errors_are_the_cli_messages(cli_calibration, tmp_path):
     with pytest.raises(gravcal.Error) as e:
         gravcal.export(str(cli_calibration), "kalibr")
     assert str(e.value) == error
-    with pytest.raises(gravcal.Error, match=r"^to: expected one of kalibr, .*, not 'matlab'$"):
+    with pytest.raises(gravcal.Error, match=r"^key 'to': 'matlab' is not one of kalibr, .* or c$"):
         gravcal.export(str(cli_calibration), "matlab")
 
 

@@ -66,7 +66,8 @@ bool CheckLimitsFile(const std::string& limits, std::string* error) {
   return limits.empty() || ReadAcceptanceLimits(limits, &parsed, error);
 }
 
-int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration) {
+int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration,
+                     const AcceptanceLimits* limits) {
   std::string error;
   if (!args.store.empty()) {
     // The stored copy always has the covariance: history and compare need it.
@@ -78,19 +79,16 @@ int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration) 
     std::fprintf(stderr, "gravcal: filed as unit '%s', %s, in %s\n", UnitName(args).c_str(),
                  date.c_str(), args.store.c_str());
   }
-  if (args.limits.empty() && args.certificate.empty()) return 0;
-  AcceptanceLimits limits;
-  const bool has_limits = !args.limits.empty();
-  if (has_limits && !ReadAcceptanceLimits(args.limits, &limits, &error)) return Fail(error);
+  if (limits == nullptr && args.certificate.empty()) return 0;
   AcceptanceResult acceptance;
-  if (has_limits) CheckAcceptance(calibration, limits, &acceptance);
+  if (limits != nullptr) CheckAcceptance(calibration, *limits, &acceptance);
   if (!args.certificate.empty()) {
     CertificateInfo info = StationInfo(args.config_path);
     info.unit = UnitName(args);
     info.input_file = args.input;
     info.input_hash = calibration.provenance.log_hash;
     Certificate certificate;
-    if (!MakeCertificate(calibration, info, has_limits ? &limits : nullptr, &certificate, &error)) {
+    if (!MakeCertificate(calibration, info, limits, &certificate, &error)) {
       return Fail(error);
     }
     if (!WriteFileAtomically(args.certificate + ".json", CertificateToJson(certificate), &error) ||
@@ -98,7 +96,7 @@ int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration) 
       return Fail(error);
     }
   }
-  if (!has_limits) return 0;
+  if (limits == nullptr) return 0;
   std::fprintf(stderr, "gravcal: limits %s: %s\n", args.limits.c_str(), acceptance.message.c_str());
   return acceptance.pass ? 0 : kOutOfLimits;
 }

@@ -129,7 +129,11 @@ int RunCalibrate(const CalibrateArgs& args) {
   if (args.output.empty()) return Fail("calibrate needs --output <calib.json>");
   std::string error;
   if (!CheckConfig(args.config, &error)) return Fail(error);
-  if (!CheckLimitsFile(args.limits, &error)) return Fail(error);
+  // The limits are read once, before the work.
+  AcceptanceLimits limits;
+  if (!args.limits.empty() && !ReadAcceptanceLimits(args.limits, &limits, &error)) {
+    return Fail(error);
+  }
   // --history only for a method that keeps one, said before the work.
   const CalibrationMethod* method = FindCalibrationMethod(args.config.method);
   if (!args.history.empty() && method != nullptr && !method->keeps_history) {
@@ -189,7 +193,7 @@ int RunCalibrate(const CalibrateArgs& args) {
   }
   std::fprintf(stderr, "gravcal: %s; wrote %s\n", c.BriefReport().c_str(),
                args.output == "-" ? "standard output" : args.output.c_str());
-  return FinishAcceptance(args, c);
+  return FinishAcceptance(args, c, args.limits.empty() ? nullptr : &limits);
 }
 
 int RunSimulate(const SimulateArgs& args) {

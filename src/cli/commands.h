@@ -3,11 +3,15 @@
 #ifndef GRAVCAL_SRC_CLI_COMMANDS_H_
 #define GRAVCAL_SRC_CLI_COMMANDS_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "gravcal/estimation/calibration_comparison.h"
+#include "gravcal/io/calibration_export.h"
 #include "gravcal/io/calibration_io.h"
 #include "gravcal/methods/session.h"
+#include "gravcal/workflows/acceptance.h"
 #include "gravcal/workflows/config.h"
 #include "gravcal/workflows/plan.h"
 
@@ -151,8 +155,8 @@ struct InspectArgs : CommonArgs {
 struct ExportArgs : CommonArgs {
   std::string calibration;
   std::string noise;
-  // The target (--to).
-  std::string to;
+  // The target (--to; none when not given).
+  std::optional<ExportTarget> to;
   std::string output;
   std::string output_dir;
   StoredCalibrationArgs stored;
@@ -170,8 +174,8 @@ struct CompareArgs : CommonArgs {
   std::string output;
   // The test's significance level.
   double level = 0.01;
-  // The parameters compared: model or intrinsic (ComparisonSpace).
-  std::string space = "model";
+  // The parameters compared.
+  ComparisonSpace space = ComparisonSpace::kModel;
 };
 
 // verify: a short check session (--input) against a stored calibration.
@@ -228,7 +232,8 @@ int RunPlanVerify(const PlanArgs& args);
 // when given, parses), and after the calibration is written: 0, 4 when a
 // limit fails, 1 on an error.
 bool CheckLimitsFile(const std::string& limits, std::string* error);
-int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration);
+int FinishAcceptance(const CalibrateArgs& args, const Calibration& calibration,
+                     const AcceptanceLimits* limits);
 // batch --limits: each calibrated unit's <output-dir>/<unit>.json against
 // the limits, <output-dir>/limits.csv (unit, verdict, failed), the count and
 // the failing units named on stderr; returns `code` when it is not 0, else 4

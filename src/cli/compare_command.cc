@@ -59,10 +59,7 @@ int RunCompare(const CompareArgs& args) {
   std::string error;
   ComparisonOptions options;
   if (!ComparisonOptionsFromLevel(args.level, &options, &error)) return Fail(error);
-  ComparisonSpace space;
-  if (!FromString(args.space, &space)) {
-    return Fail("--space: '" + args.space + "' is not model or intrinsic");
-  }
+  const ComparisonSpace space = args.space;
   Calibration cal[2];
   LoadedCalibration loaded[2];
   ParameterVector params[2];

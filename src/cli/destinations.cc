@@ -107,8 +107,7 @@ bool CheckCommandDestinations(const LogReportArgs& args, std::string* error) {
 }
 
 bool CheckCommandDestinations(const ExportArgs& args, std::string* error) {
-  ExportTarget target;
-  const bool c_target = FromString(args.to, &target) && target == ExportTarget::kC;
+  const bool c_target = args.to == ExportTarget::kC;
   return Check(args,
                c_target ? FolderFiles(args.output_dir, "--output-dir",
                                       {"gravcal_correct.h", "gravcal_correct.c"})

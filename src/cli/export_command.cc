@@ -25,10 +25,8 @@ int RunExport(const ExportArgs& args) {
     return Fail("export needs --calibration <calib.json> (or --store DIR --unit SN)");
   }
   ExportOptions options;
-  if (!FromString(args.to, &options.target)) {
-    return Fail("export needs --to <target>, one of " + ExportTargetNames() +
-                (args.to.empty() ? "" : " (not '" + args.to + "')"));
-  }
+  if (!args.to) return Fail("export needs --to <target>, one of " + AcceptedNames(ExportTarget()));
+  options.target = *args.to;
   const bool c_target = options.target == ExportTarget::kC;
   if (c_target && args.output_dir.empty()) {
     return Fail("export --to c needs --output-dir <folder> (writes gravcal_correct.h and .c)");
@@ -49,7 +47,7 @@ int RunExport(const ExportArgs& args) {
   ExportResult result;
   if (!ExportCalibration(calibration, options, &result, &error)) return Fail(error);
   for (const std::string& line : result.dropped) {
-    std::fprintf(stderr, "gravcal: export --to %s drops: %s\n", args.to.c_str(), line.c_str());
+    std::fprintf(stderr, "gravcal: export --to %s drops: %s\n", ToString(*args.to), line.c_str());
   }
   if (c_target && !MakeFolders(args.output_dir, &error)) return Fail(error);
   // Every file in place, or none.

@@ -28,6 +28,14 @@ std::string FlagText(const char* name) {
   return text;
 }
 
+std::string FlagSpelling(const char* name) {
+  std::string s = std::string("--") + name;
+  for (char& c : s) {
+    if (c == '_') c = '-';
+  }
+  return s;
+}
+
 void ParseFlagText(const std::string& text, std::string* value) { *value = text; }
 void ParseFlagText(const std::string& text, bool* value) { *value = text == "true"; }
 void ParseFlagText(const std::string& text, int* value) {

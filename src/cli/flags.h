@@ -7,9 +7,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <type_traits>
 
+#include "gravcal/estimation/calibration_comparison.h"
 #include "gravcal/workflows/fleet_summary.h"
 #include "gravcal/workflows/plan.h"
 
@@ -55,7 +57,7 @@
     "plan, check: targets, e.g. \"accel_bias=0.5mg accel_scale=50ppm "                           \
     "accel_misalignment=0.1mrad\" (or parameter names bias_x ... u_zz)")                         \
   X(string, pose_set, gravcal::ToString(gravcal::PlanRequest().pose_set),                        \
-    "plan, check: candidate orientations: faces, faces+45 or free")                              \
+    "plan, check: candidate orientations")                                                       \
   X(int32, candidates, gravcal::PlanRequest().free_candidates,                                   \
     "plan, check: directions of the free pose set (besides faces+45)")                           \
   X(double, max_time, 0.0, "plan: the session may not take longer, seconds (0 = no limit)")      \
@@ -84,9 +86,9 @@
   X(string, plan, "", "simulate: plan.json from gravcal plan (its poses replace sim_scheme)")    \
   X(double, level, 0.01,                                                                         \
     "compare, verify, history, plan --verify: significance level of the test")                   \
-  X(string, space, "model",                                                                      \
-    "compare: model (the calibrations' own parameters, same mounting) or intrinsic "             \
-    "(mount-invariant, Geist and Gaitan)")                                                       \
+  X(string, space, gravcal::ToString(gravcal::ComparisonSpace::kModel),                          \
+    "compare: the parameters compared (model: the calibrations' own, same mounting; "            \
+    "intrinsic: mount-invariant, Geist and Gaitan)")                                             \
   X(string, limits, "", "calibrate, batch: acceptance limits (YAML); exit 4 when one fails")     \
   X(string, certificate, "",                                                                     \
     "calibrate: write the calibration certificate to <prefix>.json and <prefix>.html; "          \
@@ -107,7 +109,7 @@
     "plan: design the shortest check session for this stored calibration (JSON) "                \
     "instead: four poses, detecting 10 stored sigmas in any one parameter with power "           \
     "0.9 at --level (needs --accel_noise_density)")                                              \
-  X(string, to, "", "export: the target (kalibr, openvins, ros, px4, ardupilot, c)")             \
+  X(string, to, "", "export: the target")                                                        \
   X(string, events, "", "record: write the events as JSON lines here (- = standard output)")     \
   X(int32, baud, 0, "record: baud rate of a serial --input (0 = the device's setting)")          \
   X(string, stream, "",                                                                          \
@@ -147,43 +149,95 @@ void ParseFlagText(const std::string& text, int* value);
 void ParseFlagText(const std::string& text, uint64_t* value);
 void ParseFlagText(const std::string& text, double* value);
 
-// Text to the value of flag `name`; an enum by its one string table
-// (core/types.h ParseName): false with a one-line error naming the flag and
-// the accepted names.
+// "--output-dir" for "output_dir".
+std::string FlagSpelling(const char* name);
+
+// Whether T is an enum with a string table, or an optional one (a flag that
+// may be left empty).
+template <typename T>
+struct FlagEnum : std::is_enum<T> {};
+template <typename T>
+struct FlagEnum<std::optional<T>> : std::is_enum<T> {};
+
+// Text to an enum by its one string table (core/types.h): false with a
+// one-line error naming the flag and the accepted names ("--space: 'x' is
+// not one of model or intrinsic"). An optional enum stays empty for empty
+// text.
+template <typename E>
+bool SetFlagEnum(const char* name, const std::string& text, E* value, std::string* error) {
+  if (FromString(text, value)) return true;
+  *error = FlagSpelling(name) + ": '" + text + "' is not one of " + AcceptedNames(E());
+  return false;
+}
+template <typename E>
+bool SetFlagEnum(const char* name, const std::string& text, std::optional<E>* value,
+                 std::string* error) {
+  E v{};
+  if (text.empty()) {
+    value->reset();
+  } else if (SetFlagEnum(name, text, &v, error)) {
+    *value = v;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// Text to the value of flag `name` (an enum by SetFlagEnum).
 template <typename T>
 bool SetFlagValue(const char* name, const std::string& text, T* value, std::string* error) {
-  if constexpr (std::is_enum_v<T>) {
-    return ParseName(name, text, value, error);
+  if constexpr (FlagEnum<T>::value) {
+    return SetFlagEnum(name, text, value, error);
   } else {
     ParseFlagText(text, value);
     return true;
   }
 }
 
-// A command's use of one flag: its name, and where its value goes in the
-// command's args struct (false with a one-line error on a bad value).
+// The names an enum flag accepts (core/types.h AcceptedNames), empty for
+// other flags: help lists them after the flag's own help.
+template <typename T>
+std::string FlagAcceptedNames() {
+  if constexpr (std::is_enum_v<T>) {
+    return AcceptedNames(T());
+  } else if constexpr (FlagEnum<T>::value) {
+    return AcceptedNames(typename T::value_type());
+  } else {
+    return std::string();
+  }
+}
+
+// A command's use of one flag: its name, where its value goes in the
+// command's args struct (false with a one-line error on a bad value), and
+// the names it accepts if it takes an enum (FlagAcceptedNames).
 template <typename Args>
 struct FlagBinding {
   const char* name;
   std::function<bool(const std::string& text, Args* args, std::string* error)> set;
+  std::string accepted;
 };
 
 // The flag `name` into the field `field` of Args (or of its base).
 template <typename Args, typename Class, typename T>
 FlagBinding<Args> FlagField(const char* name, T Class::*field) {
   static_assert(std::is_base_of_v<Class, Args>, "the field is not one of the args struct");
-  return {name, [name, field](const std::string& text, Args* args, std::string* error) {
+  return {name,
+          [name, field](const std::string& text, Args* args, std::string* error) {
             return SetFlagValue(name, text, &(args->*field), error);
-          }};
+          },
+          FlagAcceptedNames<T>()};
 }
 
 // The flag `name` into the field that `at` returns a pointer to (a field of
 // a nested struct: &args->request.targets).
 template <typename Args, typename At>
 FlagBinding<Args> FlagAt(const char* name, At at) {
-  return {name, [name, at](const std::string& text, Args* args, std::string* error) {
+  using T = std::remove_pointer_t<std::invoke_result_t<At, Args*>>;
+  return {name,
+          [name, at](const std::string& text, Args* args, std::string* error) {
             return SetFlagValue(name, text, at(args), error);
-          }};
+          },
+          FlagAcceptedNames<T>()};
 }
 
 }  // namespace cli

@@ -40,14 +40,20 @@ struct CommandInfo {
   bool positional = false;
   // Reads the config: takes config keys as flags (--gravity 9.81).
   bool config_keys = true;
+  // For each flag, the names it accepts (an enum flag's,
+  // FlagBinding::accepted; empty for others).
+  std::vector<std::string> accepted;
 };
 
 // A command whose flags fill Args (commands.h) and that runs as `run`.
 template <typename Args>
 CommandInfo Command(const char* name, const char* summary, std::vector<FlagBinding<Args>> bindings,
                     int (*run)(const Args&), bool positional = false, bool config_keys = true) {
-  CommandInfo info{name, summary, {}, nullptr, positional, config_keys};
-  for (const FlagBinding<Args>& b : bindings) info.flags.push_back(b.name);
+  CommandInfo info{name, summary, {}, nullptr, positional, config_keys, {}};
+  for (const FlagBinding<Args>& b : bindings) {
+    info.flags.push_back(b.name);
+    info.accepted.push_back(b.accepted);
+  }
   info.run = [bindings, run](CommonArgs common) {
     Args args;
     static_cast<CommonArgs&>(args) = std::move(common);
@@ -334,12 +340,10 @@ bool PrintHelp(const std::string& command) {
   for (const CommandInfo& c : Commands()) {
     if (command != c.name) continue;
     std::printf("gravcal %s: %s\n\nflags:\n", c.name, c.summary);
-    for (const char* f : c.flags) {
-      std::string name = f;
-      for (char& ch : name) {
-        if (ch == '_') ch = '-';
-      }
-      std::printf("  --%-22s %s\n", name.c_str(), FindFlag(f)->help);
+    for (size_t i = 0; i < c.flags.size(); ++i) {
+      const std::string& accepted = c.accepted[i];
+      std::printf("  %-24s %s%s\n", FlagSpelling(c.flags[i]).c_str(), FindFlag(c.flags[i])->help,
+                  accepted.empty() ? "" : (": " + accepted).c_str());
     }
     if (!c.config_keys) {
       std::printf("\nconfig keys: none (this command reads no config)\n");

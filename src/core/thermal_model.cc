@@ -2,50 +2,21 @@
 
 #include <cstdio>
 
+#include "core/enum_names.h"
+
 namespace gravcal {
 
-const char* ToString(ThermalQuantity quantity) {
-  switch (quantity) {
-    case ThermalQuantity::kBias:
-      return "bias";
-    case ThermalQuantity::kScale:
-      return "scale";
-    case ThermalQuantity::kMisalignment:
-      return "misalignment";
-  }
-  return "unknown";
-}
+namespace {
+const internal::EnumName<ThermalQuantity> kThermalQuantities[] = {
+    {ThermalQuantity::kBias, "bias"},
+    {ThermalQuantity::kScale, "scale"},
+    {ThermalQuantity::kMisalignment, "misalignment"}};
+const internal::EnumName<ThermalSensor> kThermalSensors[] = {{ThermalSensor::kAccel, "accel"},
+                                                             {ThermalSensor::kGyro, "gyro"}};
+}  // namespace
 
-bool FromString(const std::string& name, ThermalQuantity* quantity) {
-  for (ThermalQuantity q :
-       {ThermalQuantity::kBias, ThermalQuantity::kScale, ThermalQuantity::kMisalignment}) {
-    if (name == ToString(q) && quantity != nullptr) {
-      *quantity = q;
-      return true;
-    }
-  }
-  return false;
-}
-
-const char* ToString(ThermalSensor sensor) {
-  switch (sensor) {
-    case ThermalSensor::kAccel:
-      return "accel";
-    case ThermalSensor::kGyro:
-      return "gyro";
-  }
-  return "unknown";
-}
-
-bool FromString(const std::string& name, ThermalSensor* sensor) {
-  for (ThermalSensor s : {ThermalSensor::kAccel, ThermalSensor::kGyro}) {
-    if (name == ToString(s) && sensor != nullptr) {
-      *sensor = s;
-      return true;
-    }
-  }
-  return false;
-}
+GRAVCAL_ENUM_STRINGS(ThermalQuantity, kThermalQuantities)
+GRAVCAL_ENUM_STRINGS(ThermalSensor, kThermalSensors)
 
 int ThermalComponents(ThermalSensor sensor, ThermalQuantity quantity) {
   if (quantity == ThermalQuantity::kMisalignment && sensor == ThermalSensor::kGyro) return 6;

@@ -2,37 +2,13 @@
 
 #include <cstddef>
 
+#include "core/enum_names.h"
 #include "gravcal/core/effect_registry.h"
 
 namespace gravcal {
 namespace {
 
-// One row of an enum's table: a value and its string form.
-template <typename E>
-struct EnumName {
-  E value;
-  const char* name;
-};
-
-template <typename E, std::size_t N>
-const char* NameOf(const EnumName<E> (&table)[N], E value) {
-  for (const EnumName<E>& row : table) {
-    if (row.value == value) return row.name;
-  }
-  return "unknown";
-}
-
-template <typename E, std::size_t N>
-bool ValueOf(const EnumName<E> (&table)[N], const std::string& name, E* value) {
-  if (value == nullptr) return false;
-  for (const EnumName<E>& row : table) {
-    if (name == row.name) {
-      *value = row.value;
-      return true;
-    }
-  }
-  return false;
-}
+using internal::EnumName;
 
 const EnumName<AccelParameterization> kAccelParameterizations[] = {
     {AccelParameterization::kScale, "scale"},
@@ -98,6 +74,16 @@ const EnumName<PoseScheme> kPoseSchemes[] = {
     {PoseScheme::kRandom, "random"},
 };
 
+const EnumName<RotationProfile> kRotationProfiles[] = {
+    {RotationProfile::kSmooth, "smooth"},
+    {RotationProfile::kHand, "hand"},
+};
+
+const EnumName<PlateMounting> kPlateMountings[] = {
+    {PlateMounting::kAligned, "aligned"},
+    {PlateMounting::kRandom, "random"},
+};
+
 const EnumName<BatchStatus> kBatchStatuses[] = {
     {BatchStatus::kOk, "ok"},
     {BatchStatus::kFailed, "failed"},
@@ -147,22 +133,7 @@ const EnumName<WarningCode> kWarningCodes[] = {
     {WarningCode::kSensorData, "sensor_data"},
 };
 
-// "a, b or c".
-template <typename E, std::size_t N>
-std::string NamesOf(const EnumName<E> (&table)[N]) {
-  std::string s;
-  for (std::size_t i = 0; i < N; ++i) {
-    s += std::string(i == 0 ? "" : i + 1 == N ? " or " : ", ") + table[i].name;
-  }
-  return s;
-}
-
 }  // namespace
-
-// Each enum's pair, from its table.
-#define GRAVCAL_ENUM_STRINGS(Type, table)                           \
-  const char* ToString(Type value) { return NameOf(table, value); } \
-  bool FromString(const std::string& name, Type* value) { return ValueOf(table, name, value); }
 
 GRAVCAL_ENUM_STRINGS(AccelParameterization, kAccelParameterizations)
 GRAVCAL_ENUM_STRINGS(GyroParameterization, kGyroParameterizations)
@@ -174,7 +145,9 @@ GRAVCAL_ENUM_STRINGS(LogFormat, kLogFormats)
 GRAVCAL_ENUM_STRINGS(Method, kMethods)
 GRAVCAL_ENUM_STRINGS(PoseSet, kPoseSets)
 GRAVCAL_ENUM_STRINGS(MotionProfile, kMotionProfiles)
-GRAVCAL_ENUM_STRINGS(PoseScheme, kPoseSchemes)
+GRAVCAL_ENUM_TO_FROM_STRING(PoseScheme, kPoseSchemes)
+GRAVCAL_ENUM_STRINGS(RotationProfile, kRotationProfiles)
+GRAVCAL_ENUM_STRINGS(PlateMounting, kPlateMountings)
 GRAVCAL_ENUM_STRINGS(BatchStatus, kBatchStatuses)
 GRAVCAL_ENUM_STRINGS(Effect, kEffects)
 GRAVCAL_ENUM_STRINGS(EffectSensor, kEffectSensors)
@@ -182,12 +155,7 @@ GRAVCAL_ENUM_STRINGS(EffectRegressor, kEffectRegressors)
 GRAVCAL_ENUM_STRINGS(RejectionReason, kRejectionReasons)
 GRAVCAL_ENUM_STRINGS(WarningCode, kWarningCodes)
 
-#undef GRAVCAL_ENUM_STRINGS
-
-std::string AcceptedNames(Method) { return NamesOf(kMethods); }
-std::string AcceptedNames(PoseSet) { return NamesOf(kPoseSets); }
-std::string AcceptedNames(MotionProfile) { return NamesOf(kMotionProfiles); }
 // random takes its count.
-std::string AcceptedNames(PoseScheme) { return NamesOf(kPoseSchemes) + ":N"; }
+std::string AcceptedNames(PoseScheme) { return internal::NamesOf(kPoseSchemes) + ":N"; }
 
 }  // namespace gravcal

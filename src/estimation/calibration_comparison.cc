@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "core/enum_names.h"
 #include "util/statistics.h"
 
 namespace gravcal {
@@ -200,20 +201,12 @@ double TwoSidedNormalTail(double t) { return std::erfc(std::fabs(t) / std::sqrt(
 
 }  // namespace
 
-const char* ToString(ComparisonSpace space) {
-  return space == ComparisonSpace::kIntrinsic ? "intrinsic" : "model";
-}
+namespace {
+const internal::EnumName<ComparisonSpace> kComparisonSpaces[] = {
+    {ComparisonSpace::kModel, "model"}, {ComparisonSpace::kIntrinsic, "intrinsic"}};
+}  // namespace
 
-bool FromString(const std::string& name, ComparisonSpace* space) {
-  if (name == "model") {
-    *space = ComparisonSpace::kModel;
-  } else if (name == "intrinsic") {
-    *space = ComparisonSpace::kIntrinsic;
-  } else {
-    return false;
-  }
-  return true;
-}
+GRAVCAL_ENUM_STRINGS(ComparisonSpace, kComparisonSpaces)
 
 bool ComparisonOptions::IsValid(std::string* error) const {
   if (!(level > 0.0 && level < 1.0)) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/enum_names.h"
 #include "gravcal/core/gravity.h"
 #include "gravcal/estimation/coarse_fit.h"
 #include "util/matrix_checks.h"
@@ -84,26 +85,12 @@ double ScaleFromPoses(const std::vector<Position>& positions, std::string* how) 
 }  // namespace
 }  // namespace internal
 
-const char* ToString(PoseNoise pose_noise) {
-  switch (pose_noise) {
-    case PoseNoise::kWhite:
-      return "white";
-    case PoseNoise::kBatchMeans:
-      return "batch_means";
-  }
-  return "?";
-}
+namespace {
+const internal::EnumName<PoseNoise> kPoseNoises[] = {{PoseNoise::kWhite, "white"},
+                                                     {PoseNoise::kBatchMeans, "batch_means"}};
+}  // namespace
 
-bool FromString(const std::string& name, PoseNoise* pose_noise) {
-  if (name == "white") {
-    *pose_noise = PoseNoise::kWhite;
-  } else if (name == "batch_means") {
-    *pose_noise = PoseNoise::kBatchMeans;
-  } else {
-    return false;
-  }
-  return true;
-}
+GRAVCAL_ENUM_STRINGS(PoseNoise, kPoseNoises)
 
 bool PoseNoiseOptions::IsValid(std::string* error) const {
   if (batches < 5) {

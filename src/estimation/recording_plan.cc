@@ -26,13 +26,21 @@ std::string AxisText(const Eigen::Vector3d& axis) {
   return text;
 }
 
+// An accelerometer parameter's readable unit, and the reference standard
+// deviation in that unit (1 mg, 100 ppm, 0.1 mrad).
+struct UnitAndReference {
+  ReadableUnit unit;
+  double reference;
+};
+UnitAndReference AccelUnitOf(const std::string& parameter) {
+  if (parameter.rfind("bias_", 0) == 0) return {{"mg", 1e3 / kStandardGravity}, 1.0};
+  if (parameter.size() == 4 && parameter[2] == parameter[3]) return {{"ppm", 1e6}, 100.0};
+  return {{"mrad", 1e3}, 0.1};
+}
+
 }  // namespace
 
-ReadableUnit ReadableUnitOf(const std::string& parameter) {
-  if (parameter.rfind("bias_", 0) == 0) return {"mg", 1e3 / kStandardGravity};
-  if (parameter.size() == 4 && parameter[2] == parameter[3]) return {"ppm", 1e6};
-  return {"mrad", 1e3};
-}
+ReadableUnit ReadableUnitOf(const std::string& parameter) { return AccelUnitOf(parameter).unit; }
 
 ReadableUnit GyroReadableUnitOf(const std::string& parameter) {
   if (parameter.rfind("bias_", 0) == 0) return {"deg/h", internal::kRadToDeg * 3600.0};
@@ -43,8 +51,8 @@ ReadableUnit GyroReadableUnitOf(const std::string& parameter) {
 }
 
 double ReferenceStd(const std::string& parameter) {
-  const ReadableUnit unit = ReadableUnitOf(parameter);
-  return (unit.unit == "mg" ? 1.0 : (unit.unit == "ppm" ? 100.0 : 0.1)) / unit.factor;
+  const UnitAndReference u = AccelUnitOf(parameter);
+  return u.reference / u.unit.factor;
 }
 
 std::string PoseInstruction(const Eigen::Vector3d& up) {

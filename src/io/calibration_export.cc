@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "core/enum_names.h"
 #include "gravcal/io/noise_io.h"
 #include "io/c_corrector_export.h"
 #include "io/export_format.h"
@@ -19,16 +20,12 @@ using internal::YamlRow;
 
 namespace {
 
-struct TargetName {
-  ExportTarget target;
-  const char* name;
-};
-constexpr TargetName kTargets[] = {{ExportTarget::kKalibr, "kalibr"},
-                                   {ExportTarget::kOpenVins, "openvins"},
-                                   {ExportTarget::kRos, "ros"},
-                                   {ExportTarget::kPx4, "px4"},
-                                   {ExportTarget::kArduPilot, "ardupilot"},
-                                   {ExportTarget::kC, "c"}};
+const internal::EnumName<ExportTarget> kTargets[] = {{ExportTarget::kKalibr, "kalibr"},
+                                                     {ExportTarget::kOpenVins, "openvins"},
+                                                     {ExportTarget::kRos, "ros"},
+                                                     {ExportTarget::kPx4, "px4"},
+                                                     {ExportTarget::kArduPilot, "ardupilot"},
+                                                     {ExportTarget::kC, "c"}};
 
 // A = L Q with L lower triangular (positive diagonal) and Q a rotation, from
 // the QR decomposition of A^T. False when det(A) <= 0.
@@ -367,28 +364,7 @@ AutopilotFormat ArduPilotFormat(int imu) {
 
 }  // namespace
 
-const char* ToString(ExportTarget target) {
-  for (const TargetName& t : kTargets) {
-    if (t.target == target) return t.name;
-  }
-  return "c";
-}
-
-bool FromString(const std::string& name, ExportTarget* target) {
-  for (const TargetName& t : kTargets) {
-    if (name == t.name) {
-      *target = t.target;
-      return true;
-    }
-  }
-  return false;
-}
-
-std::string ExportTargetNames() {
-  std::string s;
-  for (const TargetName& t : kTargets) s += (s.empty() ? "" : ", ") + std::string(t.name);
-  return s;
-}
+GRAVCAL_ENUM_STRINGS(ExportTarget, kTargets)
 
 bool NeedsNoise(ExportTarget target) {
   return target == ExportTarget::kKalibr || target == ExportTarget::kOpenVins ||

@@ -108,6 +108,29 @@ std::unique_ptr<ceres::LossFunctionWrapper> GraduatedLoss(const EffectFitOptions
                                                       ceres::TAKE_OWNERSHIP);
 }
 
+ceres::Solver::Summary SolveGraduated(const EffectFitOptions& options,
+                                      const std::vector<double>& scales, double* effect_block,
+                                      int block_size, const std::vector<int>& effect_free,
+                                      const std::vector<int>& effect_held,
+                                      ceres::LossFunctionWrapper* loss, ceres::Problem* problem,
+                                      SensorFitSummary* fit) {
+  if (effect_free.empty()) {
+    problem->SetParameterBlockConstant(effect_block);
+  } else if (!effect_held.empty()) {
+    problem->SetManifold(effect_block, new ceres::SubsetManifold(block_size, effect_held));
+  }
+  ceres::Solver::Summary summary;
+  fit->iterations = 0;
+  for (auto it = scales.rbegin(); it != scales.rend(); ++it) {
+    if (loss) loss->Reset(MakeLoss(options.loss, *it), ceres::TAKE_OWNERSHIP);
+    ceres::Solve(EffectFitSolverOptions(options), problem, &summary);
+    fit->iterations += static_cast<int>(summary.iterations.size()) - 1;
+    if (!summary.IsSolutionUsable()) break;
+  }
+  fit->converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
+  return summary;
+}
+
 }  // namespace internal
 
 namespace {

@@ -351,28 +351,15 @@ bool FitAccel(const std::vector<StaticObservation>& observations, const AccelMod
   if (!free_off_diagonal) {
     problem.SetManifold(upper, new ceres::SubsetManifold(6, {1, 2, 4}));
   }
-  if (effect_free.empty()) {
-    problem.SetParameterBlockConstant(effect_block);
-  } else if (!effect_held.empty()) {
-    problem.SetManifold(effect_block,
-                        new ceres::SubsetManifold(kAccelEffectParameters, effect_held));
-  }
-  // Once per loss scale, widest first (one solve without a loss).
-  ceres::Solver::Summary summary;
   SensorFitSummary& fit = result->accel_fit;
-  fit.iterations = 0;
-  for (auto it = scales.rbegin(); it != scales.rend(); ++it) {
-    if (loss) loss->Reset(internal::MakeLoss(options.loss, *it), ceres::TAKE_OWNERSHIP);
-    ceres::Solve(EffectFitSolverOptions(options), &problem, &summary);
-    fit.iterations += static_cast<int>(summary.iterations.size()) - 1;
-    if (!summary.IsSolutionUsable()) break;
-  }
+  const ceres::Solver::Summary summary =
+      SolveGraduated(options, scales, effect_block, kAccelEffectParameters, effect_free,
+                     effect_held, loss.get(), &problem, &fit);
   fit.fitted = true;
   fit.information =
       trend_rows > 0 ? "position magnitudes + within-pose trends" : "position magnitudes";
   if (rotations) fit.information += " + rotations between poses";
   if (loss) fit.information += std::string(" (") + ToString(options.loss) + " loss)";
-  fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {
     result->message = "accelerometer effect fit failed: " + summary.message;
     return false;

@@ -111,26 +111,13 @@ bool FitGyro(const std::vector<StaticObservation>& observations, const GyroModel
   for (const auto& cost : owned) {
     problem.AddResidualBlock(cost.get(), loss.get(), bias, effect_block);
   }
-  if (effect_free.empty()) {
-    problem.SetParameterBlockConstant(effect_block);
-  } else if (!effect_held.empty()) {
-    problem.SetManifold(effect_block,
-                        new ceres::SubsetManifold(kGyroEffectParameters, effect_held));
-  }
-  // Once per loss scale, widest first (one solve without a loss).
-  ceres::Solver::Summary summary;
   SensorFitSummary& fit = result->gyro_fit;
-  fit.iterations = 0;
-  for (auto it = scales.rbegin(); it != scales.rend(); ++it) {
-    if (loss) loss->Reset(MakeLoss(options.loss, *it), ceres::TAKE_OWNERSHIP);
-    ceres::Solve(EffectFitSolverOptions(options), &problem, &summary);
-    fit.iterations += static_cast<int>(summary.iterations.size()) - 1;
-    if (!summary.IsSolutionUsable()) break;
-  }
+  const ceres::Solver::Summary summary =
+      SolveGraduated(options, scales, effect_block, kGyroEffectParameters, effect_free, effect_held,
+                     loss.get(), &problem, &fit);
   fit.fitted = true;
   fit.information = "static mean rates";
   if (loss) fit.information += std::string(" (") + ToString(options.loss) + " loss)";
-  fit.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {
     result->message = "gyroscope effect fit failed: " + summary.message;
     return false;

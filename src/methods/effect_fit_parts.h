@@ -54,6 +54,18 @@ ceres::Problem::Options ProblemKeepingOwnership();
 std::unique_ptr<ceres::LossFunctionWrapper> GraduatedLoss(const EffectFitOptions& options,
                                                           double first_scale);
 
+// Solves `problem` once per loss scale of `scales`, widest first (one solve
+// without a loss), `loss` (may be null) set to each in turn, with the
+// effects' block (block_size values) held as effect_free / effect_held say:
+// constant when none is free, else its held entries fixed. Fills
+// fit->iterations and fit->converged; the summary of the last solve.
+ceres::Solver::Summary SolveGraduated(const EffectFitOptions& options,
+                                      const std::vector<double>& scales, double* effect_block,
+                                      int block_size, const std::vector<int>& effect_free,
+                                      const std::vector<int>& effect_held,
+                                      ceres::LossFunctionWrapper* loss, ceres::Problem* problem,
+                                      SensorFitSummary* fit);
+
 // The accelerometer part, in normalised raw units (normalization.h), with
 // `extra_variance` added to every magnitude's sigma_k^2; the whitened
 // Jacobian and residuals at the optimum (magnitude rows first) for the REML.

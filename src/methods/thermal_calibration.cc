@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 
+#include "core/enum_names.h"
 #include "gravcal/core/imu_corrector.h"
 #include "methods/thermal_fitter.h"
 #include "methods/thermal_residual.h"
@@ -13,21 +14,12 @@
 
 namespace gravcal {
 
-const char* ToString(ThermalOrderSelection selection) {
-  return selection == ThermalOrderSelection::kAicc ? "aicc" : "bic";
-}
+namespace {
+const internal::EnumName<ThermalOrderSelection> kOrderSelections[] = {
+    {ThermalOrderSelection::kBic, "bic"}, {ThermalOrderSelection::kAicc, "aicc"}};
+}  // namespace
 
-bool FromString(const std::string& name, ThermalOrderSelection* selection) {
-  if (selection == nullptr) return false;
-  if (name == "bic") {
-    *selection = ThermalOrderSelection::kBic;
-  } else if (name == "aicc") {
-    *selection = ThermalOrderSelection::kAicc;
-  } else {
-    return false;
-  }
-  return true;
-}
+GRAVCAL_ENUM_STRINGS(ThermalOrderSelection, kOrderSelections)
 
 double ThermalMinimumSpan(int order) { return order <= 0 ? 0.0 : 10.0 * order - 5.0; }
 

@@ -98,8 +98,9 @@ bool SimulatePlateImpl(const PlateSimulatorOptions& options, uint64_t seed, Simu
     // The mounting.
     const Eigen::Vector3d error_vector = internal::DrawVector3([&] { return n01(rng); }) *
                                          options.mounting_error_deg * internal::kDegToRad;
-    const Eigen::Matrix3d stated =
-        options.mounting == "random" && i > 0 ? RandomRotation(&rng) : Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d stated = options.mounting == PlateMounting::kRandom && i > 0
+                                       ? RandomRotation(&rng)
+                                       : Eigen::Matrix3d::Identity();
     truth.stated_mounting = stated;
     truth.mounting_start = stated * (i > 0 ? FromRotationVector(error_vector).toRotationMatrix()
                                            : Eigen::Matrix3d::Identity());
@@ -188,8 +189,6 @@ bool PlateSimulatorOptions::IsValid(std::string* error) const {
     return false;
   };
   if (imus < 1 || imus > 64) return fail("imus must be 1..64");
-  if (mounting != "random" && mounting != "aligned")
-    return fail("mounting must be 'random' or 'aligned'");
   if (!(mounting_error_deg >= 0.0) || !(max_clock_offset >= 0.0) || !(clock_drift_std >= 0.0))
     return fail("mounting_error_deg, max_clock_offset and clock_drift_std must be >= 0");
   if (permuted_imu >= imus || slip_imu >= imus || flipped_imu >= imus)

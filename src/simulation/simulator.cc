@@ -197,7 +197,7 @@ bool PlanTimeline(const SimulatorOptions& options, uint64_t seed,
   plan->first_still = SampleCount(options.initial_still_seconds + hold_seconds[0], rate);
   plan->hold.resize(pose_count);
   for (size_t k = 0; k < pose_count; ++k) plan->hold[k] = SampleCount(hold_seconds[k], rate);
-  plan->hand = options.rotation_profile == "hand";
+  plan->hand = options.rotation_profile == RotationProfile::kHand;
   std::mt19937_64 extra_rng(seed ^ 0xc2b2ae3d27d4eb4fULL);
   plan->profiles.assign(pose_count > 0 ? pose_count - 1 : 0, HandProfile());
   plan->rotation.assign(plan->profiles.size(), SampleCount(options.rotation_seconds, rate));

@@ -81,7 +81,8 @@ const std::vector<SimulatorField>& SimulatorFields() {
         {"sim_temperature_tau", "temperature_tau", "warm-up time constant, s",
          &SimulatorOptions::temperature_tau},
         {"sim_rotation_profile", "rotation_profile",
-         "rotations between poses: smooth (fixed axis) or hand (1-4 s, irregular)",
+         "rotations between poses (smooth: fixed axis; hand: 1-4 s, irregular): " +
+             AcceptedNames(RotationProfile()),
          &SimulatorOptions::rotation_profile},
         {"sim_hand_min_rotation", "hand_min_seconds", "hand profile: shortest rotation, s",
          &SimulatorOptions::hand_min_seconds},

@@ -26,7 +26,8 @@ struct SimulatorField {
   // The member, or the effect whose spread (SimulatorOptions::effect_std)
   // it is.
   std::variant<double SimulatorOptions::*, bool SimulatorOptions::*,
-               std::string SimulatorOptions::*, SimulatorScheme SimulatorOptions::*, Effect>
+               std::string SimulatorOptions::*, SimulatorScheme SimulatorOptions::*,
+               RotationProfile SimulatorOptions::*, Effect>
       member;
 };
 

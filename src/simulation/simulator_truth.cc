@@ -17,6 +17,7 @@ nlohmann::json OptionJson(double v) { return internal::JsonNumber(v); }
 nlohmann::json OptionJson(bool v) { return v; }
 nlohmann::json OptionJson(const std::string& v) { return v; }
 nlohmann::json OptionJson(const SimulatorScheme& v) { return ToString(v); }
+nlohmann::json OptionJson(RotationProfile v) { return ToString(v); }
 
 }  // namespace
 

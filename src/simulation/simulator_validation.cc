@@ -165,11 +165,6 @@ bool CheckTruthSpreads(const SimulatorOptions& o, const FieldCheck& c) {
 // Placement, rotations between poses, tremor and per-pose disturbances.
 bool CheckPlacement(const SimulatorOptions& o, const FieldCheck& c) {
   if (!c.NonNegative("placement_error_deg", o.placement_error_deg)) return false;
-  if (o.rotation_profile != "smooth" && o.rotation_profile != "hand") {
-    c.Say("SimulatorOptions.rotation_profile: '" + o.rotation_profile +
-          "' is not one of smooth, hand");
-    return false;
-  }
   if (!c.OneSample("hand_min_seconds", o.hand_min_seconds)) return false;
   if (!(o.hand_max_seconds >= o.hand_min_seconds) || !std::isfinite(o.hand_max_seconds)) {
     return c.Fail("hand_max_seconds", o.hand_max_seconds, "must be at least hand_min_seconds");
@@ -207,11 +202,11 @@ bool CheckLength(const SimulatorOptions& o, long pose_count, const FieldCheck& c
     hold_total = 0.0;
     for (const PlannedHold& p : o.planned_poses) hold_total += p.hold_seconds;
   }
-  const double samples =
-      (o.initial_still_seconds + hold_total +
-       static_cast<double>(pose_count - 1) *
-           (o.rotation_profile == "hand" ? o.hand_max_seconds : o.rotation_seconds)) *
-      o.sample_rate;
+  const double samples = (o.initial_still_seconds + hold_total +
+                          static_cast<double>(pose_count - 1) *
+                              (o.rotation_profile == RotationProfile::kHand ? o.hand_max_seconds
+                                                                            : o.rotation_seconds)) *
+                         o.sample_rate;
   if (samples <= internal::kMaxSimulatedSamples) return true;
   std::ostringstream msg;
   msg << "SimulatorOptions: the session would have " << samples << " samples (limit "

@@ -6,35 +6,20 @@
 #include <cmath>
 #include <random>
 
+#include "core/enum_names.h"
+
 namespace gravcal {
 
-const char* ToString(ThermalProfile profile) {
-  switch (profile) {
-    case ThermalProfile::kSoakSteps:
-      return "soak_steps";
-    case ThermalProfile::kWarmUp:
-      return "warm_up";
-    case ThermalProfile::kCoolDown:
-      return "cool_down";
-    case ThermalProfile::kWarmUpPoses:
-      return "warm_up_poses";
-    case ThermalProfile::kWarmCoolPoses:
-      return "warm_cool_poses";
-  }
-  return "unknown";
-}
+namespace {
+const internal::EnumName<ThermalProfile> kThermalProfiles[] = {
+    {ThermalProfile::kSoakSteps, "soak_steps"},
+    {ThermalProfile::kWarmUp, "warm_up"},
+    {ThermalProfile::kCoolDown, "cool_down"},
+    {ThermalProfile::kWarmUpPoses, "warm_up_poses"},
+    {ThermalProfile::kWarmCoolPoses, "warm_cool_poses"}};
+}  // namespace
 
-bool FromString(const std::string& name, ThermalProfile* profile) {
-  for (ThermalProfile p :
-       {ThermalProfile::kSoakSteps, ThermalProfile::kWarmUp, ThermalProfile::kCoolDown,
-        ThermalProfile::kWarmUpPoses, ThermalProfile::kWarmCoolPoses}) {
-    if (name == ToString(p) && profile != nullptr) {
-      *profile = p;
-      return true;
-    }
-  }
-  return false;
-}
+GRAVCAL_ENUM_STRINGS(ThermalProfile, kThermalProfiles)
 
 bool ThermalSimulatorOptions::IsValid(std::string* error) const {
   auto fail = [error](const std::string& what) {

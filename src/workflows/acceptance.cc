@@ -5,11 +5,22 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "core/enum_names.h"
 #include "gravcal/estimation/calibration_comparison.h"
 #include "gravcal/io/files.h"
 #include "workflows/acceptance_internal.h"
 
 namespace gravcal {
+
+namespace {
+const internal::EnumName<UncertaintySource> kUncertaintySources[] = {
+    {UncertaintySource::kPlacement, "placement"},
+    {UncertaintySource::kNoise, "noise"},
+    {UncertaintySource::kPoseScatter, "pose scatter"},
+    {UncertaintySource::kGravity, "gravity"}};
+}  // namespace
+
+GRAVCAL_ENUM_STRINGS(UncertaintySource, kUncertaintySources)
 
 namespace internal {
 
@@ -523,14 +534,14 @@ bool MakeCertificate(const Calibration& c, const CertificateInfo& info,
       const double fit = values.stds[i];
       const bool placement = e.name.find(".rot_") != std::string::npos;
       if (placement) {
-        e.budget.emplace_back("placement", fit);
+        e.budget.emplace_back(UncertaintySource::kPlacement, fit);
       } else {
-        e.budget.emplace_back("noise", fit * std::sqrt(noise_share));
-        e.budget.emplace_back("pose scatter", fit * std::sqrt(1.0 - noise_share));
+        e.budget.emplace_back(UncertaintySource::kNoise, fit * std::sqrt(noise_share));
+        e.budget.emplace_back(UncertaintySource::kPoseScatter, fit * std::sqrt(1.0 - noise_share));
       }
-      e.budget.emplace_back("gravity", ScalesWithGravity(e.name)
-                                           ? std::fabs(e.value) * out.gravity_std / c.gravity
-                                           : 0.0);
+      e.budget.emplace_back(
+          UncertaintySource::kGravity,
+          ScalesWithGravity(e.name) ? std::fabs(e.value) * out.gravity_std / c.gravity : 0.0);
       double sum = 0.0;
       for (const auto& [source, u] : e.budget) sum += u * u;
       e.standard_uncertainty = std::sqrt(sum);

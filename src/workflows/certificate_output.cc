@@ -79,7 +79,8 @@ std::string CertificateToJson(const Certificate& cert) {
     p["expanded_uncertainty"] = JsonNumber<Json>(e.expanded_uncertainty);
     Json budget = Json::array();
     for (const auto& [source, u] : e.budget) {
-      budget.push_back({{"source", source}, {"standard_uncertainty", JsonNumber<Json>(u)}});
+      budget.push_back(
+          {{"source", ToString(source)}, {"standard_uncertainty", JsonNumber<Json>(u)}});
     }
     p["budget"] = budget;
     parameters.push_back(p);
@@ -148,7 +149,9 @@ std::string CertificateToHtml(const Certificate& cert) {
     }
     std::string noise = "", scatter = "", gravity = "";
     for (const auto& [source, u] : e.budget) {
-      (source == "noise" ? noise : source == "gravity" ? gravity : scatter) = LimitNumber(u);
+      (source == UncertaintySource::kNoise     ? noise
+       : source == UncertaintySource::kGravity ? gravity
+                                               : scatter) = LimitNumber(u);
     }
     h += "<td>" + noise + "</td><td>" + scatter + "</td><td>" + gravity + "</td><td>" +
          LimitNumber(e.standard_uncertainty) + "</td><td>" + LimitNumber(e.expanded_uncertainty) +

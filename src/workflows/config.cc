@@ -26,12 +26,14 @@ ConfigSection Lift(const SectionOf<Part>& section) {
   ConfigSection whole{section.name, section.use, {}};
   for (const KeyHandlerOf<Part>& h : section.keys) {
     whole.keys.push_back(
-        {h.name, h.help,
+        {h.name,
+         h.accepted ? h.help + ": " + h.accepted(Part()) : h.help,
          [set = h.set](const YAML::Node& n, Config* c, std::string* e) { return set(n, c, e); },
          [get = h.get](const Config& c) { return get(c); },
          [fields = h.fields](const Config& c) {
            return fields ? fields(c) : std::vector<const void*>();
-         }});
+         },
+         {}});
   }
   return whole;
 }

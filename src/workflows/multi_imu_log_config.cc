@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/enum_names.h"
 #include "gravcal/core/gravity.h"
 #include "gravcal/workflows/multi_imu_log.h"
 #include "util/units.h"
@@ -48,9 +49,35 @@ bool Text(const std::string& name, const std::string& key, const YAML::Node& nod
   return true;
 }
 
+// The raw units of accel_units and gyro_units, from their tables.
+enum class AccelUnit { kMetresPerSecond2, kG, kCounts };
+enum class GyroUnit { kRadiansPerSecond, kDegreesPerSecond, kCounts };
+const internal::EnumName<AccelUnit> kAccelUnits[] = {{AccelUnit::kMetresPerSecond2, "m/s^2"},
+                                                     {AccelUnit::kMetresPerSecond2, "m/s2"},
+                                                     {AccelUnit::kG, "g"},
+                                                     {AccelUnit::kCounts, "counts"}};
+const internal::EnumName<GyroUnit> kGyroUnits[] = {{GyroUnit::kRadiansPerSecond, "rad/s"},
+                                                   {GyroUnit::kDegreesPerSecond, "deg/s"},
+                                                   {GyroUnit::kCounts, "counts"}};
+GRAVCAL_ENUM_STRINGS(AccelUnit, kAccelUnits)
+GRAVCAL_ENUM_STRINGS(GyroUnit, kGyroUnits)
+
+// A unit key's value by its table; false with the line, the key and the
+// accepted names.
+template <typename Unit>
+bool UnitValue(const std::string& name, const std::string& key, const YAML::Node& v, Unit* unit,
+               std::string* error) {
+  std::string text;
+  if (!Text(name, key, v, &text, error)) return false;
+  if (ParseName(key, text, unit, error)) return true;
+  *error = At(name, v) + *error;
+  return false;
+}
+
 // The unit keys, at the top level (every IMU's default) or per IMU.
 struct Units {
-  std::string accel_units = "m/s^2", gyro_units = "rad/s";
+  AccelUnit accel_units = AccelUnit::kMetresPerSecond2;
+  GyroUnit gyro_units = GyroUnit::kRadiansPerSecond;
   double counts_per_g = 16384.0, counts_per_dps = 131.0;
   double accel_scale = 0.0, gyro_scale = 0.0;
 };
@@ -59,9 +86,9 @@ struct Units {
 bool UnitKey(const std::string& name, const std::string& key, const YAML::Node& v, Units* units,
              bool* ok, std::string* error) {
   if (key == "accel_units") {
-    *ok = Text(name, key, v, &units->accel_units, error);
+    *ok = UnitValue(name, key, v, &units->accel_units, error);
   } else if (key == "gyro_units") {
-    *ok = Text(name, key, v, &units->gyro_units, error);
+    *ok = UnitValue(name, key, v, &units->gyro_units, error);
   } else if (key == "accel_counts_per_g") {
     *ok = Number(name, key, v, &units->counts_per_g, error);
   } else if (key == "gyro_counts_per_dps") {
@@ -80,30 +107,26 @@ bool UnitKey(const std::string& name, const std::string& key, const YAML::Node& 
 bool Scales(const Units& u, double* accel_scale, double* gyro_scale, std::string* error) {
   if (u.accel_scale > 0.0) {
     *accel_scale = u.accel_scale;
-  } else if (u.accel_units == "m/s^2" || u.accel_units == "m/s2") {
+  } else if (u.accel_units == AccelUnit::kMetresPerSecond2) {
     *accel_scale = 1.0;
-  } else if (u.accel_units == "g") {
+  } else if (u.accel_units == AccelUnit::kG) {
     *accel_scale = kStandardGravity;
-  } else if (u.accel_units == "counts" && u.counts_per_g > 0.0) {
+  } else if (u.accel_units == AccelUnit::kCounts && u.counts_per_g > 0.0) {
     *accel_scale = kStandardGravity / u.counts_per_g;
   } else {
-    *error =
-        "accel_units must be m/s^2, g or counts (with accel_counts_per_g > 0), or give "
-        "accel_scale > 0";
+    *error = "accel_units counts needs accel_counts_per_g > 0 (or give accel_scale > 0)";
     return false;
   }
   if (u.gyro_scale > 0.0) {
     *gyro_scale = u.gyro_scale;
-  } else if (u.gyro_units == "rad/s") {
+  } else if (u.gyro_units == GyroUnit::kRadiansPerSecond) {
     *gyro_scale = 1.0;
-  } else if (u.gyro_units == "deg/s") {
+  } else if (u.gyro_units == GyroUnit::kDegreesPerSecond) {
     *gyro_scale = kDegToRad;
-  } else if (u.gyro_units == "counts" && u.counts_per_dps > 0.0) {
+  } else if (u.gyro_units == GyroUnit::kCounts && u.counts_per_dps > 0.0) {
     *gyro_scale = kDegToRad / u.counts_per_dps;
   } else {
-    *error =
-        "gyro_units must be rad/s, deg/s or counts (with gyro_counts_per_dps > 0), or give "
-        "gyro_scale > 0";
+    *error = "gyro_units counts needs gyro_counts_per_dps > 0 (or give gyro_scale > 0)";
     return false;
   }
   return true;
@@ -188,9 +211,10 @@ bool SimKey(const std::string& name, const std::string& key, const YAML::Node& v
             PlateSimulatorOptions* sim, std::string* error) {
   double x = 0.0;
   if (key == "sim_mounting") {
-    if (!Text(name, key, v, &sim->mounting, error)) return false;
-    if (sim->mounting != "aligned" && sim->mounting != "random") {
-      *error = At(name, v) + "sim_mounting is aligned or random";
+    std::string text;
+    if (!Text(name, key, v, &text, error)) return false;
+    if (!ParseName(key, text, &sim->mounting, error)) {
+      *error = At(name, v) + *error;
       return false;
     }
     return true;
@@ -262,7 +286,7 @@ bool ParseMultiImuConfig(const std::string& text, const std::string& name, Multi
   MultiImuConfig c;
   // The simulated plate: aligned units (the shipped config states no
   // mountings), holds and turns of a bench session.
-  c.simulation.mounting = "aligned";
+  c.simulation.mounting = PlateMounting::kAligned;
   c.simulation.imu.hold_seconds = 4.0;
   c.simulation.imu.initial_still_seconds = 4.0;
   c.simulation.imu.rotation_seconds = 2.0;
@@ -396,7 +420,7 @@ bool ParseMultiImuConfig(const std::string& text, const std::string& name, Multi
   }
   // The simulated table is written in the top-level units: raw counts or
   // SI.
-  if (defaults.accel_units == "counts" && defaults.gyro_units == "counts") {
+  if (defaults.accel_units == AccelUnit::kCounts && defaults.gyro_units == GyroUnit::kCounts) {
     c.simulation.imu.raw_counts = true;
     c.simulation.imu.accel_counts_per_g = defaults.counts_per_g;
     c.simulation.imu.gyro_counts_per_dps = defaults.counts_per_dps;

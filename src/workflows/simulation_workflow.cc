@@ -35,10 +35,10 @@ bool SimulateFromConfig(const Config& config, const SimulationRequest& request,
     sim.initial_still_seconds = 0.0;
   }
   files->segments.clear();
-  if (!config.sim_thermal.empty()) {
+  if (config.sim_thermal) {
     // Issue 35: a session across temperature; truth.json gains "thermal".
     ThermalSimulatorOptions thermal = config.thermal_simulation;
-    FromString(config.sim_thermal, &thermal.profile);
+    thermal.profile = *config.sim_thermal;
     thermal.gravity = sim.gravity;
     thermal.raw_counts = sim.raw_counts;
     ThermalSimulatedSession session;
@@ -53,7 +53,7 @@ bool SimulateFromConfig(const Config& config, const SimulationRequest& request,
     out.seed = request.seed;
     nlohmann::json truth = nlohmann::json::parse(TruthToJson(out, sim));
     truth["thermal"] = internal::ThermalJson(session.thermal);
-    truth["thermal_profile"] = config.sim_thermal;
+    truth["thermal_profile"] = ToString(*config.sim_thermal);
     truth["thermal_datasheet"] = "Bosch BMI088 (BST-BMI088-DS001) magnitudes unless overridden";
     files->truth_json = truth.dump(2) + "\n";
     files->attitudes_csv = FixtureAttitudesToCsv(std::vector<FixtureAttitude>());

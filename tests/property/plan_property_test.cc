@@ -151,7 +151,7 @@ void CheckGyroPlanSpread(const std::string& target, const std::string& pose_set)
   std::string error;
   ASSERT_TRUE(LoadConfigFile(SourceDir() + "/configs/twelve_position_gyro.yaml", &config, &error))
       << error;
-  config.simulation.rotation_profile = "smooth";
+  config.simulation.rotation_profile = RotationProfile::kSmooth;
   config.calibration.nominal_scale = kStandardGravity / config.simulation.accel_counts_per_g;
   config.ten_position.gyro_nominal_scale = M_PI / 180.0 / config.simulation.gyro_counts_per_dps;
   PlanRequest request;

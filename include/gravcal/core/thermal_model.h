@@ -77,12 +77,14 @@ enum class ThermalQuantity { kBias, kScale, kMisalignment };
 // "bias", "scale", "misalignment".
 const char* ToString(ThermalQuantity quantity);
 bool FromString(const std::string& name, ThermalQuantity* quantity);
+std::string AcceptedNames(ThermalQuantity);
 
 // Which sensor a thermal model belongs to.
 enum class ThermalSensor { kAccel, kGyro };
 // "accel", "gyro".
 const char* ToString(ThermalSensor sensor);
 bool FromString(const std::string& name, ThermalSensor* sensor);
+std::string AcceptedNames(ThermalSensor);
 
 // The number of components of a term: 3 for bias and scale, 3 for the
 // accelerometer's misalignment, 6 for the gyroscope's.

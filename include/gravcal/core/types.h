@@ -1,8 +1,12 @@
 // gravcal/core/types.h: every enum of the library with its string forms, in
 // one place (as ceres/types.h does). The names are the ones configs, YAML,
 // JSON and command-line flags use; ToString gives "unknown" for a value
-// outside the enum and FromString returns false (leaving *value unchanged) on
-// a name it does not know or a null output.
+// outside the enum, FromString returns false (leaving *value unchanged) on
+// a name it does not know or a null output, and AcceptedNames gives every
+// name ("a, b or c", for errors and help). All three come from one table per
+// enum (src/core/enum_names.h); the enums of other headers
+// (ThermalOrderSelection, PoseNoise, ComparisonSpace, ExportTarget,
+// ThermalProfile, ThermalQuantity, ThermalSensor) get theirs the same way.
 #ifndef GRAVCAL_CORE_TYPES_H_
 #define GRAVCAL_CORE_TYPES_H_
 
@@ -23,6 +27,7 @@ enum class AccelParameterization {
 // "scale", "scale_misalignment", "affine".
 const char* ToString(AccelParameterization p);
 bool FromString(const std::string& name, AccelParameterization* p);
+std::string AcceptedNames(AccelParameterization);
 
 // Which gyroscope parameters are free.
 enum class GyroParameterization {
@@ -38,24 +43,28 @@ enum class GyroParameterization {
 // "none", "bias", "scale", "full".
 const char* ToString(GyroParameterization p);
 bool FromString(const std::string& name, GyroParameterization* p);
+std::string AcceptedNames(GyroParameterization);
 
 // The robust loss applied to the whitened residuals.
 enum class LossType { kNone, kHuber, kCauchy, kSoftL1, kArctan, kTukey };
 // "none", "huber", "cauchy", "soft_l1", "arctan", "tukey".
 const char* ToString(LossType loss);
 bool FromString(const std::string& name, LossType* loss);
+std::string AcceptedNames(LossType);
 
 // How the coarse fit found its model.
 enum class CoarseMethod { kSixPosition, kEllipsoid };
 // "six_position_least_squares", "ellipsoid_fit".
 const char* ToString(CoarseMethod method);
 bool FromString(const std::string& name, CoarseMethod* method);
+std::string AcceptedNames(CoarseMethod);
 
 // Which solver refines the twelve-position fit.
 enum class RefinementSolver { kCeres, kNewton };
 // "ceres", "newton".
 const char* ToString(RefinementSolver solver);
 bool FromString(const std::string& name, RefinementSolver* solver);
+std::string AcceptedNames(RefinementSolver);
 
 // The residual the Newton baseline minimises.
 enum class NewtonResidual {
@@ -67,6 +76,7 @@ enum class NewtonResidual {
 // "squared_magnitude", "magnitude".
 const char* ToString(NewtonResidual residual);
 bool FromString(const std::string& name, NewtonResidual* residual);
+std::string AcceptedNames(NewtonResidual);
 
 // Text layout of a log file.
 enum class LogFormat {
@@ -78,6 +88,7 @@ enum class LogFormat {
 // "csv", "whitespace".
 const char* ToString(LogFormat format);
 bool FromString(const std::string& name, LogFormat* format);
+std::string AcceptedNames(LogFormat);
 
 // The calibration methods, the values of the config key `method`
 // (workflows/method_registry.h gives each its help, sections and entry
@@ -126,10 +137,35 @@ const char* ToString(PoseScheme scheme);
 bool FromString(const std::string& name, PoseScheme* scheme);
 std::string AcceptedNames(PoseScheme);
 
+// How a simulated multi-position session turns between poses (the
+// simulator's sim_rotation_profile).
+enum class RotationProfile {
+  // Minimum-jerk about one fixed axis, rotation_seconds each.
+  kSmooth,
+  // Hand-like: random duration, irregular rate, a wobbling axis.
+  kHand,
+};
+// "smooth", "hand".
+const char* ToString(RotationProfile profile);
+bool FromString(const std::string& name, RotationProfile* profile);
+std::string AcceptedNames(RotationProfile);
+
+// How the plate simulator mounts its IMUs (simulation/plate_simulator.h).
+enum class PlateMounting {
+  // Every IMU stated aligned with the plate.
+  kAligned,
+  // IMUs after the first get a random stated rotation.
+  kRandom,
+};
+// "aligned", "random".
+const char* ToString(PlateMounting mounting);
+bool FromString(const std::string& name, PlateMounting* mounting);
+std::string AcceptedNames(PlateMounting);
+
 // FromString for the value of a key (config key or flag): false with a
 // one-line `error` (may be null) naming the key, the value and the names
 // the enum's table accepts: "key 'pose_set': 'edges' is not one of faces,
-// faces+45 or free". For the enums with AcceptedNames.
+// faces+45 or free".
 template <typename E>
 bool ParseName(const std::string& key, const std::string& name, E* value, std::string* error) {
   if (FromString(name, value)) return true;
@@ -151,6 +187,7 @@ enum class BatchStatus {
 // "ok", "failed", "not_converged".
 const char* ToString(BatchStatus status);
 bool FromString(const std::string& name, BatchStatus* status);
+std::string AcceptedNames(BatchStatus);
 
 // The sensor effects beyond the textbook model: one value per effect of the
 // registry (core/effect_registry.h defines the enum; model_effects.h holds
@@ -159,18 +196,21 @@ bool FromString(const std::string& name, BatchStatus* status);
 enum class Effect : int;
 const char* ToString(Effect effect);
 bool FromString(const std::string& name, Effect* effect);
+std::string AcceptedNames(Effect);
 
 // The sensor an effect acts on.
 enum class EffectSensor { kAccelerometer, kGyroscope };
 // "accelerometer", "gyroscope".
 const char* ToString(EffectSensor sensor);
 bool FromString(const std::string& name, EffectSensor* sensor);
+std::string AcceptedNames(EffectSensor);
 
 // What an effect's residual varies with: the regressor plotted in reports.
 enum class EffectRegressor { kOrientation, kTemperature, kTime };
 // "orientation", "temperature", "time".
 const char* ToString(EffectRegressor regressor);
 bool FromString(const std::string& name, EffectRegressor* regressor);
+std::string AcceptedNames(EffectRegressor);
 
 // Why a stretch of a log that looked like a pose is not a static interval
 // (detection/static_detector.h).
@@ -188,6 +228,7 @@ enum class RejectionReason {
 // "too_short", "too_much_motion", "rotating".
 const char* ToString(RejectionReason reason);
 bool FromString(const std::string& name, RejectionReason* reason);
+std::string AcceptedNames(RejectionReason);
 
 // What kind of thing a warning says. Every warning a method adds to a
 // result (Calibration::warnings and the results it is built from) has its
@@ -246,6 +287,7 @@ enum class WarningCode {
 // "effect_untestable", "rotations_above_noise", "sensor_data".
 const char* ToString(WarningCode code);
 bool FromString(const std::string& name, WarningCode* code);
+std::string AcceptedNames(WarningCode);
 
 }  // namespace gravcal
 

@@ -62,6 +62,7 @@ enum class ComparisonSpace {
 
 const char* ToString(ComparisonSpace space);
 bool FromString(const std::string& name, ComparisonSpace* space);
+std::string AcceptedNames(ComparisonSpace);
 
 // A calibration's parameters as one vector with its covariance.
 struct ParameterVector {

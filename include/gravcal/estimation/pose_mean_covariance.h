@@ -63,6 +63,7 @@ enum class PoseNoise {
 const char* ToString(PoseNoise pose_noise);
 // Accepts "white", "batch_means".
 bool FromString(const std::string& name, PoseNoise* pose_noise);
+std::string AcceptedNames(PoseNoise);
 
 struct PoseNoiseOptions {
   // The estimate used when no noise model is given.

@@ -34,8 +34,8 @@ enum class ExportTarget { kKalibr, kOpenVins, kRos, kPx4, kArduPilot, kC };
 
 const char* ToString(ExportTarget target);
 bool FromString(const std::string& name, ExportTarget* target);
-// "kalibr, openvins, ros, px4, ardupilot, c".
-std::string ExportTargetNames();
+// "kalibr, openvins, ros, px4, ardupilot or c".
+std::string AcceptedNames(ExportTarget);
 // kalibr, openvins and ros need a noise model.
 bool NeedsNoise(ExportTarget target);
 

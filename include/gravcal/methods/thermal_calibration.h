@@ -60,6 +60,7 @@ enum class ThermalOrderSelection { kBic, kAicc };
 // "bic", "aicc".
 const char* ToString(ThermalOrderSelection selection);
 bool FromString(const std::string& name, ThermalOrderSelection* selection);
+std::string AcceptedNames(ThermalOrderSelection);
 
 // The smallest temperature span (degrees C) gravcal asks for before it tries
 // a polynomial of `order`: 0 for order 0, then 5, 15, 25, 35, 45. A rule

@@ -40,9 +40,9 @@ struct PlateSimulatorOptions {
   // turns, sample rate). Its effects beyond the textbook model are ignored.
   SimulatorOptions imu;
   int imus = 3;
-  // Mounting: "aligned" (every Q_i near the identity, by
-  // mounting_error_deg per axis) or "random" (uniformly random rotations).
-  std::string mounting = "random";
+  // Mounting: aligned (every Q_i near the identity, by mounting_error_deg
+  // per axis) or random (uniformly random rotations).
+  PlateMounting mounting = PlateMounting::kRandom;
   double mounting_error_deg = 1.0;
   // Clock offsets uniform in [0, max_clock_offset] s (IMU 0: 0), and clock
   // drift N(0, clock_drift_std) (s per s; IMU 0: 0).

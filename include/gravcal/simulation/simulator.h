@@ -155,12 +155,12 @@ struct SimulatorOptions {
   // show, exactly as a pose-to-pose variance component. 0 = off.
   double pose_disturbance = 0.0;
 
-  // Rotations between poses: "smooth" (minimum-jerk about one fixed axis,
-  // rotation_seconds each) or "hand" (hand-like: each lasts a random
+  // Rotations between poses: smooth (minimum-jerk about one fixed axis,
+  // rotation_seconds each) or hand (hand-like: each lasts a random
   // hand_min_seconds..hand_max_seconds, its rate speeds up and slows down
   // irregularly, and the axis wobbles by about hand_wobble_deg on the way;
   // still at both ends).
-  std::string rotation_profile = "smooth";
+  RotationProfile rotation_profile = RotationProfile::kSmooth;
   double hand_min_seconds = 1.0;
   double hand_max_seconds = 4.0;
   double hand_wobble_deg = 10.0;

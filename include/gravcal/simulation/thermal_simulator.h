@@ -61,6 +61,7 @@ enum class ThermalProfile {
 // "soak_steps", "warm_up", "cool_down", "warm_up_poses", "warm_cool_poses".
 const char* ToString(ThermalProfile profile);
 bool FromString(const std::string& name, ThermalProfile* profile);
+std::string AcceptedNames(ThermalProfile);
 
 struct ThermalSimulatorOptions {
   ThermalProfile profile = ThermalProfile::kSoakSteps;

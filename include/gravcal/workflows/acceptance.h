@@ -168,6 +168,13 @@ struct CertificateInfo {
   double coverage_factor = 2.0;
 };
 
+// Where a share of a parameter's uncertainty comes from (its budget).
+enum class UncertaintySource { kPlacement, kNoise, kPoseScatter, kGravity };
+// "placement", "noise", "pose scatter", "gravity".
+const char* ToString(UncertaintySource source);
+bool FromString(const std::string& name, UncertaintySource* source);
+std::string AcceptedNames(UncertaintySource);
+
 struct CertificateEntry {
   std::string name;
   std::string unit;
@@ -176,7 +183,7 @@ struct CertificateEntry {
   double standard_uncertainty = NAN;
   double expanded_uncertainty = NAN;
   // (source, standard uncertainty) whose squares sum to u_c^2.
-  std::vector<std::pair<std::string, double>> budget;
+  std::vector<std::pair<UncertaintySource, double>> budget;
 };
 
 struct Certificate {

@@ -25,10 +25,10 @@ struct SimulationConfig {
   MotionOptions motion;
   std::optional<MotionProfile> sim_motion;
   // Issue 35: the thermal simulator (thermal_simulator.h), used when
-  // sim_thermal names a profile (soak_steps, warm_up, cool_down,
-  // warm_up_poses, warm_cool_poses; empty = off).
+  // sim_thermal names a profile (none, written empty = off). It replaces
+  // thermal_simulation.profile.
   ThermalSimulatorOptions thermal_simulation;
-  std::string sim_thermal;
+  std::optional<ThermalProfile> sim_thermal;
 };
 
 }  // namespace gravcal

@@ -9,7 +9,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include <functional>
+#include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "gravcal/workflows/config.h"
@@ -30,6 +32,9 @@ struct KeyHandlerOf {
   std::function<bool(const YAML::Node&, Part*, std::string*)> set;
   std::function<std::string(const Part&)> get;
   std::function<std::vector<const void*>(const Part&)> fields;
+  // An enum key: the names its table accepts, which `gravcal help` adds to
+  // `help` (config.cc); empty for other keys.
+  std::function<std::string(const Part&)> accepted;
 };
 
 // A group of keys, owned by one part: its handlers reach that part's
@@ -83,14 +88,15 @@ bool ReadInt(const YAML::Node& n, int* v, std::string* error);
 bool ReadBool(const YAML::Node& n, bool* v, std::string* error);
 bool ReadString(const YAML::Node& n, std::string* v, std::string* error);
 bool ReadStringList(const YAML::Node& n, std::vector<std::string>* v, std::string* error);
+// An enum by its name in the enum's table (core/types.h); the error gives
+// the value and the accepted names ("'x' is not one of a, b or c").
 template <typename Enum>
-bool ReadEnum(const YAML::Node& n, Enum* v, const char* choices, std::string* error) {
+bool ReadEnum(const YAML::Node& n, Enum* v, std::string* error) {
   std::string s;
-  if (!ReadString(n, &s, error) || !FromString(s, v)) {
-    *error = std::string("must be one of ") + choices;
-    return false;
-  }
-  return true;
+  if (!ReadString(n, &s, error)) return false;
+  if (FromString(s, v)) return true;
+  *error = "'" + s + "' is not one of " + AcceptedNames(Enum());
+  return false;
 }
 
 // Value printers (YAML text).
@@ -116,6 +122,36 @@ inline std::string ValueText(int v) { return std::to_string(v); }
 inline std::string ValueText(bool v) { return v ? "true" : "false"; }
 inline std::string ValueText(const std::string& v) { return v.empty() ? "\"\"" : v; }
 inline std::string ValueText(const SimulatorScheme& v) { return ToString(v); }
+// An enum with a string table (core/types.h).
+template <typename Enum, typename = std::enable_if_t<std::is_enum_v<Enum>>>
+bool ReadValue(const YAML::Node& n, Enum* v, std::string* e) {
+  return ReadEnum(n, v, e);
+}
+template <typename Enum, typename = std::enable_if_t<std::is_enum_v<Enum>>>
+std::string ValueText(Enum v) {
+  return ToString(v);
+}
+// An enum that may be absent (written empty): "'x' is not one of a, b or c
+// (or empty)".
+template <typename Enum>
+bool ReadOptionalEnum(const YAML::Node& n, std::optional<Enum>* v, std::string* e) {
+  std::string name;
+  if (!ReadString(n, &name, e)) return false;
+  Enum value{};
+  if (name.empty()) {
+    v->reset();
+  } else if (FromString(name, &value)) {
+    *v = value;
+  } else {
+    *e = "'" + name + "' is not one of " + AcceptedNames(value) + " (or empty)";
+    return false;
+  }
+  return true;
+}
+template <typename Enum>
+std::string ValueText(const std::optional<Enum>& v) {
+  return v ? ValueText(*v) : ValueText(std::string());
+}
 
 }  // namespace internal
 }  // namespace gravcal
@@ -130,13 +166,13 @@ inline std::string ValueText(const SimulatorScheme& v) { return ToString(v); }
   {                                                                                \
     name, help, [](const YAML::Node& n, auto* c, std::string* e) { return read; }, \
         [](const auto& c) { return print; },                                       \
-        [](const auto& c) { return std::vector<const void*>{__VA_ARGS__}; }        \
+        [](const auto& c) { return std::vector<const void*>{__VA_ARGS__}; }, {}    \
   }
 #define GRAVCAL_KEY(name, help, read, print)                                       \
   {                                                                                \
     name, help, [](const YAML::Node& n, auto* c, std::string* e) { return read; }, \
         [](const auto& c) { return print; },                                       \
-        [](const auto&) { return std::vector<const void*>(); }                     \
+        [](const auto&) { return std::vector<const void*>(); }, {}                 \
   }
 #define GRAVCAL_DOUBLE(name, field, help) \
   GRAVCAL_KEY_AT(name, help, ReadDouble(n, &c->field, e), ValueText(c.field), &c.field)
@@ -146,8 +182,16 @@ inline std::string ValueText(const SimulatorScheme& v) { return ToString(v); }
   GRAVCAL_KEY_AT(name, help, ReadBool(n, &c->field, e), ValueText(c.field), &c.field)
 #define GRAVCAL_STRING(name, field, help) \
   GRAVCAL_KEY_AT(name, help, ReadString(n, &c->field, e), ValueText(c.field), &c.field)
-#define GRAVCAL_ENUM(name, field, choices, help)                                                 \
-  GRAVCAL_KEY_AT(name, help, ReadEnum(n, &c->field, choices, e), std::string(ToString(c.field)), \
-                 &c.field)
+// An enum key: its help ends in the names the enum's table accepts
+// (KeyHandlerOf::accepted): GRAVCAL_ENUM("loss", ..., "robust loss") reads
+// "robust loss: none, huber, ... or tukey".
+#define GRAVCAL_ENUM(name, field, help)                                                         \
+  {                                                                                             \
+    name, help,                                                                                 \
+        [](const YAML::Node& n, auto* c, std::string* e) { return ReadEnum(n, &c->field, e); }, \
+        [](const auto& c) { return std::string(ToString(c.field)); },                           \
+        [](const auto& c) { return std::vector<const void*>{&c.field}; },                       \
+        [](const auto& c) { return AcceptedNames(c.field); }                                    \
+  }
 
 #endif  // GRAVCAL_SRC_WORKFLOWS_CONFIG_CONFIG_KEY_H_

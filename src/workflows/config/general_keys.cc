@@ -73,8 +73,8 @@ SectionOf<CalibrationConfig> InputSection() {
       "input",
       ConfigSectionUse::kAllMethods,
       {
-          GRAVCAL_ENUM("format", input.format, "csv, whitespace",
-                       "log format: csv (header row) or whitespace (no header; give columns)"),
+          GRAVCAL_ENUM("format", input.format,
+                       "log format (csv has a header row; whitespace none: give columns)"),
           GRAVCAL_KEY("columns",
                       "column names in file order (t, ax, ay, az, gx, gy, gz, temp; others "
                       "ignored)",

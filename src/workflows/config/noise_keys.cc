@@ -23,9 +23,9 @@ SectionOf<CalibrationConfig> PoseNoiseSection() {
   return {"pose_noise",
           ConfigSectionUse::kSomeMethods,
           {
-              GRAVCAL_ENUM("pose_noise", calibration.pose_noise.method, "white, batch_means",
-                           "variance of each pose's mean when no --noise model is given: white "
-                           "(sample covariance / n) or batch_means (from the pose's own batches; "
+              GRAVCAL_ENUM("pose_noise", calibration.pose_noise.method,
+                           "variance of each pose's mean when no --noise model is given (white: "
+                           "sample covariance / n; batch_means: from the pose's own batches, "
                            "counts correlated noise)"),
               GRAVCAL_INT("pose_noise_batches", calibration.pose_noise.batches,
                           "batch_means: batches per pose (>= 5)"),

@@ -29,23 +29,6 @@ KeyHandlerOf<SimulationConfig> FieldHandler(const SimulatorField& field) {
   return h;
 }
 
-// sim_motion: a MotionProfile by its name, or none (empty).
-bool ReadMotion(const YAML::Node& n, SimulationConfig* c, std::string* e) {
-  std::string name;
-  if (!ReadString(n, &name, e)) return false;
-  if (name.empty()) {
-    c->sim_motion.reset();
-    return true;
-  }
-  MotionProfile profile;
-  if (!FromString(name, &profile)) {
-    *e = "'" + name + "' is not one of " + AcceptedNames(profile) + " (or empty)";
-    return false;
-  }
-  c->sim_motion = profile;
-  return true;
-}
-
 }  // namespace
 
 SectionOf<SimulationConfig> SimulatorSection() {
@@ -61,8 +44,7 @@ SectionOf<SimulationConfig> MotionSimulatorSection() {
       {
           GRAVCAL_KEY("sim_motion",
                       "simulate: " + AcceptedNames(MotionProfile()) + " (empty = sim_scheme)",
-                      ReadMotion(n, c, e),
-                      ValueText(c.sim_motion ? std::string(ToString(*c.sim_motion)) : "")),
+                      ReadOptionalEnum(n, &c->sim_motion, e), ValueText(c.sim_motion)),
           GRAVCAL_DOUBLE("hh_initial_still", motion.initial_still_seconds, "still at the start, s"),
           GRAVCAL_DOUBLE("hh_final_still", motion.final_still_seconds, "still at the end, s"),
           GRAVCAL_DOUBLE("hh_seconds_per_axis", motion.seconds_per_axis,

@@ -39,7 +39,7 @@ SectionOf<CalibrationConfig> ThermalSection() {
                       "fixed order of the gyroscope misalignment(T); -1 = from the data"),
           GRAVCAL_BOOL("thermal_lag", thermal.fit_lag,
                        "try a first-order lag of the sensing element behind the temperature"),
-          GRAVCAL_ENUM("thermal_selection", thermal.selection, "bic, aicc",
+          GRAVCAL_ENUM("thermal_selection", thermal.selection,
                        "information criterion that chooses the orders"),
           GRAVCAL_DOUBLE("thermal_reference_temperature", thermal.reference_temperature,
                          "T_ref of the polynomials, degC; null = the middle of the range"),
@@ -79,18 +79,6 @@ std::string TemperaturesText(const std::vector<double>& v) {
   return out + "]";
 }
 
-bool ReadProfile(const YAML::Node& n, std::string* v, std::string* e) {
-  std::string s;
-  ThermalProfile p;
-  if (!ReadString(n, &s, e) || (!s.empty() && !FromString(s, &p))) {
-    *e = "must be empty or one of soak_steps, warm_up, cool_down, warm_up_poses, "
-         "warm_cool_poses";
-    return false;
-  }
-  *v = s;
-  return true;
-}
-
 }  // namespace
 
 SectionOf<SimulationConfig> ThermalSimulatorSection() {
@@ -98,9 +86,9 @@ SectionOf<SimulationConfig> ThermalSimulatorSection() {
           ConfigSectionUse::kCommand,
           {
               GRAVCAL_KEY("sim_thermal",
-                          "thermal session to simulate instead of the pose scheme: soak_steps, "
-                          "warm_up, cool_down, warm_up_poses, warm_cool_poses (empty = off)",
-                          ReadProfile(n, &c->sim_thermal, e), ValueText(c.sim_thermal)),
+                          "thermal session to simulate instead of the pose scheme: " +
+                              AcceptedNames(ThermalProfile()) + " (empty = off)",
+                          ReadOptionalEnum(n, &c->sim_thermal, e), ValueText(c.sim_thermal)),
               GRAVCAL_KEY("sim_thermal_soaks", "soak temperatures of soak_steps, degC",
                           ReadTemperatures(n, &c->thermal_simulation.soak_temperatures, e),
                           TemperaturesText(c.thermal_simulation.soak_temperatures)),
