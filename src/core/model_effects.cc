@@ -15,10 +15,8 @@ const std::vector<EffectInfo>& EffectCatalogue() {
           e,          D::kDescription,
           D::kSensor, D::kRegressor,
           D::kSize,   std::vector<std::string>(D::kParameters, D::kParameters + D::kSize),
-          D::kUnit};
-      info.name = D::kName;
-      info.form = D::kForm;
-      info.simulation = D::kSimulation;
+          D::kUnit,   D::kName,
+          D::kForm,   D::kSimulation};
       entries.push_back(info);
     });
     return entries;
