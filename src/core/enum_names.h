@@ -56,14 +56,14 @@ std::string NamesOf(const EnumName<E> (&table)[N]) {
 
 // ToString and FromString of `Type` from `table` (at namespace gravcal
 // scope).
-#define GRAVCAL_ENUM_TO_FROM_STRING(Type, table)                              \
-  const char* ToString(Type value) { return internal::NameOf(table, value); } \
-  bool FromString(const std::string& name, Type* value) {                     \
-    return internal::ValueOf(table, name, value);                             \
+#define GRAVCAL_ENUM_TO_FROM_STRING(Type, table)                                               \
+  [[maybe_unused]] const char* ToString(Type value) { return internal::NameOf(table, value); } \
+  [[maybe_unused]] bool FromString(const std::string& name, Type* value) {                     \
+    return internal::ValueOf(table, name, value);                                              \
   }
 // The same and AcceptedNames.
 #define GRAVCAL_ENUM_STRINGS(Type, table)  \
   GRAVCAL_ENUM_TO_FROM_STRING(Type, table) \
-  std::string AcceptedNames(Type) { return internal::NamesOf(table); }
+  [[maybe_unused]] std::string AcceptedNames(Type) { return internal::NamesOf(table); }
 
 #endif  // GRAVCAL_SRC_CORE_ENUM_NAMES_H_
