@@ -74,7 +74,7 @@
     "plan, check: per-pose disturbance of |a|, m/s^2 rms (0 = none)")                            \
   X(double, gyro_noise_density, 0.0,                                                             \
     "plan: gyroscope white noise N, rad/s/sqrt(Hz) (datasheet; instead of --noise): "            \
-    "plans the turns between poses for the gyroscope; noise: the datasheet's, to compare with") \
+    "plans the turns between poses for the gyroscope; noise: the datasheet's, to compare with")  \
   X(double, attitude_std, 0.0,                                                                   \
     "plan (method known_attitude): the fixture's roll and pitch standard deviation, "            \
     "degrees")                                                                                   \

@@ -1,8 +1,8 @@
 #include "gravcal/simulation/thermal_simulator.h"
 
 #include <Eigen/Geometry>
-#include <algorithm>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
