@@ -5,7 +5,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <system_error>
 #include <utility>
@@ -236,19 +235,24 @@ bool LogLines::Next(std::string_view* line, std::string* error) {
 
 namespace {
 
+// Whether `text`, without surrounding blanks, is one number as the reader
+// parses a cell (internal::ParseNumber).
+bool IsNumberText(std::string_view text) {
+  const size_t first = text.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return false;
+  const size_t last = text.find_last_not_of(" \t\r");
+  double x;
+  const char* end = text.data() + last + 1;
+  const std::from_chars_result r = internal::ParseNumber(text.data() + first, end, &x);
+  return r.ec == std::errc() && r.ptr == end;
+}
+
 // Whether every comma-separated cell of [begin, end) is a number: a first
 // line that a CSV file with `columns` given holds as data, not as a header.
 bool CellsAreNumbers(const char* begin, const char* end) {
   while (begin <= end) {
     const char* comma = std::find(begin, end, ',');
-    std::string cell(begin, comma);
-    const size_t first = cell.find_first_not_of(" \t\r");
-    const size_t last = cell.find_last_not_of(" \t\r");
-    if (first == std::string::npos) return false;
-    cell = cell.substr(first, last - first + 1);
-    char* stop = nullptr;
-    std::strtod(cell.c_str(), &stop);
-    if (stop != cell.c_str() + cell.size()) return false;
+    if (!IsNumberText(std::string_view(begin, static_cast<size_t>(comma - begin)))) return false;
     begin = comma + 1;
   }
   return true;
@@ -347,10 +351,7 @@ bool LogRowParser::BuildLayout(const char* begin, const char* end, size_t line,
       if (from == std::string::npos) only_numbers = false;
       while (only_numbers && from != std::string::npos) {
         const size_t to = std::min(name.find_first_of(" \t", from), name.size());
-        const std::string token = name.substr(from, to - from);
-        char* stop = nullptr;
-        std::strtod(token.c_str(), &stop);
-        if (stop != token.c_str() + token.size()) only_numbers = false;
+        only_numbers = IsNumberText(std::string_view(name).substr(from, to - from));
         ++numbers;
         from = name.find_first_not_of(" \t", to);
         spaced = spaced || from != std::string::npos;
